@@ -1,0 +1,13 @@
+"""airtable: a 2D air-table physics engine and multiplayer teaching app.
+
+`import airtable` gives the physics and the network client without importing
+pygame; the window lives in `airtable.window`.
+"""
+
+from airtable.bodies import Puck, Spring
+from airtable.client import Client
+from airtable.environment import Environment
+from airtable.table import AirTable
+
+__all__ = ["AirTable", "Puck", "Spring", "Environment", "Client"]
+__version__ = "0.1.0"

@@ -1,0 +1,138 @@
+"""Puck and Spring: thin handles onto the state arrays of an AirTable.
+
+The table stores all pucks as rows of numpy arrays (structure of arrays) so the
+physics step is vectorised. A handle remembers its row and reads and writes
+that row, so demo code can still say `puck.vel_mps = (1, 0)`. Getters return
+copies: change a puck through its setters (`p.pos_m += (0.1, 0)` works).
+"""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from airtable.colors import rgb
+
+if TYPE_CHECKING:
+    from airtable.table import AirTable
+
+
+def as_vector(value, what: str) -> np.ndarray:
+    """`value` as a finite float (2,) array, or ValueError naming `what`."""
+    try:
+        v = np.array(value, dtype=float).reshape(2)
+    except (TypeError, ValueError):
+        raise ValueError(f"{what} must be a pair of numbers (x, y), not {value!r}") from None
+    if not np.all(np.isfinite(v)):
+        raise ValueError(f"{what} must be finite, not {value!r}")
+    return v
+
+
+class Puck:
+    """A round puck on the table. Create with `AirTable.add_puck`."""
+
+    __slots__ = ("_table", "_index")
+
+    def __init__(self, table: AirTable, index: int) -> None:
+        self._table = table
+        self._index: int | None = index
+
+    @property
+    def index(self) -> int:
+        """Row of this puck in the table's arrays (changes when pucks are removed)."""
+        if self._index is None:
+            raise ValueError("this puck was removed from the table")
+        return self._index
+
+    @property
+    def alive(self) -> bool:
+        return self._index is not None
+
+    @property
+    def pos_m(self) -> np.ndarray:
+        return self._table.pos_m[self.index].copy()
+
+    @pos_m.setter
+    def pos_m(self, value) -> None:
+        self._table.pos_m[self.index] = as_vector(value, "pos_m")
+
+    @property
+    def vel_mps(self) -> np.ndarray:
+        return self._table.vel_mps[self.index].copy()
+
+    @vel_mps.setter
+    def vel_mps(self, value) -> None:
+        self._table.vel_mps[self.index] = as_vector(value, "vel_mps")
+
+    @property
+    def radius_m(self) -> float:
+        return float(self._table.radius_m[self.index])
+
+    @property
+    def mass_kg(self) -> float:
+        return float(self._table.mass_kg[self.index])
+
+    @property
+    def color(self) -> tuple[int, int, int]:
+        return tuple(int(c) for c in self._table.color_rgb[self.index])
+
+    @color.setter
+    def color(self, value) -> None:
+        self._table.color_rgb[self.index] = rgb(value)
+
+    def __repr__(self) -> str:
+        if self._index is None:
+            return "<Puck (removed)>"
+        x, y = self.pos_m
+        return f"<Puck #{self._index} at ({x:.3f}, {y:.3f}) m, r={self.radius_m} m>"
+
+
+class Spring:
+    """A spring with a damper between two pucks. Create with `AirTable.add_spring`."""
+
+    __slots__ = ("_table", "_index", "p1", "p2")
+
+    def __init__(self, table: AirTable, index: int, p1: Puck, p2: Puck) -> None:
+        self._table = table
+        self._index: int | None = index
+        self.p1 = p1
+        self.p2 = p2
+
+    @property
+    def index(self) -> int:
+        if self._index is None:
+            raise ValueError("this spring was removed from the table (one of its pucks was removed)")
+        return self._index
+
+    @property
+    def alive(self) -> bool:
+        return self._index is not None
+
+    def _get(self, name: str) -> float:
+        return float(getattr(self._table, name)[self.index])
+
+    @property
+    def length_m(self) -> float:
+        return self._get("spring_length_m")
+
+    @property
+    def k_Npm(self) -> float:
+        return self._get("spring_k_Npm")
+
+    @property
+    def damper_Nspm(self) -> float:
+        return self._get("spring_damper_Nspm")
+
+    @property
+    def width_m(self) -> float:
+        return self._get("spring_width_m")
+
+    @property
+    def color(self) -> tuple[int, int, int]:
+        return tuple(int(c) for c in self._table.spring_color_rgb[self.index])
+
+    def __repr__(self) -> str:
+        if self._index is None:
+            return "<Spring (removed)>"
+        return f"<Spring #{self._index} L={self.length_m} m k={self.k_Npm} N/m>"

@@ -1,0 +1,55 @@
+"""Client: one user at the table (the local mouse or a network player).
+
+A client holds its latest input: cursor position in world metres, which mouse
+button is down (0 none, 1-3 the three cursor strings) and the keys held. When a
+button goes down over a puck the client grabs it; the table then pulls that
+puck toward the cursor with the string's spring and drag every step, until the
+button is released. No pygame and no sockets here.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+# Cursor strings by mouse button: (spring k in N/m, drag c in N s/m).
+# F = k (cursor - puck) - c v_puck.
+CURSOR_STRINGS: dict[int, tuple[float, float]] = {
+    1: (60.0, 2.0),  # medium
+    2: (2.0, 0.2),  # soft
+    3: (1000.0, 20.0),  # stiff
+}
+
+
+@dataclass
+class Client:
+    """One user's input state and the puck they hold."""
+
+    name: str = "local"
+    color: tuple[int, int, int] = (0, 255, 0)
+    cursor_m: np.ndarray = field(default_factory=lambda: np.zeros(2))
+    button: int = 0
+    keys: frozenset[str] = frozenset()
+    held: object = None  # airtable.bodies.Puck or None
+    active: bool = True
+
+    def set_input(self, table, cursor_m, button: int, keys=frozenset()) -> None:
+        """Take new input; grab the puck under the cursor when a button goes down."""
+        self.cursor_m = np.asarray(cursor_m, dtype=float).reshape(2).copy()
+        if button not in (0, *CURSOR_STRINGS):
+            raise ValueError(f"mouse button must be 0-3, not {button!r}")
+        pressed = button != 0 and self.button == 0
+        self.button = button
+        self.keys = frozenset(keys)
+        if button == 0:
+            self.held = None
+        elif pressed:
+            self.held = table.puck_at(self.cursor_m)
+        if self.held is not None and not self.held.alive:
+            self.held = None
+
+    def release(self) -> None:
+        """Let go of the puck (button up); used when a network client leaves."""
+        self.button = 0
+        self.held = None
