@@ -376,9 +376,7 @@ class AirTable:
         if self.puck_collisions:
             i, j = collisions.find_overlapping_pairs(pos, radius)
             if len(i):
-                hits = collisions.resolve_pairs(
-                    pos, vel, radius, mass, i, j, self.cr_puck, self.puck_correction, dt
-                )
+                hits = collisions.resolve_pairs(pos, vel, radius, mass, i, j, self.cr_puck, self.puck_correction, dt)
                 self.last_collisions = hits
                 self.collision_count += len(hits)
                 moved = np.union1d(i, j)  # only pairs moved pucks
