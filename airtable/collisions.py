@@ -232,7 +232,7 @@ def disjoint_rounds(i: np.ndarray, j: np.ndarray, n: int) -> list[np.ndarray]:
     # Python: the pairs of one step are a few per cent of the pucks.
     busy_until = [0] * n  # per puck: first level at which it is free again
     level = [0] * m
-    for k, (a, b) in enumerate(zip(i.tolist(), j.tolist())):
+    for k, (a, b) in enumerate(zip(i.tolist(), j.tolist(), strict=True)):
         lvl = max(busy_until[a], busy_until[b])
         level[k] = lvl
         busy_until[a] = busy_until[b] = lvl + 1
