@@ -4,6 +4,11 @@
 pygame; the window lives in `airtable.window`.
 """
 
+import os
+
+# pygame-ce prints a banner on import; the app has its own window title.
+os.environ.setdefault("PYGAME_HIDE_SUPPORT_PROMPT", "1")
+
 from airtable.bodies import Puck, Spring
 from airtable.client import Client
 from airtable.environment import Environment

@@ -43,6 +43,8 @@ class GameWindow:
     """Owns the display surface (or an off-screen one when headless) and draws scenes."""
 
     def __init__(self, env: Environment, caption: str = "Air Table", headless: bool = False) -> None:
+        if headless:  # no screen needed, so none is asked for
+            os.environ.setdefault("SDL_VIDEODRIVER", "dummy")
         pygame.display.init()
         pygame.font.init()
         self.env = env
@@ -93,11 +95,11 @@ class GameWindow:
             surf.blit(self._trail_layer, (0, 0))
         else:
             self._trail_layer = None
-        self._draw_walls(scene)
         self._draw_springs(scene)
         self._draw_pucks(surf, scene)
         self._draw_cursors(scene)
         self._draw_hud(scene, hud)
+        self._draw_walls(scene)  # last, so the status bar never hides the bottom wall
         if banner:
             self.draw_banner(banner)
 

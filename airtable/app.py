@@ -1,0 +1,491 @@
+"""The server app: game loop, keys, demo switching (`python -m airtable`).
+
+The loop runs the physics at a fixed step with an accumulator (so results do
+not depend on the frame rate) and draws at the display's rate. App-level keys
+live in one table, `BINDINGS`, that drives both the dispatch and the F1 help
+screen; demo scenes come from the demo files (demo_loader.py).
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import sys
+import time
+from collections.abc import Sequence
+from dataclasses import dataclass
+from pathlib import Path
+
+import pygame
+
+from airtable.client import Client
+from airtable.demo_loader import BUILTIN_DIR, Demo, DemoError, discover, error_from_exception, key_order
+from airtable.environment import Environment
+from airtable.scene import Scene
+from airtable.table import AirTable
+from airtable.window import GameWindow
+
+LOCAL_COLOR = (0, 255, 0)
+# A stalled frame (window dragged, laptop busy) runs at most this much
+# simulated time; the rest is dropped rather than exploding the physics.
+MAX_SIM_PER_FRAME_S = 0.1
+MAX_FPS = 120
+ZOOM_RATE_PER_S = 1.5  # held h / n: zoom factor e**1.5 per second
+WHEEL_ZOOM = 1.1
+MESSAGE_S = 4.0
+
+
+@dataclass(frozen=True)
+class Binding:
+    """One row of the key table: which keys, what the help screen says, what runs."""
+
+    label: str
+    help: str
+    keys: tuple[int, ...] = ()
+    action: str | None = None  # App method taking the KEYDOWN event
+    held: bool = False  # acts every frame while held, not on the press
+
+
+DIGIT_KEYS = (
+    pygame.K_1,
+    pygame.K_2,
+    pygame.K_3,
+    pygame.K_4,
+    pygame.K_5,
+    pygame.K_6,
+    pygame.K_7,
+    pygame.K_8,
+    pygame.K_9,
+    pygame.K_0,
+)
+
+BINDINGS: tuple[Binding, ...] = (
+    Binding("1-9, 0", "start that demo (press again to restart it)", DIGIT_KEYS, "key_demo"),
+    Binding("Shift+1/2/3", "correction comparison: off, two-step, perfect kiss"),
+    Binding("Left / Right", "previous / next variation", (pygame.K_LEFT, pygame.K_RIGHT), "key_variation"),
+    Binding("PageUp / PageDown", "previous / next demo", (pygame.K_PAGEUP, pygame.K_PAGEDOWN), "key_page"),
+    Binding("Space", "pause / resume", (pygame.K_SPACE,), "key_pause"),
+    Binding(".", "one step while paused", (pygame.K_PERIOD,), "key_single_step"),
+    Binding("f", "freeze: all velocities to zero", (pygame.K_f,), "key_freeze"),
+    Binding("g", "gravity on/off (restitution 0.9 with gravity, 1.0 without)", (pygame.K_g,), "key_gravity"),
+    Binding("p", "puck penetration correction off / two-step", (pygame.K_p,), "key_correction"),
+    Binding("z", "perfect kiss on/off", (pygame.K_z,), "key_perfect_kiss"),
+    Binding("h / n (hold)", "zoom in / out about the cursor", (pygame.K_h, pygame.K_n), "hold_zoom", held=True),
+    Binding("mouse wheel", "zoom in / out about the cursor"),
+    Binding("Ctrl + mouse drag", "pan the view"),
+    Binding("q", "reset the view", (pygame.K_q,), "key_reset_view"),
+    Binding("mouse buttons 1 / 2 / 3", "grab a puck with the medium / soft / stiff cursor string"),
+    Binding("F1", "this help screen", (pygame.K_F1,), "key_help"),
+    Binding("F12", "save a screenshot PNG", (pygame.K_F12,), "key_screenshot"),
+    Binding("Esc", "quit", (pygame.K_ESCAPE,), "key_quit"),
+)
+
+
+def _ctrl_held(keys_down: set[int]) -> bool:
+    return bool(keys_down & {pygame.K_LCTRL, pygame.K_RCTRL}) or bool(pygame.key.get_mods() & pygame.KMOD_CTRL)
+
+
+def _shift_held(event: pygame.event.Event) -> bool:
+    return bool(getattr(event, "mod", 0) & pygame.KMOD_SHIFT)
+
+
+class App:
+    """The teacher's table: one AirTable, its clients, a window and the loop."""
+
+    def __init__(
+        self,
+        demos: dict[str, Demo],
+        *,
+        demo_key: str = "1",
+        variation: int = 0,
+        headless: bool = False,
+        server=None,
+        demo_errors: Sequence[DemoError] = (),
+    ) -> None:
+        if not demos:
+            raise ValueError("no demos found")
+        self.demos = demos
+        self.env = Environment()
+        self.table = AirTable(self.env.size_px[0] / self.env.base_px_per_m, self.env.view_height_m)
+        self.local = Client(name="local", color=LOCAL_COLOR)
+        self.table.clients.append(self.local)
+        self.window = GameWindow(self.env, headless=headless)
+        self.server = server
+        self.errors: list[DemoError] = list(demo_errors)
+        self.running = True
+        self.paused = False
+        self.show_help = False
+        self.trails = False
+        self.speed = 1.0
+        self.keys_down: set[int] = set()
+        self.mouse_px = (self.env.size_px[0] / 2, self.env.size_px[1] / 2)
+        self.mouse_button = 0
+        self.panning = False
+        self.fps = 0.0
+        self.accumulator_s = 0.0
+        self.message = ""
+        self.message_until = 0.0
+        self.clock_s = 0.0  # real time the app has run (sum of frame times)
+        self._dispatch = {k: b for b in BINDINGS for k in b.keys}
+        self.start_demo(demo_key if demo_key in demos else next(iter(demos)), variation)
+
+    # ------------------------------------------------------------ demos
+
+    @property
+    def demo(self) -> Demo:
+        return self.demos[self.demo_key]
+
+    def start_demo(self, key: str, variation: int = 0) -> None:
+        """Clear the table and build demo `key` (a demo that fails shows its error)."""
+        demo = self.demos[key]
+        self.demo_key = key
+        self.variation = variation % len(demo.variations) if demo.variations else 0
+        self.table.clear()
+        self.table.reset_settings()
+        for client in self.table.clients:
+            client.held = None
+        self.build_error: DemoError | None = None
+        try:
+            demo.build(self.table, self.variation)
+        except Exception as exc:  # a teacher's demo may fail in any way; the app goes on
+            self.build_error = error_from_exception(demo.path or Path(f"demo {key}"), exc)
+            self.table.clear()
+        self.dt_s = demo.dt_s
+        self.trails = demo.trails
+        self.accumulator_s = 0.0
+        self.window.clear_trails()
+        self.window.set_caption(f"Air Table - {demo.label(self.variation)}")
+
+    def key_demo(self, event: pygame.event.Event) -> None:
+        digit = DIGIT_KEYS.index(event.key)
+        key = str((digit + 1) % 10)
+        if _shift_held(event):
+            key += "p"
+        if key in self.demos:
+            self.start_demo(key)
+        else:
+            self.say(f"no demo on key {'Shift+' + key[0] if key.endswith('p') else key}")
+
+    def key_variation(self, event: pygame.event.Event) -> None:
+        if not self.demo.variations:
+            self.say("this demo has no variations")
+            return
+        step = 1 if event.key == pygame.K_RIGHT else -1
+        self.start_demo(self.demo_key, self.variation + step)
+
+    def key_page(self, event: pygame.event.Event) -> None:
+        keys = list(self.demos)
+        step = 1 if event.key == pygame.K_PAGEDOWN else -1
+        self.start_demo(keys[(keys.index(self.demo_key) + step) % len(keys)])
+
+    # ------------------------------------------------------------ controls
+
+    def key_pause(self, event) -> None:
+        self.paused = not self.paused
+
+    def key_single_step(self, event) -> None:
+        if self.paused:
+            self.physics_step()
+        else:
+            self.say("'.' steps once while paused (Space pauses)")
+
+    def key_freeze(self, event) -> None:
+        self.table.vel_mps[:] = 0.0
+
+    def key_gravity(self, event) -> None:
+        self.table.gravity_on = not self.table.gravity_on
+        restitution = 0.9 if self.table.gravity_on else 1.0
+        self.table.cr_puck = self.table.cr_wall = restitution
+
+    def key_correction(self, event) -> None:
+        self.table.puck_correction = "two-step" if self.table.puck_correction == "off" else "off"
+
+    def key_perfect_kiss(self, event) -> None:
+        self.table.puck_correction = "two-step" if self.table.puck_correction == "perfect-kiss" else "perfect-kiss"
+
+    def hold_zoom(self, key: int, frame_dt_s: float) -> None:
+        rate = ZOOM_RATE_PER_S if key == pygame.K_h else -ZOOM_RATE_PER_S
+        self.zoom(math.exp(rate * frame_dt_s))
+
+    def zoom(self, factor: float) -> None:
+        self.env.zoom_about(self.mouse_px, factor)
+        self.window.clear_trails()
+
+    def key_reset_view(self, event) -> None:
+        self.env.reset()
+        self.window.clear_trails()
+
+    def key_help(self, event) -> None:
+        self.show_help = not self.show_help
+
+    def key_screenshot(self, event) -> None:
+        path = Path("screenshots") / time.strftime("airtable-%Y%m%d-%H%M%S.png")
+        try:
+            saved = self.window.save_screenshot(path)
+        except (OSError, pygame.error) as exc:
+            self.say(f"could not save the screenshot: {exc}")
+        else:
+            self.say(f"screenshot saved to {saved.resolve()}")
+
+    def key_quit(self, event) -> None:
+        self.running = False
+
+    def say(self, text: str) -> None:
+        """Show a one-line message on screen for a few seconds."""
+        self.message = text
+        self.message_until = self.clock_s + MESSAGE_S
+
+    # ------------------------------------------------------------ input
+
+    def handle_event(self, event: pygame.event.Event) -> None:
+        if event.type == pygame.QUIT:
+            self.running = False
+        elif event.type == pygame.KEYDOWN:
+            self.keys_down.add(event.key)
+            binding = self._dispatch.get(event.key)
+            if binding is not None and not binding.held:
+                getattr(self, binding.action)(event)
+        elif event.type == pygame.KEYUP:
+            self.keys_down.discard(event.key)
+        elif event.type == pygame.MOUSEMOTION:
+            if self.panning:
+                self.env.pan(event.rel)
+                self.window.clear_trails()
+            self.mouse_px = event.pos
+        elif event.type == pygame.MOUSEBUTTONDOWN and event.button in (1, 2, 3):
+            self.mouse_px = event.pos
+            if _ctrl_held(self.keys_down):
+                self.panning = True
+            else:
+                self.mouse_button = event.button
+        elif event.type == pygame.MOUSEBUTTONUP and event.button in (1, 2, 3):
+            self.mouse_px = event.pos
+            self.panning = False
+            if event.button == self.mouse_button:
+                self.mouse_button = 0
+        elif event.type == pygame.MOUSEWHEEL:
+            self.zoom(WHEEL_ZOOM**event.y)
+
+    def _update_local_client(self) -> None:
+        # Recomputed every frame: zooming moves the world under a still mouse.
+        held = frozenset(pygame.key.name(k) for k in self.keys_down)
+        self.local.set_input(self.table, self.env.to_world(self.mouse_px), self.mouse_button, held)
+
+    # ------------------------------------------------------------ loop
+
+    def physics_step(self) -> None:
+        if self.server is not None:
+            self.server.apply_inputs(self.table)
+        self.table.step(self.dt_s)
+
+    def frame(self, frame_dt_s: float) -> None:
+        """One frame: input, as many fixed physics steps as time allows, drawing."""
+        self.clock_s += frame_dt_s
+        for event in pygame.event.get():
+            self.handle_event(event)
+        for key in self.keys_down:
+            binding = self._dispatch.get(key)
+            if binding is not None and binding.held:
+                getattr(self, binding.action)(key, frame_dt_s)
+        self._update_local_client()
+        if not self.paused:
+            self.accumulator_s += frame_dt_s * self.speed
+            max_steps = max(1, int(MAX_SIM_PER_FRAME_S / self.dt_s))
+            steps = 0
+            while self.accumulator_s >= self.dt_s and steps < max_steps:
+                self.physics_step()
+                self.accumulator_s -= self.dt_s
+                steps += 1
+            if steps == max_steps:
+                self.accumulator_s = min(self.accumulator_s, self.dt_s)
+        if frame_dt_s > 0:
+            self.fps = 1.0 / frame_dt_s if self.fps == 0 else 0.9 * self.fps + 0.1 / frame_dt_s
+        self.draw()
+
+    def scene(self) -> Scene:
+        return Scene.from_table(
+            self.table,
+            self.table.clients,
+            title=self.demo.label(self.variation),
+            status=self.status_line(),
+            fps=self.fps,
+            zoom=self.env.zoom,
+            origin_m=(float(self.env.origin_m[0]), float(self.env.origin_m[1])),
+        )
+
+    def status_line(self) -> str:
+        t = self.table
+        parts = []
+        if self.paused:
+            parts.append("PAUSED")
+        if self.speed != 1.0:
+            parts.append(f"slow motion x1/{round(1 / self.speed)}")
+        parts.append("gravity on" if t.gravity_on else "gravity off")
+        parts.append(f"correction: {t.puck_correction}")
+        parts.append(f"restitution: pucks {t.cr_puck:g}, walls {t.cr_wall:g}")
+        parts.append(f"{len(t.pos_m)} pucks")
+        parts.append(f"t = {t.time_s:.2f} s")
+        parts.append("F1: help")
+        return "   ".join(parts)
+
+    def hud_lines(self) -> list[str]:
+        lines = []
+        if self.server is not None:
+            lines.extend(self.server.join_lines())
+        if self.message and self.clock_s < self.message_until:
+            lines.append(self.message)
+        return lines
+
+    def draw(self) -> None:
+        scene = self.scene()
+        self.window.draw(scene, trails=self.trails, hud=self.hud_lines())
+        error = self.build_error
+        if error is not None:
+            self.window.draw_panel(
+                f"Demo {self.demo_key} could not be built", [str(error), "Fix the file and press its key again."]
+            )
+        elif self.show_help:
+            self.window.draw_panel("Keys", [(b.label, b.help) for b in BINDINGS] + self._demo_rows())
+        if self.server is not None:
+            self.server.publish(scene)
+        self.window.present()
+
+    def _demo_rows(self) -> list[tuple[str, str]]:
+        rows = []
+        for key, demo in self.demos.items():
+            label = f"Shift+{key[0]}" if key.endswith("p") and key[:-1].isdigit() else key
+            rows.append((f"demo {label}", demo.title))
+        return rows
+
+    def run(self, seconds: float | None = None, max_frames: int | None = None, frame_dt_s: float | None = None) -> None:
+        """Run until Esc / window close, `seconds` of real time or `max_frames` frames.
+
+        `frame_dt_s` fixes each frame's time step instead of reading the clock
+        (tests use it, so they never depend on timing).
+        """
+        clock = pygame.time.Clock()
+        start = time.monotonic()
+        frames = 0
+        clock.tick()
+        while self.running:
+            if frame_dt_s is None:
+                dt = min(clock.tick(MAX_FPS) / 1000.0, 0.25)
+            else:
+                dt = frame_dt_s
+            self.frame(dt)
+            frames += 1
+            if max_frames is not None and frames >= max_frames:
+                break
+            if seconds is not None and time.monotonic() - start >= seconds:
+                break
+
+
+# ---------------------------------------------------------------- command line
+
+
+def build_parser() -> argparse.ArgumentParser:
+    p = argparse.ArgumentParser(
+        prog="python -m airtable",
+        description="The air table: pucks, springs and cursor strings. Students join with airtable-client HOST.",
+    )
+    p.add_argument("--demo", default="1", metavar="KEY", help="demo to start with (see --list-demos); default 1")
+    p.add_argument("--variation", type=_non_negative_int, default=0, metavar="N", help="variation of that demo")
+    p.add_argument("--list-demos", action="store_true", help="list the demos and exit")
+    p.add_argument("--port", type=_port, default=8888, help="port students join on (default 8888)")
+    p.add_argument("--host", default="0.0.0.0", help="address to listen on (default 0.0.0.0: every network)")
+    p.add_argument("--password", default=None, help="students must give this password to join")
+    p.add_argument("--max-clients", type=_positive_int, default=30, metavar="N", help="most students at once")
+    p.add_argument("--snapshot-hz", type=_positive_float, default=30.0, metavar="HZ", help="snapshots per second")
+    p.add_argument("--no-server", action="store_true", help="do not accept students over the network")
+    p.add_argument("--headless", action="store_true", help="run the same loop without a window")
+    p.add_argument("--seconds", type=_positive_float, default=None, metavar="S", help="quit after S seconds")
+    p.add_argument("--screenshot", default=None, metavar="FILE.png", help="save the last frame to FILE.png at exit")
+    return p
+
+
+def _number(kind, text: str, check, what: str):
+    try:
+        value = kind(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r} is not {what}") from None
+    if not check(value):
+        raise argparse.ArgumentTypeError(f"{text!r} is not {what}")
+    return value
+
+
+def _positive_float(text: str) -> float:
+    return _number(float, text, lambda v: math.isfinite(v) and v > 0, "a positive number")
+
+
+def _positive_int(text: str) -> int:
+    return _number(int, text, lambda v: v > 0, "a positive whole number")
+
+
+def _non_negative_int(text: str) -> int:
+    return _number(int, text, lambda v: v >= 0, "a whole number, 0 or more")
+
+
+def _port(text: str) -> int:
+    return _number(int, text, lambda v: 0 <= v <= 65535, "a port number (0-65535)")
+
+
+def list_demos(demos: dict[str, Demo], errors: Sequence[DemoError]) -> str:
+    lines = []
+    for key, demo in demos.items():
+        line = f"{key:>3}  {demo.title}"
+        if demo.variations:
+            line += f"  [variations: {', '.join(demo.variations)}]"
+        lines.append(line)
+    lines.extend(f"  !  could not load {e}" for e in errors)
+    return "\n".join(lines)
+
+
+def start_server(args):
+    """Start the network server, or explain on stderr why students cannot join."""
+    try:
+        from airtable.net.server import GameServer
+    except ImportError:
+        return None
+    server = GameServer(
+        host=args.host,
+        port=args.port,
+        password=args.password,
+        max_clients=args.max_clients,
+        snapshot_hz=args.snapshot_hz,
+    )
+    try:
+        server.start()
+    except OSError as exc:
+        print(f"airtable: students cannot join: {exc}", file=sys.stderr)
+        return None
+    for line in server.join_lines():
+        print(line)
+    return server
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    demos, errors = discover([BUILTIN_DIR])
+    if args.list_demos:
+        print(list_demos(demos, errors))
+        return 0
+    if args.demo not in demos:
+        parser.error(f"there is no demo {args.demo!r}; choose one of: {', '.join(sorted(demos, key=key_order))}")
+    variations = demos[args.demo].variations
+    if args.variation and args.variation >= max(1, len(variations)):
+        parser.error(f"demo {args.demo} has {len(variations) or 'no'} variations; --variation must be below that")
+    server = None if args.no_server else start_server(args)
+    app = App(demos, demo_key=args.demo, variation=args.variation, headless=args.headless, server=server)
+    try:
+        app.run(seconds=args.seconds)
+        if args.screenshot:
+            path = app.window.save_screenshot(args.screenshot)
+            print(f"screenshot saved to {path}")
+    except KeyboardInterrupt:
+        pass
+    finally:
+        if server is not None:
+            server.stop()
+        pygame.quit()
+    return 0

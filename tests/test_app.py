@@ -1,0 +1,255 @@
+"""The app driven the way a user drives it: real pygame events through its own input handling."""
+
+from __future__ import annotations
+
+import numpy as np
+import pygame
+import pytest
+
+from airtable.app import App, main
+from airtable.demo_loader import BUILTIN_DIR, discover
+
+FRAME_S = 1 / 60
+
+
+@pytest.fixture(scope="module")
+def demos():
+    found, errors = discover([BUILTIN_DIR])
+    assert not errors
+    return found
+
+
+@pytest.fixture
+def app(demos):
+    a = App(demos, demo_key="1", headless=True)
+    pygame.event.clear()
+    yield a
+    pygame.event.clear()
+
+
+def press(app: App, key: int, mod: int = 0, frames: int = 1) -> None:
+    pygame.event.post(pygame.event.Event(pygame.KEYDOWN, key=key, mod=mod, unicode="", scancode=0))
+    pygame.event.post(pygame.event.Event(pygame.KEYUP, key=key, mod=mod, unicode="", scancode=0))
+    for _ in range(frames):
+        app.frame(FRAME_S)
+
+
+def to_px(app: App, point_m) -> tuple[int, int]:
+    x, y = app.env.to_screen(np.asarray(point_m, dtype=float))
+    return (int(round(x)), int(round(y)))
+
+
+def test_digit_keys_switch_demos_and_restart(app):
+    press(app, pygame.K_2)
+    assert app.demo_key == "2"
+    assert len(app.table.pucks) == 8
+    assert "Demo 2" in app.window.caption
+    start = app.table.pos_m.copy()
+    app.table.vel_mps[:] = 1.0
+    for _ in range(30):
+        app.frame(FRAME_S)
+    assert not np.allclose(app.table.pos_m, start)
+    press(app, pygame.K_2)  # again: restart
+    # one frame of physics ran after the restart, with every puck at rest
+    assert np.allclose(app.table.pos_m, start)
+    assert np.all(app.table.vel_mps == 0.0)
+
+
+def test_shift_digit_starts_the_correction_comparison(app):
+    press(app, pygame.K_2, mod=pygame.KMOD_LSHIFT)
+    assert app.demo_key == "2p"
+    assert app.table.puck_correction == "two-step"
+    assert app.dt_s == pytest.approx(1 / 20)
+
+
+def test_variations_and_page_keys(app, demos):
+    press(app, pygame.K_0)
+    assert app.demo_key == "0"
+    n0 = len(app.table.pucks)
+    press(app, pygame.K_RIGHT)
+    assert app.variation == 1
+    assert len(app.table.pucks) > n0
+    assert demos["0"].variations[1] in app.window.caption
+    press(app, pygame.K_LEFT)
+    press(app, pygame.K_LEFT)  # wraps round to the last variation
+    assert app.variation == len(demos["0"].variations) - 1
+    press(app, pygame.K_PAGEDOWN)
+    keys = list(demos)
+    assert app.demo_key == keys[(keys.index("0") + 1) % len(keys)]
+    press(app, pygame.K_PAGEUP)
+    assert app.demo_key == "0"
+
+
+def test_pause_and_single_step(app):
+    app.table.vel_mps[:] = (0.5, 0.0)
+    press(app, pygame.K_SPACE)
+    assert app.paused
+    t0 = app.table.time_s
+    for _ in range(10):
+        app.frame(FRAME_S)
+    assert app.table.time_s == t0
+    press(app, pygame.K_PERIOD)
+    assert app.table.time_s == pytest.approx(t0 + app.dt_s)
+    press(app, pygame.K_SPACE)
+    assert not app.paused
+    app.frame(FRAME_S)
+    assert app.table.time_s > t0 + app.dt_s
+
+
+def test_fixed_step_does_not_depend_on_frame_rate(demos):
+    """Same simulated time at 30 fps and at 144 fps gives the same state."""
+    results = []
+    for fps, frames in ((30, 60), (144, 288)):
+        a = App(demos, demo_key="3", headless=True)
+        a.table.pucks[0].vel_mps = (3.0, 1.0)
+        a.run(max_frames=frames, frame_dt_s=1 / fps)
+        assert a.table.steps == 480
+        results.append(a.table.pos_m.copy())
+    np.testing.assert_array_equal(results[0], results[1])
+
+
+def test_stalled_frame_is_capped(app):
+    steps0 = app.table.steps
+    app.frame(5.0)  # the window was dragged for five seconds
+    assert app.table.steps - steps0 == int(0.1 / app.dt_s)
+
+
+def test_freeze_gravity_and_corrections(app):
+    app.table.vel_mps[:] = (1.0, -2.0)
+    press(app, pygame.K_f)
+    assert np.all(app.table.vel_mps == 0.0)
+    press(app, pygame.K_g)
+    assert app.table.gravity_on and app.table.cr_puck == 0.9 and app.table.cr_wall == 0.9
+    app.frame(FRAME_S)
+    assert app.window.surface.get_at((450, 300))[:3] == (20, 20, 70)
+    press(app, pygame.K_g)
+    assert not app.table.gravity_on and app.table.cr_puck == 1.0
+    press(app, pygame.K_p)
+    assert app.table.puck_correction == "off"
+    assert app.window.surface.get_at((450, 300))[:3] == (40, 40, 40)
+    press(app, pygame.K_p)
+    assert app.table.puck_correction == "two-step"
+    press(app, pygame.K_z)
+    assert app.table.puck_correction == "perfect-kiss"
+    press(app, pygame.K_z)
+    assert app.table.puck_correction == "two-step"
+
+
+def test_zoom_keys_keep_the_point_under_the_cursor(app):
+    mouse = (300, 200)
+    pygame.event.post(pygame.event.Event(pygame.MOUSEMOTION, pos=mouse, rel=(0, 0), buttons=(0, 0, 0)))
+    app.frame(FRAME_S)
+    anchor = app.env.to_world(mouse)
+    pygame.event.post(pygame.event.Event(pygame.KEYDOWN, key=pygame.K_h, mod=0, unicode="h", scancode=0))
+    for _ in range(30):
+        app.frame(FRAME_S)
+    pygame.event.post(pygame.event.Event(pygame.KEYUP, key=pygame.K_h, mod=0, unicode="h", scancode=0))
+    app.frame(FRAME_S)
+    assert app.env.zoom == pytest.approx(np.exp(1.5 * 30 * FRAME_S), rel=1e-6)
+    np.testing.assert_allclose(app.env.to_world(mouse), anchor, atol=1e-9)
+    pygame.event.post(pygame.event.Event(pygame.MOUSEWHEEL, x=0, y=-2, flipped=False, precise_x=0.0, precise_y=-2.0))
+    app.frame(FRAME_S)
+    assert app.env.zoom == pytest.approx(np.exp(1.5 * 30 * FRAME_S) / 1.21, rel=1e-6)
+    press(app, pygame.K_q)
+    assert app.env.zoom == 1.0 and np.all(app.env.origin_m == 0.0)
+
+
+def test_ctrl_drag_pans(app):
+    pygame.event.post(pygame.event.Event(pygame.KEYDOWN, key=pygame.K_LCTRL, mod=pygame.KMOD_LCTRL, unicode="", scancode=0))
+    pygame.event.post(pygame.event.Event(pygame.MOUSEBUTTONDOWN, pos=(400, 400), button=1))
+    pygame.event.post(pygame.event.Event(pygame.MOUSEMOTION, pos=(490, 400), rel=(90, 0), buttons=(1, 0, 0)))
+    pygame.event.post(pygame.event.Event(pygame.MOUSEBUTTONUP, pos=(490, 400), button=1))
+    app.frame(FRAME_S)
+    assert app.env.origin_m[0] == pytest.approx(-1.0)  # 90 px = 1 m dragged right
+    assert app.local.held is None
+
+
+def test_help_screen_toggles_and_lists_every_key(app):
+    app.frame(FRAME_S)
+    before = pygame.surfarray.array3d(app.window.surface).copy()
+    press(app, pygame.K_F1)
+    assert app.show_help
+    after = pygame.surfarray.array3d(app.window.surface)
+    assert np.mean(np.any(before != after, axis=2)) > 0.3
+    press(app, pygame.K_F1)
+    assert not app.show_help
+
+
+def test_mouse_drags_and_flings_a_puck(app):
+    press(app, pygame.K_1)
+    puck = app.table.pucks[0]  # the small orange one at (2.5, 7.5)
+    start = puck.pos_m
+    grab = to_px(app, start)
+    target_m = start + np.array([2.0, -1.0])
+    pygame.event.post(pygame.event.Event(pygame.MOUSEMOTION, pos=grab, rel=(0, 0), buttons=(0, 0, 0)))
+    pygame.event.post(pygame.event.Event(pygame.MOUSEBUTTONDOWN, pos=grab, button=1))
+    app.frame(FRAME_S)
+    assert app.local.held is puck
+    pygame.event.post(pygame.event.Event(pygame.MOUSEMOTION, pos=to_px(app, target_m), rel=(1, 1), buttons=(1, 0, 0)))
+    for _ in range(60):
+        app.frame(FRAME_S)
+    moved = puck.pos_m
+    # pulled most of the way to the cursor along the line to it
+    assert np.linalg.norm(moved - start) > 1.0
+    assert np.linalg.norm(moved - target_m) < np.linalg.norm(start - target_m)
+    pygame.event.post(pygame.event.Event(pygame.MOUSEMOTION, pos=to_px(app, (8.0, 7.0)), rel=(1, 1), buttons=(1, 0, 0)))
+    for _ in range(6):
+        app.frame(FRAME_S)
+    pygame.event.post(pygame.event.Event(pygame.MOUSEBUTTONUP, pos=to_px(app, (8.0, 7.0)), button=1))
+    app.frame(FRAME_S)
+    assert app.local.held is None
+    v = puck.vel_mps
+    assert np.linalg.norm(v) > 1.0  # flung: it keeps moving after the release
+    p0 = puck.pos_m
+    app.frame(FRAME_S)
+    assert np.linalg.norm(puck.pos_m - p0) > 0.01
+
+
+def test_clicking_empty_table_grabs_nothing(app):
+    empty = to_px(app, (5.0, 0.3))
+    assert app.table.puck_at(app.env.to_world(empty)) is None
+    pygame.event.post(pygame.event.Event(pygame.MOUSEMOTION, pos=empty, rel=(0, 0), buttons=(0, 0, 0)))
+    pygame.event.post(pygame.event.Event(pygame.MOUSEBUTTONDOWN, pos=empty, button=3))
+    before = app.table.pos_m.copy()
+    for _ in range(10):
+        app.frame(FRAME_S)
+    assert app.local.held is None
+    np.testing.assert_array_equal(app.table.pos_m, before)
+
+
+def test_screenshot_key_saves_a_png(app, tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    press(app, pygame.K_F12)
+    files = list((tmp_path / "screenshots").glob("*.png"))
+    assert len(files) == 1
+    assert str(files[0].resolve()) in app.message
+
+
+def test_escape_quits(app):
+    press(app, pygame.K_ESCAPE)
+    assert not app.running
+
+
+@pytest.mark.parametrize(
+    "argv, message",
+    [
+        (["--demo", "42"], "there is no demo '42'"),
+        (["--seconds", "soon"], "'soon' is not a positive number"),
+        (["--port", "99999"], "is not a port number"),
+        (["--demo", "5", "--variation", "3"], "variations"),
+    ],
+)
+def test_bad_arguments_exit_2_with_a_message(argv, message, capsys):
+    with pytest.raises(SystemExit) as exc:
+        main(argv)
+    assert exc.value.code == 2
+    err = capsys.readouterr().err
+    assert message in err
+    assert "Traceback" not in err
+
+
+def test_list_demos(capsys, demos):
+    assert main(["--list-demos"]) == 0
+    out = capsys.readouterr().out
+    for key, demo in demos.items():
+        assert demo.title in out
