@@ -1,0 +1,668 @@
+"""The airtable wire protocol, version 1 (no pygame, no sockets).
+
+Every message is a frame: ``[u32 big-endian length L][u8 type][L-1 payload bytes]``.
+HELLO, WELCOME, ERROR and INPUT carry a JSON object; SNAPSHOT carries a binary
+Scene (layout in `encode_snapshot`); BYE is empty. See DESIGN.md section 5.
+
+Everything that comes off the network is checked here and turned into small
+immutable values (`Hello`, `InputRecord`, `Welcome`, a `Scene`); a bad message
+raises `ProtocolError` whose text is a sentence a person can act on. Nothing is
+ever built from network bytes except numbers, strings and numpy arrays of a
+fixed dtype.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import struct
+from collections.abc import Iterable, Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from airtable.scene import CursorView, Scene
+
+PROTOCOL_VERSION = 1
+DEFAULT_PORT = 8888
+
+HELLO = 1
+WELCOME = 2
+ERROR = 3
+INPUT = 4
+SNAPSHOT = 5
+BYE = 6
+FRAME_NAMES = {HELLO: "HELLO", WELCOME: "WELCOME", ERROR: "ERROR", INPUT: "INPUT", SNAPSHOT: "SNAPSHOT", BYE: "BYE"}
+CLIENT_FRAMES = frozenset({HELLO, INPUT, BYE})
+
+MAX_CLIENT_FRAME = 64 * 1024  # bytes of L (type + payload) a client may send
+# Snapshots grow with the number of pucks (27 bytes each); this still allows
+# about two million of them while stopping a bogus length from eating memory.
+MAX_SERVER_FRAME = 64 * 1024 * 1024
+
+MAX_NAME_CHARS = 20
+MAX_PASSWORD_CHARS = 200
+MAX_KEYS = 16
+MAX_KEY_CHARS = 16
+MAX_ERROR_CHARS = 500
+# A cursor may wander off the table (the view can be zoomed out), but not
+# further than this many table sizes from it; the player clamps to the same box.
+CURSOR_MARGIN_TABLES = 5.0
+MAX_TABLE_M = 1e6
+
+_HEADER = struct.Struct(">IB")
+
+
+class ProtocolError(Exception):
+    """A message broke the protocol; str(error) is a sentence for a person."""
+
+
+# ---------------------------------------------------------------- frames
+
+
+def encode_frame(frame_type: int, payload: bytes = b"") -> bytes:
+    """One frame: length, type, payload."""
+    if frame_type not in FRAME_NAMES:
+        raise ValueError(f"unknown frame type {frame_type!r}")
+    return _HEADER.pack(len(payload) + 1, frame_type) + payload
+
+
+def _looks_like_text(head: bytes) -> bool:
+    return len(head) > 0 and all(32 <= b < 127 or b in (9, 10, 13) for b in head)
+
+
+class FrameReader:
+    """Incremental frame decoder: feed it bytes as they arrive, get whole frames back.
+
+    `max_frame` bounds L (type + payload); the server uses MAX_CLIENT_FRAME and
+    the player MAX_SERVER_FRAME. `allowed` lists the frame types the peer may
+    send. Errors are raised as early as the bytes show them (a huge length or a
+    bad type byte before the payload arrives). After an error the reader is
+    dead: the connection must be dropped.
+    """
+
+    def __init__(
+        self, max_frame: int = MAX_CLIENT_FRAME, allowed: Iterable[int] = FRAME_NAMES, sender: str = "the client"
+    ) -> None:
+        self.max_frame = int(max_frame)
+        self.allowed = frozenset(allowed)
+        self.sender = sender
+        self._buf = bytearray()
+        self._checked_header = False  # the frame at the buffer start has passed the checks
+
+    @property
+    def pending(self) -> int:
+        """Bytes of a frame received but not yet complete."""
+        return len(self._buf)
+
+    def feed(self, data: bytes) -> list[tuple[int, bytes]]:
+        """Add received bytes; return the frames they complete, in order."""
+        buf = self._buf
+        buf += data
+        frames: list[tuple[int, bytes]] = []
+        while len(buf) >= 4:
+            length = int.from_bytes(buf[:4], "big")
+            if not self._checked_header:
+                self._check_length(length, bytes(buf[:4]))
+                if len(buf) < 5:
+                    break
+                self._check_type(buf[4])
+                self._checked_header = True
+            if len(buf) < 4 + length:
+                break
+            frames.append((buf[4], bytes(buf[5 : 4 + length])))
+            del buf[: 4 + length]
+            self._checked_header = False
+        return frames
+
+    def _check_length(self, length: int, head: bytes) -> None:
+        hint = "this port speaks the airtable protocol: join with airtable-client"
+        if _looks_like_text(head):
+            hint = f"the data looks like text ({head!r}), not an airtable message; {hint}, not a web browser or telnet"
+        if length == 0:
+            raise ProtocolError(f"received an empty message (length 0); {hint}")
+        if length > self.max_frame:
+            raise ProtocolError(f"received a message of {length} bytes, over the {self.max_frame} byte limit; {hint}")
+
+    def _check_type(self, frame_type: int) -> None:
+        if frame_type in self.allowed:
+            return
+        allowed = ", ".join(f"{FRAME_NAMES[t]} ({t})" for t in sorted(self.allowed))
+        if frame_type in FRAME_NAMES:
+            raise ProtocolError(f"{self.sender} may not send {FRAME_NAMES[frame_type]} messages, only {allowed}")
+        raise ProtocolError(
+            f"unknown message type {frame_type}; airtable protocol {PROTOCOL_VERSION} has only {allowed} "
+            "here: check that both sides run the same airtable version"
+        )
+
+
+# ---------------------------------------------------------------- JSON helpers
+
+
+class _NonFiniteError(Exception):
+    pass
+
+
+def _reject_constant(name: str):
+    raise _NonFiniteError(name)
+
+
+def _short(value: object, limit: int = 40) -> str:
+    text = repr(value)
+    return text if len(text) <= limit else text[: limit - 3] + "..."
+
+
+def encode_json(frame_type: int, message: dict) -> bytes:
+    """A frame carrying `message` as compact UTF-8 JSON."""
+    text = json.dumps(message, separators=(",", ":"), allow_nan=False, ensure_ascii=False)
+    return encode_frame(frame_type, text.encode("utf-8"))
+
+
+def parse_json(payload: bytes, what: str, example: str) -> dict:
+    """Decode a JSON object strictly (UTF-8, no NaN/Infinity, an object at the top)."""
+    try:
+        text = payload.decode("utf-8")
+    except UnicodeDecodeError as e:
+        raise ProtocolError(f"{what} is not UTF-8 text (bad byte at position {e.start}); send UTF-8 JSON") from None
+    try:
+        message = json.loads(text, parse_constant=_reject_constant)
+    except _NonFiniteError as e:
+        raise ProtocolError(f"{what} contains {e.args[0]}, which is not a finite number; send finite numbers") from None
+    except (ValueError, RecursionError) as e:  # JSONDecodeError is a ValueError; so is a 5000-digit int
+        detail = str(e)[:60]
+        raise ProtocolError(f"{what} is not valid JSON ({detail}); send an object like {example}") from None
+    if not isinstance(message, dict):
+        raise ProtocolError(f"{what} must be a JSON object like {example}, not {type(message).__name__}")
+    return message
+
+
+def _check_fields(message: dict, what: str, required: Sequence[str], optional: Sequence[str] = ()) -> None:
+    for key in required:
+        if key not in message:
+            raise ProtocolError(f'{what} is missing the field "{key}"; it needs {", ".join(required)}')
+    for key in message:
+        if key not in required and key not in optional:
+            allowed = ", ".join([*required, *optional])
+            raise ProtocolError(f"{what} has an unknown field {_short(key)}; the fields are {allowed}")
+
+
+def _number(value: object, what: str) -> float:
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
+        raise ProtocolError(f"{what} must be a number, not {_short(value)}")
+    try:
+        x = float(value)
+    except OverflowError:
+        x = math.inf
+    if not math.isfinite(x):
+        raise ProtocolError(f"{what} must be a finite number, not {_short(value)}")
+    return x
+
+
+def _integer(value: object, what: str) -> int:
+    if isinstance(value, bool) or not isinstance(value, int):
+        raise ProtocolError(f"{what} must be a whole number, not {_short(value)}")
+    return value
+
+
+def check_name(name: object) -> str:
+    """A player name: printable text of 1-20 characters (spaces around are dropped)."""
+    if not isinstance(name, str):
+        raise ProtocolError(f"the name must be text, not {_short(name)}")
+    name = name.strip()
+    if not (1 <= len(name) <= MAX_NAME_CHARS and name.isprintable()):
+        raise ProtocolError(
+            f"the name must be 1 to {MAX_NAME_CHARS} printable characters, not {_short(name)}; pick a shorter name"
+        )
+    return name
+
+
+def _text(value: object, what: str, limit: int) -> str:
+    if not isinstance(value, str):
+        raise ProtocolError(f"{what} must be text, not {_short(value)}")
+    if len(value) > limit:
+        raise ProtocolError(f"{what} is longer than {limit} characters")
+    return value
+
+
+def _color(value: object, what: str) -> tuple[int, int, int]:
+    if not (isinstance(value, list) and len(value) == 3):
+        raise ProtocolError(f"{what} must be [r, g, b], not {_short(value)}")
+    rgb = tuple(_integer(v, what) for v in value)
+    if not all(0 <= v <= 255 for v in rgb):
+        raise ProtocolError(f"{what} components must be 0-255, not {_short(value)}")
+    return rgb  # type: ignore[return-value]
+
+
+# ---------------------------------------------------------------- HELLO
+
+
+@dataclass(frozen=True)
+class Hello:
+    """A validated HELLO: protocol version, optional name and password."""
+
+    protocol: int
+    name: str | None = None
+    password: str | None = None
+
+
+HELLO_EXAMPLE = '{"protocol": 1, "name": "Ann"}'
+
+
+def encode_hello(name: str | None = None, password: str | None = None, protocol: int = PROTOCOL_VERSION) -> bytes:
+    """A HELLO frame."""
+    message: dict = {"protocol": protocol}
+    if name is not None:
+        message["name"] = name
+    if password is not None:
+        message["password"] = password
+    return encode_json(HELLO, message)
+
+
+def version_mismatch(theirs: object) -> str:
+    return (
+        f"this server speaks airtable protocol {PROTOCOL_VERSION} but the client speaks protocol {_short(theirs)}; "
+        "install the same airtable version as the teacher's"
+    )
+
+
+def validate_hello(message: dict) -> Hello:
+    """Check a HELLO object; the protocol version is checked first, so a newer client
+    with new fields still learns that the versions differ."""
+    if "protocol" not in message:
+        raise ProtocolError(f'HELLO is missing the field "protocol"; send {HELLO_EXAMPLE}')
+    protocol = message["protocol"]
+    if isinstance(protocol, bool) or not isinstance(protocol, int):
+        raise ProtocolError(f'HELLO "protocol" must be a whole number like {PROTOCOL_VERSION}, not {_short(protocol)}')
+    if protocol != PROTOCOL_VERSION:
+        raise ProtocolError(version_mismatch(protocol))
+    _check_fields(message, "HELLO", ("protocol",), ("name", "password"))
+    name = message.get("name")
+    if name is not None:
+        name = check_name(name)
+    password = message.get("password")
+    if password is not None:
+        password = _text(password, "the password", MAX_PASSWORD_CHARS)
+    return Hello(protocol, name, password)
+
+
+def parse_hello(payload: bytes) -> Hello:
+    return validate_hello(parse_json(payload, "HELLO", HELLO_EXAMPLE))
+
+
+# ---------------------------------------------------------------- INPUT
+
+
+@dataclass(frozen=True)
+class InputRecord:
+    """One client's input, validated: cursor in world metres, button 0-3, keys held."""
+
+    cursor_m: tuple[float, float]
+    button: int
+    keys: frozenset[str] = frozenset()
+
+
+INPUT_EXAMPLE = '{"cursor_m": [2.5, 4.0], "button": 1, "keys": ["a"]}'
+
+
+def cursor_limits(width_m: float, height_m: float) -> tuple[float, float, float, float]:
+    """(x_min, y_min, x_max, y_max): where a cursor may be, in metres."""
+    margin = CURSOR_MARGIN_TABLES * max(width_m, height_m)
+    return (-margin, -margin, width_m + margin, height_m + margin)
+
+
+def clamp_cursor(cursor_m: Sequence[float], width_m: float, height_m: float) -> tuple[float, float]:
+    """The cursor moved into `cursor_limits` (players send only positions the server accepts)."""
+    x0, y0, x1, y1 = cursor_limits(width_m, height_m)
+    x, y = (float(v) for v in cursor_m)
+    x = x0 if not math.isfinite(x) else min(max(x, x0), x1)
+    y = y0 if not math.isfinite(y) else min(max(y, y0), y1)
+    return (x, y)
+
+
+def encode_input(cursor_m: Sequence[float], button: int = 0, keys: Iterable[str] = ()) -> bytes:
+    """An INPUT frame."""
+    return encode_json(
+        INPUT,
+        {"cursor_m": [float(cursor_m[0]), float(cursor_m[1])], "button": int(button), "keys": sorted(keys)},
+    )
+
+
+def validate_input(message: dict, table_size_m: Sequence[float] = (10.0, 8.7556)) -> InputRecord:
+    """Check an INPUT object against the table size (width_m, height_m)."""
+    _check_fields(message, "INPUT", ("cursor_m", "button", "keys"))
+    x0, y0, x1, y1 = cursor_limits(*table_size_m)
+    where = f"within {x0:g}..{x1:g} m across and {y0:g}..{y1:g} m up"
+    cursor = message["cursor_m"]
+    if not (isinstance(cursor, list) and len(cursor) == 2):
+        raise ProtocolError(f"INPUT cursor_m must be a pair [x, y] of numbers in metres, not {_short(cursor)}")
+    x = _number(cursor[0], "INPUT cursor_m x")
+    y = _number(cursor[1], "INPUT cursor_m y")
+    if not (x0 <= x <= x1 and y0 <= y <= y1):
+        raise ProtocolError(f"INPUT cursor_m {_short(cursor)} is too far off the table; it must be {where}")
+    button = message["button"]
+    if isinstance(button, bool) or not isinstance(button, int) or not 0 <= button <= 3:
+        raise ProtocolError(f"INPUT button must be 0 (none) or 1, 2, 3 (the mouse buttons), not {_short(button)}")
+    keys = message["keys"]
+    if not (isinstance(keys, list) and len(keys) <= MAX_KEYS):
+        raise ProtocolError(f'INPUT keys must be a list of at most {MAX_KEYS} key names like ["a", "w"]')
+    for key in keys:
+        if not (isinstance(key, str) and 1 <= len(key) <= MAX_KEY_CHARS and key.isprintable()):
+            raise ProtocolError(
+                f"INPUT keys must be key names of 1 to {MAX_KEY_CHARS} printable characters, not {_short(key)}"
+            )
+    return InputRecord((x, y), button, frozenset(keys))
+
+
+def parse_input(payload: bytes, table_size_m: Sequence[float] = (10.0, 8.7556)) -> InputRecord:
+    return validate_input(parse_json(payload, "INPUT", INPUT_EXAMPLE), table_size_m)
+
+
+# ---------------------------------------------------------------- WELCOME, ERROR, BYE
+
+
+@dataclass(frozen=True)
+class Welcome:
+    """A validated WELCOME: the player's name and colour and the table size (m)."""
+
+    client: str
+    color: tuple[int, int, int]
+    width_m: float
+    height_m: float
+    protocol: int = PROTOCOL_VERSION
+
+
+def encode_welcome(client: str, color: Sequence[int], width_m: float, height_m: float) -> bytes:
+    """A WELCOME frame."""
+    return encode_json(
+        WELCOME,
+        {
+            "protocol": PROTOCOL_VERSION,
+            "client": client,
+            "color": [int(c) for c in color],
+            "table": {"width_m": float(width_m), "height_m": float(height_m)},
+        },
+    )
+
+
+def parse_welcome(payload: bytes) -> Welcome:
+    """Check a WELCOME from the server (the player trusts no bytes either)."""
+    message = parse_json(payload, "the server's WELCOME", '{"protocol": 1, ...}')
+    protocol = message.get("protocol")
+    if protocol != PROTOCOL_VERSION or isinstance(protocol, bool):
+        raise ProtocolError(
+            f"the server speaks airtable protocol {_short(protocol)} but this client speaks protocol "
+            f"{PROTOCOL_VERSION}; install the same airtable version as the teacher's"
+        )
+    _check_fields(message, "the server's WELCOME", ("protocol", "client", "color", "table"))
+    client = message["client"]
+    if not (isinstance(client, str) and 1 <= len(client) <= 2 * MAX_NAME_CHARS and client.isprintable()):
+        raise ProtocolError(f"the server's WELCOME has a bad client name {_short(client)}")
+    color = _color(message["color"], "the server's WELCOME colour")
+    table = message["table"]
+    if not isinstance(table, dict):
+        raise ProtocolError("the server's WELCOME has no table size")
+    _check_fields(table, "the server's WELCOME table", ("width_m", "height_m"))
+    w = _number(table["width_m"], "the table width")
+    h = _number(table["height_m"], "the table height")
+    if not (0 < w <= MAX_TABLE_M and 0 < h <= MAX_TABLE_M):
+        raise ProtocolError(f"the server's WELCOME has a bad table size {w:g} x {h:g} m")
+    return Welcome(client, color, w, h, protocol)
+
+
+def encode_error(sentence: str) -> bytes:
+    """An ERROR frame (the server closes the connection after it)."""
+    return encode_json(ERROR, {"error": sentence[:MAX_ERROR_CHARS]})
+
+
+def parse_error(payload: bytes) -> str:
+    """The sentence of an ERROR, made safe to print on one line."""
+    try:
+        message = parse_json(payload, "the server's ERROR", '{"error": "..."}')
+        sentence = message.get("error")
+    except ProtocolError as e:
+        return f"the server sent an unreadable error ({e})"
+    if not isinstance(sentence, str) or not sentence:
+        return "the server sent an error without a reason"
+    return printable(sentence[:MAX_ERROR_CHARS])
+
+
+def encode_bye() -> bytes:
+    return encode_frame(BYE)
+
+
+# ---------------------------------------------------------------- SNAPSHOT
+
+SNAPSHOT_MAGIC = b"ATSN"
+SNAPSHOT_VERSION = 1
+FLAG_GRAVITY = 1
+# magic, version, flags, reserved, n_pucks, n_springs, n_cursors,
+# width_m, height_m, time_s, fps, zoom, origin_x_m, origin_y_m (little-endian)
+_SNAP_HEADER = struct.Struct("<4sBBHIII7d")
+_F8 = np.dtype("<f8")
+_U1 = np.dtype("u1")
+_U4 = np.dtype("<u4")
+_I4 = np.dtype("<i4")
+# Bytes per row of each section: pucks (pos 16, radius 8, colour 3), springs
+# (pair 8, length 8, width 8, colour 3), cursors (pos 16, colour 3, button 1, held 4).
+_PUCK_BYTES = 16 + 8 + 3
+_SPRING_BYTES = 8 + 8 + 8 + 3
+_CURSOR_BYTES = 16 + 3 + 1 + 4
+_MAX_TEXT_BYTES = 0xFFFF
+
+
+def printable(text: str) -> str:
+    """`text` with every unprintable character (newline, NUL, ...) replaced by a space."""
+    text = str(text)
+    return text if text.isprintable() else "".join(c if c.isprintable() else " " for c in text)
+
+
+def _text_bytes(text: str) -> bytes:
+    # Only printable text goes out, so the player can draw any string it receives.
+    raw = printable(text).encode("utf-8")
+    if len(raw) > _MAX_TEXT_BYTES:  # cut at a character boundary rather than fail the frame
+        raw = raw[:_MAX_TEXT_BYTES].decode("utf-8", "ignore").encode("utf-8")
+    return len(raw).to_bytes(2, "little") + raw
+
+
+def _array_bytes(values, dtype: np.dtype, shape: tuple[int, ...]) -> bytes:
+    return np.ascontiguousarray(np.asarray(values).reshape(shape), dtype=dtype).tobytes()
+
+
+def encode_snapshot(scene: Scene) -> bytes:
+    """The SNAPSHOT payload for `scene` (wrap it with `encode_frame(SNAPSHOT, ...)`).
+
+    Layout (all little-endian, no padding):
+      header  magic "ATSN", u8 version, u8 flags (bit 0 gravity), u16 0,
+              u32 N pucks, u32 S springs, u32 C cursors,
+              f8 width_m, height_m, time_s, fps, zoom, origin_x_m, origin_y_m
+      pucks   pos_m N x 2 f8, radius_m N f8, color_rgb N x 3 u1
+      springs pairs S x 2 u4, length_m S f8, width_m S f8, color_rgb S x 3 u1
+      cursors cursor_m C x 2 f8, color C x 3 u1, button C u1, held C i4 (-1: none)
+      text    title, status, puck_correction, then C cursor names,
+              each as u16 byte count + UTF-8 bytes
+    """
+    n = len(scene.pos_m)
+    s = len(scene.spring_pairs)
+    cursors = scene.cursors
+    c = len(cursors)
+    flags = FLAG_GRAVITY if scene.gravity_on else 0
+    header = _SNAP_HEADER.pack(
+        SNAPSHOT_MAGIC,
+        SNAPSHOT_VERSION,
+        flags,
+        0,
+        n,
+        s,
+        c,
+        float(scene.width_m),
+        float(scene.height_m),
+        float(scene.time_s),
+        float(scene.fps),
+        float(scene.zoom),
+        float(scene.origin_m[0]),
+        float(scene.origin_m[1]),
+    )
+    parts = [
+        header,
+        _array_bytes(scene.pos_m, _F8, (n, 2)),
+        _array_bytes(scene.radius_m, _F8, (n,)),
+        _array_bytes(scene.color_rgb, _U1, (n, 3)),
+        _array_bytes(scene.spring_pairs, _U4, (s, 2)),
+        _array_bytes(scene.spring_length_m, _F8, (s,)),
+        _array_bytes(scene.spring_width_m, _F8, (s,)),
+        _array_bytes(scene.spring_color_rgb, _U1, (s, 3)),
+        _array_bytes([cv.cursor_m for cv in cursors], _F8, (c, 2)),
+        _array_bytes([cv.color for cv in cursors], _U1, (c, 3)),
+        _array_bytes([cv.button for cv in cursors], _U1, (c,)),
+        _array_bytes([cv.held for cv in cursors], _I4, (c,)),
+        _text_bytes(scene.title),
+        _text_bytes(scene.status),
+        _text_bytes(scene.puck_correction),
+        *(_text_bytes(cv.name) for cv in cursors),
+    ]
+    return b"".join(parts)
+
+
+class _Cut:
+    """Reads consecutive sections of a payload whose total size was checked up front."""
+
+    def __init__(self, payload: bytes, offset: int) -> None:
+        self.payload = payload
+        self.offset = offset
+
+    def array(self, dtype: np.dtype, shape: tuple[int, ...]) -> np.ndarray:
+        count = int(np.prod(shape, dtype=np.int64))
+        a = np.frombuffer(self.payload, dtype=dtype, count=count, offset=self.offset).reshape(shape)
+        self.offset += count * dtype.itemsize
+        return a
+
+    def text(self, what: str) -> str:
+        end = self.offset + 2
+        if end > len(self.payload):
+            raise ProtocolError(f"the snapshot is cut short in its {what}")
+        size = int.from_bytes(self.payload[self.offset : end], "little")
+        if end + size > len(self.payload):
+            raise ProtocolError(f"the snapshot is cut short in its {what}")
+        try:
+            value = self.payload[end : end + size].decode("utf-8")
+        except UnicodeDecodeError:
+            raise ProtocolError(f"the snapshot's {what} is not valid UTF-8") from None
+        self.offset = end + size
+        return value
+
+
+def _bad(what: str) -> ProtocolError:
+    return ProtocolError(f"the snapshot has {what}; the server may run a different airtable version")
+
+
+def decode_snapshot(payload: bytes) -> Scene:
+    """Check and decode a SNAPSHOT payload into a Scene; anything wrong raises ProtocolError."""
+    payload = bytes(payload)
+    if len(payload) < _SNAP_HEADER.size:
+        raise ProtocolError(f"the snapshot is only {len(payload)} bytes, less than its {_SNAP_HEADER.size} byte header")
+    magic, version, flags, _, n, s, c, *floats = _SNAP_HEADER.unpack_from(payload)
+    if magic != SNAPSHOT_MAGIC:
+        raise ProtocolError("the snapshot does not start with ATSN; is the server an airtable server?")
+    if version != SNAPSHOT_VERSION:
+        raise ProtocolError(
+            f"the snapshot format is version {version} but this client reads version {SNAPSHOT_VERSION}; "
+            "install the same airtable version as the teacher's"
+        )
+    fixed = _SNAP_HEADER.size + n * _PUCK_BYTES + s * _SPRING_BYTES + c * _CURSOR_BYTES
+    # Each text section needs at least its 2-byte count.
+    if fixed + 2 * (3 + c) > len(payload):
+        raise ProtocolError(
+            f"the snapshot claims {n} pucks, {s} springs and {c} cursors but is only {len(payload)} bytes long"
+        )
+    if not all(math.isfinite(v) for v in floats):
+        raise _bad("a number that is not finite in its header")
+    width_m, height_m, time_s, fps, zoom, ox, oy = floats
+    if not (0 < width_m <= MAX_TABLE_M and 0 < height_m <= MAX_TABLE_M and zoom > 0):
+        raise _bad(f"a bad table size or zoom ({width_m:g} x {height_m:g} m, zoom {zoom:g})")
+    cut = _Cut(payload, _SNAP_HEADER.size)
+    pos = cut.array(_F8, (n, 2))
+    radius = cut.array(_F8, (n,))
+    color = cut.array(_U1, (n, 3))
+    pairs = cut.array(_U4, (s, 2))
+    spring_length = cut.array(_F8, (s,))
+    spring_width = cut.array(_F8, (s,))
+    spring_color = cut.array(_U1, (s, 3))
+    cursor_pos = cut.array(_F8, (c, 2))
+    cursor_color = cut.array(_U1, (c, 3))
+    cursor_button = cut.array(_U1, (c,))
+    cursor_held = cut.array(_I4, (c,))
+    title = cut.text("title")
+    status = cut.text("status")
+    correction = cut.text("puck correction mode")
+    names = [cut.text("cursor names") for _ in range(c)]
+    if cut.offset != len(payload):
+        raise _bad(f"{len(payload) - cut.offset} bytes too many at its end")
+    if not (np.isfinite(pos).all() and np.isfinite(cursor_pos).all()):
+        raise _bad("a position that is not finite")
+    if not (np.isfinite(radius).all() and (radius > 0).all()):
+        raise _bad("a puck radius that is not a positive number")
+    if not (np.isfinite(spring_length).all() and np.isfinite(spring_width).all()):
+        raise _bad("a spring size that is not finite")
+    if s and int(pairs.max()) >= n:
+        raise _bad("a spring joined to a puck that is not there")
+    if c and (int(cursor_button.max()) > 3 or int(cursor_held.min()) < -1 or int(cursor_held.max()) >= n):
+        raise _bad("a cursor with a bad button or held puck")
+    if not all(t.isprintable() for t in (title, status, correction, *names)):
+        raise _bad("unprintable text")
+    cursors = tuple(
+        CursorView(
+            name=names[i],
+            color=(int(cursor_color[i, 0]), int(cursor_color[i, 1]), int(cursor_color[i, 2])),
+            cursor_m=(float(cursor_pos[i, 0]), float(cursor_pos[i, 1])),
+            button=int(cursor_button[i]),
+            held=int(cursor_held[i]),
+        )
+        for i in range(c)
+    )
+    # frombuffer views are read-only and may be unaligned: copy into owned native arrays.
+    return Scene(
+        width_m=width_m,
+        height_m=height_m,
+        pos_m=pos.astype(float),
+        radius_m=radius.astype(float),
+        color_rgb=color.copy(),
+        spring_pairs=pairs.astype(np.intp),
+        spring_length_m=spring_length.astype(float),
+        spring_width_m=spring_width.astype(float),
+        spring_color_rgb=spring_color.copy(),
+        cursors=cursors,
+        title=title,
+        status=status,
+        gravity_on=bool(flags & FLAG_GRAVITY),
+        puck_correction=correction,
+        time_s=time_s,
+        fps=fps,
+        zoom=zoom,
+        origin_m=(ox, oy),
+    )
+
+
+def parse_host_port(text: str, default_port: int = DEFAULT_PORT) -> tuple[str, int]:
+    """'host', 'host:port', '[v6addr]:port' or a bare IPv6 address -> (host, port)."""
+    text = text.strip()
+    if not text:
+        raise ValueError("no server address given; use HOST or HOST:PORT, e.g. 192.168.1.23:8888")
+    host, port_text = text, ""
+    if text.startswith("["):
+        close = text.find("]")
+        if close < 0:
+            raise ValueError(f"{text!r} is missing the closing ']' of an IPv6 address")
+        host, rest = text[1:close], text[close + 1 :]
+        if rest:
+            if not rest.startswith(":"):
+                raise ValueError(f"{text!r} is not HOST:PORT")
+            port_text = rest[1:]
+    elif text.count(":") == 1:
+        host, port_text = text.split(":")
+    if not host:
+        raise ValueError(f"{text!r} has no host name")
+    if not port_text:
+        return host, default_port
+    if not port_text.isdigit() or not 1 <= int(port_text) <= 65535:
+        raise ValueError(f"{port_text!r} is not a port number (1-65535)")
+    return host, int(port_text)
