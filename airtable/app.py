@@ -110,6 +110,8 @@ class App:
         self.local = Client(name="local", color=LOCAL_COLOR)
         self.table.clients.append(self.local)
         self.window = GameWindow(self.env, headless=headless)
+        if not headless:
+            pygame.mouse.set_visible(False)  # the local client's arrow is the pointer
         self.server = server
         self.errors: list[DemoError] = list(demo_errors)
         self.running = True

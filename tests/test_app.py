@@ -155,7 +155,9 @@ def test_zoom_keys_keep_the_point_under_the_cursor(app):
 
 
 def test_ctrl_drag_pans(app):
-    pygame.event.post(pygame.event.Event(pygame.KEYDOWN, key=pygame.K_LCTRL, mod=pygame.KMOD_LCTRL, unicode="", scancode=0))
+    pygame.event.post(
+        pygame.event.Event(pygame.KEYDOWN, key=pygame.K_LCTRL, mod=pygame.KMOD_LCTRL, unicode="", scancode=0)
+    )
     pygame.event.post(pygame.event.Event(pygame.MOUSEBUTTONDOWN, pos=(400, 400), button=1))
     pygame.event.post(pygame.event.Event(pygame.MOUSEMOTION, pos=(490, 400), rel=(90, 0), buttons=(1, 0, 0)))
     pygame.event.post(pygame.event.Event(pygame.MOUSEBUTTONUP, pos=(490, 400), button=1))
