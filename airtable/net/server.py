@@ -192,6 +192,7 @@ class GameServer:
         self._wake_w: socket.socket | None = None
         self._thread: threading.Thread | None = None
         self._stopping = threading.Event()
+        self._join_lines: tuple[int, list[str]] | None = None
 
     # ---------------------------------------------------------------- lifecycle
 
@@ -200,6 +201,7 @@ class GameServer:
         if self._thread is not None:
             raise RuntimeError("the server is already started")
         self._listener = self._bind()
+        self._stopping.clear()
         self.port = self._listener.getsockname()[1]
         self._wake_r, self._wake_w = socket.socketpair()
         self._wake_r.setblocking(False)
@@ -279,7 +281,14 @@ class GameServer:
         return self._thread is not None and not self._stopping.is_set()
 
     def join_lines(self) -> list[str]:
-        """What students type to join, e.g. ["join with: airtable-client 192.168.1.23"]."""
+        """What students type to join, e.g. ["join with: airtable-client 192.168.1.23"].
+
+        Worked out once per port and cached, since the app may ask every frame."""
+        if self._join_lines is None or self._join_lines[0] != self.port:
+            self._join_lines = (self.port, self._make_join_lines())
+        return list(self._join_lines[1])
+
+    def _make_join_lines(self) -> list[str]:
         host = self.host or "0.0.0.0"
         hosts = lan_addresses() if host in ("0.0.0.0", "::", "") else [host]
         lines = []
