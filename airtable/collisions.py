@@ -146,9 +146,16 @@ def _grid_candidates(pos: np.ndarray, cell: float) -> tuple[np.ndarray, np.ndarr
     span = pos.max(axis=0) - lo
     # Far more cells than pucks only costs memory: widen the cells instead.
     cell = max(cell, float(np.sqrt(span[0] * span[1] / (4.0 * n))))
+    # A hair wider than the largest reach: two pucks exactly one reach apart
+    # can count as overlapping after rounding, and their cell indices must
+    # then not round two cells apart.
+    cell *= 1.0 + 1e-9
     cxy = ((pos - lo) * (1.0 / cell)).astype(np.intp)
-    ny = int(span[1] / cell) + 3  # a margin row on each side for the neighbours
-    nx = int(span[0] / cell) + 3
+    # Size the grid from the cells actually used, not span / cell: the two can
+    # round differently (0.6 * (1 / 0.2) is 3.0 but 0.6 / 0.2 is 2.999...), and
+    # a grid one cell short sends the neighbour look-ups out of bounds.
+    # One margin cell on each side for the neighbours.
+    nx, ny = (int(v) + 3 for v in cxy.max(axis=0))
     key = (cxy[:, 0] + 1) * ny + (cxy[:, 1] + 1)
     order = np.argsort(key)
     skey = key[order]
