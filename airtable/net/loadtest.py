@@ -17,6 +17,11 @@ Start the table first, e.g. `python -m airtable --headless --demo 4` on the
 teacher's laptop, and run this from another machine on the same network (or
 on the laptop itself with HOST 127.0.0.1, which also counts this tool's own
 CPU use against the laptop).
+
+    python -m airtable.net.loadtest --serve [--port 8888] [--fps 60]
+
+runs a bare headless table (a grid of pucks, no window) with a GameServer, to
+measure the network layer on its own; the tests use the same `TableLoop`.
 """
 
 from __future__ import annotations
@@ -25,13 +30,18 @@ import argparse
 import math
 import statistics
 import sys
+import threading
 import time
+from collections import deque
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 
+from airtable.client import Client
 from airtable.net import protocol as proto
 from airtable.net.player import NetPlayer, PlayerError
+from airtable.net.server import GameServer
 from airtable.scene import Scene
+from airtable.table import AirTable
 
 MAX_CLIENTS = 200
 MAX_SECONDS = 600.0
@@ -126,6 +136,112 @@ class LoadResult:
         if problems:
             return "struggling: " + "; ".join(problems)
         return f"OK, this server holds {self.connected} players"
+
+
+def grid_table(columns: int = 6, rows: int = 5) -> AirTable:
+    """A table with a grid of pucks and the local user at clients[0]."""
+    table = AirTable()
+    for i in range(columns):
+        for j in range(rows):
+            x = table.width_m * (i + 0.5) / columns
+            y = table.height_m * (j + 0.5) / rows
+            table.add_puck((x, y), radius_m=0.3, color="orange")
+    table.clients.append(Client(name="local", active=False))
+    return table
+
+
+class TableLoop:
+    """A headless game loop in a thread: inputs, fixed physics steps, snapshots.
+
+    Each frame, under `lock`: `server.apply_inputs(table)` and `table.step(dt_s)`
+    for each physics step, then `server.publish(...)` with the measured frame
+    rate. Hold `lock` to look at or step the table from another thread.
+    """
+
+    def __init__(
+        self,
+        server: GameServer,
+        table: AirTable | None = None,
+        fps: float = 60.0,
+        dt_s: float = 1 / 240,
+        title: str = "headless table",
+    ) -> None:
+        self.server = server
+        self.table = table if table is not None else grid_table()
+        self.period_s = 1.0 / fps
+        self.dt_s = dt_s
+        self.steps_per_frame = max(1, round(self.period_s / dt_s))
+        self.title = title
+        self.fps = 0.0
+        self.frames = 0
+        self._frame_times: deque[float] = deque()
+        self.lock = threading.RLock()
+        self._stop = threading.Event()
+        self._thread: threading.Thread | None = None
+
+    def frame(self) -> None:
+        with self.lock:
+            for _ in range(self.steps_per_frame):
+                self.server.apply_inputs(self.table)
+                self.table.step(self.dt_s)
+            # Frames counted over the last second: an average of 1/dt would favour short frames.
+            now = time.monotonic()
+            times = self._frame_times
+            times.append(now)
+            while now - times[0] > 1.0:
+                times.popleft()
+            if len(times) > 1:
+                self.fps = (len(times) - 1) / (times[-1] - times[0])
+            t = self.table
+            status = f"{len(t.pos_m)} pucks   {len(self.server.player_names())} players   t = {t.time_s:.2f} s"
+            self.server.publish(Scene.from_table(t, t.clients, title=self.title, status=status, fps=self.fps))
+            self.frames += 1
+
+    def _run(self) -> None:
+        next_t = time.monotonic()
+        while not self._stop.is_set():
+            self.frame()
+            next_t += self.period_s
+            delay = next_t - time.monotonic()
+            if delay > 0:
+                self._stop.wait(delay)
+            else:
+                next_t = time.monotonic()
+
+    def start(self) -> TableLoop:
+        self._thread = threading.Thread(target=self._run, name="airtable-table-loop", daemon=True)
+        self._thread.start()
+        return self
+
+    def stop(self) -> None:
+        self._stop.set()
+        if self._thread is not None:
+            self._thread.join(timeout=5.0)
+            self._thread = None
+
+
+def serve(host: str, port: int, fps: float, seconds: float | None, password: str | None, max_clients: int) -> int:
+    """`--serve`: a bare headless table for load tests; prints its frame rate every 5 s."""
+    server = GameServer(host=host, port=port, password=password, max_clients=max_clients)
+    try:
+        server.start()
+    except OSError as e:
+        print(f"loadtest: {e}", file=sys.stderr)
+        return 1
+    for line in server.join_lines():
+        print(line, flush=True)
+    loop = TableLoop(server, fps=fps).start()
+    start = time.monotonic()
+    try:
+        while seconds is None or time.monotonic() - start < seconds:
+            time.sleep(min(5.0, seconds - (time.monotonic() - start)) if seconds is not None else 5.0)
+            print(f"{loop.fps:.1f} fps, {len(server.player_names())} players", flush=True)
+    except KeyboardInterrupt:
+        pass
+    finally:
+        loop.stop()
+        server.stop()
+    return 0
 
 
 def _percentile(values: Sequence[float], q: float) -> float:
@@ -252,15 +368,30 @@ def main(argv: Sequence[str] | None = None) -> int:
         prog="python -m airtable.net.loadtest",
         description="Connect simulated players to a running air table and measure whether it holds a class.",
     )
-    parser.add_argument("server", metavar="HOST[:PORT]", help="the table's address, as in its 'join with:' line")
+    parser.add_argument(
+        "server", metavar="HOST[:PORT]", nargs="?", help="the table's address, as in its 'join with:' line"
+    )
     parser.add_argument("--clients", type=int, default=30, help=f"simulated players (1-{MAX_CLIENTS}, default 30)")
-    parser.add_argument("--seconds", type=float, default=10.0, help="how long they play (default 10)")
+    parser.add_argument("--seconds", type=float, help="how long they play (default 10; --serve: forever)")
     parser.add_argument("--password", help="the table's password, if it has one")
     parser.add_argument("--input-hz", type=float, default=60.0, help="INPUT messages a second per player (default 60)")
+    serving = parser.add_argument_group("serving a bare table instead (--serve)")
+    serving.add_argument("--serve", action="store_true", help="run a headless table with a server, no window")
+    serving.add_argument("--host", default="0.0.0.0", help="address to listen on (default 0.0.0.0)")
+    serving.add_argument("--port", type=int, default=proto.DEFAULT_PORT, help="port (default 8888)")
+    serving.add_argument("--fps", type=float, default=60.0, help="frames a second (default 60)")
+    serving.add_argument("--max-clients", type=int, default=MAX_CLIENTS, help=f"default {MAX_CLIENTS}")
     args = parser.parse_args(argv)
+    if args.serve:
+        if not (math.isfinite(args.fps) and 1 <= args.fps <= 1000):
+            parser.error("--fps must be 1-1000")
+        return serve(args.host, args.port, args.fps, args.seconds, args.password, args.max_clients)
+    if args.server is None:
+        parser.error("give the table's address HOST[:PORT], or --serve to run one")
     try:
         host, port = proto.parse_host_port(args.server)
-        result = run_load(host, port, args.clients, args.seconds, args.password, args.input_hz)
+        seconds = 10.0 if args.seconds is None else args.seconds
+        result = run_load(host, port, args.clients, seconds, args.password, args.input_hz)
     except ValueError as e:
         print(f"loadtest: {e}", file=sys.stderr)
         return 1

@@ -298,6 +298,11 @@ class GameServer:
             lines.append(f"join with: airtable-client {h}")
         return lines
 
+    @property
+    def connection_count(self) -> int:
+        """Open connections, including ones still saying HELLO or being closed."""
+        return len(self._conns)
+
     def player_names(self) -> list[str]:
         """Names of the players now welcomed, in player-number order."""
         with self._lock:
