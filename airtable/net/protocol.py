@@ -647,7 +647,7 @@ def parse_host_port(text: str, default_port: int = DEFAULT_PORT) -> tuple[str, i
     text = text.strip()
     if not text:
         raise ValueError("no server address given; use HOST or HOST:PORT, e.g. 192.168.1.23:8888")
-    host, port_text = text, ""
+    host, port_text = text, None
     if text.startswith("["):
         close = text.find("]")
         if close < 0:
@@ -661,7 +661,7 @@ def parse_host_port(text: str, default_port: int = DEFAULT_PORT) -> tuple[str, i
         host, port_text = text.split(":")
     if not host:
         raise ValueError(f"{text!r} has no host name")
-    if not port_text:
+    if port_text is None:
         return host, default_port
     if not port_text.isdigit() or not 1 <= int(port_text) <= 65535:
         raise ValueError(f"{port_text!r} is not a port number (1-65535)")

@@ -1,0 +1,409 @@
+"""The wire protocol: framing, validation of every client field, SNAPSHOT round trips."""
+
+from __future__ import annotations
+
+import json
+import struct
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+from hypothesis.extra import numpy as hnp
+
+from airtable import AirTable, Client
+from airtable.net import protocol as proto
+from airtable.scene import CursorView, Scene
+
+
+def scenes_equal(a: Scene, b: Scene) -> bool:
+    """Field by field; Scene's own == would compare numpy arrays ambiguously."""
+    for name in Scene.__dataclass_fields__:
+        x, y = getattr(a, name), getattr(b, name)
+        if isinstance(x, np.ndarray) or isinstance(y, np.ndarray):
+            x, y = np.asarray(x), np.asarray(y)
+            if x.shape != y.shape or x.dtype.kind != y.dtype.kind or not np.array_equal(x, y):
+                return False
+        elif x != y:
+            return False
+    return True
+
+
+def assert_sentence(message: str, *hints: str) -> None:
+    """A person can read it: one line of words, no traceback, naming what to do."""
+    assert "\n" not in message and "Traceback" not in message
+    assert len(message.split()) >= 5, message
+    for hint in hints:
+        assert hint.lower() in message.lower(), f"{hint!r} not in {message!r}"
+
+
+def frame(frame_type: int, payload: bytes) -> bytes:
+    return struct.pack(">IB", len(payload) + 1, frame_type) + payload
+
+
+# ---------------------------------------------------------------- framing
+
+
+def test_frames_survive_any_split():
+    data = proto.encode_hello("Ann") + proto.encode_input((1.0, 2.0), 1, ["a"]) + proto.encode_bye()
+    for chunk in (1, 2, 3, 7, len(data)):
+        reader = proto.FrameReader()
+        frames = []
+        for i in range(0, len(data), chunk):
+            frames += reader.feed(data[i : i + chunk])
+        assert [t for t, _ in frames] == [proto.HELLO, proto.INPUT, proto.BYE]
+        assert frames[2][1] == b""
+        assert reader.pending == 0
+
+
+def test_frame_header_is_big_endian_length_then_type():
+    assert proto.encode_frame(proto.BYE) == b"\x00\x00\x00\x01\x06"
+    assert proto.encode_frame(proto.INPUT, b"{}") == b"\x00\x00\x00\x03\x04{}"
+
+
+@pytest.mark.parametrize(
+    "data, hints",
+    [
+        (b"\x00\x00\x00\x00", ["empty", "airtable-client"]),
+        (struct.pack(">IB", proto.MAX_CLIENT_FRAME + 1, 1), ["65536 byte limit"]),
+        (b"GET / HTTP/1.1\r\n", ["looks like text", "web browser"]),
+        (b"\x00\x00\x00\x02\x09x", ["unknown message type 9", "same airtable version"]),
+        (b"\x00\x00\x00\x02\x05x", ["may not send SNAPSHOT"]),
+    ],
+)
+def test_bad_frames_are_refused_early(data, hints):
+    reader = proto.FrameReader(proto.MAX_CLIENT_FRAME, proto.CLIENT_FRAMES, sender="a client")
+    with pytest.raises(proto.ProtocolError) as err:
+        reader.feed(data)
+    assert_sentence(str(err.value), *hints)
+
+
+def test_a_huge_length_is_refused_before_its_payload_arrives():
+    reader = proto.FrameReader()
+    with pytest.raises(proto.ProtocolError):
+        reader.feed(struct.pack(">I", 10**9))
+
+
+# ---------------------------------------------------------------- HELLO
+
+
+def test_hello_round_trip():
+    (t, payload), *_ = proto.FrameReader().feed(proto.encode_hello("  Ann  ", "pw"))
+    assert t == proto.HELLO
+    assert json.loads(payload) == {"protocol": 1, "name": "  Ann  ", "password": "pw"}
+    assert proto.parse_hello(payload) == proto.Hello(1, "Ann", "pw")
+    assert proto.parse_hello(b'{"protocol": 1}') == proto.Hello(1)
+
+
+@pytest.mark.parametrize(
+    "payload, hints",
+    [
+        (b"\xff\xfe{}", ["UTF-8"]),
+        (b"{nope", ["not valid JSON", "protocol"]),
+        (b"[1, 2]", ["JSON object"]),
+        (b"{}", ["missing", "protocol"]),
+        (b'{"protocol": 2}', ["protocol 1", "protocol 2", "same airtable version"]),
+        (b'{"protocol": 2, "shiny": true}', ["protocol 2"]),  # the version is checked first
+        (b'{"protocol": "1"}', ["whole number"]),
+        (b'{"protocol": true}', ["whole number"]),
+        (b'{"protocol": 1, "name": "' + b"x" * 21 + b'"}', ["name", "20"]),
+        (b'{"protocol": 1, "name": "   "}', ["name"]),
+        (b'{"protocol": 1, "name": "a\\u0007b"}', ["printable"]),
+        (b'{"protocol": 1, "name": 7}', ["name must be text"]),
+        (b'{"protocol": 1, "password": 1234}', ["password must be text"]),
+        (b'{"protocol": 1, "colour": "red"}', ["unknown field", "protocol, name, password"]),
+        (b"[" * 100000, ["not valid JSON"]),
+        (b'{"protocol": ' + b"9" * 5000 + b"}", []),
+    ],
+)
+def test_bad_hello(payload, hints):
+    with pytest.raises(proto.ProtocolError) as err:
+        proto.parse_hello(payload)
+    assert_sentence(str(err.value), *hints)
+
+
+# ---------------------------------------------------------------- INPUT
+
+
+def test_input_round_trip():
+    (t, payload), *_ = proto.FrameReader().feed(proto.encode_input((1.5, -2), 3, ["w", "a"]))
+    assert t == proto.INPUT
+    assert json.loads(payload) == {"cursor_m": [1.5, -2.0], "button": 3, "keys": ["a", "w"]}
+    record = proto.parse_input(payload)
+    assert record == proto.InputRecord((1.5, -2.0), 3, frozenset({"a", "w"}))
+    with pytest.raises(AttributeError):
+        record.button = 1  # frozen: the game loop can share it safely
+
+
+def _input(cursor="[1, 2]", button="1", keys="[]") -> bytes:
+    return f'{{"cursor_m": {cursor}, "button": {button}, "keys": {keys}}}'.encode()
+
+
+@pytest.mark.parametrize(
+    "payload, hints",
+    [
+        (_input(cursor="[NaN, 1]"), ["NaN", "finite"]),
+        (_input(cursor="[1, Infinity]"), ["Infinity", "finite"]),
+        (_input(cursor="[-Infinity, 1]"), ["finite"]),
+        (_input(cursor="[1e308, 1]"), ["too far off the table", "within"]),
+        (_input(cursor="[1e400, 1]"), ["finite"]),
+        (_input(cursor='["5", 1]'), ["must be a number"]),
+        (_input(cursor="[true, 1]"), ["must be a number"]),
+        (_input(cursor="[1, 2, 3]"), ["pair"]),
+        (_input(cursor='{"x": 1}'), ["pair"]),
+        (_input(cursor="[1, " + "9" * 400 + "]"), ["finite"]),
+        (_input(button="7"), ["button must be 0", "mouse buttons"]),
+        (_input(button="-1"), ["button must be 0"]),
+        (_input(button="1.0"), ["button must be 0"]),
+        (_input(button="true"), ["button must be 0"]),
+        (_input(button='"1"'), ["button must be 0"]),
+        (_input(keys='"abc"'), ["list"]),
+        (_input(keys=json.dumps(["k"] * 17)), ["at most 16"]),
+        (_input(keys='["' + "x" * 17 + '"]'), ["1 to 16"]),
+        (_input(keys="[1]"), ["key names"]),
+        (_input(keys='[""]'), ["key names"]),
+        (b'{"cursor_m": [1, 2], "button": 1}', ["missing", "keys"]),
+        (b'{"button": 1, "keys": []}', ["missing", "cursor_m"]),
+        (b'{"cursor_m": [1, 2], "button": 1, "keys": [], "extra": 1}', ["unknown field"]),
+        (b"null", ["JSON object"]),
+    ],
+)
+def test_bad_input(payload, hints):
+    with pytest.raises(proto.ProtocolError) as err:
+        proto.parse_input(payload, (10.0, 8.7556))
+    assert_sentence(str(err.value), *hints)
+
+
+def test_cursor_limits_scale_with_the_table_and_clamp_matches():
+    assert proto.parse_input(_input(cursor="[-40, 45]"), (10, 8)).cursor_m == (-40.0, 45.0)
+    with pytest.raises(proto.ProtocolError):
+        proto.parse_input(_input(cursor="[-40, 45]"), (1, 1))
+    x, y = proto.clamp_cursor((1e9, float("nan")), 1, 1)
+    assert proto.parse_input(_input(cursor=json.dumps([x, y])), (1, 1)).cursor_m == (x, y)
+
+
+json_values = st.recursive(
+    st.none() | st.booleans() | st.integers() | st.floats() | st.text(max_size=20),
+    lambda inner: st.lists(inner, max_size=4),
+    max_leaves=8,
+)
+
+
+@given(st.dictionaries(st.sampled_from(["cursor_m", "button", "keys", "x"]), json_values))
+@settings(max_examples=200, deadline=None)
+def test_input_validation_only_ever_raises_protocol_error(message):
+    try:
+        record = proto.validate_input(message)
+    except proto.ProtocolError:
+        return
+    assert isinstance(record, proto.InputRecord)
+
+
+# ---------------------------------------------------------------- WELCOME and ERROR
+
+
+def test_welcome_has_the_fields_of_the_design():
+    (t, payload), *_ = proto.FrameReader().feed(proto.encode_welcome("C3", (0, 255, 255), 10.0, 8.7556))
+    assert t == proto.WELCOME
+    assert json.loads(payload) == {
+        "protocol": 1,
+        "client": "C3",
+        "color": [0, 255, 255],
+        "table": {"width_m": 10.0, "height_m": 8.7556},
+    }
+    assert proto.parse_welcome(payload) == proto.Welcome("C3", (0, 255, 255), 10.0, 8.7556)
+
+
+def test_welcome_from_a_newer_server_names_the_versions():
+    payload = json.dumps({"protocol": 2, "client": "C1"}).encode()
+    with pytest.raises(proto.ProtocolError) as err:
+        proto.parse_welcome(payload)
+    assert_sentence(str(err.value), "protocol 2", "same airtable version")
+
+
+def test_error_sentences_come_back_printable():
+    (t, payload), *_ = proto.FrameReader().feed(proto.encode_error("server full\nreally"))
+    assert t == proto.ERROR
+    assert proto.parse_error(payload) == "server full really"
+    assert "unreadable" in proto.parse_error(b"\xff")
+
+
+# ---------------------------------------------------------------- SNAPSHOT
+
+
+def table_scene() -> Scene:
+    table = AirTable()
+    a = table.add_puck((2, 2), 0.3, color="orange")
+    b = table.add_puck((4, 2), 0.2, color="cyan")
+    table.add_puck((6, 6), 0.5)
+    table.add_spring(a, b, 1.5, color="gold")
+    table.gravity_on = True
+    table.puck_correction = "perfect-kiss"
+    c = Client(name="C2 Zoë", color=(255, 52, 179))
+    c.set_input(table, (4.05, 2.0), 3)
+    table.step(1 / 240)
+    return Scene.from_table(
+        table,
+        [Client(), c],
+        title="Demo 6: Spring triangle",
+        status="gravity on   t = 0.00 s",
+        fps=59.94,
+        zoom=1.5,
+        origin_m=(-1.0, 0.25),
+    )
+
+
+def test_snapshot_round_trip_of_a_table_scene():
+    scene = table_scene()
+    back = proto.decode_snapshot(proto.encode_snapshot(scene))
+    assert scenes_equal(scene, back)
+    assert back.cursors[1] == CursorView("C2 Zoë", (255, 52, 179), scene.cursors[1].cursor_m, 3, 1)
+    assert back.pos_m.flags.writeable and back.spring_pairs.dtype == np.intp
+
+
+def test_snapshot_layout_header():
+    payload = proto.encode_snapshot(table_scene())
+    assert payload[:4] == b"ATSN" and payload[4] == proto.SNAPSHOT_VERSION and payload[5] == proto.FLAG_GRAVITY
+    assert struct.unpack_from("<III", payload, 8) == (3, 1, 2)
+
+
+def test_empty_scene_round_trip():
+    scene = Scene(10.0, 8.7556, np.zeros((0, 2)), np.zeros(0), np.zeros((0, 3), np.uint8))
+    assert scenes_equal(scene, proto.decode_snapshot(proto.encode_snapshot(scene)))
+
+
+finite = st.floats(-1e6, 1e6, allow_nan=False)
+# What str.isprintable() accepts: no control/format characters and no spaces but " ".
+printable_text = st.text(st.characters(blacklist_categories=("C", "Z"), whitelist_characters=" "), max_size=30)
+
+
+@st.composite
+def scenes(draw) -> Scene:
+    n = draw(st.integers(0, 20))
+    s = draw(st.integers(0, 10)) if n else 0
+    c = draw(st.integers(0, 5))
+    color = hnp.arrays(np.uint8, (n, 3))
+    cursors = tuple(
+        CursorView(
+            name=draw(printable_text),
+            color=draw(st.tuples(*[st.integers(0, 255)] * 3)),
+            cursor_m=(draw(finite), draw(finite)),
+            button=draw(st.integers(0, 3)),
+            held=draw(st.integers(-1, n - 1)),
+        )
+        for _ in range(c)
+    )
+    return Scene(
+        width_m=draw(st.floats(0.1, 1000)),
+        height_m=draw(st.floats(0.1, 1000)),
+        pos_m=draw(hnp.arrays(float, (n, 2), elements=finite)),
+        radius_m=draw(hnp.arrays(float, (n,), elements=st.floats(1e-3, 10))),
+        color_rgb=draw(color),
+        spring_pairs=draw(hnp.arrays(np.intp, (s, 2), elements=st.integers(0, max(n - 1, 0)))),
+        spring_length_m=draw(hnp.arrays(float, (s,), elements=st.floats(0, 100))),
+        spring_width_m=draw(hnp.arrays(float, (s,), elements=st.floats(0, 1))),
+        spring_color_rgb=draw(hnp.arrays(np.uint8, (s, 3))),
+        cursors=cursors,
+        title=draw(printable_text),
+        status=draw(printable_text),
+        gravity_on=draw(st.booleans()),
+        puck_correction=draw(st.sampled_from(["off", "two-step", "perfect-kiss"])),
+        time_s=draw(st.floats(0, 1e6)),
+        fps=draw(st.floats(0, 1000)),
+        zoom=draw(st.floats(0.05, 200)),
+        origin_m=(draw(finite), draw(finite)),
+    )
+
+
+@given(scenes())
+@settings(max_examples=100, deadline=None)
+def test_snapshot_round_trip(scene):
+    assert scenes_equal(scene, proto.decode_snapshot(proto.encode_snapshot(scene)))
+
+
+def test_every_truncation_of_a_snapshot_is_a_protocol_error():
+    payload = proto.encode_snapshot(table_scene())
+    for cut in range(len(payload)):
+        with pytest.raises(proto.ProtocolError):
+            proto.decode_snapshot(payload[:cut])
+    with pytest.raises(proto.ProtocolError):
+        proto.decode_snapshot(payload + b"\0")
+
+
+@given(scenes(), st.data())
+@settings(max_examples=100, deadline=None)
+def test_garbled_snapshots_decode_or_raise_protocol_error(scene, data):
+    payload = bytearray(proto.encode_snapshot(scene))
+    for _ in range(data.draw(st.integers(1, 8))):
+        i = data.draw(st.integers(0, len(payload) - 1))
+        payload[i] = data.draw(st.integers(0, 255))
+    try:
+        back = proto.decode_snapshot(bytes(payload))
+    except proto.ProtocolError as e:
+        assert_sentence(str(e))
+        return
+    # Whatever decodes is safe to draw: finite, in range, printable.
+    assert np.isfinite(back.pos_m).all() and (back.radius_m > 0).all()
+    assert all(-1 <= c.held < len(back.pos_m) and 0 <= c.button <= 3 for c in back.cursors)
+    assert back.title.isprintable() and back.status.isprintable()
+
+
+@given(st.binary(max_size=400))
+@settings(max_examples=200, deadline=None)
+def test_random_bytes_never_leak_other_errors(data):
+    with pytest.raises(proto.ProtocolError):
+        proto.decode_snapshot(data)
+
+
+def test_snapshot_claiming_billions_of_pucks_is_refused_without_allocating():
+    payload = bytearray(proto.encode_snapshot(table_scene()))
+    struct.pack_into("<I", payload, 8, 0xFFFFFFFF)
+    with pytest.raises(proto.ProtocolError) as err:
+        proto.decode_snapshot(bytes(payload))
+    assert "4294967295 pucks" in str(err.value)
+
+
+@pytest.mark.parametrize(
+    "offset, value, hint",
+    [
+        (0, b"XXXX", "ATSN"),
+        (4, b"\x02", "version 2"),
+        (20, struct.pack("<d", float("nan")), "not finite"),
+        (20, struct.pack("<d", -1.0), "table size"),
+    ],
+)
+def test_snapshot_header_checks(offset, value, hint):
+    payload = bytearray(proto.encode_snapshot(table_scene()))
+    payload[offset : offset + len(value)] = value
+    with pytest.raises(proto.ProtocolError) as err:
+        proto.decode_snapshot(bytes(payload))
+    assert hint in str(err.value)
+
+
+def test_unprintable_text_is_cleaned_when_encoding():
+    scene = table_scene()
+    scene.status = "line one\nline\x00two"
+    assert proto.decode_snapshot(proto.encode_snapshot(scene)).status == "line one line two"
+
+
+# ---------------------------------------------------------------- addresses
+
+
+@pytest.mark.parametrize(
+    "text, expected",
+    [
+        ("192.168.1.23", ("192.168.1.23", 8888)),
+        ("teacher-laptop:9000", ("teacher-laptop", 9000)),
+        ("[::1]:9000", ("::1", 9000)),
+        ("[fe80::1]", ("fe80::1", 8888)),
+        ("fe80::1", ("fe80::1", 8888)),
+    ],
+)
+def test_parse_host_port(text, expected):
+    assert proto.parse_host_port(text) == expected
+
+
+@pytest.mark.parametrize("text", ["", "host:", "host:http", "host:70000", "[::1", ":80"])
+def test_parse_host_port_refuses(text):
+    with pytest.raises(ValueError):
+        proto.parse_host_port(text)
