@@ -16,14 +16,16 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
+import numpy as np
 import pygame
 
+from airtable import aids
 from airtable.client import Client
 from airtable.demo_loader import BUILTIN_DIR, Demo, DemoError, discover, error_from_exception, key_order
 from airtable.environment import Environment
 from airtable.scene import Scene
 from airtable.table import AirTable
-from airtable.window import GameWindow
+from airtable.window import AidsPainter, GameWindow
 
 LOCAL_COLOR = (0, 255, 0)
 # A stalled frame (window dragged, laptop busy) runs at most this much
@@ -33,6 +35,9 @@ MAX_FPS = 120
 ZOOM_RATE_PER_S = 1.5  # held h / n: zoom factor e**1.5 per second
 WHEEL_ZOOM = 1.1
 MESSAGE_S = 4.0
+DIM_FORCE = (200, 200, 200)
+COM_COLOR = (255, 255, 255)
+FORCE_COLORS = {"cursor strings": (255, 120, 80), "springs": (255, 215, 0), "gravity": (90, 160, 255)}
 
 
 @dataclass(frozen=True)
@@ -75,6 +80,14 @@ BINDINGS: tuple[Binding, ...] = (
     Binding("Ctrl + mouse drag", "pan the view"),
     Binding("q", "reset the view", (pygame.K_q,), "key_reset_view"),
     Binding("mouse buttons 1 / 2 / 3", "grab a puck with the medium / soft / stiff cursor string"),
+    Binding("e", "trails: stop erasing, so each frame's pucks stay on screen", (pygame.K_e,), "key_trails"),
+    Binding("s", "slow motion: 1, 1/2, 1/4, 1/8, 1/16 of real time", (pygame.K_s,), "key_slow_motion"),
+    Binding("r", "reverse time: flip every velocity", (pygame.K_r,), "key_reverse"),
+    Binding("a", "collision annotations: axes, overlap, separation, angle", (pygame.K_a,), "key_annotations"),
+    Binding("v", "vectors: velocity / momentum arrows, forces, centre of mass", (pygame.K_v,), "key_vectors"),
+    Binding("c", "energy and momentum chart", (pygame.K_c,), "key_chart"),
+    Binding("i (hold)", "inspect the puck under the cursor", (pygame.K_i,), "hold_inspect", held=True),
+    Binding("l", "lecture notes for this demo", (pygame.K_l,), "key_notes"),
     Binding("F1", "this help screen", (pygame.K_F1,), "key_help"),
     Binding("F12", "save a screenshot PNG", (pygame.K_F12,), "key_screenshot"),
     Binding("Esc", "quit", (pygame.K_ESCAPE,), "key_quit"),
@@ -110,15 +123,23 @@ class App:
         self.local = Client(name="local", color=LOCAL_COLOR)
         self.table.clients.append(self.local)
         self.window = GameWindow(self.env, headless=headless)
+        self.painter = AidsPainter(self.window)
         if not headless:
             pygame.mouse.set_visible(False)  # the local client's arrow is the pointer
         self.server = server
-        self.errors: list[DemoError] = list(demo_errors)
         self.running = True
         self.paused = False
         self.show_help = False
         self.trails = False
         self.speed = 1.0
+        self.show_annotations = False
+        self.vectors = 0  # 0 off, 1 velocity, 2 momentum
+        self.show_chart = False
+        self.show_notes = False
+        self.inspecting = False
+        self.collision_log = aids.CollisionLog()
+        self.chart = aids.EnergyChart()
+        self.notice: list[str] = [f"could not load {e}" for e in demo_errors]
         self.keys_down: set[int] = set()
         self.mouse_px = (self.env.size_px[0] / 2, self.env.size_px[1] / 2)
         self.mouse_button = 0
@@ -156,6 +177,9 @@ class App:
         self.trails = demo.trails
         self.accumulator_s = 0.0
         self.window.clear_trails()
+        self.collision_log.clear()
+        self.chart.clear()
+        self.chart.sample(self.table)
         self.window.set_caption(f"Air Table - {demo.label(self.variation)}")
 
     def key_demo(self, event: pygame.event.Event) -> None:
@@ -217,6 +241,34 @@ class App:
         self.env.reset()
         self.window.clear_trails()
 
+    def key_trails(self, event) -> None:
+        self.trails = not self.trails
+        self.window.clear_trails()
+
+    def key_slow_motion(self, event) -> None:
+        factors = aids.SLOW_MOTION_FACTORS
+        self.speed = factors[(factors.index(self.speed) + 1) % len(factors)] if self.speed in factors else 1.0
+
+    def key_reverse(self, event) -> None:
+        self.table.vel_mps[:] *= -1.0
+        self.say("time reversed: every velocity flipped")
+
+    def key_annotations(self, event) -> None:
+        self.show_annotations = not self.show_annotations
+        self.collision_log.clear()
+
+    def key_vectors(self, event) -> None:
+        self.vectors = (self.vectors + 1) % 3
+
+    def key_chart(self, event) -> None:
+        self.show_chart = not self.show_chart
+
+    def key_notes(self, event) -> None:
+        self.show_notes = not self.show_notes
+
+    def hold_inspect(self, key: int, frame_dt_s: float) -> None:
+        self.inspecting = True
+
     def key_help(self, event) -> None:
         self.show_help = not self.show_help
 
@@ -243,6 +295,7 @@ class App:
         if event.type == pygame.QUIT:
             self.running = False
         elif event.type == pygame.KEYDOWN:
+            self.notice = []  # any key dismisses the start-up notice
             self.keys_down.add(event.key)
             binding = self._dispatch.get(event.key)
             if binding is not None and not binding.held:
@@ -279,12 +332,16 @@ class App:
         if self.server is not None:
             self.server.apply_inputs(self.table)
         self.table.step(self.dt_s)
+        self.chart.sample(self.table)
+        if self.show_annotations:
+            self.collision_log.add(self.table, self.clock_s)
 
     def frame(self, frame_dt_s: float) -> None:
         """One frame: input, as many fixed physics steps as time allows, drawing."""
         self.clock_s += frame_dt_s
         for event in pygame.event.get():
             self.handle_event(event)
+        self.inspecting = False
         for key in self.keys_down:
             binding = self._dispatch.get(key)
             if binding is not None and binding.held:
@@ -326,6 +383,7 @@ class App:
         parts.append(f"correction: {t.puck_correction}")
         parts.append(f"restitution: pucks {t.cr_puck:g}, walls {t.cr_wall:g}")
         parts.append(f"{len(t.pos_m)} pucks")
+        parts.append(f"{t.collision_count} collisions")
         parts.append(f"t = {t.time_s:.2f} s")
         parts.append("F1: help")
         return "   ".join(parts)
@@ -341,16 +399,79 @@ class App:
     def draw(self) -> None:
         scene = self.scene()
         self.window.draw(scene, trails=self.trails, hud=self.hud_lines())
+        self.draw_aids()
         error = self.build_error
-        if error is not None:
+        if self.notice:
+            self.window.draw_panel("Some demo files could not be loaded", [*self.notice, "Press any key to go on."])
+        elif error is not None:
             self.window.draw_panel(
                 f"Demo {self.demo_key} could not be built", [str(error), "Fix the file and press its key again."]
             )
         elif self.show_help:
             self.window.draw_panel("Keys", [(b.label, b.help) for b in BINDINGS] + self._demo_rows())
+        elif self.show_notes:
+            self.window.draw_panel(self.demo.label(self.variation), [self.demo.notes or "(no notes)"], large=True)
         if self.server is not None:
             self.server.publish(scene)
         self.window.present()
+
+    def draw_aids(self) -> None:
+        t, paint = self.table, self.painter
+        if self.show_annotations:
+            for annotation in self.collision_log.live(self.clock_s):
+                paint.annotation(annotation, self.clock_s)
+        if self.vectors and len(t.pos_m):
+            self._draw_vectors()
+        if self.show_chart:
+            wiggle = self.chart.total_wiggle()
+            note = None
+            if wiggle > 1e-4:
+                note = (
+                    f"The total wiggles by {100 * wiggle:.2g} %: semi-implicit Euler keeps a nearby energy "
+                    "exactly, so E swings by about omega dt / 2 but does not drift."
+                )
+            paint.energy_chart(self.chart.series(), self.chart.latest(), note)
+        if self.inspecting:
+            puck = t.puck_at(self.env.to_world(self.mouse_px))
+            if puck is not None:
+                v = puck.vel_mps
+                speed = float(np.hypot(*v))
+                paint.inspector(
+                    puck.pos_m,
+                    [
+                        f"mass {puck.mass_kg:.4g} kg   radius {puck.radius_m:.4g} m",
+                        f"speed {speed:.4g} m/s",
+                        f"velocity ({v[0]:.3f}, {v[1]:.3f}) m/s",
+                        f"kinetic energy {0.5 * puck.mass_kg * speed**2:.4g} J",
+                    ],
+                )
+
+    def _draw_vectors(self) -> None:
+        t, paint = self.table, self.painter
+        if self.vectors == 1:
+            name, unit, values, color = "velocity", "m/s", t.vel_mps, (120, 220, 255)
+        else:
+            name, unit, values, color = "momentum", "N s", t.vel_mps * t.mass_kg[:, None], (230, 120, 230)
+        amount, m_per_unit = aids.nice_scale(float(np.hypot(values[:, 0], values[:, 1]).max()), target_m=1.0)
+        paint.arrows(t.pos_m, values * m_per_unit, color)
+        legend = [(f"{name}: an arrow 1 m long is {amount:g} {unit}", color)]
+        # The centre of mass moves in a straight line while no outside force acts.
+        com, com_v = t.center_of_mass_m(), t.center_of_mass_vel_mps()
+        speed, m_per_mps = aids.nice_scale(float(np.hypot(t.vel_mps[:, 0], t.vel_mps[:, 1]).max()), target_m=1.0)
+        paint.arrow(com, com_v * m_per_mps, COM_COLOR, width=3)
+        paint.marker(com, COM_COLOR, f"centre of mass, {np.hypot(*com_v):.3g} m/s")
+        held = self.local.held
+        if held is not None and held.alive:
+            forces = t.forces_on(held, self.dt_s)
+            if forces:
+                biggest = max(float(np.hypot(*f)) for f in forces.values())
+                newtons, m_per_n = aids.nice_scale(biggest, target_m=1.5)
+                for source, f in forces.items():
+                    c = FORCE_COLORS[source]
+                    paint.arrow(held.pos_m, f * m_per_n, c, width=3)
+                    legend.append((f"force, {source}: {np.hypot(*f):.3g} N", c))
+                legend.append((f"forces: an arrow 1 m long is {newtons / 1.5:.3g} N", DIM_FORCE))
+        paint.legend(legend)
 
     def _demo_rows(self) -> list[tuple[str, str]]:
         rows = []
@@ -402,6 +523,16 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--headless", action="store_true", help="run the same loop without a window")
     p.add_argument("--seconds", type=_positive_float, default=None, metavar="S", help="quit after S seconds")
     p.add_argument("--screenshot", default=None, metavar="FILE.png", help="save the last frame to FILE.png at exit")
+    p.add_argument(
+        "--demos",
+        action="append",
+        default=[],
+        metavar="DIR",
+        help="also load every demo file in DIR (a key already taken is replaced); may be repeated",
+    )
+    p.add_argument(
+        "--new-demo", default=None, metavar="FILE.py", help="write a commented starter demo to FILE.py and exit"
+    )
     return p
 
 
@@ -442,6 +573,17 @@ def list_demos(demos: dict[str, Demo], errors: Sequence[DemoError]) -> str:
     return "\n".join(lines)
 
 
+def write_starter_demo(path: Path) -> Path:
+    """Copy the commented starter demo to `path` (never over an existing file)."""
+    if path.suffix != ".py":
+        raise ValueError(f"{path}: a demo file name must end in .py")
+    if path.exists():
+        raise ValueError(f"{path} already exists; choose another name or delete it first")
+    starter = Path(__file__).resolve().parent / "assets" / "starter_demo.py.txt"
+    path.write_text(starter.read_text(encoding="utf-8"), encoding="utf-8")
+    return path
+
+
 def start_server(args):
     """Start the network server, or explain on stderr why students cannot join."""
     try:
@@ -468,7 +610,17 @@ def start_server(args):
 def main(argv: Sequence[str] | None = None) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)
-    demos, errors = discover([BUILTIN_DIR])
+    if args.new_demo:
+        try:
+            path = write_starter_demo(Path(args.new_demo))
+        except (OSError, ValueError) as exc:
+            parser.error(str(exc))
+        print(f"wrote {path}; edit it, then run: python -m airtable --demos {path.parent}")
+        return 0
+    for directory in args.demos:
+        if not Path(directory).is_dir():
+            parser.error(f"--demos {directory}: no such folder")
+    demos, errors = discover([BUILTIN_DIR, *map(Path, args.demos)])
     if args.list_demos:
         print(list_demos(demos, errors))
         return 0
@@ -478,7 +630,9 @@ def main(argv: Sequence[str] | None = None) -> int:
     if args.variation and args.variation >= max(1, len(variations)):
         parser.error(f"demo {args.demo} has {len(variations) or 'no'} variations; --variation must be below that")
     server = None if args.no_server else start_server(args)
-    app = App(demos, demo_key=args.demo, variation=args.variation, headless=args.headless, server=server)
+    app = App(
+        demos, demo_key=args.demo, variation=args.variation, headless=args.headless, server=server, demo_errors=errors
+    )
     try:
         app.run(seconds=args.seconds)
         if args.screenshot:

@@ -193,9 +193,10 @@ class Collisions:
     """What the pair resolution of one step did, for diagnostics and drawing.
 
     One row per collision (an approaching pair whose velocities were changed):
-    puck indices, the contact normal (unit, from j to i), the contact point,
-    the overlap when detected and the gap (separation) left after the position
-    correction, both in metres. A negative gap means they still overlap.
+    puck rows i and j, the contact normal (unit, from j to i), the contact
+    point, the overlap when detected and the gap (separation) left after the
+    position correction, both in metres (a negative gap: still overlapping),
+    and both pucks' positions and velocities before and after this collision.
     """
 
     i: np.ndarray
@@ -204,12 +205,21 @@ class Collisions:
     contact_m: np.ndarray
     overlap_m: np.ndarray
     separation_m: np.ndarray
+    pos_i_before: np.ndarray
+    pos_j_before: np.ndarray
+    pos_i_after: np.ndarray
+    pos_j_after: np.ndarray
+    vel_i_before: np.ndarray
+    vel_j_before: np.ndarray
+    vel_i_after: np.ndarray
+    vel_j_after: np.ndarray
 
     @classmethod
     def empty(cls) -> Collisions:
         z = np.empty(0)
         zi = np.empty(0, dtype=np.intp)
-        return cls(zi, zi, np.empty((0, 2)), np.empty((0, 2)), z, z)
+        z2 = np.empty((0, 2))
+        return cls(zi, zi, z2, z2, z, z, *([z2] * 8))
 
     def __len__(self) -> int:
         return len(self.i)
@@ -287,6 +297,7 @@ def _resolve_round(pos, vel, radius, mass, a, b, cr, mode, dt_s) -> Collisions:
     """Resolve pairs that share no puck, all at once (see `disjoint_rounds`)."""
     x1, x2 = pos[a], pos[b]
     reach = radius[a] + radius[b]
+    x1_in, x2_in = x1, x2
     n, dist = unit_vectors(x1 - x2)
     overlap = reach - dist
     touching = overlap > 0.0
@@ -295,7 +306,9 @@ def _resolve_round(pos, vel, radius, mass, a, b, cr, mode, dt_s) -> Collisions:
         if len(keep) == 0:
             return Collisions.empty()
         a, b, x1, x2, reach, n, overlap = a[keep], b[keep], x1[keep], x2[keep], reach[keep], n[keep], overlap[keep]
+        x1_in, x2_in = x1, x2
     v1, v2 = vel[a], vel[b]
+    v1_in, v2_in = v1, v2
     m1, m2 = mass[a], mass[b]
     share1 = m2 / (m1 + m2)  # puck 1's part of a change in relative motion
     share2 = m1 / (m1 + m2)
@@ -364,4 +377,19 @@ def _resolve_round(pos, vel, radius, mass, a, b, cr, mode, dt_s) -> Collisions:
     k = np.flatnonzero(approach)
     gap = np.hypot(*(x1[k] - x2[k]).T) - reach[k]
     contact = contact_from[k] + n[k] * radius[b[k]][:, None]
-    return Collisions(a[k], b[k], n[k], contact, overlap[k], gap)
+    return Collisions(
+        a[k],
+        b[k],
+        n[k],
+        contact,
+        overlap[k],
+        gap,
+        x1_in[k],
+        x2_in[k],
+        x1[k],
+        x2[k],
+        v1_in[k],
+        v2_in[k],
+        v1[k],
+        v2[k],
+    )

@@ -341,6 +341,17 @@ class AirTable:
     def momentum_Ns(self) -> np.ndarray:
         return self.mass_kg @ self.vel_mps if self._pucks.n else np.zeros(2)
 
+    def center_of_mass_m(self) -> np.ndarray:
+        """Mass-weighted mean position (the table centre when there are no pucks)."""
+        if self._pucks.n == 0:
+            return 0.5 * self.size_m
+        return self.mass_kg @ self.pos_m / self.mass_kg.sum()
+
+    def center_of_mass_vel_mps(self) -> np.ndarray:
+        if self._pucks.n == 0:
+            return np.zeros(2)
+        return self.momentum_Ns() / self.mass_kg.sum()
+
     # ------------------------------------------------------------ the step
 
     def step(self, dt_s: float) -> None:
@@ -382,9 +393,8 @@ class AirTable:
                 moved = np.union1d(i, j)  # only pairs moved pucks
                 collisions.resolve_walls(pos, vel, radius, size, self.cr_wall, self.wall_correction, only=moved)
 
-    def _add_spring_forces(self, force: np.ndarray, dt: float) -> None:
-        if self._springs.n == 0:
-            return
+    def _spring_forces(self, dt: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(rows of p1, rows of p2, force on p1) for every spring; p2 gets minus that."""
         pairs = self.spring_pairs
         a, b = pairs[:, 0], pairs[:, 1]
         pos, vel, mass = self.pos_m, self.vel_mps, self.mass_kg
@@ -393,11 +403,11 @@ class AirTable:
         k = np.minimum(self.spring_k_Npm, STIFFNESS_LIMIT * mu / (dt * dt))
         c = np.minimum(self.spring_damper_Nspm, STIFFNESS_LIMIT * mu / dt)
         vn = collisions.dot_rows(vel[a] - vel[b], n)
-        f1 = (k * (self.spring_length_m - dist) - c * vn)[:, None] * n
-        np.add.at(force, a, f1)
-        np.add.at(force, b, -f1)
+        return a, b, (k * (self.spring_length_m - dist) - c * vn)[:, None] * n
 
-    def _add_cursor_forces(self, force: np.ndarray, dt: float) -> None:
+    def _cursor_forces(self, dt: float) -> list[tuple[int, np.ndarray]]:
+        """(puck row, force) for every client pulling a puck with its cursor string."""
+        out = []
         for client in self.clients:
             puck = getattr(client, "held", None)
             if puck is None or not puck.alive or client.button not in CURSOR_STRINGS:
@@ -407,4 +417,35 @@ class AirTable:
             k, c = CURSOR_STRINGS[client.button]
             k = min(k, STIFFNESS_LIMIT * m / (dt * dt))
             c = min(c, STIFFNESS_LIMIT * m / dt)
-            force[row] += k * (np.asarray(client.cursor_m) - self.pos_m[row]) - c * self.vel_mps[row]
+            out.append((row, k * (np.asarray(client.cursor_m) - self.pos_m[row]) - c * self.vel_mps[row]))
+        return out
+
+    def _add_spring_forces(self, force: np.ndarray, dt: float) -> None:
+        if self._springs.n:
+            a, b, f1 = self._spring_forces(dt)
+            np.add.at(force, a, f1)
+            np.add.at(force, b, -f1)
+
+    def _add_cursor_forces(self, force: np.ndarray, dt: float) -> None:
+        for row, f in self._cursor_forces(dt):
+            force[row] += f
+
+    def forces_on(self, puck: Puck, dt_s: float = 1 / 240) -> dict[str, np.ndarray]:
+        """The forces (N) the next step will apply to `puck`, by source.
+
+        Keys: "cursor strings", "springs", "gravity" (only the non-zero ones).
+        `dt_s` matters only for springs stiffer than the step can integrate.
+        """
+        row = puck.index
+        out: dict[str, np.ndarray] = {}
+        strings = [f for r, f in self._cursor_forces(dt_s) if r == row]
+        if strings:
+            out["cursor strings"] = np.sum(strings, axis=0)
+        if self._springs.n:
+            a, b, f1 = self._spring_forces(dt_s)
+            total = f1[a == row].sum(axis=0) - f1[b == row].sum(axis=0)
+            if (a == row).any() or (b == row).any():
+                out["springs"] = total
+        if self.gravity_on:
+            out["gravity"] = np.array([0.0, -self.mass_kg[row] * GRAVITY_MPS2])
+        return out

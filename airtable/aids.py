@@ -1,0 +1,164 @@
+"""Teaching aids: the numbers behind what the window shows (no pygame).
+
+The physics exposes what it did (AirTable.last_collisions, energies,
+forces_on); this module keeps short histories of those numbers for drawing:
+collision annotations that fade, and the energy strip chart.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from airtable.table import AirTable
+
+SLOW_MOTION_FACTORS = (1.0, 1 / 2, 1 / 4, 1 / 8, 1 / 16)
+ANNOTATION_LIFE_S = 2.5
+MAX_ANNOTATIONS = 12  # a gas makes hundreds a second; show the newest few
+CHART_WINDOW_S = 10.0
+
+
+@dataclass(frozen=True)
+class Annotation:
+    """One puck-puck collision as the physics computed it, plus when it was seen."""
+
+    born_s: float  # app clock (real seconds), for fading
+    contact_m: tuple[float, float]
+    normal: tuple[float, float]  # unit, from puck j to puck i
+    overlap_m: float  # overlap when detected
+    separation_m: float  # gap after the correction (negative: still overlapping)
+    pos_i_before: tuple[float, float]
+    pos_j_before: tuple[float, float]
+    pos_i_after: tuple[float, float]
+    pos_j_after: tuple[float, float]
+    radius_i_m: float
+    radius_j_m: float
+    angle_deg: float | None  # between the two outgoing paths, for an equal-mass hit on a still puck
+
+    @property
+    def ratio(self) -> float | None:
+        """separation / overlap: 1.0000 for the two-step correction."""
+        return self.separation_m / self.overlap_m if self.overlap_m > 0 else None
+
+    def alpha(self, now_s: float) -> float:
+        """1 when new, fading to 0 at the end of its life."""
+        return max(0.0, 1.0 - (now_s - self.born_s) / ANNOTATION_LIFE_S)
+
+
+def _tuple(v) -> tuple[float, float]:
+    return (float(v[0]), float(v[1]))
+
+
+def annotations_from(table: AirTable, now_s: float) -> list[Annotation]:
+    """Annotations for the collisions of the table's last step."""
+    c = table.last_collisions
+    out = []
+    for k in range(len(c)):
+        i, j = int(c.i[k]), int(c.j[k])
+        angle = None
+        m_i, m_j = table.mass_kg[i], table.mass_kg[j]
+        vi0, vj0 = c.vel_i_before[k], c.vel_j_before[k]
+        still = min(np.hypot(*vi0), np.hypot(*vj0)) <= 1e-9 * max(np.hypot(*vi0), np.hypot(*vj0), 1e-300)
+        if abs(m_i - m_j) <= 1e-9 * max(m_i, m_j) and still:
+            vi, vj = c.vel_i_after[k], c.vel_j_after[k]
+            si, sj = np.hypot(*vi), np.hypot(*vj)
+            if si > 1e-9 and sj > 1e-9:  # a head-on hit leaves one puck still: no angle
+                cos = float(np.clip(np.dot(vi, vj) / (si * sj), -1.0, 1.0))
+                angle = math.degrees(math.acos(cos))
+        out.append(
+            Annotation(
+                born_s=now_s,
+                contact_m=_tuple(c.contact_m[k]),
+                normal=_tuple(c.normal[k]),
+                overlap_m=float(c.overlap_m[k]),
+                separation_m=float(c.separation_m[k]),
+                pos_i_before=_tuple(c.pos_i_before[k]),
+                pos_j_before=_tuple(c.pos_j_before[k]),
+                pos_i_after=_tuple(c.pos_i_after[k]),
+                pos_j_after=_tuple(c.pos_j_after[k]),
+                radius_i_m=float(table.radius_m[i]),
+                radius_j_m=float(table.radius_m[j]),
+                angle_deg=angle,
+            )
+        )
+    return out
+
+
+class CollisionLog:
+    """The newest collision annotations, dropping those that have faded."""
+
+    def __init__(self) -> None:
+        self.items: list[Annotation] = []
+
+    def add(self, table: AirTable, now_s: float) -> None:
+        if len(table.last_collisions):
+            self.items.extend(annotations_from(table, now_s))
+            del self.items[:-MAX_ANNOTATIONS]
+
+    def live(self, now_s: float) -> list[Annotation]:
+        self.items = [a for a in self.items if a.alpha(now_s) > 0.0]
+        return self.items
+
+    def clear(self) -> None:
+        self.items = []
+
+
+class EnergyChart:
+    """A ring buffer of energy and momentum samples, one per physics step."""
+
+    FIELDS = ("time_s", "kinetic_J", "spring_J", "gravity_J", "total_J", "momentum_Ns")
+
+    def __init__(self, capacity: int = 8192) -> None:
+        self._data = np.zeros((capacity, len(self.FIELDS)))
+        self._next = 0
+        self._count = 0
+
+    def clear(self) -> None:
+        self._next = self._count = 0
+
+    def sample(self, table: AirTable) -> None:
+        ke, se, ge = table.kinetic_energy_J(), table.spring_energy_J(), table.gravity_energy_J()
+        p = table.momentum_Ns()
+        self._data[self._next] = (table.time_s, ke, se, ge, ke + se + ge, float(np.hypot(p[0], p[1])))
+        self._next = (self._next + 1) % len(self._data)
+        self._count = min(self._count + 1, len(self._data))
+
+    def series(self, window_s: float = CHART_WINDOW_S) -> dict[str, np.ndarray]:
+        """The samples of the last `window_s` seconds of simulation, oldest first."""
+        if self._count == 0:
+            return {f: np.zeros(0) for f in self.FIELDS}
+        idx = (self._next - self._count + np.arange(self._count)) % len(self._data)
+        rows = self._data[idx]
+        rows = rows[rows[:, 0] >= rows[-1, 0] - window_s]
+        return {f: rows[:, k] for k, f in enumerate(self.FIELDS)}
+
+    def latest(self) -> dict[str, float]:
+        if self._count == 0:
+            return {f: 0.0 for f in self.FIELDS}
+        row = self._data[(self._next - 1) % len(self._data)]
+        return {f: float(row[k]) for k, f in enumerate(self.FIELDS)}
+
+    def total_wiggle(self, window_s: float = CHART_WINDOW_S) -> float:
+        """(max - min) / (2 mean) of the total energy over the window: its relative amplitude."""
+        total = self.series(window_s)["total_J"]
+        if len(total) < 2 or np.mean(total) <= 0:
+            return 0.0
+        return float((total.max() - total.min()) / (2.0 * np.mean(total)))
+
+
+def nice_scale(largest: float, target_m: float = 1.0) -> tuple[float, float]:
+    """A round quantity (1, 2 or 5 x 10^k) and the metres per unit that draw it `target_m` long.
+
+    Used to scale arrows so the largest is about `target_m` and the legend
+    reads "1 m = 2 m/s" rather than "1 m = 1.7372 m/s".
+    """
+    if not (largest > 0 and math.isfinite(largest)):
+        return 1.0, target_m
+    exp = math.floor(math.log10(largest))
+    for step in (1, 2, 5, 10):
+        unit = step * 10.0**exp
+        if unit >= largest:
+            break
+    return unit, target_m / unit

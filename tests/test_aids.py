@@ -1,0 +1,292 @@
+"""Teaching aids: each toggles and changes the frame, and shows the physics' own numbers."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pygame
+import pytest
+
+from airtable import aids
+from airtable.app import App, main
+from airtable.demo_loader import BUILTIN_DIR, discover
+from airtable.table import AirTable
+
+FRAME_S = 1 / 60
+
+
+@pytest.fixture(scope="module")
+def demos():
+    found, errors = discover([BUILTIN_DIR])
+    assert not errors
+    return found
+
+
+def make_app(demos, key="1", **kw) -> App:
+    app = App(demos, demo_key=key, headless=True, **kw)
+    pygame.event.clear()
+    return app
+
+
+def post_key(key: int, down: bool = True) -> None:
+    kind = pygame.KEYDOWN if down else pygame.KEYUP
+    pygame.event.post(pygame.event.Event(kind, key=key, mod=0, unicode="", scancode=0))
+
+
+def press(app: App, key: int) -> None:
+    post_key(key)
+    post_key(key, down=False)
+    app.frame(FRAME_S)
+
+
+def frame_pixels(app: App) -> np.ndarray:
+    return pygame.surfarray.array3d(app.window.surface).copy()
+
+
+def changed_fraction(a: np.ndarray, b: np.ndarray) -> float:
+    return float(np.mean(np.any(a != b, axis=2)))
+
+
+def twin_frames(demos, key: str, toggle: int, setup=None, frames: int = 1):
+    """Frames of two identical apps, one with the aid toggled: same physics, different drawing."""
+    shots = []
+    for with_aid in (False, True):
+        app = make_app(demos, key)
+        if setup:
+            setup(app)
+        if with_aid:
+            post_key(toggle)
+            post_key(toggle, down=False)
+        for _ in range(frames):
+            app.frame(FRAME_S)
+        shots.append(frame_pixels(app))
+    return shots
+
+
+def fling(app: App) -> None:
+    rng = np.random.default_rng(3)
+    app.table.vel_mps[:] = rng.uniform(-2, 2, app.table.vel_mps.shape)
+
+
+@pytest.mark.parametrize(
+    "key, toggle, setup, frames",
+    [
+        ("2", pygame.K_e, fling, 30),  # trails
+        ("2", pygame.K_v, fling, 2),  # vectors
+        ("5", pygame.K_c, None, 30),  # energy chart
+        ("1", pygame.K_l, None, 1),  # lecture notes
+        ("1", pygame.K_F1, None, 1),  # help
+    ],
+)
+def test_each_aid_changes_the_frame(demos, key, toggle, setup, frames):
+    without, with_aid = twin_frames(demos, key, toggle, setup, frames)
+    assert changed_fraction(without, with_aid) > 0.002
+
+
+def test_annotations_draw_at_a_collision(demos):
+    shots = []
+    for on in (False, True):
+        app = make_app(demos, "2p")
+        if on:
+            press(app, pygame.K_a)
+        while app.table.collision_count == 0:
+            app.frame(FRAME_S)
+        app.frame(0.0)  # redraw without stepping
+        shots.append(frame_pixels(app))
+    assert changed_fraction(*shots) > 0.002
+
+
+def test_annotations_fade_out(demos):
+    app = make_app(demos, "2p")
+    press(app, pygame.K_a)
+    while app.table.collision_count == 0:
+        app.frame(FRAME_S)
+    assert len(app.collision_log.live(app.clock_s)) == 1
+    app.paused = True
+    for _ in range(int(aids.ANNOTATION_LIFE_S / FRAME_S) + 2):
+        app.frame(FRAME_S)
+    assert app.collision_log.live(app.clock_s) == []
+
+
+def test_inspector_shows_the_puck_under_the_cursor(demos):
+    app = make_app(demos, "1")
+    texts: list[str] = []
+    original = app.painter.inspector
+    app.painter.inspector = lambda point, lines: (texts.extend(lines), original(point, lines))
+    puck = app.table.pucks[0]
+    puck.vel_mps = (0.0, 0.0)
+    x, y = app.env.to_screen(puck.pos_m)
+    pygame.event.post(pygame.event.Event(pygame.MOUSEMOTION, pos=(int(x), int(y)), rel=(0, 0), buttons=(0, 0, 0)))
+    post_key(pygame.K_i)
+    app.frame(FRAME_S)
+    mass = 0.3 * math.pi * 0.25**2
+    assert f"mass {mass:.4g} kg   radius 0.25 m" in texts
+    assert "speed 0 m/s" in texts
+    post_key(pygame.K_i, down=False)
+    texts.clear()
+    app.frame(FRAME_S)
+    assert texts == []
+
+
+def test_slow_motion_runs_fewer_steps_of_the_same_size(demos):
+    app = make_app(demos, "1")
+    for factor in (0.5, 0.25, 0.125, 0.0625, 1.0):
+        press(app, pygame.K_s)
+        assert app.speed == factor
+        if factor != 1.0:
+            assert f"slow motion x1/{round(1 / factor)}" in app.status_line()
+        steps0, t0 = app.table.steps, app.table.time_s
+        for _ in range(120):
+            app.frame(FRAME_S)
+        assert app.dt_s == pytest.approx(1 / 240)
+        assert app.table.time_s - t0 == pytest.approx(2.0 * factor, abs=2 * app.dt_s)
+        assert app.table.steps - steps0 == pytest.approx(480 * factor, abs=2)
+
+
+def test_collision_counter_on_the_status_line(demos):
+    app = make_app(demos, "2p")
+    while app.table.collision_count == 0:
+        app.frame(FRAME_S)
+    assert f"{app.table.collision_count} collisions" in app.status_line()
+
+
+def test_reverse_time_brings_every_puck_back(demos):
+    app = make_app(demos, "2")
+    t = app.table
+    t.cr_puck = t.cr_wall = 1.0
+    t.puck_correction = "perfect-kiss"
+    rng = np.random.default_rng(0)
+    angles = rng.uniform(0, 2 * np.pi, len(t.pucks))
+    t.vel_mps[:] = 2.0 * np.stack([np.cos(angles), np.sin(angles)], axis=1)
+    start = t.pos_m.copy()
+    for _ in range(240):  # 1 s
+        app.physics_step()
+    hits = t.collision_count
+    assert hits >= 4, "the test needs several collisions"
+    press_r = pygame.event.Event(pygame.KEYDOWN, key=pygame.K_r, mod=0, unicode="r", scancode=0)
+    app.handle_event(press_r)
+    for _ in range(240):
+        app.physics_step()
+    assert t.collision_count >= 2 * hits - 1
+    assert np.max(np.hypot(*(t.pos_m - start).T)) < 1e-3
+
+
+def test_energy_chart_numbers_match_a_hand_computation():
+    table = AirTable()
+    a = table.add_puck((2.0, 3.0), 0.4, 0.3, vel_mps=(1.0, 0.5))
+    b = table.add_puck((4.0, 3.0), 0.5, 0.6, vel_mps=(-0.5, 0.0))
+    table.add_spring(a, b, length_m=1.5, k_Npm=20.0, damper_Nspm=0.0)
+    table.gravity_on = True
+    chart = aids.EnergyChart()
+    chart.sample(table)
+    m_a, m_b = 0.3 * math.pi * 0.16, 0.6 * math.pi * 0.25
+    ke = 0.5 * m_a * (1.0**2 + 0.5**2) + 0.5 * m_b * 0.5**2
+    pe_spring = 0.5 * 20.0 * (2.0 - 1.5) ** 2
+    pe_gravity = 9.8 * (m_a + m_b) * 3.0
+    p = math.hypot(m_a * 1.0 - m_b * 0.5, m_a * 0.5)
+    latest = chart.latest()
+    assert latest["kinetic_J"] == pytest.approx(ke, rel=1e-12)
+    assert latest["spring_J"] == pytest.approx(pe_spring, rel=1e-12)
+    assert latest["gravity_J"] == pytest.approx(pe_gravity, rel=1e-12)
+    assert latest["total_J"] == pytest.approx(ke + pe_spring + pe_gravity, rel=1e-12)
+    assert latest["momentum_Ns"] == pytest.approx(p, rel=1e-12)
+
+
+def test_demo_5_without_damping_keeps_its_energy(demos):
+    app = make_app(demos, "5")
+    app.table.spring_damper_Nspm[:] = 0.0
+    app.chart.clear()
+    for _ in range(20 * 60):  # 20 s
+        app.frame(FRAME_S)
+    series = app.chart.series(window_s=25.0)
+    t, total = series["time_s"], series["total_J"]
+    assert t[-1] - t[0] == pytest.approx(20.0, abs=0.01)
+    m = 0.3 * math.pi * 0.4**2
+    omega = math.sqrt(20.0 / (m / 2))
+    # E swings at twice the spring's frequency by about 3 %, so a plain 1 s mean
+    # carries up to 0.2 % from the unfinished swing; average over the whole
+    # swings that fit in one second instead (5 of them, 0.96 s).
+    swing_s = math.pi / omega
+    window_s = math.floor(1.0 / swing_s) * swing_s
+    first = total[t < t[0] + window_s].mean()
+    last = total[t > t[-1] - window_s].mean()
+    assert abs(last - first) / first < 1e-3
+    # Semi-implicit Euler: E swings with relative amplitude about omega dt / 2.
+    expected = omega * app.dt_s / 2
+    wiggle = (total.max() - total.min()) / (2 * total.mean())
+    assert 0.5 * expected < wiggle < 1.5 * expected
+    assert app.chart.total_wiggle() > 1e-4  # so the explanation under the chart shows
+
+
+@pytest.mark.parametrize("key, mode", [("1p", "off"), ("2p", "two-step"), ("3p", "perfect-kiss")])
+def test_annotation_numbers_are_the_physics_numbers(demos, key, mode):
+    app = make_app(demos, key)
+    assert app.table.puck_correction == mode
+    press(app, pygame.K_a)
+    shown: list[str] = []
+    original = app.painter._text
+    app.painter._text = lambda text, *a, **k: (shown.append(text), original(text, *a, **k))
+    hit = None
+    for _ in range(600):
+        app.physics_step()
+        if len(app.table.last_collisions):
+            hit = app.table.last_collisions
+            break
+    assert hit is not None
+    app.draw()
+    note = app.collision_log.items[-1]
+    assert note.overlap_m == hit.overlap_m[0]
+    assert note.separation_m == hit.separation_m[0]
+    assert f"overlap {hit.overlap_m[0] * 1000:.1f} mm" in shown
+    assert f"separation {hit.separation_m[0] * 1000:.1f} mm" in shown
+    if mode == "two-step":
+        assert "ratio 1.0000" in shown
+    # Equal masses, target still: the outgoing paths are 90 degrees apart.
+    assert "paths 90.00 deg apart" in shown
+
+
+BROKEN_SYNTAX = "KEY = 't8'\nTITLE = 'Broken'\ndef build(table, variation=0)\n    pass\n"
+BROKEN_BUILD = (
+    "KEY = 't9'\nTITLE = 'Throws'\nNOTES = 'x'\n\n"
+    "def build(table, variation=0):\n    table.add_puck((1, 1), 0.2)\n    raise RuntimeError('my mistake')\n"
+)
+
+
+def test_broken_teacher_demos_show_their_errors_and_the_app_goes_on(demos, tmp_path):
+    (tmp_path / "syntax.py").write_text(BROKEN_SYNTAX)
+    (tmp_path / "throws.py").write_text(BROKEN_BUILD)
+    found, errors = discover([BUILTIN_DIR, tmp_path])
+    assert [(e.path.name, e.line) for e in errors] == [("syntax.py", 3)]
+    app = make_app(found, "1", demo_errors=errors)
+    app.frame(FRAME_S)
+    assert any("syntax.py, line 3: syntax error" in line for line in app.notice)
+    press(app, pygame.K_SPACE)  # any key dismisses the notice
+    assert app.notice == []
+    app.start_demo("t9")
+    app.frame(FRAME_S)
+    assert app.build_error is not None
+    assert str(app.build_error) == "throws.py, line 7: RuntimeError: my mistake"
+    assert len(app.table.pucks) == 0
+    press(app, pygame.K_3)
+    assert app.demo_key == "3" and app.build_error is None and len(app.table.pucks) == 15
+
+
+def test_new_demo_writes_a_starter_that_runs(tmp_path, capsys):
+    path = tmp_path / "mine.py"
+    assert main(["--new-demo", str(path)]) == 0
+    assert "python -m airtable --demos" in capsys.readouterr().out
+    found, errors = discover([tmp_path])
+    assert errors == [] and list(found) == ["t1"]
+    table = AirTable()
+    for variation in (0, 1):
+        table.clear()
+        found["t1"].build(table, variation)
+        for _ in range(720):  # 3 s: the cue is thrown at 1 s
+            table.step(found["t1"].dt_s)
+        assert np.isfinite(table.pos_m).all()
+        assert table.collision_count >= 1
+    with pytest.raises(SystemExit) as exc:
+        main(["--new-demo", str(path)])  # never overwrites
+    assert exc.value.code == 2
+    assert "already exists" in capsys.readouterr().err
