@@ -15,8 +15,10 @@ import numpy as np
 from airtable.table import AirTable
 
 SLOW_MOTION_FACTORS = (1.0, 1 / 2, 1 / 4, 1 / 8, 1 / 16)
-ANNOTATION_LIFE_S = 2.5
-MAX_ANNOTATIONS = 12  # a gas makes hundreds a second; show the newest few
+ANNOTATION_LIFE_S = 3.0
+ANNOTATION_FADE_S = 1.0  # full strength, then fading over the last second
+MAX_ANNOTATIONS = 4  # a gas makes hundreds a second; show the newest few
+WIGGLE_WINDOW_S = 2.0
 CHART_WINDOW_S = 10.0
 
 
@@ -43,8 +45,9 @@ class Annotation:
         return self.separation_m / self.overlap_m if self.overlap_m > 0 else None
 
     def alpha(self, now_s: float) -> float:
-        """1 when new, fading to 0 at the end of its life."""
-        return max(0.0, 1.0 - (now_s - self.born_s) / ANNOTATION_LIFE_S)
+        """1 while fresh, fading to 0 over the last ANNOTATION_FADE_S of its life."""
+        left = ANNOTATION_LIFE_S - (now_s - self.born_s)
+        return min(1.0, max(0.0, left / ANNOTATION_FADE_S))
 
 
 def _tuple(v) -> tuple[float, float]:
@@ -139,6 +142,16 @@ class EnergyChart:
             return {f: 0.0 for f in self.FIELDS}
         row = self._data[(self._next - 1) % len(self._data)]
         return {f: float(row[k]) for k, f in enumerate(self.FIELDS)}
+
+    def euler_wiggle_note(self, table: AirTable) -> str | None:
+        """One line explaining the swing of the total, when springs make it visible."""
+        wiggle = self.total_wiggle(WIGGLE_WINDOW_S)
+        if table.spring_pairs.size == 0 or not (1e-4 < wiggle < 0.2):
+            return None
+        return (
+            f"The total swings by {100 * wiggle:.2g} % but does not drift: semi-implicit Euler "
+            "keeps a nearby energy exactly, so E wiggles by about omega dt / 2."
+        )
 
     def total_wiggle(self, window_s: float = CHART_WINDOW_S) -> float:
         """(max - min) / (2 mean) of the total energy over the window: its relative amplitude."""

@@ -423,13 +423,7 @@ class App:
         if self.vectors and len(t.pos_m):
             self._draw_vectors()
         if self.show_chart:
-            wiggle = self.chart.total_wiggle()
-            note = None
-            if wiggle > 1e-4:
-                note = (
-                    f"The total wiggles by {100 * wiggle:.2g} %: semi-implicit Euler keeps a nearby energy "
-                    "exactly, so E swings by about omega dt / 2 but does not drift."
-                )
+            note = self.chart.euler_wiggle_note(t)
             paint.energy_chart(self.chart.series(), self.chart.latest(), note)
         if self.inspecting:
             puck = t.puck_at(self.env.to_world(self.mouse_px))

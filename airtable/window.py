@@ -379,7 +379,7 @@ class AidsPainter:
         reach = 0.8 * (a.radius_i_m + a.radius_j_m)
         for axis, color, name in ((n, ANNOTATION_NORMAL, "normal"), (t, ANNOTATION_TANGENT, "tangent")):
             p0, p1 = self._px(c - reach * axis), self._px(c + reach * axis)
-            pygame.draw.line(self.w.surface, _faded(color, alpha), p0, p1, 1)
+            pygame.draw.line(self.w.surface, _faded(color, alpha), p0, p1, 2)
             self._text(name, p1, _faded(color, alpha))
         # Where the pucks were when the overlap was found, and after the correction.
         for pos, r, color in (
@@ -418,7 +418,7 @@ class AidsPainter:
         if a.angle_deg is not None:
             lines.append((f"paths {a.angle_deg:.2f} deg apart", ANNOTATION_NORMAL))
         for k, (text, color) in enumerate(lines):
-            self._text(text, (x + 14, y + 14 + 16 * k), _faded(color, alpha))
+            self._text(text, (x + 24, y + 24 + 20 * k), _faded(color, alpha), font=self.w.font)
 
     def energy_chart(self, series: dict[str, np.ndarray], latest: dict[str, float], note: str | None) -> None:
         """Strip chart of energies (left scale) and |momentum| (right scale), bottom right."""
