@@ -408,7 +408,9 @@ class App:
                 f"Demo {self.demo_key} could not be built", [str(error), "Fix the file and press its key again."]
             )
         elif self.show_help:
-            self.window.draw_panel("Keys", [(b.label, b.help) for b in BINDINGS] + self._demo_rows())
+            self.window.draw_panel(
+                "Keys", [(b.label, b.help) for b in BINDINGS], side_title="Demos", side_rows=self._demo_rows()
+            )
         elif self.show_notes:
             self.window.draw_panel(self.demo.label(self.variation), [self.demo.notes or "(no notes)"], large=True)
         if self.server is not None:
@@ -453,7 +455,7 @@ class App:
         com, com_v = t.center_of_mass_m(), t.center_of_mass_vel_mps()
         speed, m_per_mps = aids.nice_scale(float(np.hypot(t.vel_mps[:, 0], t.vel_mps[:, 1]).max()), target_m=1.0)
         paint.arrow(com, com_v * m_per_mps, COM_COLOR, width=3)
-        paint.marker(com, COM_COLOR, f"centre of mass, {np.hypot(*com_v):.3g} m/s")
+        paint.marker(com, COM_COLOR, f"centre of mass, {np.hypot(*com_v):.2f} m/s")
         held = self.local.held
         if held is not None and held.alive:
             forces = t.forces_on(held, self.dt_s)
@@ -471,7 +473,7 @@ class App:
         rows = []
         for key, demo in self.demos.items():
             label = f"Shift+{key[0]}" if key.endswith("p") and key[:-1].isdigit() else key
-            rows.append((f"demo {label}", demo.title))
+            rows.append((label, demo.title))
         return rows
 
     def run(self, seconds: float | None = None, max_frames: int | None = None, frame_dt_s: float | None = None) -> None:

@@ -248,34 +248,51 @@ class GameWindow:
         pygame.draw.rect(self.surface, (255, 220, 120), box, 2)
         self.surface.blit(label, label.get_rect(center=box.center))
 
-    def draw_panel(self, title: str, rows: Sequence[tuple[str, str] | str], *, large: bool = False) -> None:
+    def draw_panel(
+        self,
+        title: str,
+        rows: Sequence[tuple[str, str] | str],
+        *,
+        large: bool = False,
+        side_title: str = "",
+        side_rows: Sequence[tuple[str, str] | str] = (),
+    ) -> None:
         """A translucent panel over the table: a title, then rows of text.
 
         A row is either a line of text (wrapped to the panel) or a
         (key, description) pair shown in two columns, as on the help screen.
+        `side_rows`, if any, fill a narrower column on the right.
         """
         w, h = self.surface.get_size()
         font = self.big_font if large else self.font
-        line_h = font.get_linesize() + 2
         panel = pygame.Surface((w - 80, h - 80), pygame.SRCALPHA)
         panel.fill(PANEL_COLOR)
-        inner_w = panel.get_width() - 40
-        y = 16
-        panel.blit(self.big_font.render(title, True, (255, 220, 120)), (20, y))
-        y += self.big_font.get_linesize() + 10
-        key_w = max((font.size(r[0])[0] for r in rows if isinstance(r, tuple)), default=0) + 24
+        top = 26 + self.big_font.get_linesize()
+        panel.blit(self.big_font.render(title, True, (255, 220, 120)), (20, 16))
+        width = panel.get_width() - 40
+        if side_rows:
+            side_w = int(width * 0.34)
+            width -= side_w + 20
+            x_side = 20 + width + 20
+            panel.blit(self.font.render(side_title, True, (255, 220, 120)), (x_side, top - 24))
+            self._panel_rows(panel, self.font, side_rows, x_side, top, side_w)
+        self._panel_rows(panel, font, rows, 20, top, width)
+        self.surface.blit(panel, (40, 40))
+
+    def _panel_rows(self, panel, font, rows, x: int, y: int, width: int) -> None:
+        line_h = font.get_linesize() + 2
+        key_w = max((font.size(r[0])[0] for r in rows if isinstance(r, tuple)), default=0) + 16
         for row in rows:
             if isinstance(row, tuple):
                 key, text = row
-                panel.blit(font.render(key, True, (255, 220, 120)), (20, y))
-                for line in _wrap(font, text, inner_w - key_w):
-                    panel.blit(font.render(line, True, TEXT_COLOR), (20 + key_w, y))
+                panel.blit(font.render(key, True, (255, 220, 120)), (x, y))
+                for line in _wrap(font, text, width - key_w) or [""]:
+                    panel.blit(font.render(line, True, TEXT_COLOR), (x + key_w, y))
                     y += line_h
             else:
-                for line in _wrap(font, row, inner_w) or [""]:
-                    panel.blit(font.render(line, True, TEXT_COLOR), (20, y))
+                for line in _wrap(font, row, width) or [""]:
+                    panel.blit(font.render(line, True, TEXT_COLOR), (x, y))
                     y += line_h
-        self.surface.blit(panel, (40, 40))
 
 
 def _wrap(font: pygame.font.Font, text: str, width: int) -> list[str]:
@@ -423,12 +440,12 @@ class AidsPainter:
     def energy_chart(self, series: dict[str, np.ndarray], latest: dict[str, float], note: str | None) -> None:
         """Strip chart of energies (left scale) and |momentum| (right scale), bottom right."""
         w, h = self.w.surface.get_size()
-        box = pygame.Rect(w - 430, h - 250, 420, 215)
+        box = pygame.Rect(w - 430, h - 266, 420, 231)
         panel = pygame.Surface(box.size, pygame.SRCALPHA)
         panel.fill((0, 0, 0, 200))
         self.w.surface.blit(panel, box)
         pygame.draw.rect(self.w.surface, DIM_TEXT, box, 1)
-        plot = pygame.Rect(box.x + 10, box.y + 10, box.width - 150, box.height - 50)
+        plot = pygame.Rect(box.x + 10, box.y + 10, box.width - 150, box.height - 66)
         pygame.draw.rect(self.w.surface, (60, 60, 60), plot, 1)
         t = series["time_s"]
         if len(t) >= 2:
@@ -447,12 +464,12 @@ class AidsPainter:
             self._text(f"last {span:.1f} s", (plot.x + 2, plot.bottom - 16), DIM_TEXT)
         y = box.y + 10
         for key, color in CHART_COLORS.items():
-            unit = "N s" if key == "momentum_Ns" else "J"
+            value = f"{latest[key]:.4f} N s" if key == "momentum_Ns" else f"{latest[key]:.5g} J"
             self._text(f"{CHART_LABELS[key]}", (plot.right + 10, y), color)
-            self._text(f"{latest[key]:.5g} {unit}", (plot.right + 10, y + 14), color)
+            self._text(value, (plot.right + 10, y + 14), color)
             y += 34
         if note:
-            for k, line in enumerate(_wrap(self.w.label_font, note, box.width - 20)[:2]):
+            for k, line in enumerate(_wrap(self.w.label_font, note, box.width - 20)[:3]):
                 self._text(line, (box.x + 10, plot.bottom + 6 + 16 * k), DIM_TEXT)
 
     def inspector(self, point_m, lines: Sequence[str]) -> None:
