@@ -255,3 +255,14 @@ def test_list_demos(capsys, demos):
     out = capsys.readouterr().out
     for key, demo in demos.items():
         assert demo.title in out
+
+
+def test_readme_lists_every_key_of_the_key_table():
+    """The help screen and README both come from BINDINGS; keep the README in step."""
+    from pathlib import Path
+
+    from airtable.app import BINDINGS
+
+    readme = (Path(__file__).resolve().parent.parent / "README.md").read_text(encoding="utf-8")
+    for binding in BINDINGS:
+        assert f"| {binding.label} |" in readme, f"README's key table lacks {binding.label!r}"
