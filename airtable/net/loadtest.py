@@ -141,11 +141,13 @@ class LoadResult:
 def grid_table(columns: int = 6, rows: int = 5) -> AirTable:
     """A table with a grid of pucks and the local user at clients[0]."""
     table = AirTable()
+    # Small enough that neighbours never touch, however many there are.
+    radius_m = min(0.3, 0.4 * table.width_m / columns, 0.4 * table.height_m / rows)
     for i in range(columns):
         for j in range(rows):
             x = table.width_m * (i + 0.5) / columns
             y = table.height_m * (j + 0.5) / rows
-            table.add_puck((x, y), radius_m=0.3, color="orange")
+            table.add_puck((x, y), radius_m=radius_m, color="orange")
     table.clients.append(Client(name="local", active=False))
     return table
 

@@ -129,7 +129,10 @@ class FrameReader:
             return
         allowed = ", ".join(f"{FRAME_NAMES[t]} ({t})" for t in sorted(self.allowed))
         if frame_type in FRAME_NAMES:
-            raise ProtocolError(f"{self.sender} may not send {FRAME_NAMES[frame_type]} messages, only {allowed}")
+            raise ProtocolError(
+                f"{self.sender} may not send {FRAME_NAMES[frame_type]} messages, only {allowed}; "
+                "check that both sides run the same airtable version"
+            )
         raise ProtocolError(
             f"unknown message type {frame_type}; airtable protocol {PROTOCOL_VERSION} has only {allowed} "
             "here: check that both sides run the same airtable version"
@@ -265,9 +268,22 @@ def version_mismatch(theirs: object) -> str:
     )
 
 
+def _with_example(error: ProtocolError, example: str) -> ProtocolError:
+    """The error with an example of a good message, unless it already says what to do."""
+    text = str(error)
+    return error if ";" in text else ProtocolError(f"{text}; send something like {example}")
+
+
 def validate_hello(message: dict) -> Hello:
     """Check a HELLO object; the protocol version is checked first, so a newer client
     with new fields still learns that the versions differ."""
+    try:
+        return _validate_hello(message)
+    except ProtocolError as e:
+        raise _with_example(e, HELLO_EXAMPLE) from None
+
+
+def _validate_hello(message: dict) -> Hello:
     if "protocol" not in message:
         raise ProtocolError(f'HELLO is missing the field "protocol"; send {HELLO_EXAMPLE}')
     protocol = message["protocol"]
@@ -329,6 +345,13 @@ def encode_input(cursor_m: Sequence[float], button: int = 0, keys: Iterable[str]
 
 def validate_input(message: dict, table_size_m: Sequence[float] = (10.0, 8.7556)) -> InputRecord:
     """Check an INPUT object against the table size (width_m, height_m)."""
+    try:
+        return _validate_input(message, table_size_m)
+    except ProtocolError as e:
+        raise _with_example(e, INPUT_EXAMPLE) from None
+
+
+def _validate_input(message: dict, table_size_m: Sequence[float]) -> InputRecord:
     _check_fields(message, "INPUT", ("cursor_m", "button", "keys"))
     x0, y0, x1, y1 = cursor_limits(*table_size_m)
     where = f"within {x0:g}..{x1:g} m across and {y0:g}..{y1:g} m up"
