@@ -1,0 +1,406 @@
+"""Benchmarks: `python -m airtable.bench` (or `make bench`).
+
+The "physics" section times one `AirTable.step` on a gas of pucks (see
+`gas_scene`) for growing N and, when pymunk is installed, runs the very same
+scene in pymunk side by side as a yardstick. Besides speed it reports how deep
+pucks overlap at the end of a step and how much kinetic energy drifts, since a
+fast step that lets pucks sink into each other is no use on a projector.
+
+Timing is the best (minimum) over several blocks of steps after a warm-up:
+this machine is shared and noisy, and the minimum is the least disturbed
+estimate of what the code itself costs. Garbage collection is off while
+timing, as `timeit` does.
+
+Sections are listed in `SECTIONS`; add one (for example whole-frame timings
+with drawing) by writing a function that takes the parsed arguments and
+registering it there. `--only` picks sections by name.
+"""
+
+from __future__ import annotations
+
+import argparse
+import gc
+import math
+import sys
+import time
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from airtable import collisions
+from airtable.table import AirTable
+
+# The gas scene (units in the names).
+RADIUS_M = 0.1
+DENSITY_KGPM2 = 0.3
+COVERAGE = 0.3  # fraction of the table area covered by pucks
+SPEED_MPS = 1.0
+ASPECT = 8.0 / 7.0  # width / height, as the default window
+DT_S = 1.0 / 120.0
+
+# Targets: ours / pymunk time ratio by N, and the deepest overlap allowed.
+TARGET_RATIO = {1000: 2.0, 10000: 1.2}
+TARGET_OVERLAP_MM = 10.0
+
+
+def gas_scene(
+    table_or_n: AirTable | int,
+    *,
+    radius_m: float = RADIUS_M,
+    density_kgpm2: float = DENSITY_KGPM2,
+    coverage: float = COVERAGE,
+    speed_mps: float = SPEED_MPS,
+    seed: int = 0,
+) -> AirTable:
+    """A gas: equal pucks covering `coverage` of the table, all at `speed_mps` in random directions.
+
+    Given a puck count N, makes a table with aspect 8:7 and area
+    N pi r^2 / coverage (m^2). Given a table, clears it and fills it with as
+    many pucks as give that coverage. Pucks start on a jittered grid (no two
+    overlap, none touches a wall); the settings are those of the benchmark:
+    restitution 1, no gravity, two-step correction. Deterministic for a seed.
+    """
+    r = float(radius_m)
+    puck_area = math.pi * r * r
+    if isinstance(table_or_n, AirTable):
+        table = table_or_n
+        table.clear()
+        n = int(round(coverage * table.width_m * table.height_m / puck_area))
+    else:
+        n = int(table_or_n)
+        if n < 1:
+            raise ValueError(f"a gas needs at least one puck, not {table_or_n!r}")
+        area = n * puck_area / coverage
+        table = AirTable(width_m=math.sqrt(area * ASPECT), height_m=math.sqrt(area / ASPECT))
+    table.reset_settings()
+    table.gravity_on = False
+    table.cr_puck = table.cr_wall = 1.0
+    table.puck_correction = "two-step"
+
+    w, h = table.width_m, table.height_m
+    nx = max(1, math.ceil(math.sqrt(n * w / h)))
+    ny = max(1, math.ceil(n / nx))
+    cw, ch = w / nx, h / ny
+    if min(cw, ch) < 2.0 * r:
+        raise ValueError(f"{n} pucks of radius {r} m do not fit on a grid in a {w:.3g} x {h:.3g} m table")
+    rng = np.random.default_rng(seed)
+    cells = np.sort(rng.choice(nx * ny, size=n, replace=False))  # spread the empty cells
+    centre = np.column_stack([(cells // ny + 0.5) * cw, (cells % ny + 0.5) * ch])
+    # Jitter stays 1 % short of the cell edge, so neighbours never touch.
+    room = 0.99 * np.array([cw / 2.0 - r, ch / 2.0 - r])
+    pos = centre + rng.uniform(-1.0, 1.0, size=(n, 2)) * room
+    angle = rng.uniform(0.0, 2.0 * math.pi, size=n)
+    vel = speed_mps * np.column_stack([np.cos(angle), np.sin(angle)])
+    for p, v in zip(pos, vel, strict=True):
+        table.add_puck(pos_m=p, radius_m=r, density_kgpm2=density_kgpm2, vel_mps=v, color="white")
+    return table
+
+
+def deepest_overlap_m(pos_m: np.ndarray, radius_m: np.ndarray) -> float:
+    """The largest overlap between any two pucks (m), 0 if none touch."""
+    i, j = collisions.find_overlapping_pairs(pos_m, radius_m)
+    if len(i) == 0:
+        return 0.0
+    d = np.hypot(*(pos_m[i] - pos_m[j]).T)
+    return float(np.max(radius_m[i] + radius_m[j] - d))
+
+
+def kinetic_energy_J(mass_kg: np.ndarray, vel_mps: np.ndarray) -> float:
+    return float(0.5 * np.dot(mass_kg, np.einsum("ij,ij->i", vel_mps, vel_mps)))
+
+
+# ---------------------------------------------------------------- engines
+
+
+class Engine:
+    """One physics engine running a scene: step, and read back state as arrays."""
+
+    name = ""
+
+    def step(self) -> None:
+        raise NotImplementedError
+
+    def state(self) -> tuple[np.ndarray, np.ndarray]:
+        """(positions (N, 2) m, velocities (N, 2) m/s)."""
+        raise NotImplementedError
+
+
+class OursEngine(Engine):
+    name = "ours"
+
+    def __init__(self, table: AirTable, dt_s: float) -> None:
+        self.table, self.dt_s = table, dt_s
+
+    def step(self) -> None:
+        self.table.step(self.dt_s)
+
+    def state(self) -> tuple[np.ndarray, np.ndarray]:
+        return self.table.pos_m, self.table.vel_mps
+
+
+class PymunkEngine(Engine):
+    """The same pucks in pymunk: static segment walls, elasticity 1, friction 0, default space."""
+
+    name = "pymunk"
+
+    def __init__(self, table: AirTable, dt_s: float) -> None:
+        import pymunk
+
+        self.pymunk, self.dt_s = pymunk, dt_s
+        self.space = space = pymunk.Space()
+        w, h = table.width_m, table.height_m
+        thick = 1.0  # wall half-thickness (m), laid outside the table so the inner faces are at 0 and w, h
+        corners = [(-thick, -thick), (w + thick, -thick), (w + thick, h + thick), (-thick, h + thick)]
+        for a, b in zip(corners, corners[1:] + corners[:1], strict=True):
+            wall = pymunk.Segment(space.static_body, a, b, thick)
+            wall.elasticity, wall.friction = 1.0, 0.0
+            space.add(wall)
+        self.bodies = []
+        for p, v, r, m in zip(table.pos_m, table.vel_mps, table.radius_m, table.mass_kg, strict=True):
+            body = pymunk.Body(float(m), pymunk.moment_for_circle(float(m), 0.0, float(r)))
+            body.position, body.velocity = (float(p[0]), float(p[1])), (float(v[0]), float(v[1]))
+            shape = pymunk.Circle(body, float(r))
+            shape.elasticity, shape.friction = 1.0, 0.0
+            space.add(body, shape)
+            self.bodies.append(body)
+        try:  # pymunk >= 7 reads every body in one call
+            import pymunk.batch as batch
+
+            self._batch, self._buffer = batch, batch.Buffer()
+        except ImportError:
+            self._batch = None
+
+    def step(self) -> None:
+        self.space.step(self.dt_s)
+
+    def state(self) -> tuple[np.ndarray, np.ndarray]:
+        if self._batch is None:
+            pos = np.array([tuple(b.position) for b in self.bodies])
+            vel = np.array([tuple(b.velocity) for b in self.bodies])
+            return pos, vel
+        b = self._batch
+        self._buffer.clear()
+        fields = b.BodyFields.BODY_ID | b.BodyFields.POSITION | b.BodyFields.VELOCITY
+        b.get_space_bodies(self.space, fields, self._buffer)
+        rows = np.frombuffer(self._buffer.float_buf(), dtype=np.float64).reshape(-1, 4)
+        ids = np.frombuffer(self._buffer.int_buf(), dtype=np.int64)
+        rows = rows[ids != self.space.static_body.id]  # the walls' body comes too
+        return rows[:, :2].copy(), rows[:, 2:].copy()
+
+
+def pymunk_version() -> str | None:
+    """pymunk's version if it can be imported, else None."""
+    try:
+        import pymunk
+    except ImportError:
+        return None
+    return str(pymunk.version)
+
+
+# ---------------------------------------------------------------- measuring
+
+
+@dataclass
+class Run:
+    """What one engine did on one scene."""
+
+    ms_per_step: float  # best block
+    deepest_overlap_mm: float  # over every sample of the run
+    energy_drift: float  # (KE_end - KE_start) / KE_start
+
+
+@dataclass
+class Plan:
+    """How long to run: warm-up steps, then `blocks` timed blocks of `block_steps`."""
+
+    warmup_steps: int
+    blocks: int
+    block_steps: int
+    sample_every: int  # steps between overlap samples
+
+
+def measure(engine: Engine, radius_m: np.ndarray, mass_kg: np.ndarray, plan: Plan) -> Run:
+    """Run the plan; time only the steps, sample overlaps between them."""
+    _, vel = engine.state()
+    ke0 = kinetic_energy_J(mass_kg, vel)
+    deepest = 0.0
+    best = math.inf
+    count = 0
+    gc_was_on = gc.isenabled()
+    gc.disable()
+    try:
+        for block in range(-1, plan.blocks):  # block -1 is the warm-up
+            steps = plan.warmup_steps if block < 0 else plan.block_steps
+            elapsed = 0.0
+            for _ in range(steps):
+                t0 = time.perf_counter()
+                engine.step()
+                elapsed += time.perf_counter() - t0
+                count += 1
+                if count % plan.sample_every == 0:
+                    deepest = max(deepest, deepest_overlap_m(engine.state()[0], radius_m))
+            if block >= 0:
+                best = min(best, elapsed / steps)
+    finally:
+        if gc_was_on:
+            gc.enable()
+    _, vel = engine.state()
+    drift = (kinetic_energy_J(mass_kg, vel) - ke0) / ke0
+    return Run(ms_per_step=1e3 * best, deepest_overlap_mm=1e3 * deepest, energy_drift=drift)
+
+
+def _plan_for(n: int, quick: bool) -> Plan:
+    """Enough steps for a stable minimum; the whole bench stays well under two minutes."""
+    if quick:
+        return Plan(warmup_steps=10, blocks=3, block_steps=20, sample_every=5)
+    if n >= 10000:
+        return Plan(warmup_steps=50, blocks=10, block_steps=50, sample_every=5)
+    if n >= 1000:
+        return Plan(warmup_steps=100, blocks=10, block_steps=100, sample_every=5)
+    return Plan(warmup_steps=200, blocks=10, block_steps=200, sample_every=5)
+
+
+# ---------------------------------------------------------------- sections
+
+
+class TextTable:
+    """A fixed-width text table printed row by row, so rows appear as they are measured."""
+
+    def __init__(self, columns: Sequence[tuple[str, int, str]]) -> None:
+        self.columns = columns  # (title, width, "<" or ">")
+
+    def _line(self, cells: Sequence[str]) -> str:
+        return "  ".join(f"{c:{align}{w}}" for c, (_, w, align) in zip(cells, self.columns)).rstrip()
+
+    def header(self) -> None:
+        line = self._line([title for title, _, _ in self.columns])
+        print(line)
+        print("-" * len(line))
+
+    def row(self, *cells: str) -> None:
+        print(self._line(cells), flush=True)
+
+
+def _fmt(value: float | None, spec: str) -> str:
+    return "-" if value is None else format(value, spec)
+
+
+def _verdict(n: int, ours: Run, ratio: float | None) -> tuple[str, str]:
+    """(targets that apply to this row, PASS/MISS)."""
+    targets = [f"overlap<{TARGET_OVERLAP_MM:g}mm"]
+    ok = ours.deepest_overlap_mm < TARGET_OVERLAP_MM
+    if n in TARGET_RATIO:
+        targets.append(f"<={TARGET_RATIO[n]:g}x pymunk")
+        if ratio is not None:
+            ok = ok and ratio <= TARGET_RATIO[n]
+    return ", ".join(targets), "PASS" if ok else "MISS"
+
+
+def physics_section(args: argparse.Namespace) -> bool:
+    """ms per step of the gas scene for several N, ours beside pymunk; True if every row passes."""
+    counts = (10, 100, 1000) if args.quick else (10, 100, 1000, 10000)
+    version = None if args.no_pymunk else pymunk_version()
+    print(
+        f"physics: gas of r = {RADIUS_M:g} m pucks covering {COVERAGE:.0%} of an 8:7 table, {SPEED_MPS:g} m/s"
+        f" in random directions, restitution 1, no gravity, dt = 1/{1 / DT_S:.0f} s"
+    )
+    print("  ours:   two-step correction")
+    if version is None:
+        print("  pymunk: not run" + (" (--no-pymunk)" if args.no_pymunk else " (not installed: pip install pymunk)"))
+    else:
+        import pymunk
+
+        space = pymunk.Space()
+        print(
+            f"  pymunk: {version}, static segment walls, elasticity 1, friction 0, default space"
+            f" ({space.iterations} iterations, collision_slop {space.collision_slop:.2g} m)"
+        )
+    print(
+        "  ms/step: best block of steps after a warm-up; overlap: deepest at the end of a step, sampled every few"
+        " steps; drift: KE end / KE start - 1"
+    )
+    print(
+        f"  targets: N=1000 at most {TARGET_RATIO[1000]:g}x pymunk, N=10000 at most {TARGET_RATIO[10000]:g}x,"
+        f" our overlaps under {TARGET_OVERLAP_MM:g} mm"
+    )
+    print()
+    out = TextTable(
+        [
+            ("N", 6, ">"),
+            ("table m", 11, ">"),
+            ("steps", 5, ">"),
+            ("ours ms", 8, ">"),
+            ("pymunk ms", 9, ">"),
+            ("ours/pm", 7, ">"),
+            ("ours ov mm", 10, ">"),
+            ("pm ov mm", 8, ">"),
+            ("ours drift", 10, ">"),
+            ("pm drift", 9, ">"),
+            ("targets", 28, "<"),
+            ("result", 6, "<"),
+        ]
+    )
+    out.header()
+    all_ok = True
+    for n in counts:
+        table = gas_scene(n, seed=args.seed)
+        radius, mass = table.radius_m.copy(), table.mass_kg.copy()
+        plan = _plan_for(n, args.quick)
+        pm = measure(PymunkEngine(table, DT_S), radius, mass, plan) if version else None  # copies the start state
+        ours = measure(OursEngine(table, DT_S), radius, mass, plan)
+        ratio = ours.ms_per_step / pm.ms_per_step if pm else None
+        targets, result = _verdict(n, ours, ratio)
+        all_ok = all_ok and result == "PASS"
+        out.row(
+            str(n),
+            f"{table.width_m:.1f} x {table.height_m:.1f}",
+            str(plan.warmup_steps + plan.blocks * plan.block_steps),
+            _fmt(ours.ms_per_step, ".3f"),
+            _fmt(pm.ms_per_step if pm else None, ".3f"),
+            _fmt(ratio, ".2f"),
+            _fmt(ours.deepest_overlap_mm, ".2f"),
+            _fmt(pm.deepest_overlap_mm if pm else None, ".2f"),
+            _fmt(ours.energy_drift, ".1e"),
+            _fmt(pm.energy_drift if pm else None, ".1e"),
+            targets,
+            result,
+        )
+    print()
+    return all_ok
+
+
+# Name -> section. A section takes the parsed arguments, prints its own
+# report and returns True when every target it checks is met.
+SECTIONS: dict[str, Callable[[argparse.Namespace], bool]] = {
+    "physics": physics_section,
+    # "frames": whole-frame timings with drawing, to come.
+}
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(
+        prog="python -m airtable.bench",
+        description="Time the physics step on a gas of pucks, beside pymunk when it is installed.",
+    )
+    parser.add_argument("--quick", action="store_true", help="smaller counts and fewer steps (a few seconds)")
+    parser.add_argument(
+        "--only",
+        action="append",
+        choices=sorted(SECTIONS),
+        metavar="SECTION",
+        help=f"run only this section (repeatable; one of: {', '.join(SECTIONS)})",
+    )
+    parser.add_argument("--no-pymunk", action="store_true", help="skip the pymunk comparison")
+    parser.add_argument("--seed", type=int, default=0, help="random seed of the scenes (default 0)")
+    args = parser.parse_args(argv)
+    t0 = time.perf_counter()
+    ok = True
+    for name in args.only or list(SECTIONS):
+        ok = SECTIONS[name](args) and ok
+    print(f"{'all targets met' if ok else 'some targets missed'} ({time.perf_counter() - t0:.0f} s)")
+    return 0  # a missed target is a finding, not a failure of the bench
+
+
+if __name__ == "__main__":
+    sys.exit(main())
