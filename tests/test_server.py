@@ -311,6 +311,22 @@ def test_two_players_on_one_puck_add_their_forces(make_server, clients):
     assert table.vel_mps[0, 1] == pytest.approx(0.0, abs=1e-12)
 
 
+def test_a_grab_and_a_move_within_one_frame_still_grab(make_server, clients):
+    server = make_server()
+    table = one_puck_table()
+    c = clients(server.port)
+    c.hello()
+    # Press over the puck and move away at once: both arrive before the next frame.
+    c.send(proto.encode_input((5.1, 4.0), 1) + proto.encode_input((6.0, 4.0), 1) + proto.encode_input((7.0, 4.0), 1))
+
+    def moved() -> bool:
+        server.apply_inputs(table)  # this test is the game loop
+        return len(table.clients) == 2 and table.clients[1].cursor_m[0] == 7.0
+
+    wait_until(moved, what="the last input")
+    assert table.clients[1].held is table.pucks[0]
+
+
 def test_bye_frees_the_name_and_removes_the_client(make_server, clients):
     server = make_server()
     table = one_puck_table()

@@ -389,9 +389,13 @@ class PlayerApp:
         self.headless = headless
         self.fps = fps
         self.window = None  # the GameWindow, once run() has opened it
+        self.frames = 0
+        self.states_seen: set[str] = set()  # connection states shown, for tests
 
     def run(self, seconds: float | None = None, screenshot: str | None = None) -> int:
-        """The UI loop; returns the process exit status (1 when the connection failed for good)."""
+        """The UI loop; returns the process exit status (1 when the connection failed for good).
+
+        Closes the connection when it ends, but leaves pygame running (main() quits it)."""
         import pygame
 
         from airtable.environment import DEFAULT_SIZE_PX, Environment
@@ -451,6 +455,8 @@ class PlayerApp:
                 # Our own cursor comes from the mouse, not from the (older) snapshot.
                 others = tuple(c for c in scene.cursors if c.name != welcome.client)
                 retrying = net.state == net.RETRYING
+                self.states_seen.add(net.state)
+                self.frames += 1
                 win.draw(
                     dataclasses.replace(scene, cursors=others),
                     hud=(f"You are {welcome.client}", net.status_text),
@@ -458,7 +464,8 @@ class PlayerApp:
                 )
                 # A sample of our colour under the HUD, then the live cursor.
                 win.draw_cursor("you", welcome.color, env.to_world(np.array([14.0, 78.0])))
-                win.draw_cursor(welcome.client, welcome.color, cursor_m)
+                if pygame.mouse.get_focused():  # no arrow while the mouse is in another window
+                    win.draw_cursor(welcome.client, welcome.color, cursor_m)
                 win.present()
                 if seconds is not None and time.monotonic() - start >= seconds:
                     break
@@ -469,7 +476,6 @@ class PlayerApp:
             if screenshot:
                 win.save_screenshot(screenshot)
             net.close(bye=True)
-            pygame.quit()
         return status
 
 
@@ -508,7 +514,12 @@ def main(argv: Sequence[str] | None = None) -> int:
     except KeyboardInterrupt:
         return 1
     print(f"airtable-client: connected to {net.address}; you are {welcome.client}")
-    return PlayerApp(net, headless=args.headless).run(seconds=args.seconds, screenshot=args.screenshot)
+    try:
+        return PlayerApp(net, headless=args.headless).run(seconds=args.seconds, screenshot=args.screenshot)
+    finally:
+        import pygame
+
+        pygame.quit()
 
 
 if __name__ == "__main__":

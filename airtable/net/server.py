@@ -56,6 +56,7 @@ RATE_PER_S = 240.0  # sustained messages a second per client (a player sends <= 
 RATE_BURST = 480.0
 EXTRA_CONNECTIONS = 32  # connections still saying HELLO, beyond max_clients
 RECV_BYTES = 65536
+MAX_QUEUED_INPUTS = 6  # records kept per player between two frames (see _queue_input)
 
 
 def client_color(number: int) -> tuple[int, int, int]:
@@ -170,7 +171,7 @@ class GameServer:
         # Shared between the network thread and the game loop, under _lock.
         self._lock = threading.Lock()
         self._events: list[tuple] = []  # ("join", cid, name, color) / ("leave", cid)
-        self._inputs: dict[int, proto.InputRecord] = {}  # newest record per connection
+        self._inputs: dict[int, list[proto.InputRecord]] = {}  # per connection, see _queue_input
         self._snapshot: bytes | None = None  # newest SNAPSHOT frame
         self._snapshot_seq = 0
         self._names: dict[int, str] = {}  # player number -> name, for player_names()
@@ -312,8 +313,9 @@ class GameServer:
 
     def apply_inputs(self, table) -> None:
         """Main thread, before each step: add joined players' Clients to table.clients,
-        apply each player's newest input, remove departed players' Clients. Never blocks
-        on the network (the lock is only held to swap two containers)."""
+        apply each player's newest input (after any button change it skipped over),
+        remove departed players' Clients. Never blocks on the network (the lock is
+        only held to swap two containers)."""
         self._table_size_m = (float(table.width_m), float(table.height_m))
         with self._lock:
             events, self._events = self._events, []
@@ -340,10 +342,11 @@ class GameServer:
                 if id(client) not in present:
                     client.release()
                     clients.append(client)
-        for cid, record in inputs.items():
+        for cid, records in inputs.items():
             client = self._clients.get(cid)
             if client is not None:
-                client.set_input(table, record.cursor_m, record.button, record.keys)
+                for record in records:
+                    client.set_input(table, record.cursor_m, record.button, record.keys)
                 client.active = True
 
     def publish(self, scene: Scene) -> None:
@@ -506,7 +509,24 @@ class GameServer:
                 )
             record = proto.parse_input(payload, self._table_size_m)
             with self._lock:
-                self._inputs[conn.cid] = record
+                self._queue_input(conn.cid, record)
+
+    def _queue_input(self, cid: int, record: proto.InputRecord) -> None:
+        """Keep the newest record, plus the first record after each button change.
+
+        Motion between two frames collapses into the newest position, but a
+        press (and where it happened) survives even when the press and the
+        next move arrive within one frame, so a quick grab is not lost.
+        """
+        queue = self._inputs.get(cid)
+        if queue is None:
+            self._inputs[cid] = [record]
+        elif len(queue) >= 2 and queue[-1].button == queue[-2].button == record.button:
+            queue[-1] = record  # same run of one button: only its first and newest matter
+        else:
+            queue.append(record)
+            if len(queue) > MAX_QUEUED_INPUTS:
+                del queue[0]
 
     def _full_sentence(self) -> str:
         return (
