@@ -2,7 +2,8 @@
 
 One network thread runs a `selectors` loop over every socket. It turns bytes
 into validated, immutable `InputRecord`s and keeps only the newest one per
-player; it never touches the table (STYLE.md item 12). The game loop calls
+player (plus any button change since the last frame, so a quick click is not
+lost); it never touches the table (STYLE.md item 12). The game loop calls
 
     server.apply_inputs(table)   # before each step: joins, newest inputs, leaves
     server.publish(scene)        # every frame: at most snapshot_hz snapshots a second
@@ -570,6 +571,10 @@ class GameServer:
                 self._names.pop(conn.number, None)
                 self._inputs.pop(conn.cid, None)
                 self._events.append(("leave", conn.cid))
+                if not self._names:
+                    # publish() stops encoding when nobody plays: do not greet the
+                    # next player with a picture from long ago.
+                    self._snapshot = None
         conn.number = 0
 
     def _fail(self, conn: _Conn, sentence: str) -> None:
