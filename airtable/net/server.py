@@ -375,8 +375,8 @@ class GameServer:
         try:
             if self._wake_w is not None:
                 self._wake_w.send(b"\0")
-        except (BlockingIOError, OSError):
-            pass  # already awake (buffer full) or shutting down
+        except OSError:
+            pass  # already awake (the buffer is full) or shutting down
 
     # ---------------------------------------------------------------- network thread
 
