@@ -28,9 +28,15 @@ from airtable.colors import rgb
 
 GRAVITY_MPS2 = 9.8
 # Springs and cursor strings stiffer than a step can integrate are softened to
-# this fraction of the limit (k dt^2 / m and c dt / m each at most this), which
-# keeps semi-implicit Euler stable for any mass the user picks.
+# this fraction of the limit (k dt^2 / m, and a spring's c dt / m, at most
+# this), which keeps semi-implicit Euler stable for any mass the user picks.
+# The cursor strings' drag needs no limit: it is applied implicitly.
 STIFFNESS_LIMIT = 0.5
+# Pairs are resolved in one pass, then up to this many more passes over the
+# pairs that the corrections pushed into overlap.
+EXTRA_PASSES = 2
+# Overlaps smaller than this (m) are left to the next step: round-off only.
+OVERLAP_SLOP_M = 1e-9
 # A last guard against runaway values: nothing real on a table moves this fast.
 MAX_SPEED_MPS = 1e8
 
@@ -372,26 +378,48 @@ class AirTable:
         pos, vel, force = self.pos_m, self.vel_mps, self.force_N
         mass, radius = self.mass_kg, self.radius_m
         if dt > 0.0:
-            self._add_cursor_forces(force, dt)
+            drag = np.zeros(len(mass))
+            self._add_cursor_forces(force, drag, dt)
             self._add_spring_forces(force, dt)
             if self.gravity_on:
                 force[:, 1] -= mass * GRAVITY_MPS2
             vel += force / mass[:, None] * dt
+            if self.clients and drag.any():
+                # The strings' drag -c v is taken at the end of the step
+                # (backward Euler), which stays stable for any c and mass.
+                vel /= (1.0 + drag * dt / mass)[:, None]
             speed = np.hypot(vel[:, 0], vel[:, 1])
             if speed.max() > MAX_SPEED_MPS:
                 vel *= np.minimum(1.0, MAX_SPEED_MPS / np.maximum(speed, 1e-300))[:, None]
             pos += vel * dt
         force[:] = 0.0
-        size = self.size_m
-        collisions.resolve_walls(pos, vel, radius, size, self.cr_wall, self.wall_correction)
+        collisions.resolve_walls(pos, vel, radius, self.size_m, self.cr_wall, self.wall_correction)
         if self.puck_collisions:
-            i, j = collisions.find_overlapping_pairs(pos, radius)
-            if len(i):
-                hits = collisions.resolve_pairs(pos, vel, radius, mass, i, j, self.cr_puck, self.puck_correction, dt)
-                self.last_collisions = hits
-                self.collision_count += len(hits)
-                moved = np.union1d(i, j)  # only pairs moved pucks
-                collisions.resolve_walls(pos, vel, radius, size, self.cr_wall, self.wall_correction, only=moved)
+            self._resolve_pucks(dt)
+
+    def _resolve_pucks(self, dt: float) -> None:
+        pos, vel, radius = self.pos_m, self.vel_mps, self.radius_m
+        ci, cj = collisions.find_candidate_pairs(pos, radius)
+        i, j = collisions.overlapping_pairs(pos, radius, ci, cj)
+        found, moved = [], []
+        passes = 1 if self.puck_correction == "off" else 1 + EXTRA_PASSES
+        for _ in range(passes):
+            if len(i) == 0:
+                break
+            hits = collisions.resolve_pairs(
+                pos, vel, radius, self.mass_kg, i, j, self.cr_puck, self.puck_correction, dt
+            )
+            found.append(hits)
+            moved += [i, j]
+            # Parting a pair can push one of its pucks into a third one that
+            # was already handled: look again among the same candidates.
+            i, j = collisions.overlapping_pairs(pos, radius, ci, cj, min_overlap_m=OVERLAP_SLOP_M)
+        if moved:
+            self.last_collisions = collisions.Collisions.concatenate([h for h in found if len(h)])
+            self.collision_count += len(self.last_collisions)
+            # Only pucks that pairs moved can have been pushed into a wall.
+            rows = np.unique(np.concatenate(moved))
+            collisions.resolve_walls(pos, vel, radius, self.size_m, self.cr_wall, self.wall_correction, only=rows)
 
     def _spring_forces(self, dt: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """(rows of p1, rows of p2, force on p1) for every spring; p2 gets minus that."""
@@ -405,19 +433,17 @@ class AirTable:
         vn = collisions.dot_rows(vel[a] - vel[b], n)
         return a, b, (k * (self.spring_length_m - dist) - c * vn)[:, None] * n
 
-    def _cursor_forces(self, dt: float) -> list[tuple[int, np.ndarray]]:
-        """(puck row, force) for every client pulling a puck with its cursor string."""
+    def _cursor_strings(self, dt: float) -> list[tuple[int, np.ndarray, float]]:
+        """(puck row, spring force k (cursor - x), drag c) for every client holding a puck."""
         out = []
         for client in self.clients:
             puck = getattr(client, "held", None)
             if puck is None or not puck.alive or client.button not in CURSOR_STRINGS:
                 continue
             row = puck.index
-            m = self.mass_kg[row]
             k, c = CURSOR_STRINGS[client.button]
-            k = min(k, STIFFNESS_LIMIT * m / (dt * dt))
-            c = min(c, STIFFNESS_LIMIT * m / dt)
-            out.append((row, k * (np.asarray(client.cursor_m) - self.pos_m[row]) - c * self.vel_mps[row]))
+            k = min(k, STIFFNESS_LIMIT * self.mass_kg[row] / (dt * dt))
+            out.append((row, k * (np.asarray(client.cursor_m) - self.pos_m[row]), c))
         return out
 
     def _add_spring_forces(self, force: np.ndarray, dt: float) -> None:
@@ -426,9 +452,10 @@ class AirTable:
             np.add.at(force, a, f1)
             np.add.at(force, b, -f1)
 
-    def _add_cursor_forces(self, force: np.ndarray, dt: float) -> None:
-        for row, f in self._cursor_forces(dt):
+    def _add_cursor_forces(self, force: np.ndarray, drag: np.ndarray, dt: float) -> None:
+        for row, f, c in self._cursor_strings(dt):
             force[row] += f
+            drag[row] += c
 
     def forces_on(self, puck: Puck, dt_s: float = 1 / 240) -> dict[str, np.ndarray]:
         """The forces (N) the next step will apply to `puck`, by source.
@@ -438,7 +465,8 @@ class AirTable:
         """
         row = puck.index
         out: dict[str, np.ndarray] = {}
-        strings = [f for r, f in self._cursor_forces(dt_s) if r == row]
+        v = self.vel_mps[row]
+        strings = [f - c * v for r, f, c in self._cursor_strings(dt_s) if r == row]
         if strings:
             out["cursor strings"] = np.sum(strings, axis=0)
         if self._springs.n:

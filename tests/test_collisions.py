@@ -330,3 +330,9 @@ def test_disjoint_rounds_keep_order_and_never_repeat_a_puck(pairs: tuple[np.ndar
         for later in range(k + 1, len(i)):
             if {i[k], j[k]} & {i[later], j[later]}:
                 assert round_of[k] < round_of[later], "pairs sharing a puck were reordered"
+
+
+@pytest.mark.parametrize("n_cells", [10, 1 << 16, (1 << 16) + 1, 5_000_000])
+def test_cell_sort_matches_a_stable_argsort(n_cells: int) -> None:
+    keys = np.random.default_rng(n_cells).integers(0, n_cells, 5000)
+    np.testing.assert_array_equal(collisions._argsort_cells(keys, n_cells), np.argsort(keys, kind="stable"))

@@ -104,9 +104,11 @@ def test_cursor_string_pulls_the_held_puck() -> None:
     dt = 1 / 120
     x0, v0, m = puck.pos_m, puck.vel_mps, puck.mass_kg
     table.step(dt)
-    force = 60.0 * (np.array([4.0, 5.0]) - x0) - 2.0 * v0  # button 1: k = 60 N/m, c = 2 N s/m
-    np.testing.assert_allclose(puck.vel_mps, v0 + force / m * dt, rtol=1e-12)
-    np.testing.assert_allclose(puck.pos_m, x0 + (v0 + force / m * dt) * dt, rtol=1e-12)
+    # Button 1: k = 60 N/m, c = 2 N s/m; F = k (cursor - x) - c v, with the drag
+    # taken at the end of the step: v1 = v0 + (k (cursor - x0) - c v1) dt / m.
+    v1 = (v0 + 60.0 * (np.array([4.0, 5.0]) - x0) / m * dt) / (1.0 + 2.0 * dt / m)
+    np.testing.assert_allclose(puck.vel_mps, v1, rtol=1e-12)
+    np.testing.assert_allclose(puck.pos_m, x0 + v1 * dt, rtol=1e-12)
 
     client.set_input(table, cursor_m=(4.0, 5.0), button=0)  # release: no more pull
     assert client.held is None
