@@ -393,11 +393,82 @@ def physics_section(args: argparse.Namespace) -> bool:
     return all_ok
 
 
+FRAME_S = 1.0 / 60.0
+TARGET_FPS = {5000: 60.0}
+
+
+def _best_ms(fn: Callable[[], None], blocks: int, per_block: int) -> float:
+    """Best (minimum) ms per call over `blocks` blocks of `per_block` calls, GC off."""
+    best = math.inf
+    gc.disable()
+    try:
+        for _ in range(blocks):
+            t0 = time.perf_counter()
+            for _ in range(per_block):
+                fn()
+            best = min(best, (time.perf_counter() - t0) / per_block)
+    finally:
+        gc.enable()
+    return best * 1e3
+
+
+def frames_section(args: argparse.Namespace) -> bool:
+    """Whole frames of the burst demo (physics for 1/60 s plus drawing); True if the fps targets are met."""
+    import os
+
+    os.environ.setdefault("SDL_VIDEODRIVER", "dummy")
+    from airtable.app import App
+    from airtable.demo_loader import BUILTIN_DIR, discover
+
+    demos, _ = discover([BUILTIN_DIR])
+    burst = demos["0"]
+    counts = (1000, 5000) if args.quick else (1000, 5000, 10000)
+    print(
+        f"frames: demo 0 (burst) in the app, headless (dummy video driver): one frame = physics for 1/60 s"
+        f" ({round(FRAME_S / burst.dt_s)} steps of 1/{1 / burst.dt_s:.0f} s) + drawing"
+    )
+    print(f"  target: {TARGET_FPS[5000]:g} fps with 5000 pucks")
+    print()
+    out = TextTable(
+        [
+            ("N", 6, ">"),
+            ("frame ms", 8, ">"),
+            ("fps", 6, ">"),
+            ("draw ms", 7, ">"),
+            ("target", 10, "<"),
+            ("result", 6, "<"),
+        ]
+    )
+    out.header()
+    all_ok = True
+    blocks, per_block = (3, 10) if args.quick else (5, 20)
+    for n in counts:
+        app = App(demos, demo_key="0", variation=burst.variations.index(f"n = {n}"), headless=True, server=None)
+        for _ in range(30):  # warm up: sprites cached, pucks spread out
+            app.frame(FRAME_S)
+        frame_ms = _best_ms(lambda app=app: app.frame(FRAME_S), blocks, per_block)
+        draw_ms = _best_ms(app.draw, blocks, per_block)
+        fps = 1000.0 / frame_ms
+        target = TARGET_FPS.get(n)
+        ok = target is None or fps >= target
+        all_ok = all_ok and ok
+        out.row(
+            str(n),
+            f"{frame_ms:.2f}",
+            f"{fps:.0f}",
+            f"{draw_ms:.2f}",
+            f">={target:g} fps" if target else "-",
+            ("PASS" if ok else "MISS") if target else "",
+        )
+    print()
+    return all_ok
+
+
 # Name -> section. A section takes the parsed arguments, prints its own
 # report and returns True when every target it checks is met.
 SECTIONS: dict[str, Callable[[argparse.Namespace], bool]] = {
     "physics": physics_section,
-    # "frames": whole-frame timings with drawing, to come.
+    "frames": frames_section,
 }
 
 
