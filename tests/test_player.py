@@ -13,8 +13,9 @@ from test_server import RawClient, wait_until
 
 from airtable.net import protocol as proto
 from airtable.net.loadtest import TableLoop, grid_table
-from airtable.net.player import InputThrottle, NetPlayer, PlayerApp, PlayerError, main
+from airtable.net.player import InputThrottle, NetPlayer, PlayerApp, PlayerError, _own_cursor_live, main
 from airtable.net.server import GameServer
+from airtable.scene import CursorView
 from airtable.window import background_for
 
 
@@ -100,6 +101,16 @@ def test_input_throttle_sends_changes_at_most_60_a_second_and_a_heartbeat():
     assert throttle.due(a, 1.0), "heartbeat"
     throttle.reset()
     assert throttle.due(a, 0.0)
+
+
+def test_own_cursor_is_drawn_at_the_live_mouse_position_with_its_string():
+    welcome = proto.Welcome("C2", (210, 180, 140), 10.0, 8.7556)
+    other = CursorView("C1", (255, 52, 179), (1.0, 1.0), 1, 0)
+    mine = CursorView("C2", (210, 180, 140), (2.0, 2.0), 1, 3)
+    cursors, extra = _own_cursor_live((mine, other), welcome, np.array([2.5, 2.25]), 1, focused=True)
+    assert cursors == (other, CursorView("C2", (210, 180, 140), (2.5, 2.25), 1, 3)) and not extra
+    assert _own_cursor_live((other,), welcome, (2.5, 2.25), 0, focused=True) == ((other,), True)
+    assert _own_cursor_live((mine, other), welcome, (2.5, 2.25), 0, focused=False) == ((other, mine), False)
 
 
 # ---------------------------------------------------------------- NetPlayer

@@ -26,7 +26,7 @@ from collections.abc import Callable, Iterable, Sequence
 import numpy as np
 
 from airtable.net import protocol as proto
-from airtable.scene import Scene
+from airtable.scene import CursorView, Scene
 
 CONNECT_TIMEOUT_S = 5.0
 SILENCE_S = 10.0  # no snapshot for this long: the server is gone (snapshots come 30 times a second)
@@ -404,7 +404,8 @@ class PlayerApp:
         net = self.net
         welcome = net.welcome
         assert welcome is not None, "connect() first"
-        env = Environment(DEFAULT_SIZE_PX, width_m=welcome.width_m)
+        env_width_m = welcome.width_m
+        env = Environment(DEFAULT_SIZE_PX, width_m=env_width_m)
         win = GameWindow(env, caption=f"Air Table - {welcome.client}", headless=self.headless)
         self.window = win
         if not self.headless:
@@ -441,8 +442,9 @@ class PlayerApp:
                 if net.welcome is not None and net.welcome is not welcome:  # reconnected
                     welcome = net.welcome
                     win.set_caption(f"Air Table - {welcome.client}")
-                    if welcome.width_m * env.base_px_per_m != env.size_px[0]:
-                        env = Environment(DEFAULT_SIZE_PX, width_m=welcome.width_m)
+                    if welcome.width_m != env_width_m:  # the teacher restarted with another table
+                        env_width_m = welcome.width_m
+                        env = Environment(DEFAULT_SIZE_PX, width_m=env_width_m)
                         win.env = env
                 scene = net.latest()
                 if scene is None:
@@ -452,19 +454,18 @@ class PlayerApp:
                 env.origin_m = np.array(scene.origin_m, dtype=float)
                 cursor_m = env.to_world(np.array(pygame.mouse.get_pos(), dtype=float))
                 net.update_input(cursor_m, button, keys)
-                # Our own cursor comes from the mouse, not from the (older) snapshot.
-                others = tuple(c for c in scene.cursors if c.name != welcome.client)
-                retrying = net.state == net.RETRYING
                 self.states_seen.add(net.state)
                 self.frames += 1
+                focused = bool(pygame.mouse.get_focused())
+                cursors, extra = _own_cursor_live(scene.cursors, welcome, cursor_m, button, focused)
                 win.draw(
-                    dataclasses.replace(scene, cursors=others),
+                    dataclasses.replace(scene, cursors=cursors),
                     hud=(f"You are {welcome.client}", net.status_text),
-                    banner=net.RETRYING if retrying else None,
+                    banner=net.RETRYING if net.state == net.RETRYING else None,
                 )
-                # A sample of our colour under the HUD, then the live cursor.
+                # A sample of our colour under the HUD.
                 win.draw_cursor("you", welcome.color, env.to_world(np.array([14.0, 78.0])))
-                if pygame.mouse.get_focused():  # no arrow while the mouse is in another window
+                if extra:  # not in the snapshots yet: the arrow alone
                     win.draw_cursor(welcome.client, welcome.color, cursor_m)
                 win.present()
                 if seconds is not None and time.monotonic() - start >= seconds:
@@ -477,6 +478,26 @@ class PlayerApp:
                 win.save_screenshot(screenshot)
             net.close(bye=True)
         return status
+
+
+def _own_cursor_live(
+    cursors: Sequence[CursorView], welcome: proto.Welcome, cursor_m: Sequence[float], button: int, focused: bool
+) -> tuple[tuple[CursorView, ...], bool]:
+    """The snapshot's cursors with ours moved to where the mouse is now.
+
+    Our cursor in a snapshot is a round trip old; drawing it at the live mouse
+    position (and last, on top) makes the arrow and its string follow the hand
+    without delay. Returns the cursors and whether ours still needs drawing
+    on its own (it is not in the snapshots yet).
+    """
+    others = tuple(c for c in cursors if c.name != welcome.client)
+    mine = next((c for c in cursors if c.name == welcome.client), None)
+    if not focused:  # the mouse is in another window: show what the server has
+        return others + ((mine,) if mine else ()), False
+    if mine is None:
+        return others, True
+    live = dataclasses.replace(mine, cursor_m=(float(cursor_m[0]), float(cursor_m[1])), button=button)
+    return others + (live,), False
 
 
 def _parse_args(argv: Sequence[str] | None) -> argparse.Namespace:
