@@ -301,6 +301,22 @@ def resolve_pairs(
     return Collisions.concatenate(parts)
 
 
+def push_apart(pos: np.ndarray, radius: np.ndarray, mass: np.ndarray, i: np.ndarray, j: np.ndarray) -> None:
+    """Move each overlapping pair (i, j) apart along its line of centres, in place.
+
+    Positions only: each puck moves its mass-weighted share of the overlap
+    (the lighter one more), so the centre of mass stays put. Pairs that share
+    a puck add their pushes. Used for the small overlaps a correction leaves
+    behind; velocities (and so energy and momentum) are untouched.
+    """
+    n, dist = unit_vectors(pos[i] - pos[j])
+    left = np.maximum(radius[i] + radius[j] - dist, 0.0)
+    m_i, m_j = mass[i], mass[j]
+    push = (left / (m_i + m_j))[:, None] * n
+    np.add.at(pos, i, push * m_j[:, None])
+    np.add.at(pos, j, -push * m_i[:, None])
+
+
 def unit_vectors(d: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Unit vectors along the rows of d and their lengths; zero rows get a fixed normal."""
     dist = np.hypot(d[:, 0], d[:, 1])

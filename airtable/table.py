@@ -25,6 +25,7 @@ from airtable import collisions
 from airtable.bodies import Puck, Spring, as_vector
 from airtable.client import CURSOR_STRINGS
 from airtable.colors import rgb
+from airtable.memory import keep_freed_memory
 
 GRAVITY_MPS2 = 9.8
 # Springs and cursor strings stiffer than a step can integrate are softened to
@@ -32,8 +33,9 @@ GRAVITY_MPS2 = 9.8
 # this), which keeps semi-implicit Euler stable for any mass the user picks.
 # The cursor strings' drag needs no limit: it is applied implicitly.
 STIFFNESS_LIMIT = 0.5
-# Pairs are resolved in one pass, then up to this many more passes over the
-# pairs that the corrections pushed into overlap.
+# After the first pass over the overlapping pairs, up to this many more passes
+# over the pairs the corrections pushed into overlap: collisions again, then a
+# last pass that only pushes apart.
 EXTRA_PASSES = 2
 # Overlaps smaller than this (m) are left to the next step: round-off only.
 OVERLAP_SLOP_M = 1e-9
@@ -100,6 +102,7 @@ class AirTable:
     """A rectangular air table with walls at x = 0..width_m and y = 0..height_m."""
 
     def __init__(self, width_m: float = 10.0, height_m: float = 8.7556) -> None:
+        keep_freed_memory()  # the step's temporary arrays are reused, not re-faulted (memory.py)
         self.width_m = _positive(width_m, "width_m")
         self.height_m = _positive(height_m, "height_m")
         self._pucks = _Columns(
@@ -398,28 +401,33 @@ class AirTable:
             self._resolve_pucks(dt)
 
     def _resolve_pucks(self, dt: float) -> None:
-        pos, vel, radius = self.pos_m, self.vel_mps, self.radius_m
+        pos, vel, radius, mass = self.pos_m, self.vel_mps, self.radius_m, self.mass_kg
         ci, cj = collisions.find_candidate_pairs(pos, radius)
         i, j = collisions.overlapping_pairs(pos, radius, ci, cj)
         found, moved = [], []
-        passes = 1 if self.puck_correction == "off" else 1 + EXTRA_PASSES
-        for _ in range(passes):
+        for attempt in range(1 + EXTRA_PASSES):
             if len(i) == 0:
                 break
-            hits = collisions.resolve_pairs(
-                pos, vel, radius, self.mass_kg, i, j, self.cr_puck, self.puck_correction, dt
-            )
-            found.append(hits)
+            if attempt < EXTRA_PASSES:
+                found.append(
+                    collisions.resolve_pairs(pos, vel, radius, mass, i, j, self.cr_puck, self.puck_correction, dt)
+                )
+            else:
+                collisions.push_apart(pos, radius, mass, i, j)
             moved += [i, j]
+            if self.puck_correction == "off":
+                break  # overlaps stay: that is what "off" shows
             # Parting a pair can push one of its pucks into a third one that
-            # was already handled: look again among the same candidates.
+            # was already handled: look again among the same candidates,
+            # collide those pairs too, and at last just push apart what is left.
             i, j = collisions.overlapping_pairs(pos, radius, ci, cj, min_overlap_m=OVERLAP_SLOP_M)
-        if moved:
-            self.last_collisions = collisions.Collisions.concatenate([h for h in found if len(h)])
-            self.collision_count += len(self.last_collisions)
-            # Only pucks that pairs moved can have been pushed into a wall.
-            rows = np.unique(np.concatenate(moved))
-            collisions.resolve_walls(pos, vel, radius, self.size_m, self.cr_wall, self.wall_correction, only=rows)
+        if not moved:
+            return
+        self.last_collisions = collisions.Collisions.concatenate([h for h in found if len(h)])
+        self.collision_count += len(self.last_collisions)
+        # Only pucks that pairs moved can have been pushed into a wall.
+        rows = np.unique(np.concatenate(moved))
+        collisions.resolve_walls(pos, vel, radius, self.size_m, self.cr_wall, self.wall_correction, only=rows)
 
     def _spring_forces(self, dt: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """(rows of p1, rows of p2, force on p1) for every spring; p2 gets minus that."""

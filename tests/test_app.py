@@ -253,7 +253,7 @@ def test_bad_arguments_exit_2_with_a_message(argv, message, capsys):
 def test_list_demos(capsys, demos):
     assert main(["--list-demos"]) == 0
     out = capsys.readouterr().out
-    for key, demo in demos.items():
+    for demo in demos.values():
         assert demo.title in out
 
 

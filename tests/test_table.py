@@ -307,3 +307,12 @@ def test_physics_modules_do_not_import_pygame() -> None:
         "assert not bad, bad\n"
     )
     subprocess.run([sys.executable, "-c", code], check=True, timeout=60)
+
+
+def test_freed_memory_is_kept_for_reuse_on_linux() -> None:
+    import sys
+
+    from airtable.memory import keep_freed_memory
+
+    assert keep_freed_memory() is sys.platform.startswith("linux")
+    assert keep_freed_memory() is sys.platform.startswith("linux")  # idempotent
