@@ -9,9 +9,11 @@ screen; demo scenes come from the demo files (demo_loader.py).
 from __future__ import annotations
 
 import argparse
+import logging
 import math
 import sys
 import time
+from collections import deque
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -145,6 +147,7 @@ class App:
         self.mouse_button = 0
         self.panning = False
         self.fps = 0.0
+        self._frame_times: deque[float] = deque()
         self.accumulator_s = 0.0
         self.message = ""
         self.message_until = 0.0
@@ -357,8 +360,13 @@ class App:
                 steps += 1
             if steps == max_steps:
                 self.accumulator_s = min(self.accumulator_s, self.dt_s)
-        if frame_dt_s > 0:
-            self.fps = 1.0 / frame_dt_s if self.fps == 0 else 0.9 * self.fps + 0.1 / frame_dt_s
+        # Frames counted over the last second: steadier than 1 / dt of one frame.
+        self._frame_times.append(self.clock_s)
+        while self._frame_times[0] < self.clock_s - 1.0:
+            self._frame_times.popleft()
+        span = self._frame_times[-1] - self._frame_times[0]
+        if span > 0:
+            self.fps = (len(self._frame_times) - 1) / span
         self.draw()
 
     def scene(self) -> Scene:
@@ -625,6 +633,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     variations = demos[args.demo].variations
     if args.variation and args.variation >= max(1, len(variations)):
         parser.error(f"demo {args.demo} has {len(variations) or 'no'} variations; --variation must be below that")
+    # The server logs who joins and who is dropped (and why) for the teacher.
+    logging.basicConfig(level=logging.INFO, format="%(message)s")
     server = None if args.no_server else start_server(args)
     app = App(
         demos, demo_key=args.demo, variation=args.variation, headless=args.headless, server=server, demo_errors=errors

@@ -63,6 +63,7 @@ class GameWindow:
         self.label_font = pygame.font.Font(None, 18)
         self._sprites: dict[tuple[int, int, int, int], pygame.Surface] = {}
         self._trail_layer: pygame.Surface | None = None
+        self._labels: dict[tuple, pygame.Surface] = {}
 
     def set_caption(self, caption: str) -> None:
         self.caption = caption
@@ -215,7 +216,12 @@ class GameWindow:
         arrow = [(x, y), (x + 4, y + 15), (x + 7, y + 10), (x + 13, y + 12)]
         pygame.draw.polygon(self.surface, color, arrow)
         pygame.draw.polygon(self.surface, (0, 0, 0), arrow, 1)
-        label = self.label_font.render(name, True, color)
+        key = (name, tuple(color))
+        label = self._labels.get(key)
+        if label is None:  # rendering text is the slow part of thirty cursors
+            if len(self._labels) > 256:
+                self._labels.clear()
+            label = self._labels[key] = self.label_font.render(name, True, color)
         self.surface.blit(label, (x + 12, y + 14))
 
     def _draw_hud(self, scene: Scene, hud: Sequence[str]) -> None:

@@ -266,3 +266,10 @@ def test_readme_lists_every_key_of_the_key_table():
     readme = (Path(__file__).resolve().parent.parent / "README.md").read_text(encoding="utf-8")
     for binding in BINDINGS:
         assert f"| {binding.label} |" in readme, f"README's key table lacks {binding.label!r}"
+
+
+def test_frame_rate_counts_the_frames_of_the_last_second(app):
+    for _ in range(90):
+        app.frame(1 / 45)
+    assert app.fps == pytest.approx(45.0, rel=1e-6)
+    assert app.scene().fps == app.fps
