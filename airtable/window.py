@@ -79,8 +79,12 @@ class GameWindow:
         trails: bool = False,
         hud: Sequence[str] = (),
         banner: str | None = None,
+        hud_color: Sequence[int] | None = None,
     ) -> None:
         """Draw a whole frame of `scene` into `self.surface`.
+
+        `hud` lines go under the title; `hud_color`, if given, colours the first
+        (a player's "You are C3" in the player's colour).
 
         With `trails` on, pucks are also stamped onto a layer that is never
         erased (the course's "erase off"), while springs, cursors and text stay
@@ -100,7 +104,7 @@ class GameWindow:
         self._draw_springs(scene)
         self._draw_pucks(surf, scene)
         self._draw_cursors(scene)
-        self._draw_hud(scene, hud)
+        self._draw_hud(scene, hud, hud_color)
         self._draw_walls(scene)  # last, so the status bar never hides the bottom wall
         if banner:
             self.draw_banner(banner)
@@ -224,7 +228,7 @@ class GameWindow:
             label = self._labels[key] = self.label_font.render(name, True, color)
         self.surface.blit(label, (x + 12, y + 14))
 
-    def _draw_hud(self, scene: Scene, hud: Sequence[str]) -> None:
+    def _draw_hud(self, scene: Scene, hud: Sequence[str], hud_color: Sequence[int] | None = None) -> None:
         w, h = self.surface.get_size()
         # Frame-rate box, top right.
         fps = self.font.render(f"{scene.fps:5.1f} fps", True, TEXT_COLOR)
@@ -236,8 +240,9 @@ class GameWindow:
         if scene.title:
             self.surface.blit(self.font.render(scene.title, True, TEXT_COLOR), (10, y))
             y += 22
-        for line in hud:
-            self.surface.blit(self.font.render(line, True, DIM_TEXT), (10, y))
+        for k, line in enumerate(hud):
+            color = tuple(hud_color) if (k == 0 and hud_color is not None) else DIM_TEXT
+            self.surface.blit(self.font.render(line, True, color), (10, y))
             y += 20
         if scene.status:
             status = self.font.render(scene.status, True, TEXT_COLOR)

@@ -462,9 +462,8 @@ class PlayerApp:
                     dataclasses.replace(scene, cursors=cursors),
                     hud=(f"You are {welcome.client}", net.status_text),
                     banner=net.RETRYING if net.state == net.RETRYING else None,
+                    hud_color=welcome.color,
                 )
-                # A sample of our colour under the HUD.
-                win.draw_cursor("you", welcome.color, env.to_world(np.array([14.0, 78.0])))
                 if extra:  # not in the snapshots yet: the arrow alone
                     win.draw_cursor(welcome.client, welcome.color, cursor_m)
                 win.present()
