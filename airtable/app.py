@@ -584,6 +584,7 @@ def write_starter_demo(path: Path) -> Path:
     if path.exists():
         raise ValueError(f"{path} already exists; choose another name or delete it first")
     starter = Path(__file__).resolve().parent / "assets" / "starter_demo.py.txt"
+    path.parent.mkdir(parents=True, exist_ok=True)
     path.write_text(starter.read_text(encoding="utf-8"), encoding="utf-8")
     return path
 

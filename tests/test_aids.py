@@ -273,10 +273,10 @@ def test_broken_teacher_demos_show_their_errors_and_the_app_goes_on(demos, tmp_p
 
 
 def test_new_demo_writes_a_starter_that_runs(tmp_path, capsys):
-    path = tmp_path / "mine.py"
+    path = tmp_path / "mydemos" / "mine.py"  # the folder is made if need be
     assert main(["--new-demo", str(path)]) == 0
     assert "python -m airtable --demos" in capsys.readouterr().out
-    found, errors = discover([tmp_path])
+    found, errors = discover([path.parent])
     assert errors == [] and list(found) == ["t1"]
     table = AirTable()
     for variation in (0, 1):
