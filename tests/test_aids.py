@@ -16,13 +16,6 @@ from airtable.table import AirTable
 FRAME_S = 1 / 60
 
 
-@pytest.fixture(scope="module")
-def demos():
-    found, errors = discover([BUILTIN_DIR])
-    assert not errors
-    return found
-
-
 def make_app(demos, key="1", **kw) -> App:
     app = App(demos, demo_key=key, headless=True, **kw)
     pygame.event.clear()

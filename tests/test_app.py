@@ -7,16 +7,8 @@ import pygame
 import pytest
 
 from airtable.app import App, main
-from airtable.demo_loader import BUILTIN_DIR, discover
 
 FRAME_S = 1 / 60
-
-
-@pytest.fixture(scope="module")
-def demos():
-    found, errors = discover([BUILTIN_DIR])
-    assert not errors
-    return found
 
 
 @pytest.fixture
