@@ -164,6 +164,8 @@ class App:
     def start_demo(self, key: str, variation: int = 0) -> None:
         """Clear the table and build demo `key` (a demo that fails shows its error)."""
         demo = self.demos[key]
+        if getattr(self, "build_error", None) is not None:
+            self.paused = False  # the pause came with the error; a new start runs
         self.demo_key = key
         self.variation = variation % len(demo.variations) if demo.variations else 0
         self.table.clear()
@@ -334,7 +336,12 @@ class App:
     def physics_step(self) -> None:
         if self.server is not None:
             self.server.apply_inputs(self.table)
-        self.table.step(self.dt_s)
+        try:
+            self.table.step(self.dt_s)
+        except Exception as exc:  # a demo's timed event (teacher's code) failed
+            self.build_error = error_from_exception(self.demo.path or Path(f"demo {self.demo_key}"), exc)
+            self.paused = True
+            return
         self.chart.sample(self.table)
         if self.show_annotations:
             self.collision_log.add(self.table, self.clock_s)

@@ -102,13 +102,20 @@ def load_demo_file(path: Path) -> Demo:
         raise DemoLoadError(DemoError(path, None, f"a demo file must define {', '.join(missing)}"))
     if not callable(module.build):
         raise DemoLoadError(DemoError(path, None, "build must be a function build(table, variation=0)"))
+    dt_s = getattr(module, "DT_S", DEFAULT_DT_S)
+    if not (isinstance(dt_s, (int, float)) and 0.0 < dt_s <= 1.0):
+        raise DemoLoadError(
+            DemoError(path, None, f"DT_S must be a time step in seconds, above 0 and at most 1, not {dt_s!r}")
+        )
+    if not str(module.KEY).strip():
+        raise DemoLoadError(DemoError(path, None, 'KEY must name the key that starts the demo, like "7" or "t1"'))
     return Demo(
         key=str(module.KEY),
         title=str(module.TITLE),
         notes=" ".join(str(getattr(module, "NOTES", "")).split()),
         build=module.build,
         variations=tuple(str(v) for v in getattr(module, "VARIATIONS", ())),
-        dt_s=float(getattr(module, "DT_S", DEFAULT_DT_S)),
+        dt_s=float(dt_s),
         trails=bool(getattr(module, "TRAILS", False)),
         path=path,
     )

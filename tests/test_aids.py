@@ -283,3 +283,24 @@ def test_new_demo_writes_a_starter_that_runs(tmp_path, capsys):
         main(["--new-demo", str(path)])  # never overwrites
     assert exc.value.code == 2
     assert "already exists" in capsys.readouterr().err
+
+
+def test_a_failing_timed_event_shows_its_error_and_pauses(demos, tmp_path):
+    (tmp_path / "late.py").write_text(
+        "KEY = 't7'\nTITLE = 'Late'\n\n"
+        "def build(table, variation=0):\n    table.add_puck((1, 1), 0.2)\n"
+        "    table.schedule(0.5, lambda t: t.no_such_thing())\n"
+    )
+    (tmp_path / "bad_dt.py").write_text(
+        "KEY = 't6'\nTITLE = 'x'\nDT_S = 0\n\ndef build(table, variation=0):\n    pass\n"
+    )
+    found, errors = discover([BUILTIN_DIR, tmp_path])
+    assert [str(e) for e in errors] == ["bad_dt.py: DT_S must be a time step in seconds, above 0 and at most 1, not 0"]
+    app = make_app(found, "t7")
+    for _ in range(60):
+        app.frame(FRAME_S)
+    assert app.paused
+    assert "late.py, line 6: AttributeError" in str(app.build_error)
+    press(app, pygame.K_2)
+    assert app.build_error is None and len(app.table.pucks) == 8
+    assert not app.paused
