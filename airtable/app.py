@@ -153,6 +153,7 @@ class App:
         self.message_until = 0.0
         self.clock_s = 0.0  # real time the app has run (sum of frame times)
         self._dispatch = {k: b for b in BINDINGS for k in b.keys}
+        self.build_error: DemoError | None = None  # shown instead of the demo while set
         self.start_demo(demo_key if demo_key in demos else next(iter(demos)), variation)
 
     # ------------------------------------------------------------ demos
@@ -164,7 +165,7 @@ class App:
     def start_demo(self, key: str, variation: int = 0) -> None:
         """Clear the table and build demo `key` (a demo that fails shows its error)."""
         demo = self.demos[key]
-        if getattr(self, "build_error", None) is not None:
+        if self.build_error is not None:
             self.paused = False  # the pause came with the error; a new start runs
         self.demo_key = key
         self.variation = variation % len(demo.variations) if demo.variations else 0
@@ -172,7 +173,7 @@ class App:
         self.table.reset_settings()
         for client in self.table.clients:
             client.held = None
-        self.build_error: DemoError | None = None
+        self.build_error = None
         try:
             demo.build(self.table, self.variation)
         except Exception as exc:  # a teacher's demo may fail in any way; the app goes on
