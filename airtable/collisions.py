@@ -110,8 +110,10 @@ def find_candidate_pairs(pos: np.ndarray, radius: np.ndarray) -> tuple[np.ndarra
     n = len(pos)
     if n <= BRUTE_FORCE_MAX_PUCKS:
         return np.triu_indices(n, k=1)
-    big = radius > 2.0 * radius.mean()
-    if big.any():
+    r_max = float(radius.max())
+    # No puck can be twice the mean while the largest is within twice the smallest.
+    big = radius > 2.0 * radius.mean() if r_max > 2.0 * float(radius.min()) else None
+    if big is not None and big.any():
         small_idx = np.flatnonzero(~big)
         gi, gj = _grid_candidates(pos[small_idx], 2.0 * float(radius[small_idx].max()))
         i_parts, j_parts = [small_idx[gi]], [small_idx[gj]]
@@ -122,7 +124,7 @@ def find_candidate_pairs(pos: np.ndarray, radius: np.ndarray) -> tuple[np.ndarra
             j_parts.append(others)
         i, j = np.concatenate(i_parts), np.concatenate(j_parts)
     else:
-        i, j = _grid_candidates(pos, 2.0 * float(radius.max()))
+        i, j = _grid_candidates(pos, 2.0 * r_max)
     return np.minimum(i, j), np.maximum(i, j)
 
 
@@ -408,9 +410,12 @@ def _resolve_round(pos, vel, radius, mass, a, b, cr, mode, dt_s) -> Collisions:
         pos[a] = x1
         pos[b] = x2
 
-    if not approach.any():
+    if approach.all():
+        k = slice(None)  # the usual case: no index array needed
+    elif approach.any():
+        k = np.flatnonzero(approach)
+    else:
         return Collisions.empty()
-    k = np.flatnonzero(approach)
     gap = np.hypot(*(x1[k] - x2[k]).T) - reach[k]
     contact = contact_from[k] + n[k] * radius[b[k]][:, None]
     return Collisions(

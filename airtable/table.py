@@ -425,8 +425,9 @@ class AirTable:
             return
         self.last_collisions = collisions.Collisions.concatenate([h for h in found if len(h)])
         self.collision_count += len(self.last_collisions)
-        # Only pucks that pairs moved can have been pushed into a wall.
-        rows = np.unique(np.concatenate(moved))
+        # Only pucks that pairs moved can have been pushed into a wall (a row
+        # listed twice is just checked twice).
+        rows = np.concatenate(moved)
         collisions.resolve_walls(pos, vel, radius, self.size_m, self.cr_wall, self.wall_correction, only=rows)
 
     def _spring_forces(self, dt: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
