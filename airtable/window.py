@@ -64,6 +64,7 @@ class GameWindow:
         self._sprites: dict[tuple[int, int, int, int], pygame.Surface] = {}
         self._trail_layer: pygame.Surface | None = None
         self._labels: dict[tuple, pygame.Surface] = {}
+        self._status_bar: pygame.Surface | None = None
 
     def set_caption(self, caption: str) -> None:
         self.caption = caption
@@ -246,8 +247,11 @@ class GameWindow:
             y += 20
         if scene.status:
             status = self.font.render(scene.status, True, TEXT_COLOR)
-            bar = pygame.Rect(0, h - 26, w, 26)
-            pygame.draw.rect(self.surface, (0, 0, 0), bar)
+            # See-through, so pucks resting on the bottom wall stay visible.
+            if self._status_bar is None or self._status_bar.get_width() != w:
+                self._status_bar = pygame.Surface((w, 26), pygame.SRCALPHA)
+                self._status_bar.fill((0, 0, 0, 150))
+            self.surface.blit(self._status_bar, (0, h - 26))
             self.surface.blit(status, (10, h - 21))
 
     def draw_banner(self, text: str) -> None:
