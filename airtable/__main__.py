@@ -2,7 +2,7 @@
 
 import sys
 
-from airtable.app import main
+from airtable.cli import main
 
 if __name__ == "__main__":
     sys.exit(main())

@@ -9,7 +9,8 @@ import pygame
 import pytest
 
 from airtable import aids
-from airtable.app import App, main
+from airtable.app import App
+from airtable.cli import main
 from airtable.demo_loader import BUILTIN_DIR, discover
 from airtable.table import AirTable
 

@@ -6,7 +6,8 @@ import numpy as np
 import pygame
 import pytest
 
-from airtable.app import App, main
+from airtable.app import App
+from airtable.cli import main
 
 FRAME_S = 1 / 60
 

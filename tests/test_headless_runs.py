@@ -6,7 +6,7 @@ import numpy as np
 import pygame
 import pytest
 
-from airtable.app import main
+from airtable.cli import main
 from airtable.demo_loader import BUILTIN_DIR, discover
 from airtable.environment import Environment
 from airtable.table import AirTable
