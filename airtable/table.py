@@ -8,7 +8,8 @@ One `step(dt_s)`, in the order of the course's game loop:
 1. forces: cursor strings, springs, gravity;
 2. semi-implicit Euler: v += F/m dt, then x += v dt;
 3. walls;
-4. puck pairs: broadphase, then sequential collision + position correction;
+4. puck pairs: broadphase, then sequential collision + position correction,
+   then a second look at the pairs the corrections pushed into overlap;
 5. walls again, since pushing pairs apart can push a puck into a wall.
 """
 
