@@ -19,14 +19,13 @@ import numpy as np
 import pygame
 
 from airtable import aids
-from airtable.client import Client
+from airtable.client import LOCAL_COLOR, Client
 from airtable.demo_loader import Demo, DemoError, error_from_exception
 from airtable.environment import Environment
 from airtable.scene import Scene
 from airtable.table import AirTable
 from airtable.window import AidsPainter, GameWindow
 
-LOCAL_COLOR = (0, 255, 0)
 # A stalled frame (window dragged, laptop busy) runs at most this much
 # simulated time; the rest is dropped rather than exploding the physics.
 MAX_SIM_PER_FRAME_S = 0.1

@@ -13,6 +13,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+LOCAL_COLOR = (0, 255, 0)  # the teacher's own cursor; players get other colours
+
 # Cursor strings by mouse button: (spring k in N/m, drag c in N s/m).
 # F = k (cursor - puck) - c v_puck.
 CURSOR_STRINGS: dict[int, tuple[float, float]] = {
@@ -27,7 +29,7 @@ class Client:
     """One user's input state and the puck they hold."""
 
     name: str = "local"
-    color: tuple[int, int, int] = (0, 255, 0)
+    color: tuple[int, int, int] = LOCAL_COLOR
     cursor_m: np.ndarray = field(default_factory=lambda: np.zeros(2))
     button: int = 0
     keys: frozenset[str] = frozenset()

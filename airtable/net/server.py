@@ -49,7 +49,6 @@ COURSE_COLORS = (
     "peachpuff",
     "rosybrown3",
 )
-LOCAL_COLOR = (0, 255, 0)
 
 DEFAULT_TABLE_SIZE_M = (10.0, 8.7556)  # until the game loop tells us the real size
 LINGER_S = 2.0  # after an ERROR: time to let it reach the client before closing
