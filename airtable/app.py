@@ -20,7 +20,7 @@ import pygame
 
 from airtable import aids
 from airtable.client import LOCAL_COLOR, Client
-from airtable.demo_loader import Demo, DemoError, error_from_exception
+from airtable.demo_loader import Demo, DemoError, error_from_exception, key_label
 from airtable.environment import Environment
 from airtable.scene import Scene
 from airtable.table import AirTable
@@ -173,7 +173,7 @@ class App:
         try:
             demo.build(self.table, self.variation)
         except Exception as exc:  # a teacher's demo may fail in any way; the app goes on
-            self.build_error = error_from_exception(demo.path or Path(f"demo {key}"), exc)
+            self.build_error = self._demo_error(exc)
             self.table.clear()
         self.dt_s = demo.dt_s
         self.trails = demo.trails
@@ -184,6 +184,10 @@ class App:
         self.chart.sample(self.table)
         self.window.set_caption(f"Air Table - {demo.label(self.variation)}")
 
+    def _demo_error(self, exc: BaseException) -> DemoError:
+        """Where in the current demo's file `exc` happened (its build or a timed event)."""
+        return error_from_exception(self.demo.path or Path(f"demo {self.demo_key}"), exc)
+
     def key_demo(self, event: pygame.event.Event) -> None:
         digit = DIGIT_KEYS.index(event.key)
         key = str((digit + 1) % 10)
@@ -192,7 +196,7 @@ class App:
         if key in self.demos:
             self.start_demo(key)
         else:
-            self.say(f"no demo on key {'Shift+' + key[0] if key.endswith('p') else key}")
+            self.say(f"no demo on key {key_label(key)}")
 
     def key_variation(self, event: pygame.event.Event) -> None:
         if not self.demo.variations:
@@ -336,7 +340,7 @@ class App:
         try:
             self.table.step(self.dt_s)
         except Exception as exc:  # a demo's timed event (teacher's code) failed
-            self.build_error = error_from_exception(self.demo.path or Path(f"demo {self.demo_key}"), exc)
+            self.build_error = self._demo_error(exc)
             self.paused = True
             return
         self.chart.sample(self.table)
@@ -484,8 +488,7 @@ class App:
     def _demo_rows(self) -> list[tuple[str, str]]:
         rows = []
         for key, demo in self.demos.items():
-            label = f"Shift+{key[0]}" if key.endswith("p") and key[:-1].isdigit() else key
-            rows.append((label, demo.title))
+            rows.append((key_label(key), demo.title))
         return rows
 
     def run(self, seconds: float | None = None, max_frames: int | None = None, frame_dt_s: float | None = None) -> None:

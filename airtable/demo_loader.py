@@ -72,6 +72,13 @@ def key_order(key: str) -> tuple:
     return (1, 0, key)
 
 
+def key_label(key: str) -> str:
+    """How a person presses `key`: "1p" is Shift+1, anything else as it is."""
+    if len(key) == 2 and key[0].isdigit() and key[1] == "p":
+        return f"Shift+{key[0]}"
+    return key
+
+
 def error_from_exception(path: Path, exc: BaseException) -> DemoError:
     """Point at the line of `path` where `exc` happened (or its syntax error)."""
     if isinstance(exc, SyntaxError):
