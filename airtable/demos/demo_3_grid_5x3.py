@@ -5,7 +5,7 @@ TITLE = "Grid of 15"
 NOTES = """
 Fling the orange puck in the middle and watch the motion spread through the grid.
 Each collision passes momentum along the line joining the two centres, so the total
-momentum of all the pucks (the HUD) only changes when a puck hits a wall.
+momentum of all the pucks (press c for the chart) only changes when a puck hits a wall.
 """
 
 
