@@ -6,7 +6,7 @@ NOTES = """
 Three pucks joined by stiff, well damped springs act almost like one solid body.
 Throw the big free puck at the triangle: the triangle moves off and starts to spin,
 and it wobbles only briefly. Puck restitution is 0.7 here, so every puck-puck hit
-loses some kinetic energy, and the total kinetic energy on the HUD drops.
+loses some kinetic energy, and the total kinetic energy on the chart (c) drops.
 """
 
 DENSITY_KGPM2 = 0.9
