@@ -54,11 +54,11 @@ def _tuple(v) -> tuple[float, float]:
     return (float(v[0]), float(v[1]))
 
 
-def annotations_from(table: AirTable, now_s: float) -> list[Annotation]:
-    """Annotations for the collisions of the table's last step."""
+def annotations_from(table: AirTable, now_s: float, newest: int = MAX_ANNOTATIONS) -> list[Annotation]:
+    """Annotations for the last `newest` collisions of the table's last step."""
     c = table.last_collisions
     out = []
-    for k in range(len(c)):
+    for k in range(max(0, len(c) - newest), len(c)):
         i, j = int(c.i[k]), int(c.j[k])
         angle = None
         m_i, m_j = table.mass_kg[i], table.mass_kg[j]
