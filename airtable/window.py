@@ -120,8 +120,7 @@ class GameWindow:
 
     def save_screenshot(self, path: str | os.PathLike) -> Path:
         path = Path(path)
-        if path.parent and not path.parent.exists():
-            path.parent.mkdir(parents=True, exist_ok=True)
+        path.parent.mkdir(parents=True, exist_ok=True)
         pygame.image.save(self.surface, str(path))
         return path
 
