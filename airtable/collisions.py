@@ -24,6 +24,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from airtable import rows
+
 CORRECTION_MODES = ("off", "two-step", "perfect-kiss")
 
 # Below this many pucks, checking every pair with one numpy expression is
@@ -57,16 +59,18 @@ def resolve_walls(
     """
     if len(pos) == 0:
         return 0
-    p, r = (pos, radius) if only is None else (pos[only], radius[only])
+    p, r = (pos, radius) if only is None else (rows.take(pos, only), radius.take(only))
     r = r[:, None]
-    outside = (p < r) | (p > size_m - r)
-    rows = np.flatnonzero(outside[:, 0] | outside[:, 1])
+    below_by = r - p  # > 0: past the wall at 0
+    above_by = p + r - size_m  # > 0: past the far wall
+    if below_by.max() <= 0.0 and above_by.max() <= 0.0:
+        return 0  # the usual case: nobody touches a wall
+    past = (below_by > 0.0) | (above_by > 0.0)
+    out = np.flatnonzero(past[:, 0] | past[:, 1])
     if only is not None:
-        rows = only[rows]
-    if len(rows) == 0:
-        return 0
-    p, v = pos[rows], vel[rows]
-    lo = radius[rows][:, None]
+        out = only.take(out)
+    p, v = rows.take(pos, out), rows.take(vel, out)
+    lo = radius.take(out)[:, None]
     hi = size_m - lo
     below, above = p < lo, p > hi
     if correction:
@@ -74,11 +78,11 @@ def resolve_walls(
     else:
         target = np.where(below, lo, np.where(above, hi, p))
     into = (below & (v < 0.0)) | (above & (v > 0.0))
-    vel[rows] = np.where(into, -cr_wall * v, v)
+    rows.put(vel, out, np.where(into, -cr_wall * v, v))
     # A mirror of a huge penetration can land past the opposite wall; a puck
     # wider than the table sits in the middle.
     clipped = np.clip(target, lo, np.maximum(hi, lo))
-    pos[rows] = np.where(hi < lo, 0.5 * size_m, clipped)
+    rows.put(pos, out, np.where(hi < lo, 0.5 * size_m, clipped))
     return int(np.count_nonzero(into))
 
 
@@ -87,12 +91,14 @@ def resolve_walls(
 
 def brute_force_pairs(pos: np.ndarray, radius: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """All overlapping pairs (i < j) by checking every pair; sorted by (i, j)."""
-    return overlapping_pairs(pos, radius, *np.triu_indices(len(pos), k=1))
+    i, j = np.triu_indices(len(pos), k=1)
+    return overlapping_pairs(pos, i, j, pair_reach(radius, i, j))
 
 
 def find_overlapping_pairs(pos: np.ndarray, radius: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """All overlapping pairs (i < j), sorted by (i, j): the same as brute force."""
-    return overlapping_pairs(pos, radius, *find_candidate_pairs(pos, radius))
+    i, j = find_candidate_pairs(pos, radius)
+    return overlapping_pairs(pos, i, j, pair_reach(radius, i, j))
 
 
 def find_candidate_pairs(pos: np.ndarray, radius: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -128,17 +134,22 @@ def find_candidate_pairs(pos: np.ndarray, radius: np.ndarray) -> tuple[np.ndarra
     return np.minimum(i, j), np.maximum(i, j)
 
 
+def pair_reach(radius: np.ndarray, i: np.ndarray, j: np.ndarray) -> np.ndarray:
+    """Sum of the radii of each pair: closer centres than this overlap."""
+    return radius.take(i) + radius.take(j)
+
+
 def overlapping_pairs(
-    pos: np.ndarray, radius: np.ndarray, i: np.ndarray, j: np.ndarray, min_overlap_m: float = 0.0
+    pos: np.ndarray, i: np.ndarray, j: np.ndarray, reach: np.ndarray
 ) -> tuple[np.ndarray, np.ndarray]:
-    """The candidate pairs (i, j) that overlap by more than min_overlap_m, sorted by (i, j)."""
-    d = pos[i] - pos[j]
-    reach = radius[i] + radius[j] - min_overlap_m
-    hit = np.einsum("ij,ij->i", d, d) < reach * reach
-    i, j = i[hit], j[hit]
+    """The candidate pairs (i, j) closer than `reach`, sorted by (i, j)."""
+    d = rows.take(pos, i) - rows.take(pos, j)
+    d *= d
+    hit = np.flatnonzero(d[:, 0] + d[:, 1] < reach * reach)
+    i, j = i.take(hit), j.take(hit)
     if len(i) > 1:
         order = np.argsort(i * len(pos) + j)
-        i, j = i[order], j[order]
+        i, j = i.take(order), j.take(order)
     return i, j
 
 
@@ -216,9 +227,8 @@ class Collisions:
 
     One row per collision (an approaching pair whose velocities were changed):
     puck rows i and j, the contact normal (unit, from j to i), the contact
-    point, the overlap when detected and the gap (separation) left after the
-    position correction, both in metres (a negative gap: still overlapping),
-    and both pucks' positions and velocities before and after this collision.
+    point, the overlap when detected, the pair's reach (sum of the radii) and
+    both pucks' positions and velocities before and after this collision.
     """
 
     i: np.ndarray
@@ -226,7 +236,7 @@ class Collisions:
     normal: np.ndarray
     contact_m: np.ndarray
     overlap_m: np.ndarray
-    separation_m: np.ndarray
+    reach_m: np.ndarray
     pos_i_before: np.ndarray
     pos_j_before: np.ndarray
     pos_i_after: np.ndarray
@@ -235,6 +245,11 @@ class Collisions:
     vel_j_before: np.ndarray
     vel_i_after: np.ndarray
     vel_j_after: np.ndarray
+
+    @property
+    def separation_m(self) -> np.ndarray:
+        """The gap the position correction left (m); negative: still overlapping."""
+        return lengths(self.pos_i_after - self.pos_j_after) - self.reach_m
 
     @classmethod
     def empty(cls) -> Collisions:
@@ -253,6 +268,10 @@ class Collisions:
         if len(parts) == 1:
             return parts[0]
         return cls(*(np.concatenate([getattr(p, f) for p in parts]) for f in cls.__dataclass_fields__))
+
+    def take(self, k: np.ndarray) -> Collisions:
+        """Only the collisions k (indices into this record)."""
+        return Collisions(*(getattr(self, f).take(k, axis=0) for f in self.__dataclass_fields__))
 
 
 def disjoint_rounds(i: np.ndarray, j: np.ndarray, n: int) -> list[np.ndarray]:
@@ -291,16 +310,20 @@ def resolve_pairs(
     cr_puck: float,
     mode: str,
     dt_s: float,
-) -> Collisions:
-    """Collide the overlapping pairs (i, j) in order, in place; see module doc."""
+) -> list[Collisions]:
+    """Collide the overlapping pairs (i, j) in order, in place; see module doc.
+
+    Returns one record per round that collided anything; `Collisions.concatenate`
+    joins them, which is left to whoever reads them.
+    """
     if mode not in CORRECTION_MODES:
         raise ValueError(f"puck_correction must be one of {CORRECTION_MODES}, not {mode!r}")
-    parts = []
+    records = []
     for r in disjoint_rounds(i, j, len(pos)):
-        c = _resolve_round(pos, vel, radius, mass, i[r], j[r], cr_puck, mode, dt_s)
-        if len(c):
-            parts.append(c)
-    return Collisions.concatenate(parts)
+        c = _resolve_round(pos, vel, radius, mass, i.take(r), j.take(r), cr_puck, mode, dt_s)
+        if c is not None:
+            records.append(c)
+    return records
 
 
 def push_apart(pos: np.ndarray, radius: np.ndarray, mass: np.ndarray, i: np.ndarray, j: np.ndarray) -> None:
@@ -311,17 +334,25 @@ def push_apart(pos: np.ndarray, radius: np.ndarray, mass: np.ndarray, i: np.ndar
     a puck add their pushes. Used for the small overlaps a correction leaves
     behind; velocities (and so energy and momentum) are untouched.
     """
-    n, dist = unit_vectors(pos[i] - pos[j])
-    left = np.maximum(radius[i] + radius[j] - dist, 0.0)
-    m_i, m_j = mass[i], mass[j]
+    n, dist = unit_vectors(rows.take(pos, i) - rows.take(pos, j))
+    left = np.maximum(pair_reach(radius, i, j) - dist, 0.0)
+    m_i, m_j = mass.take(i), mass.take(j)
     push = (left / (m_i + m_j))[:, None] * n
-    np.add.at(pos, i, push * m_j[:, None])
-    np.add.at(pos, j, -push * m_i[:, None])
+    rows.add_at(pos, i, push * m_j[:, None])
+    rows.add_at(pos, j, -push * m_i[:, None])
+
+
+def lengths(d: np.ndarray) -> np.ndarray:
+    """Length of each row of d."""
+    dd = d * d
+    return np.sqrt(dd[:, 0] + dd[:, 1])
 
 
 def unit_vectors(d: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Unit vectors along the rows of d and their lengths; zero rows get a fixed normal."""
-    dist = np.hypot(d[:, 0], d[:, 1])
+    dist = lengths(d)
+    if dist.all():
+        return d / dist[:, None], dist
     safe = dist > 0.0
     n = np.where(safe[:, None], d / np.where(safe, dist, 1.0)[:, None], _FALLBACK_NORMAL)
     return n, dist
@@ -331,23 +362,23 @@ def dot_rows(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     return a[:, 0] * b[:, 0] + a[:, 1] * b[:, 1]
 
 
-def _resolve_round(pos, vel, radius, mass, a, b, cr, mode, dt_s) -> Collisions:
-    """Resolve pairs that share no puck, all at once (see `disjoint_rounds`)."""
-    x1, x2 = pos[a], pos[b]
-    reach = radius[a] + radius[b]
-    x1_in, x2_in = x1, x2
+def _resolve_round(pos, vel, radius, mass, a, b, cr, mode, dt_s) -> Collisions | None:
+    """Resolve pairs that share no puck, all at once (see `disjoint_rounds`).
+
+    Returns the record of the pairs that collided, None if none did.
+    """
+    x1, x2 = rows.take(pos, a), rows.take(pos, b)
+    r2 = radius.take(b)
+    reach = radius.take(a) + r2
     n, dist = unit_vectors(x1 - x2)
     overlap = reach - dist
-    touching = overlap > 0.0
-    if not touching.all():  # an earlier round already parted some pairs
-        keep = np.flatnonzero(touching)
+    if overlap.min() <= 0.0:  # an earlier round already parted some pairs
+        keep = np.flatnonzero(overlap > 0.0)
         if len(keep) == 0:
-            return Collisions.empty()
-        a, b, x1, x2, reach, n, overlap = a[keep], b[keep], x1[keep], x2[keep], reach[keep], n[keep], overlap[keep]
-        x1_in, x2_in = x1, x2
-    v1, v2 = vel[a], vel[b]
-    v1_in, v2_in = v1, v2
-    m1, m2 = mass[a], mass[b]
+            return None
+        a, b, x1, x2, r2, reach, n, overlap = (v.take(keep, axis=0) for v in (a, b, x1, x2, r2, reach, n, overlap))
+    v1, v2 = rows.take(vel, a), rows.take(vel, b)
+    m1, m2 = mass.take(a), mass.take(b)
     share1 = m2 / (m1 + m2)  # puck 1's part of a change in relative motion
     share2 = m1 / (m1 + m2)
     vrel = v1 - v2
@@ -358,7 +389,7 @@ def _resolve_round(pos, vel, radius, mass, a, b, cr, mode, dt_s) -> Collisions:
     # how far the correction separates the pair along that normal.
     approach = vn < -REST_SPEED_MPS
     if mode == "off":
-        move = np.zeros(len(a))
+        move = None
     else:
         # Two-step: back up t_p = overlap / |vn|, then forward t_p with the
         # restitution-1 velocities, so each puck moves twice its share of the
@@ -390,47 +421,34 @@ def _resolve_round(pos, vel, radius, mass, a, b, cr, mode, dt_s) -> Collisions:
             approach = np.where(kiss, vnk < 0.0, approach)
             move = np.where(kiss, -(1.0 + cr) * vnk * t_b[:, 0], move)
 
-    jn = np.where(approach, -(1.0 + cr) * vn, 0.0)  # change of relative normal speed
-    v1 = v1 + (jn * share1)[:, None] * n
-    v2 = v2 - (jn * share2)[:, None] * n
-    vel[a] = v1
-    vel[b] = v2
-    if mode != "off":
-        move = np.where(approach, move, 0.0)
-        x1 = x1 + (move * share1)[:, None] * n
-        x2 = x2 - (move * share2)[:, None] * n
+    all_approach = approach.all()
+    jn = -(1.0 + cr) * vn  # change of relative normal speed
+    if not all_approach:
+        jn = np.where(approach, jn, 0.0)
+    v1_out = v1 + (jn * share1)[:, None] * n
+    v2_out = v2 - (jn * share2)[:, None] * n
+    rows.put(vel, a, v1_out)
+    rows.put(vel, b, v2_out)
+    x1_out, x2_out = x1, x2
+    if move is not None:
+        if not all_approach:
+            move = np.where(approach, move, 0.0)
+        x1_out = x1 + (move * share1)[:, None] * n
+        x2_out = x2 - (move * share2)[:, None] * n
         # Whatever still overlaps (separating, resting, created on top of each
         # other, or capped above) is pushed apart by mass-weighted shares.
-        n_now, dist_now = unit_vectors(x1 - x2)
+        n_now, dist_now = unit_vectors(x1_out - x2_out)
         left = reach - dist_now
-        if (left > 0.0).any():
+        if left.max() > 0.0:
             left = np.maximum(left, 0.0)
-            x1 = x1 + (left * share1)[:, None] * n_now
-            x2 = x2 - (left * share2)[:, None] * n_now
-        pos[a] = x1
-        pos[b] = x2
+            x1_out = x1_out + (left * share1)[:, None] * n_now
+            x2_out = x2_out - (left * share2)[:, None] * n_now
+        rows.put(pos, a, x1_out)
+        rows.put(pos, b, x2_out)
 
-    if approach.all():
-        k = slice(None)  # the usual case: no index array needed
-    elif approach.any():
-        k = np.flatnonzero(approach)
-    else:
-        return Collisions.empty()
-    gap = np.hypot(*(x1[k] - x2[k]).T) - reach[k]
-    contact = contact_from[k] + n[k] * radius[b[k]][:, None]
-    return Collisions(
-        a[k],
-        b[k],
-        n[k],
-        contact,
-        overlap[k],
-        gap,
-        x1_in[k],
-        x2_in[k],
-        x1[k],
-        x2[k],
-        v1_in[k],
-        v2_in[k],
-        v1[k],
-        v2[k],
-    )
+    contact = contact_from + n * r2[:, None]
+    record = Collisions(a, b, n, contact, overlap, reach, x1, x2, x1_out, x2_out, v1, v2, v1_out, v2_out)
+    if all_approach:
+        return record
+    hit = np.flatnonzero(approach)
+    return record.take(hit) if len(hit) else None

@@ -309,7 +309,8 @@ class AirTable:
         self.time_s = 0.0
         self.steps = 0
         self.collision_count = 0
-        self.last_collisions = collisions.Collisions.empty()
+        self._collision_records: list[collisions.Collisions] = []
+        self._last_collisions: collisions.Collisions | None = None
 
     def schedule(self, t_s: float, fn: Callable[[AirTable], None]) -> None:
         """Run fn(table) at the start of the first step at or after simulation time t_s."""
@@ -362,6 +363,13 @@ class AirTable:
             return np.zeros(2)
         return self.momentum_Ns() / self.mass_kg.sum()
 
+    @property
+    def last_collisions(self) -> collisions.Collisions:
+        """What the puck-puck collisions of the last step did (collisions.Collisions)."""
+        if self._last_collisions is None:  # joined on first read: most steps nobody asks
+            self._last_collisions = collisions.Collisions.concatenate(self._collision_records)
+        return self._last_collisions
+
     # ------------------------------------------------------------ the step
 
     def step(self, dt_s: float) -> None:
@@ -372,7 +380,7 @@ class AirTable:
         while self._events and self._events[0][0] <= self.time_s + 1e-9:
             _, _, fn = heapq.heappop(self._events)
             fn(self)
-        self.last_collisions = collisions.Collisions.empty()
+        self._collision_records, self._last_collisions = [], None
         if self._pucks.n:
             self._integrate(dt)
         self.time_s += dt
@@ -404,14 +412,15 @@ class AirTable:
     def _resolve_pucks(self, dt: float) -> None:
         pos, vel, radius, mass = self.pos_m, self.vel_mps, self.radius_m, self.mass_kg
         ci, cj = collisions.find_candidate_pairs(pos, radius)
-        i, j = collisions.overlapping_pairs(pos, radius, ci, cj)
-        found, moved = [], []
+        reach = collisions.pair_reach(radius, ci, cj)
+        i, j = collisions.overlapping_pairs(pos, ci, cj, reach)
+        records, moved = [], []
         for attempt in range(1 + EXTRA_PASSES):
             if len(i) == 0:
                 break
             if attempt < EXTRA_PASSES:
-                found.append(
-                    collisions.resolve_pairs(pos, vel, radius, mass, i, j, self.cr_puck, self.puck_correction, dt)
+                records += collisions.resolve_pairs(
+                    pos, vel, radius, mass, i, j, self.cr_puck, self.puck_correction, dt
                 )
             else:
                 collisions.push_apart(pos, radius, mass, i, j)
@@ -421,11 +430,11 @@ class AirTable:
             # Parting a pair can push one of its pucks into a third one that
             # was already handled: look again among the same candidates,
             # collide those pairs too, and at last just push apart what is left.
-            i, j = collisions.overlapping_pairs(pos, radius, ci, cj, min_overlap_m=OVERLAP_SLOP_M)
+            i, j = collisions.overlapping_pairs(pos, ci, cj, reach - OVERLAP_SLOP_M)
         if not moved:
             return
-        self.last_collisions = collisions.Collisions.concatenate([h for h in found if len(h)])
-        self.collision_count += len(self.last_collisions)
+        self._collision_records = records
+        self.collision_count += sum(len(r) for r in records)
         # Only pucks that pairs moved can have been pushed into a wall (a row
         # listed twice is just checked twice).
         rows = np.concatenate(moved)
