@@ -31,6 +31,9 @@ CORRECTION_MODES = ("off", "two-step", "perfect-kiss")
 # Below this many pucks, checking every pair with one numpy expression is
 # cheaper than building a grid.
 BRUTE_FORCE_MAX_PUCKS = 48
+# Small arrays: np.count_nonzero(mask) is a quarter of the cost of mask.all()
+# or mask.any(), whose Python-level wrappers dominate at a few dozen pairs.
+
 # A relative normal speed smaller than this (m/s) counts as "not moving": such
 # an overlap cannot be explained by the last step's motion.
 REST_SPEED_MPS = 1e-9
@@ -60,29 +63,28 @@ def resolve_walls(
     if len(pos) == 0:
         return 0
     p, r = (pos, radius) if only is None else (rows.take(pos, only), radius.take(only))
-    r = r[:, None]
-    below_by = r - p  # > 0: past the wall at 0
-    above_by = p + r - size_m  # > 0: past the far wall
-    if below_by.max() <= 0.0 and above_by.max() <= 0.0:
-        return 0  # the usual case: nobody touches a wall
-    past = (below_by > 0.0) | (above_by > 0.0)
-    out = np.flatnonzero(past[:, 0] | past[:, 1])
+    # Room between each puck's edge and the nearest wall, column by column:
+    # numpy broadcasts an (N, 1) radius against (N, 2) rows several times slower.
+    x, y = p[:, 0], p[:, 1]
+    width, height = size_m
+    room = np.minimum(np.minimum(x, y), np.minimum(width - x, height - y)) - r
+    if room.min() >= 0.0:
+        return 0  # the usual case: nobody is past a wall
+    out = np.flatnonzero(~(room >= 0.0))  # NaN counts as outside
     if only is not None:
         out = only.take(out)
     p, v = rows.take(pos, out), rows.take(vel, out)
     lo = radius.take(out)[:, None]
     hi = size_m - lo
     below, above = p < lo, p > hi
-    if correction:
-        target = np.where(below, 2.0 * lo - p, np.where(above, 2.0 * hi - p, p))
-    else:
-        target = np.where(below, lo, np.where(above, hi, p))
     into = (below & (v < 0.0)) | (above & (v > 0.0))
     rows.put(vel, out, np.where(into, -cr_wall * v, v))
-    # A mirror of a huge penetration can land past the opposite wall; a puck
-    # wider than the table sits in the middle.
-    clipped = np.clip(target, lo, np.maximum(hi, lo))
-    rows.put(pos, out, np.where(hi < lo, 0.5 * size_m, clipped))
+    # Mirrored by the penetration, or else left for the clamp below to put on the surface.
+    target = np.where(below, 2.0 * lo - p, np.where(above, 2.0 * hi - p, p)) if correction else p
+    # Clamp into [lo, hi]: a mirror of a huge penetration can land past the
+    # opposite wall. A puck wider than the table (lo > hi) sits in the middle.
+    half = 0.5 * size_m
+    rows.put(pos, out, np.minimum(np.maximum(target, np.minimum(lo, half)), np.maximum(hi, half)))
     return int(np.count_nonzero(into))
 
 
@@ -148,7 +150,7 @@ def overlapping_pairs(
     hit = np.flatnonzero(d[:, 0] + d[:, 1] < reach * reach)
     i, j = i.take(hit), j.take(hit)
     if len(i) > 1:
-        order = np.argsort(i * len(pos) + j)
+        order = np.lexsort((j, i))
         i, j = i.take(order), j.take(order)
     return i, j
 
@@ -176,23 +178,35 @@ def _grid_candidates(pos: np.ndarray, cell: float) -> tuple[np.ndarray, np.ndarr
     # a grid one cell short sends the neighbour look-ups out of bounds.
     # One margin cell on each side for the neighbours.
     nx, ny = int(cx.max()) + 3, int(cy.max()) + 3
-    key = (cx + 1) * ny + (cy + 1)
-    order = _argsort_cells(key, nx * ny)
-    skey = key[order]
-    count = np.bincount(skey, minlength=nx * ny)
+    n_cells = nx * ny
+    key = cx * ny + cy + (ny + 1)  # column-major cell number, shifted past the margin
+    order = _argsort_cells(key, n_cells)
+    skey = key.take(order)
+    # start[c]: where cell c begins in sorted order; one extra cell as the end.
+    count = np.bincount(skey, minlength=n_cells + 1)
     start = np.cumsum(count) - count
-    # Own cell, then four of the eight neighbours (the other four see this
-    # cell from their side): (0,0), (+1,-1), (+1,0), (+1,+1), (0,+1).
-    cells = skey + np.array([0, ny - 1, ny, ny + 1, 1])[:, None]
-    first = start[cells]
-    size = count[cells]
-    # In its own cell a puck pairs only with the pucks after it in sorted order.
+    # Each puck (at sorted position p, in cell c) looks at two runs of the
+    # sorted order: the pucks after it in its own cell together with cell
+    # c + 1 (the next one up), and the three cells of the next column
+    # c + ny - 1 .. c + ny + 1. The other four neighbours see it from their side.
     idx = np.arange(n)
-    size[0] -= idx + 1 - first[0]
+    first = start[skey + np.array([[0], [ny - 1]])]
     first[0] = idx + 1
-    busy = np.flatnonzero(size.ravel() != 0)  # most (puck, cell) slots are empty
-    a, b = _expand_ranges(busy % n, first.ravel()[busy], size.ravel()[busy])
-    return order[a], order[b]
+    stop = start[skey + np.array([[2], [ny + 2]])]
+    a, b = _expand_ranges(np.tile(idx, 2), first.ravel(), (stop - first).ravel())
+    return order.take(a), order.take(b)
+
+
+def _expand_ranges(owner: np.ndarray, first: np.ndarray, count: np.ndarray):
+    """For each k, pair owner[k] with first[k], first[k]+1, ..., first[k]+count[k]-1."""
+    total = int(count.sum())
+    if total == 0:
+        empty = np.empty(0, dtype=np.intp)
+        return empty, empty
+    offset = np.cumsum(count) - count
+    a = np.repeat(owner, count)
+    b = np.repeat(first - offset, count) + np.arange(total)
+    return a, b
 
 
 def _argsort_cells(key: np.ndarray, n_cells: int) -> np.ndarray:
@@ -204,18 +218,6 @@ def _argsort_cells(key: np.ndarray, n_cells: int) -> np.ndarray:
         low = np.argsort((key & 0xFFFF).astype(np.uint16), kind="stable")
         return low[np.argsort((key[low] >> 16).astype(np.uint16), kind="stable")]
     return np.argsort(key, kind="stable")
-
-
-def _expand_ranges(owner: np.ndarray, start: np.ndarray, count: np.ndarray):
-    """For each k, pair owner[k] with start[k], start[k]+1, ..., start[k]+count[k]-1."""
-    total = int(count.sum())
-    if total == 0:
-        empty = np.empty(0, dtype=np.intp)
-        return empty, empty
-    offset = np.cumsum(count) - count
-    a = np.repeat(owner, count)
-    b = np.repeat(start - offset, count) + np.arange(total)
-    return a, b
 
 
 # ---------------------------------------------------------------- pair response
@@ -284,19 +286,23 @@ def disjoint_rounds(i: np.ndarray, j: np.ndarray, n: int) -> list[np.ndarray]:
     m = len(i)
     if m == 0:
         return []
-    if np.bincount(np.concatenate([i, j]), minlength=n).max() == 1:
+    uses = np.bincount(np.concatenate([i, j]), minlength=n)
+    if uses.max() == 1:
         return [np.arange(m)]  # the common case: no puck in two pairs
-    # level[k] = how many earlier pairs form a chain into pair k. One pass in
-    # Python: the pairs of one step are a few per cent of the pucks.
-    busy_until = [0] * n  # per puck: first level at which it is free again
-    level = [0] * m
-    for k, (a, b) in enumerate(zip(i.tolist(), j.tolist(), strict=True)):
-        lvl = max(busy_until[a], busy_until[b])
-        level[k] = lvl
+    # A pair whose pucks are in no other pair can go in any round: the first.
+    # For the others, level[k] = how many earlier pairs form a chain into
+    # pair k. One pass in Python over just those, a handful per step.
+    shared = np.flatnonzero((uses.take(i) > 1) | (uses.take(j) > 1))
+    busy_until: dict[int, int] = {}  # per puck: first level at which it is free again
+    levels = []
+    for a, b in zip(i.take(shared).tolist(), j.take(shared).tolist(), strict=True):
+        lvl = max(busy_until.get(a, 0), busy_until.get(b, 0))
+        levels.append(lvl)
         busy_until[a] = busy_until[b] = lvl + 1
-    level = np.asarray(level)
+    level = np.zeros(m, dtype=np.intp)
+    level[shared] = levels
     order = np.argsort(level, kind="stable")
-    bounds = np.searchsorted(level[order], np.arange(int(level.max()) + 2))
+    bounds = np.searchsorted(level.take(order), np.arange(max(levels) + 2))
     return [order[bounds[r] : bounds[r + 1]] for r in range(len(bounds) - 1)]
 
 
@@ -351,7 +357,7 @@ def lengths(d: np.ndarray) -> np.ndarray:
 def unit_vectors(d: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Unit vectors along the rows of d and their lengths; zero rows get a fixed normal."""
     dist = lengths(d)
-    if dist.all():
+    if np.count_nonzero(dist) == len(dist):
         return d / dist[:, None], dist
     safe = dist > 0.0
     n = np.where(safe[:, None], d / np.where(safe, dist, 1.0)[:, None], _FALLBACK_NORMAL)
@@ -372,7 +378,7 @@ def _resolve_round(pos, vel, radius, mass, a, b, cr, mode, dt_s) -> Collisions |
     reach = radius.take(a) + r2
     n, dist = unit_vectors(x1 - x2)
     overlap = reach - dist
-    if overlap.min() <= 0.0:  # an earlier round already parted some pairs
+    if np.count_nonzero(overlap > 0.0) < len(overlap):  # an earlier round already parted some pairs
         keep = np.flatnonzero(overlap > 0.0)
         if len(keep) == 0:
             return None
@@ -421,7 +427,7 @@ def _resolve_round(pos, vel, radius, mass, a, b, cr, mode, dt_s) -> Collisions |
             approach = np.where(kiss, vnk < 0.0, approach)
             move = np.where(kiss, -(1.0 + cr) * vnk * t_b[:, 0], move)
 
-    all_approach = approach.all()
+    all_approach = np.count_nonzero(approach) == len(approach)
     jn = -(1.0 + cr) * vn  # change of relative normal speed
     if not all_approach:
         jn = np.where(approach, jn, 0.0)
@@ -439,7 +445,7 @@ def _resolve_round(pos, vel, radius, mass, a, b, cr, mode, dt_s) -> Collisions |
         # other, or capped above) is pushed apart by mass-weighted shares.
         n_now, dist_now = unit_vectors(x1_out - x2_out)
         left = reach - dist_now
-        if left.max() > 0.0:
+        if np.count_nonzero(left > 0.0):
             left = np.maximum(left, 0.0)
             x1_out = x1_out + (left * share1)[:, None] * n_now
             x2_out = x2_out - (left * share2)[:, None] * n_now

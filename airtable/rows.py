@@ -6,7 +6,8 @@ more per row than the same operation on a 1-D array. The physics step does
 little else with its index arrays, so it uses these helpers instead: `take`
 gathers with `ndarray.take`, and `put` and `add_at` see each row of two float64
 numbers as one complex number, which turns the array into a 1-D one without
-copying. The results are exactly those of plain indexing.
+copying (so the target must be C-contiguous float64, as the table's columns
+are). The results are exactly those of plain indexing.
 """
 
 from __future__ import annotations
@@ -24,21 +25,11 @@ def _as_complex(a: np.ndarray) -> np.ndarray:
     return a.view(np.complex128).reshape(-1)
 
 
-def _vectors_fit(a: np.ndarray) -> bool:
-    return a.dtype == np.float64 and a.ndim == 2 and a.shape[1] == 2 and a.flags.c_contiguous
-
-
 def put(a: np.ndarray, idx: np.ndarray, values: np.ndarray) -> None:
-    """a[idx] = values, in place (the last write wins where idx repeats)."""
-    if _vectors_fit(a):
-        _as_complex(a)[idx] = _as_complex(np.ascontiguousarray(values, dtype=np.float64))
-    else:
-        a[idx] = values
+    """a[idx] = values for an (N, 2) float64 array, in place (the last write wins where idx repeats)."""
+    _as_complex(a)[idx] = _as_complex(np.ascontiguousarray(values, dtype=np.float64))
 
 
 def add_at(a: np.ndarray, idx: np.ndarray, values: np.ndarray) -> None:
-    """np.add.at(a, idx, values), in place: repeated rows add up."""
-    if _vectors_fit(a):
-        np.add.at(_as_complex(a), idx, _as_complex(np.ascontiguousarray(values, dtype=np.float64)))
-    else:
-        np.add.at(a, idx, values)
+    """np.add.at(a, idx, values) for an (N, 2) float64 array, in place: repeated rows add up."""
+    np.add.at(_as_complex(a), idx, _as_complex(np.ascontiguousarray(values, dtype=np.float64)))

@@ -390,18 +390,20 @@ class AirTable:
         pos, vel, force = self.pos_m, self.vel_mps, self.force_N
         mass, radius = self.mass_kg, self.radius_m
         if dt > 0.0:
-            drag = np.zeros(len(mass))
+            drag = np.zeros(len(mass)) if self.clients else None
             self._add_cursor_forces(force, drag, dt)
             self._add_spring_forces(force, dt)
+            if force.any():
+                vel += force * (dt / mass)[:, None]
             if self.gravity_on:
-                force[:, 1] -= mass * GRAVITY_MPS2
-            vel += force / mass[:, None] * dt
-            if self.clients and drag.any():
+                vel[:, 1] -= GRAVITY_MPS2 * dt
+            if drag is not None and drag.any():
                 # The strings' drag -c v is taken at the end of the step
                 # (backward Euler), which stays stable for any c and mass.
                 vel /= (1.0 + drag * dt / mass)[:, None]
-            speed = np.hypot(vel[:, 0], vel[:, 1])
-            if speed.max() > MAX_SPEED_MPS:
+            # A cheap bound first: a speed over the limit has a component over limit / sqrt(2).
+            if np.abs(vel).max() > MAX_SPEED_MPS / math.sqrt(2.0):
+                speed = np.hypot(vel[:, 0], vel[:, 1])
                 vel *= np.minimum(1.0, MAX_SPEED_MPS / np.maximum(speed, 1e-300))[:, None]
             pos += vel * dt
         force[:] = 0.0
@@ -471,7 +473,7 @@ class AirTable:
             np.add.at(force, a, f1)
             np.add.at(force, b, -f1)
 
-    def _add_cursor_forces(self, force: np.ndarray, drag: np.ndarray, dt: float) -> None:
+    def _add_cursor_forces(self, force: np.ndarray, drag: np.ndarray | None, dt: float) -> None:
         for row, f, c in self._cursor_strings(dt):
             force[row] += f
             drag[row] += c
