@@ -8,8 +8,9 @@ One `step(dt_s)`, in the order of the course's game loop:
 1. forces: cursor strings, springs, gravity;
 2. semi-implicit Euler: v += F/m dt, then x += v dt;
 3. walls;
-4. puck pairs: broadphase, then sequential collision + position correction,
-   then a second look at the pairs the corrections pushed into overlap;
+4. puck pairs: the candidates from a neighbour list (a grid rebuilds it every
+   few steps), then sequential collision + position correction, then a second
+   look at the pairs the corrections pushed into overlap;
 5. walls again, since pushing pairs apart can push a puck into a wall.
 """
 
@@ -124,6 +125,7 @@ class AirTable:
             color=((3,), np.uint8),
         )
         self._puck_handles: list[Puck] = []
+        self._neighbours = collisions.NeighbourList()
         self._spring_handles: list[Spring] = []
         self._events: list[tuple[float, int, Callable[[AirTable], None]]] = []
         self._event_seq = itertools.count()
@@ -413,8 +415,7 @@ class AirTable:
 
     def _resolve_pucks(self, dt: float) -> None:
         pos, vel, radius, mass = self.pos_m, self.vel_mps, self.radius_m, self.mass_kg
-        ci, cj = collisions.find_candidate_pairs(pos, radius)
-        reach = collisions.pair_reach(radius, ci, cj)
+        ci, cj, reach = self._neighbours.pairs(pos, radius)
         i, j = collisions.overlapping_pairs(pos, ci, cj, reach)
         records, moved = [], []
         for attempt in range(1 + EXTRA_PASSES):
@@ -427,8 +428,8 @@ class AirTable:
             else:
                 collisions.push_apart(pos, radius, mass, i, j)
             moved += [i, j]
-            if self.puck_correction == "off":
-                break  # overlaps stay: that is what "off" shows
+            if self.puck_correction == "off" or attempt == EXTRA_PASSES:
+                break  # with "off" overlaps stay: that is what it shows
             # Parting a pair can push one of its pucks into a third one that
             # was already handled: look again among the same candidates,
             # collide those pairs too, and at last just push apart what is left.
@@ -439,8 +440,8 @@ class AirTable:
         self.collision_count += sum(len(r) for r in records)
         # Only pucks that pairs moved can have been pushed into a wall (a row
         # listed twice is just checked twice).
-        rows = np.concatenate(moved)
-        collisions.resolve_walls(pos, vel, radius, self.size_m, self.cr_wall, self.wall_correction, only=rows)
+        moved_rows = np.concatenate(moved)
+        collisions.resolve_walls(pos, vel, radius, self.size_m, self.cr_wall, self.wall_correction, only=moved_rows)
 
     def _spring_forces(self, dt: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """(rows of p1, rows of p2, force on p1) for every spring; p2 gets minus that."""

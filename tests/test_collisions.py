@@ -305,6 +305,64 @@ def test_broadphase_lattice_of_touching_pucks(r: float) -> None:
     assert np.array_equal(i, bi) and np.array_equal(j, bj)
 
 
+def pairs_closer_than(pos: np.ndarray, radius: np.ndarray, margin_m: float) -> set[tuple[int, int]]:
+    """Every pair (i < j) closer than its reach plus margin_m, checked one by one."""
+    out = set()
+    for a in range(len(pos)):
+        for b in range(a + 1, len(pos)):
+            if math.dist(pos[a], pos[b]) < radius[a] + radius[b] + margin_m:
+                out.add((a, b))
+    return out
+
+
+@settings(max_examples=100, deadline=None, derandomize=True)
+@given(puck_sets(), st.floats(0.0, 1.0))
+def test_broadphase_with_a_margin_finds_every_pair_within_it(pucks: tuple[np.ndarray, np.ndarray], margin: float):
+    pos, radius = pucks
+    i, j = collisions.find_candidate_pairs(pos, radius, margin_m=margin)
+    assert np.all(i < j) and len(set(zip(i.tolist(), j.tolist(), strict=True))) == len(i)  # each pair once
+    assert pairs_closer_than(pos, radius, margin) <= set(zip(i.tolist(), j.tolist(), strict=True))
+
+
+def test_neighbour_list_finds_every_overlap_as_pucks_drift_jump_and_grow() -> None:
+    rng = np.random.default_rng(7)
+    n, r = 400, 0.1
+    pos = rng.uniform(0.0, 6.0, (n, 2))
+    radius = np.full(n, r)
+    neighbours = collisions.NeighbourList()
+    skin = collisions.SKIN_RADII * r
+
+    def check() -> None:
+        i, j = collisions.overlapping_pairs(pos, *neighbours.pairs(pos, radius))
+        bi, bj = collisions.brute_force_pairs(pos, radius)
+        assert np.array_equal(i, bi) and np.array_equal(j, bj)
+
+    check()
+    for _ in range(60):  # drift: each step a tenth of the skin at most, so the list is reused
+        pos += rng.uniform(-1.0, 1.0, (n, 2)) * (0.1 * skin / math.sqrt(2.0))
+        check()
+    assert neighbours.builds < 30
+    builds = neighbours.builds
+    pos[5] = pos[17]  # one puck jumps onto another (a teacher's drag, a demo's reset)
+    check()
+    assert neighbours.builds == builds + 1
+    radius[40] = 2.0  # a radius changed by hand
+    check()
+    assert neighbours.builds == builds + 2
+
+
+def test_a_puck_added_onto_another_collides_at_once() -> None:
+    table = AirTable()
+    for k in range(60):  # enough pucks for the grid, all at rest and apart
+        table.add_puck(pos_m=(0.5 + 0.6 * (k % 15), 0.5 + 0.6 * (k // 15)), radius_m=0.2)
+    table.step(1 / 120)
+    table.step(1 / 120)
+    hit = table.add_puck(pos_m=(0.5, 0.8), radius_m=0.2, vel_mps=(0.0, -1.0))  # 0.1 m into puck 0
+    table.step(1 / 120)
+    pairs = set(zip(table.last_collisions.i.tolist(), table.last_collisions.j.tolist(), strict=True))
+    assert (0, hit.index) in pairs
+
+
 @st.composite
 def pair_lists(draw) -> tuple[np.ndarray, np.ndarray, int]:
     n = draw(st.integers(2, 12))
