@@ -495,10 +495,10 @@ def _resolve_round(pos, vel, radius, mass, a, b, cr, mode, dt_s) -> Collisions |
         x2_out = x2 - (move * share2)[:, None] * n
         # Whatever still overlaps (separating, resting, created on top of each
         # other, or capped above) is pushed apart by mass-weighted shares.
-        n_now, dist_now = unit_vectors(x1_out - x2_out)
-        left = reach - dist_now
-        if np.count_nonzero(left > 0.0):
-            left = np.maximum(left, 0.0)
+        d = x1_out - x2_out
+        if np.count_nonzero(dot_rows(d, d) < reach * reach):
+            n_now, dist_now = unit_vectors(d)
+            left = np.maximum(reach - dist_now, 0.0)
             x1_out = x1_out + (left * share1)[:, None] * n_now
             x2_out = x2_out - (left * share2)[:, None] * n_now
         rows.put(pos, a, x1_out)

@@ -395,7 +395,7 @@ class AirTable:
             drag = np.zeros(len(mass)) if self.clients else None
             self._add_cursor_forces(force, drag, dt)
             self._add_spring_forces(force, dt)
-            if force.any():
+            if np.count_nonzero(force):  # usually nothing pushes: skip the (N, 2) update
                 vel += force * (dt / mass)[:, None]
             if self.gravity_on:
                 vel[:, 1] -= GRAVITY_MPS2 * dt
