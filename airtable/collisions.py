@@ -1,12 +1,13 @@
 """Collision detection and response for round pucks in a walled box.
 
-Everything here works on the table's numpy arrays in place and knows nothing of
-pygame. Three parts:
+Everything here works on the table's numpy arrays in place (rows gathered and
+scattered through rows.py) and knows nothing of pygame. Three parts:
 
 * `resolve_walls`: push pucks back inside the box, bounce them off the walls.
 * `find_overlapping_pairs`: the broadphase. A uniform grid in numpy finds the
   candidate pairs in O(N) work, pucks too big for the grid are checked against
   everyone by vectorised brute force, and small tables use brute force alone.
+  `NeighbourList` keeps the grid's pairs (widened by a skin) for several steps.
 * `resolve_pairs`: collide the overlapping pairs one pair at a time (Gauss-Seidel
   order), with one of three position corrections: "off", "two-step" and
   "perfect-kiss" (see DESIGN.md section 3 and the course's A10 notes).
@@ -36,9 +37,6 @@ BRUTE_FORCE_MAX_PUCKS = 48
 # pucks near 3 m/s) 1.5 radii lasts about four steps and was the fastest of
 # 0.5, 1, 1.5 and 2.
 SKIN_RADII = 1.5
-# Small arrays: np.count_nonzero(mask) is a quarter of the cost of mask.all()
-# or mask.any(), whose Python-level wrappers dominate at a few dozen pairs.
-
 # A relative normal speed smaller than this (m/s) counts as "not moving": such
 # an overlap cannot be explained by the last step's motion.
 REST_SPEED_MPS = 1e-9
@@ -409,6 +407,8 @@ def lengths(d: np.ndarray) -> np.ndarray:
 def unit_vectors(d: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Unit vectors along the rows of d and their lengths; zero rows get a fixed normal."""
     dist = lengths(d)
+    # np.count_nonzero, here and below, costs a quarter of .all() or .any(),
+    # whose Python-level wrappers dominate on a few dozen pairs.
     if np.count_nonzero(dist) == len(dist):
         return d / dist[:, None], dist
     safe = dist > 0.0

@@ -23,7 +23,7 @@ from collections.abc import Callable, Sequence
 
 import numpy as np
 
-from airtable import collisions
+from airtable import collisions, rows
 from airtable.bodies import Puck, Spring, as_vector
 from airtable.client import CURSOR_STRINGS
 from airtable.colors import rgb
@@ -448,11 +448,12 @@ class AirTable:
         pairs = self.spring_pairs
         a, b = pairs[:, 0], pairs[:, 1]
         pos, vel, mass = self.pos_m, self.vel_mps, self.mass_kg
-        n, dist = collisions.unit_vectors(pos[a] - pos[b])
-        mu = mass[a] * mass[b] / (mass[a] + mass[b])
+        n, dist = collisions.unit_vectors(rows.take(pos, a) - rows.take(pos, b))
+        m_a, m_b = mass.take(a), mass.take(b)
+        mu = m_a * m_b / (m_a + m_b)
         k = np.minimum(self.spring_k_Npm, STIFFNESS_LIMIT * mu / (dt * dt))
         c = np.minimum(self.spring_damper_Nspm, STIFFNESS_LIMIT * mu / dt)
-        vn = collisions.dot_rows(vel[a] - vel[b], n)
+        vn = collisions.dot_rows(rows.take(vel, a) - rows.take(vel, b), n)
         return a, b, (k * (self.spring_length_m - dist) - c * vn)[:, None] * n
 
     def _cursor_strings(self, dt: float) -> list[tuple[int, np.ndarray, float]]:
@@ -471,8 +472,8 @@ class AirTable:
     def _add_spring_forces(self, force: np.ndarray, dt: float) -> None:
         if self._springs.n:
             a, b, f1 = self._spring_forces(dt)
-            np.add.at(force, a, f1)
-            np.add.at(force, b, -f1)
+            rows.add_at(force, a, f1)
+            rows.add_at(force, b, -f1)
 
     def _add_cursor_forces(self, force: np.ndarray, drag: np.ndarray | None, dt: float) -> None:
         for row, f, c in self._cursor_strings(dt):
