@@ -29,7 +29,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from airtable import collisions
-from airtable.table import AirTable
+from airtable.table import AirTable, kinetic_energy_J
 
 # The gas scene (units in the names).
 RADIUS_M = 0.1
@@ -104,10 +104,6 @@ def deepest_overlap_m(pos_m: np.ndarray, radius_m: np.ndarray) -> float:
         return 0.0
     d = np.hypot(*(pos_m[i] - pos_m[j]).T)
     return float(np.max(radius_m[i] + radius_m[j] - d))
-
-
-def kinetic_energy_J(mass_kg: np.ndarray, vel_mps: np.ndarray) -> float:
-    return float(0.5 * np.dot(mass_kg, np.einsum("ij,ij->i", vel_mps, vel_mps)))
 
 
 # ---------------------------------------------------------------- engines
