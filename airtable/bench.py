@@ -102,8 +102,8 @@ def deepest_overlap_m(pos_m: np.ndarray, radius_m: np.ndarray) -> float:
     i, j = collisions.find_overlapping_pairs(pos_m, radius_m)
     if len(i) == 0:
         return 0.0
-    d = np.hypot(*(pos_m[i] - pos_m[j]).T)
-    return float(np.max(radius_m[i] + radius_m[j] - d))
+    gaps = collisions.lengths(pos_m[i] - pos_m[j]) - collisions.pair_reach(radius_m, i, j)
+    return float(-gaps.min())
 
 
 # ---------------------------------------------------------------- engines

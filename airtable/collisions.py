@@ -157,9 +157,7 @@ def overlapping_pairs(
 
 def _closer_than(pos: np.ndarray, i: np.ndarray, j: np.ndarray, reach: np.ndarray) -> np.ndarray:
     """Indices k of the pairs whose centres are less than reach[k] apart."""
-    d = rows.take(pos, i) - rows.take(pos, j)
-    d *= d
-    return np.flatnonzero(d[:, 0] + d[:, 1] < reach * reach)
+    return np.flatnonzero(squared_lengths(rows.take(pos, i) - rows.take(pos, j)) < reach * reach)
 
 
 class NeighbourList:
@@ -190,9 +188,8 @@ class NeighbourList:
             return False
         if np.count_nonzero(radius != self._built_radius):
             return False  # a radius was changed by hand
-        d = pos - self._built_pos
-        d *= d
-        return bool((d[:, 0] + d[:, 1]).max() < self._half_skin_sq)  # NaN: not valid
+        moved_sq = squared_lengths(pos - self._built_pos)
+        return bool(moved_sq.max() < self._half_skin_sq)  # NaN: not valid
 
     def _build(self, pos: np.ndarray, radius: np.ndarray) -> None:
         skin = SKIN_RADII * float(radius.mean()) if len(radius) else 0.0
@@ -398,10 +395,15 @@ def push_apart(pos: np.ndarray, radius: np.ndarray, mass: np.ndarray, i: np.ndar
     rows.add_at(pos, j, -push * m_i[:, None])
 
 
+def squared_lengths(d: np.ndarray) -> np.ndarray:
+    """Squared length of each row of d (two numpy operations on the whole array)."""
+    dd = d * d
+    return dd[:, 0] + dd[:, 1]
+
+
 def lengths(d: np.ndarray) -> np.ndarray:
     """Length of each row of d."""
-    dd = d * d
-    return np.sqrt(dd[:, 0] + dd[:, 1])
+    return np.sqrt(squared_lengths(d))
 
 
 def unit_vectors(d: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -437,8 +439,9 @@ def _resolve_round(pos, vel, radius, mass, a, b, cr, mode, dt_s) -> Collisions |
         a, b, x1, x2, r2, reach, n, overlap = (v.take(keep, axis=0) for v in (a, b, x1, x2, r2, reach, n, overlap))
     v1, v2 = rows.take(vel, a), rows.take(vel, b)
     m1, m2 = mass.take(a), mass.take(b)
-    share1 = m2 / (m1 + m2)  # puck 1's part of a change in relative motion
-    share2 = m1 / (m1 + m2)
+    m_sum = m1 + m2
+    share1 = m2 / m_sum  # puck 1's part of a change in relative motion
+    share2 = m1 / m_sum
     vrel = v1 - v2
     vn = dot_rows(vrel, n)
     contact_from = x2
@@ -458,9 +461,9 @@ def _resolve_round(pos, vel, radius, mass, a, b, cr, mode, dt_s) -> Collisions |
         # Back up along the full relative motion to first contact,
         # |d - vrel t| = reach with t > 0 (the larger root), and collide there.
         d = x1 - x2
-        vv = dot_rows(vrel, vrel)
+        vv = squared_lengths(vrel)
         dv = dot_rows(d, vrel)
-        disc = np.maximum(dv * dv - vv * (dot_rows(d, d) - reach * reach), 0.0)
+        disc = np.maximum(dv * dv - vv * (squared_lengths(d) - reach * reach), 0.0)
         moving = vv > REST_SPEED_MPS**2
         t_back = (dv + np.sqrt(disc)) / np.where(moving, vv, 1.0)
         # Only an overlap that this step's motion explains can be backed up.
@@ -496,7 +499,7 @@ def _resolve_round(pos, vel, radius, mass, a, b, cr, mode, dt_s) -> Collisions |
         # Whatever still overlaps (separating, resting, created on top of each
         # other, or capped above) is pushed apart by mass-weighted shares.
         d = x1_out - x2_out
-        if np.count_nonzero(dot_rows(d, d) < reach * reach):
+        if np.count_nonzero(squared_lengths(d) < reach * reach):
             n_now, dist_now = unit_vectors(d)
             left = np.maximum(reach - dist_now, 0.0)
             x1_out = x1_out + (left * share1)[:, None] * n_now
