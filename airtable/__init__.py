@@ -1,7 +1,7 @@
 """airtable: a 2D air-table physics engine and multiplayer teaching app.
 
 `import airtable` gives the physics and the network client without importing
-pygame; the window lives in `airtable.window`.
+pygame; the window lives in `airtable.app.window`.
 """
 
 import os
@@ -9,10 +9,10 @@ import os
 # pygame-ce prints a banner on import; the app has its own window title.
 os.environ.setdefault("PYGAME_HIDE_SUPPORT_PROMPT", "1")
 
-from airtable.bodies import Puck, Spring
-from airtable.client import Client
-from airtable.environment import Environment
-from airtable.table import AirTable
+from airtable.app.client import Client
+from airtable.app.environment import Environment
+from airtable.physics.bodies import Puck, Spring
+from airtable.physics.table import AirTable
 
 __all__ = ["AirTable", "Puck", "Spring", "Environment", "Client"]
 __version__ = "0.1.0"

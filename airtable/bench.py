@@ -28,8 +28,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from airtable import collisions
-from airtable.table import AirTable, kinetic_energy_J
+from airtable.physics import collisions
+from airtable.physics.table import AirTable, kinetic_energy_J
 
 # The gas scene (units in the names).
 RADIUS_M = 0.1
@@ -413,8 +413,8 @@ def frames_section(args: argparse.Namespace) -> bool:
     import os
 
     os.environ.setdefault("SDL_VIDEODRIVER", "dummy")
-    from airtable.app import App
-    from airtable.demo_loader import BUILTIN_DIR, discover
+    from airtable.app.app import App
+    from airtable.app.demo_loader import BUILTIN_DIR, discover
 
     demos, _ = discover([BUILTIN_DIR])
     burst = demos["0"]

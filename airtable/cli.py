@@ -16,8 +16,9 @@ from pathlib import Path
 
 import pygame
 
-from airtable.app import App
-from airtable.demo_loader import BUILTIN_DIR, Demo, DemoError, discover, key_order
+from airtable.app.app import App
+from airtable.app.demo_loader import BUILTIN_DIR, Demo, DemoError, discover, key_order
+from airtable.assets import ASSETS_DIR
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -93,7 +94,7 @@ def write_starter_demo(path: Path) -> Path:
         raise ValueError(f"{path}: a demo file name must end in .py")
     if path.exists():
         raise ValueError(f"{path} already exists; choose another name or delete it first")
-    starter = Path(__file__).resolve().parent / "assets" / "starter_demo.py.txt"
+    starter = ASSETS_DIR / "starter_demo.py.txt"
     path.parent.mkdir(parents=True, exist_ok=True)
     path.write_text(starter.read_text(encoding="utf-8"), encoding="utf-8")
     return path

@@ -13,7 +13,7 @@ import pytest  # noqa: E402  (after the SDL settings above, which must come firs
 @pytest.fixture(scope="session")
 def demos():
     """The built-in demos by key, loaded once."""
-    from airtable.demo_loader import BUILTIN_DIR, discover
+    from airtable.app.demo_loader import BUILTIN_DIR, discover
 
     found, errors = discover([BUILTIN_DIR])
     assert not errors

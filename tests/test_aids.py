@@ -8,11 +8,11 @@ import numpy as np
 import pygame
 import pytest
 
-from airtable import aids
-from airtable.app import App
+from airtable.app import aids
+from airtable.app.app import App
+from airtable.app.demo_loader import BUILTIN_DIR, discover
 from airtable.cli import main
-from airtable.demo_loader import BUILTIN_DIR, discover
-from airtable.table import AirTable
+from airtable.physics.table import AirTable
 
 FRAME_S = 1 / 60
 

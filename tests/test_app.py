@@ -6,7 +6,7 @@ import numpy as np
 import pygame
 import pytest
 
-from airtable.app import App
+from airtable.app.app import App
 from airtable.cli import main
 
 FRAME_S = 1 / 60
@@ -254,7 +254,7 @@ def test_readme_lists_every_key_of_the_key_table():
     """The help screen and README both come from BINDINGS; keep the README in step."""
     from pathlib import Path
 
-    from airtable.app import BINDINGS
+    from airtable.app.app import BINDINGS
 
     readme = (Path(__file__).resolve().parent.parent / "README.md").read_text(encoding="utf-8")
     for binding in BINDINGS:

@@ -7,8 +7,9 @@ import math
 import numpy as np
 import pytest
 
-from airtable import AirTable, collisions
+from airtable import AirTable
 from airtable.bench import gas_scene, main
+from airtable.physics import collisions
 
 
 def test_gas_scene_covers_30_percent_without_overlaps() -> None:

@@ -13,8 +13,9 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from airtable import AirTable, collisions
+from airtable import AirTable
 from airtable.bench import gas_scene
+from airtable.physics import collisions
 
 MODES = collisions.CORRECTION_MODES
 

@@ -10,10 +10,10 @@ import re
 
 import numpy as np
 import pytest
+from airtable.demos import _correction_comparison as correction_scene
 
 from airtable import AirTable
-from airtable.demo_loader import BUILTIN_DIR, discover
-from airtable.demos import _correction_comparison as correction_scene
+from airtable.app.demo_loader import BUILTIN_DIR, discover
 
 DEMOS, ERRORS = discover([BUILTIN_DIR])
 ORANGE = (255, 165, 0)

@@ -6,10 +6,10 @@ import numpy as np
 import pygame
 import pytest
 
+from airtable.app.demo_loader import BUILTIN_DIR, discover
+from airtable.app.environment import Environment
 from airtable.cli import main
-from airtable.demo_loader import BUILTIN_DIR, discover
-from airtable.environment import Environment
-from airtable.table import AirTable
+from airtable.physics.table import AirTable
 
 DEMOS, _ = discover([BUILTIN_DIR])
 HUD_PX = 30  # title line at the top, status bar at the bottom

@@ -11,12 +11,12 @@ import pygame
 import pytest
 from test_server import RawClient, wait_until
 
+from airtable.app.scene import CursorView
+from airtable.app.window import background_for
 from airtable.net import protocol as proto
 from airtable.net.loadtest import TableLoop, grid_table
 from airtable.net.player import InputThrottle, NetPlayer, PlayerApp, PlayerError, _own_cursor_live, main
 from airtable.net.server import GameServer
-from airtable.scene import CursorView
-from airtable.window import background_for
 
 
 @pytest.fixture

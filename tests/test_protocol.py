@@ -12,8 +12,8 @@ from hypothesis import strategies as st
 from hypothesis.extra import numpy as hnp
 
 from airtable import AirTable, Client
+from airtable.app.scene import CursorView, Scene
 from airtable.net import protocol as proto
-from airtable.scene import CursorView, Scene
 
 
 def scenes_equal(a: Scene, b: Scene) -> bool:

@@ -15,12 +15,12 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from airtable import AirTable, Client
-from airtable.client import LOCAL_COLOR
+from airtable.app.client import LOCAL_COLOR
+from airtable.app.scene import Scene
 from airtable.colors import rgb
 from airtable.net import protocol as proto
 from airtable.net.loadtest import TableLoop, grid_table, run_load
 from airtable.net.server import COURSE_COLORS, GameServer, client_color, lan_addresses
-from airtable.scene import Scene
 
 WAIT_S = 5.0
 

@@ -14,7 +14,7 @@ import pytest
 
 from airtable import AirTable, Client
 from airtable.bench import gas_scene
-from airtable.table import GRAVITY_MPS2
+from airtable.physics.table import GRAVITY_MPS2
 
 
 def assert_sane(table: AirTable) -> None:
@@ -301,8 +301,8 @@ def test_same_scene_gives_bit_identical_state() -> None:
 def test_physics_modules_do_not_import_pygame() -> None:
     code = (
         "import sys\n"
-        "import airtable, airtable.table, airtable.collisions, airtable.environment\n"
-        "import airtable.bodies, airtable.client, airtable.scene\n"
+        "import airtable, airtable.physics.table, airtable.physics.collisions, airtable.app.environment\n"
+        "import airtable.physics.bodies, airtable.app.client, airtable.app.scene\n"
         "bad = sorted(m for m in sys.modules if m == 'pygame' or m.startswith('pygame.'))\n"
         "assert not bad, bad\n"
     )

@@ -36,12 +36,12 @@ from collections import deque
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 
-from airtable.client import Client
+from airtable.app.client import Client
+from airtable.app.scene import Scene
 from airtable.net import protocol as proto
 from airtable.net.player import NetPlayer, PlayerError
 from airtable.net.server import GameServer
-from airtable.scene import Scene
-from airtable.table import AirTable
+from airtable.physics.table import AirTable
 
 MAX_CLIENTS = 200
 MAX_SECONDS = 600.0

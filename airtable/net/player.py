@@ -25,8 +25,8 @@ from collections.abc import Callable, Iterable, Sequence
 
 import numpy as np
 
+from airtable.app.scene import CursorView, Scene
 from airtable.net import protocol as proto
-from airtable.scene import CursorView, Scene
 
 CONNECT_TIMEOUT_S = 5.0
 SILENCE_S = 10.0  # no snapshot for this long: the server is gone (snapshots come 30 times a second)
@@ -398,8 +398,8 @@ class PlayerApp:
         Closes the connection when it ends, but leaves pygame running (main() quits it)."""
         import pygame
 
-        from airtable.environment import DEFAULT_SIZE_PX, Environment
-        from airtable.window import GameWindow
+        from airtable.app.environment import DEFAULT_SIZE_PX, Environment
+        from airtable.app.window import GameWindow
 
         net = self.net
         welcome = net.welcome

@@ -21,7 +21,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from airtable.scene import CursorView, Scene
+from airtable.app.scene import CursorView, Scene
 
 PROTOCOL_VERSION = 1
 DEFAULT_PORT = 8888

@@ -29,10 +29,10 @@ import threading
 import time
 from collections import deque
 
-from airtable.client import Client
+from airtable.app.client import Client
+from airtable.app.scene import Scene
 from airtable.colors import rgb
 from airtable.net import protocol as proto
-from airtable.scene import Scene
 
 log = logging.getLogger("airtable.net")
 

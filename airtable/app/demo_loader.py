@@ -23,7 +23,9 @@ from collections.abc import Callable, Iterable
 from dataclasses import dataclass, field
 from pathlib import Path
 
-BUILTIN_DIR = Path(__file__).resolve().parent / "demos"
+import airtable.demos
+
+BUILTIN_DIR = Path(airtable.demos.__file__).resolve().parent
 DEFAULT_DT_S = 1 / 240
 
 

@@ -15,7 +15,7 @@ import numpy as np
 from airtable.colors import rgb
 
 if TYPE_CHECKING:
-    from airtable.table import AirTable
+    from airtable.physics.table import AirTable
 
 
 def as_vector(value, what: str) -> np.ndarray:

@@ -12,7 +12,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from airtable.table import AirTable
+from airtable.physics.table import AirTable
 
 SLOW_MOTION_FACTORS = (1.0, 1 / 2, 1 / 4, 1 / 8, 1 / 16)
 ANNOTATION_LIFE_S = 3.0

@@ -23,11 +23,11 @@ from collections.abc import Callable, Sequence
 
 import numpy as np
 
-from airtable import collisions, rows
-from airtable.bodies import Puck, Spring, as_vector
-from airtable.client import CURSOR_STRINGS
+from airtable.app.client import CURSOR_STRINGS
 from airtable.colors import rgb
 from airtable.memory import keep_freed_memory
+from airtable.physics import collisions, rows
+from airtable.physics.bodies import Puck, Spring, as_vector
 
 GRAVITY_MPS2 = 9.8
 # Springs and cursor strings stiffer than a step can integrate are softened to
@@ -134,7 +134,7 @@ class AirTable:
         self._spring_handles: list[Spring] = []
         self._events: list[tuple[float, int, Callable[[AirTable], None]]] = []
         self._event_seq = itertools.count()
-        # Clients (airtable.client.Client) whose cursor strings pull on pucks;
+        # Clients (airtable.app.client.Client) whose cursor strings pull on pucks;
         # the app and the server share this list. Index 0 is the local user.
         self.clients: list = []
         self.reset_settings()

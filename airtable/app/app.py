@@ -18,13 +18,13 @@ from pathlib import Path
 import numpy as np
 import pygame
 
-from airtable import aids
-from airtable.client import LOCAL_COLOR, Client
-from airtable.demo_loader import Demo, DemoError, error_from_exception, key_label
-from airtable.environment import Environment
-from airtable.scene import Scene
-from airtable.table import AirTable
-from airtable.window import AidsPainter, GameWindow
+from airtable.app import aids
+from airtable.app.client import LOCAL_COLOR, Client
+from airtable.app.demo_loader import Demo, DemoError, error_from_exception, key_label
+from airtable.app.environment import Environment
+from airtable.app.scene import Scene
+from airtable.app.window import AidsPainter, GameWindow
+from airtable.physics.table import AirTable
 
 # A stalled frame (window dragged, laptop busy) runs at most this much
 # simulated time; the rest is dropped rather than exploding the physics.

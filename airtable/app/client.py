@@ -33,7 +33,7 @@ class Client:
     cursor_m: np.ndarray = field(default_factory=lambda: np.zeros(2))
     button: int = 0
     keys: frozenset[str] = frozenset()
-    held: object = None  # airtable.bodies.Puck or None
+    held: object = None  # airtable.physics.bodies.Puck or None
     active: bool = True
 
     def set_input(self, table, cursor_m, button: int, keys=frozenset()) -> None:

@@ -16,8 +16,9 @@ from pathlib import Path
 import numpy as np
 import pygame
 
-from airtable.environment import Environment
-from airtable.scene import Scene
+from airtable.app.environment import Environment
+from airtable.app.scene import Scene
+from airtable.assets import ASSETS_DIR
 
 BACKGROUND = (0, 0, 0)
 BACKGROUND_GRAVITY = (20, 20, 70)
@@ -54,9 +55,7 @@ class GameWindow:
             self.surface = pygame.Surface(env.size_px)
         else:
             self.surface = pygame.display.set_mode(env.size_px)
-            icon = Path(__file__).resolve().parent / "assets" / "icon.png"
-            if icon.exists():
-                pygame.display.set_icon(pygame.image.load(str(icon)))
+            pygame.display.set_icon(pygame.image.load(str(ASSETS_DIR / "icon.png")))
         self.set_caption(caption)
         self.font = pygame.font.Font(None, 22)
         self.big_font = pygame.font.Font(None, 40)

@@ -25,7 +25,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from airtable import rows
+from airtable.physics import rows
 
 CORRECTION_MODES = ("off", "two-step", "perfect-kiss")
 

@@ -1,0 +1,1 @@
+"""The physics engine: SI units, numpy, no pygame and no sockets."""
