@@ -29,6 +29,7 @@ from __future__ import annotations
 import math
 import struct
 import threading
+import time
 import zlib
 from dataclasses import dataclass
 
@@ -58,8 +59,8 @@ DEFLATED = 8
 GRAVITY = 1
 
 _ENVELOPE = struct.Struct(">IB")
-# magic, format, flags, seq, gap1, gap2, layout version, epoch, time_us, centi-fps, residual width
-_TICK = struct.Struct("<4sBBIBBHHqHB")
+# magic, format, flags, seq, gap1, gap2, layout version, epoch, time_us, server clock ms, centi-fps, residual width
+_TICK = struct.Struct("<4sBBIBBHHqIHB")
 _VIEW = struct.Struct("<3d")
 _TEXT_DELTA = struct.Struct("<HHH")
 # magic, format, flags, version, N, S, C, width_m, height_m
@@ -334,6 +335,7 @@ class Tick:
     layout: Layout
     epoch: int
     time_us: int
+    clock_ms: int  # the server's monotonic clock, milliseconds mod 2**32
     centi_fps: int
     view: tuple[float, float, float]  # zoom, origin_x_m, origin_y_m
     status: str
@@ -484,6 +486,7 @@ def encode_tick(tick: Tick, b1: Tick | None = None, b2: Tick | None = None) -> t
         tick.layout.version,
         tick.epoch & 0xFFFF,
         tick.time_us,
+        tick.clock_ms & 0xFFFFFFFF,
         tick.centi_fps,
         width,
     )
@@ -525,8 +528,9 @@ class SnapshotEncoder:
     def newest(self) -> Tick | None:
         return self._newest
 
-    def add(self, scene: Scene) -> Tick:
-        """Record the scene as the newest tick."""
+    def add(self, scene: Scene, clock_s: float | None = None) -> Tick:
+        """Record the scene as the newest tick; `clock_s` is the server's monotonic
+        clock (default: now), which lets players time their playout."""
         layout = layout_of(scene)
         old = self._layout
         if old is not None and layout.same_as(old):
@@ -547,6 +551,7 @@ class SnapshotEncoder:
             layout=layout,
             epoch=self._epoch,
             time_us=time_us,
+            clock_ms=int(round(1e3 * (time.monotonic() if clock_s is None else clock_s))) & 0xFFFFFFFF,
             centi_fps=min(max(round(fps * 100), 0), 0xFFFF),
             view=view,
             status=_clean_text(scene.status, MAX_STATUS_BYTES),
@@ -596,7 +601,8 @@ class Decoded:
     scene: Scene
     seq: int
     epoch: int
-    time_s: float
+    time_s: float  # simulation time
+    server_s: float  # the server's clock, counted from the first tick this player decoded
 
 
 @dataclass
@@ -606,6 +612,7 @@ class SnapshotDecoder:
     layout: Layout | None = None
     last: Tick | None = None
     prev: Tick | None = None
+    _clock_s: float = 0.0
 
     def feed_layout(self, payload: bytes) -> None:
         self.layout = decode_layout(payload)
@@ -615,7 +622,9 @@ class SnapshotDecoder:
         payload = bytes(payload)
         if len(payload) < _TICK.size:
             raise ProtocolError(f"the snapshot is only {len(payload)} bytes, less than its {_TICK.size} byte header")
-        magic, version, flags, seq, gap1, gap2, lv, epoch, time_us, centi_fps, width = _TICK.unpack_from(payload)
+        magic, version, flags, seq, gap1, gap2, lv, epoch, time_us, clock_ms, centi_fps, width = _TICK.unpack_from(
+            payload
+        )
         _check_magic(magic, version, TICK_MAGIC)
         layout = self.layout
         if layout is None or layout.version != lv:
@@ -645,9 +654,11 @@ class SnapshotDecoder:
                 raise _bad("a delta on a tick with another number of pucks or cursors")
             values = predict(time_us, 2 * n + 2 * c, b1, b2) + residuals
         _check_values(values, n, c)
-        tick = Tick(seq, layout, epoch, time_us, centi_fps, view, status, values)
+        tick = Tick(seq, layout, epoch, time_us, clock_ms, centi_fps, view, status, values)
+        if self.last is not None:  # unwrap the 32-bit millisecond clock
+            self._clock_s += ((clock_ms - self.last.clock_ms) & 0xFFFFFFFF) / 1e3
         self.prev, self.last = b1, tick
-        return Decoded(self._scene(tick), seq, epoch, time_us / 1e6)
+        return Decoded(self._scene(tick), seq, epoch, time_us / 1e6, self._clock_s)
 
     def _bases(self, flags: int, seq: int, gap1: int, gap2: int) -> tuple[Tick | None, Tick | None]:
         if flags & KEYFRAME:
