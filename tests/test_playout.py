@@ -7,11 +7,12 @@ import socket
 import threading
 
 import numpy as np
+import pytest
 
 from airtable.app.scene import CursorView, Scene
 from airtable.net import protocol as proto
-from airtable.net.codec import LAYOUT, SnapshotDecoder, SnapshotEncoder, Viewer
-from airtable.net.playout import PlayoutBuffer
+from airtable.net.codec import LAYOUT, SnapshotEncoder, Viewer
+from airtable.net.playout import PlayoutBuffer, SnapshotFeed
 
 SPEED_MPS = 1.0
 HZ = 30
@@ -131,41 +132,44 @@ def _serve(listener: socket.socket, count: int) -> None:
         conn.sendall(proto.encode_bye())
 
 
+def _receive_all(address) -> list[list[tuple[int, bytes]]]:
+    """Every frame until BYE, grouped: each SNAPSHOT with the LAYOUT frames before it."""
+    groups, group = [], []
+    with socket.create_connection(address, timeout=10) as sock:
+        reader = proto.FrameReader(proto.MAX_SERVER_FRAME, {proto.SNAPSHOT, LAYOUT, proto.BYE}, "the server")
+        while True:
+            data = sock.recv(65536)
+            assert data, "the scripted server hung up early"
+            for kind, payload in reader.feed(data):
+                if kind == proto.BYE:
+                    return groups
+                group.append((kind, payload))
+                if kind == proto.SNAPSHOT:
+                    groups.append(group)
+                    group = []
+
+
 def test_jittered_snapshots_through_a_real_socket_play_evenly():
-    """Format 2 over TCP on 127.0.0.1 into the playout buffer; arrival times are scripted
+    """Format 2 over TCP on 127.0.0.1 into a SnapshotFeed; arrival times are scripted
     (jittered by +-20 ms), so the result does not depend on this machine's timing."""
     count = 200
     with socket.create_server(("127.0.0.1", 0)) as listener:
         listener.settimeout(10)
         server = threading.Thread(target=_serve, args=(listener, count), daemon=True)
         server.start()
-        decoded = []
-        with socket.create_connection(listener.getsockname(), timeout=10) as sock:
-            reader = proto.FrameReader(proto.MAX_SERVER_FRAME, {proto.SNAPSHOT, LAYOUT, proto.BYE}, "the server")
-            decoder = SnapshotDecoder()
-            done = False
-            while not done:
-                data = sock.recv(65536)
-                assert data, "the scripted server hung up early"
-                for kind, payload in reader.feed(data):
-                    if kind == LAYOUT:
-                        decoder.feed_layout(payload)
-                    elif kind == proto.SNAPSHOT:
-                        decoded.append(decoder.feed_tick(payload))
-                    else:
-                        done = True
+        groups = _receive_all(listener.getsockname())
         server.join(timeout=10)
-    assert len(decoded) == count
+    assert len(groups) == count
     schedule = arrivals(0.02, count, 7)
-    by_arrival = [(arrival, d) for (arrival, _), d in zip(schedule, decoded, strict=True)]
-    buffer, drawn, i = PlayoutBuffer(), [], 0
+    feed, drawn, i = SnapshotFeed(), [], 0
     for j in range(360):
         now = CLIENT_CLOCK_S + 0.3 + j / FPS
-        while i < len(by_arrival) and by_arrival[i][0] <= now:
-            arrival, d = by_arrival[i]
-            buffer.push(d.server_s, d.scene, d.epoch, arrival)
+        while i < count and schedule[i][0] <= now:
+            for kind, payload in groups[i]:
+                feed.feed(kind, payload, schedule[i][0])
             i += 1
-        drawn.append(buffer.sample(now))
+        drawn.append(feed.scene(now))
     steps = frame_steps_mm(drawn)
     assert abs(steps.mean() - 1e3 * SPEED_MPS / FPS) < 0.1
     assert steps.std() < 0.2  # quantised to 0.25 mm on the wire, still even
+    assert feed.newest.pos_m[0, 0] == pytest.approx(1.0 + (i - 1) / HZ, abs=1e-3)  # the last one fed

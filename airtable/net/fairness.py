@@ -179,7 +179,6 @@ def measure_rates(
 
 def serve(demo_key: str, seconds: float, snapshot_format: int = 2) -> int:
     """A headless demo table with a server on 127.0.0.1:PORT, for `seconds` at most."""
-    from airtable.app.client import Client
     from airtable.app.demo_loader import BUILTIN_DIR, discover
     from airtable.net.loadtest import TableLoop
     from airtable.net.server import GameServer
@@ -189,7 +188,6 @@ def serve(demo_key: str, seconds: float, snapshot_format: int = 2) -> int:
     demo = demos[demo_key]
     table = AirTable()
     demo.build(table, 0)
-    table.clients.append(Client(name="local", active=False))
     options = {}
     if "snapshot_format" in inspect.signature(GameServer).parameters:  # until format 2 is the only one
         options["snapshot_format"] = snapshot_format

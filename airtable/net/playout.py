@@ -25,12 +25,14 @@ table into the new one.
 from __future__ import annotations
 
 import dataclasses
+import threading
 from collections import deque
 from dataclasses import dataclass
 
 import numpy as np
 
 from airtable.app.scene import Scene
+from airtable.net.codec import LAYOUT, SnapshotDecoder
 
 WINDOW_S = 2.0  # arrivals remembered for the offset, jitter and interval
 MAX_ARRIVALS = 240
@@ -149,3 +151,30 @@ def interpolate(a: Scene, b: Scene, alpha: float) -> Scene:
             c = dataclasses.replace(c, cursor_m=(x, y))
         cursors.append(c)
     return dataclasses.replace(b, pos_m=pos, cursors=tuple(cursors))
+
+
+class SnapshotFeed:
+    """The player's side of snapshot format 2: frames in (network thread), smooth Scenes
+    out (drawing thread). `feed` raises ProtocolError for a bad frame."""
+
+    def __init__(self) -> None:
+        self.decoder = SnapshotDecoder()
+        self.buffer = PlayoutBuffer()
+        self.newest: Scene | None = None  # as received, for code that wants no delay
+        self._lock = threading.Lock()
+
+    def feed(self, frame_type: int, payload: bytes, arrival_s: float) -> Scene | None:
+        """Take a LAYOUT or SNAPSHOT payload; returns the decoded Scene of a SNAPSHOT."""
+        if frame_type == LAYOUT:
+            self.decoder.feed_layout(payload)
+            return None
+        decoded = self.decoder.feed_tick(payload)
+        with self._lock:
+            self.buffer.push(decoded.server_s, decoded.scene, decoded.epoch, arrival_s)
+            self.newest = decoded.scene
+        return decoded.scene
+
+    def scene(self, now_s: float) -> Scene | None:
+        """What to draw at the player's clock `now_s` (None before the first snapshot)."""
+        with self._lock:
+            return self.buffer.sample(now_s)
