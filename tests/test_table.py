@@ -299,13 +299,15 @@ def test_same_scene_gives_bit_identical_state() -> None:
 # ---------------------------------------------------------------- imports
 
 
-def test_physics_modules_do_not_import_pygame() -> None:
+def test_physics_modules_do_not_import_pygame_or_tune_malloc() -> None:
     code = (
         "import sys\n"
         "import airtable, airtable.physics.table, airtable.physics.pairs, airtable.app.environment\n"
         "import airtable.physics.bodies, airtable.app.client, airtable.app.scene\n"
         "bad = sorted(m for m in sys.modules if m == 'pygame' or m.startswith('pygame.'))\n"
         "assert not bad, bad\n"
+        "airtable.AirTable().step(0.01)\n"
+        "assert 'airtable.memory' not in sys.modules, 'building a table must not tune the allocator'\n"
     )
     subprocess.run([sys.executable, "-c", code], check=True, timeout=60)
 

@@ -342,7 +342,7 @@ def _resolve_round(pos, vel, radius, mass, a, b, cr, mode, dt_s) -> Collisions |
     record = Collisions(
         g.a, g.b, out.n, contact, g.overlap, g.reach, g.x1, g.x2, out.x1, out.x2, g.v1, g.v2, out.v1, out.v2
     )
-    hit = np.flatnonzero(out.approach)
-    if len(hit) == len(out.approach):
+    if np.count_nonzero(out.approach) == len(out.approach):
         return record
+    hit = np.flatnonzero(out.approach)
     return record.take(hit) if len(hit) else None

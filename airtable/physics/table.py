@@ -71,9 +71,13 @@ class _Columns:
         self.n = 0
         self._cap = 0
         self._data = {name: np.zeros((0, *shape), dtype) for name, (shape, dtype) in specs.items()}
+        self._views: dict[str, np.ndarray] = {}  # the live rows of each column, until the row count changes
 
     def view(self, name: str) -> np.ndarray:
-        return self._data[name][: self.n]
+        v = self._views.get(name)
+        if v is None:
+            v = self._views[name] = self._data[name][: self.n]
+        return v
 
     def append(self, **values) -> int:
         if self.n == self._cap:
@@ -86,6 +90,7 @@ class _Columns:
         for name, value in values.items():
             self._data[name][row] = value
         self.n += 1
+        self._views = {}
         return row
 
     def delete(self, rows: np.ndarray) -> np.ndarray:
@@ -98,10 +103,12 @@ class _Columns:
             kept = self._data[name][: self.n][keep]
             self._data[name][: len(kept)] = kept
         self.n = int(keep.sum())
+        self._views = {}
         return remap
 
     def clear(self) -> None:
         self.n = 0
+        self._views = {}
 
 
 class AirTable:
