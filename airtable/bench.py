@@ -28,6 +28,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from airtable.bench_cpu import cpu_section
 from airtable.physics import collisions
 from airtable.physics.table import AirTable, kinetic_energy_J
 
@@ -465,6 +466,7 @@ def frames_section(args: argparse.Namespace) -> bool:
 SECTIONS: dict[str, Callable[[argparse.Namespace], bool]] = {
     "physics": physics_section,
     "frames": frames_section,
+    "cpu": cpu_section,
 }
 
 

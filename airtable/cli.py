@@ -138,29 +138,38 @@ def start_server(args):
 def screenshot_path(text: str) -> Path:
     """Where --screenshot saves: `.png` added if missing; ValueError if it cannot be written."""
     path = Path(text)
+    if path.is_dir():
+        raise ValueError(f"--screenshot {text}: that is a folder; give a file name like shot.png")
     if path.suffix.lower() != ".png":
         path = path.with_name(path.name + ".png")
-    folder = path.parent if str(path.parent) else Path(".")
-    if path.is_dir():
-        raise ValueError(f"--screenshot {path}: that is a folder; give a file name like shot.png")
+    folder = path.parent
     if not folder.is_dir():
         raise ValueError(f"--screenshot {path}: there is no folder {folder}")
-    if not os.access(folder, os.W_OK) or (path.exists() and not os.access(path, os.W_OK)):
-        raise ValueError(f"--screenshot {path}: cannot write there; choose a folder you may write to")
+    if path.is_dir() or not os.access(folder, os.W_OK) or (path.exists() and not os.access(path, os.W_OK)):
+        raise ValueError(f"--screenshot {path}: cannot write there; choose a file in a folder you may write to")
     return path
+
+
+NO_DISPLAY = "no display to open a window on (is DISPLAY set?); run with --headless to run without one"
 
 
 def check_display() -> str | None:
     """None if a window can open; else a sentence saying why not and what to do."""
+    asked = os.environ.get("SDL_VIDEODRIVER", "")
+    if (
+        sys.platform.startswith("linux")
+        and not asked
+        and not (os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY"))
+    ):
+        return NO_DISPLAY  # asking SDL would only add its own messages
     import pygame
 
-    asked = os.environ.get("SDL_VIDEODRIVER", "")
     try:
         pygame.display.init()
     except pygame.error as exc:
         return f"no display to open a window on ({exc}); run with --headless to run without one"
     if pygame.display.get_driver() in ("offscreen", "dummy") and asked not in ("offscreen", "dummy"):
-        return "no display to open a window on (is DISPLAY set?); run with --headless to run without one"
+        return NO_DISPLAY
     return None
 
 

@@ -217,3 +217,85 @@ def test_quitting_with_a_student_connected_takes_a_second_esc(demos):
             assert not app.running
         finally:
             student.close()
+
+
+# ---------------------------------------------------------------- a quiet laptop
+
+
+def test_a_still_table_with_nobody_at_it_is_still(demos):
+    app = App(demos, demo_key="2", headless=True)  # demo 2 waits for the cue
+    app.run(seconds=0.5, frame_dt_s=FRAME_S)
+    assert not app.still()  # start-up counts as input for a second
+    app.run(seconds=1.0, frame_dt_s=FRAME_S)
+    assert app.still()
+    app.clients.append(type(app.local)(name="C1", color=(1, 2, 3)))  # a student arrives
+    assert not app.still()
+    app.run(seconds=1.5, frame_dt_s=FRAME_S)
+    assert app.still()  # whose cursor rests
+    app.clients[1].cursor_m = app.clients[1].cursor_m + 0.1
+    assert not app.still()
+    app.run(seconds=1.5, frame_dt_s=FRAME_S)
+    press(app, pygame.K_SPACE)
+    assert app.paused and not app.still()  # a key was just pressed
+    app.run(seconds=1.5, frame_dt_s=FRAME_S)
+    assert app.still()
+    app.table.vel_mps[0] = (1.0, 0.0)
+    press(app, pygame.K_SPACE)
+    app.run(seconds=1.5, frame_dt_s=FRAME_S)
+    assert not app.paused and not app.still()  # a puck moves
+
+
+# ---------------------------------------------------------------- small things
+
+
+def test_keypad_digits_act_like_the_number_row(demos):
+    app = App(demos, headless=True)
+    press(app, pygame.K_KP_3)
+    assert app.demo_key == "3"
+    press(app, pygame.K_KP_0)
+    assert app.demo_key == "0"
+    press(app, pygame.K_KP_2, mod=pygame.KMOD_LSHIFT)
+    assert app.demo_key == "2p"
+
+
+def test_f12_screenshots_never_overwrite_each_other(demos, tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    app = App(demos, headless=True)
+    for _ in range(3):  # within one second: the same time stamp
+        press(app, pygame.K_F12)
+    files = sorted((tmp_path / "screenshots").glob("*.png"))
+    assert len(files) == 3
+    assert str(files[-1].resolve()) in app.message or any(str(f.resolve()) in app.message for f in files)
+
+
+def test_the_status_line_puts_what_matters_first(demos):
+    app = App(demos, demo_key="1", headless=True)
+    press(app, pygame.K_SPACE)
+    press(app, pygame.K_s)
+    parts = app.status_parts()
+    assert parts[:3] == ["PAUSED", "slow motion x1/2", "t = 0.00 s"]
+    assert "5 pucks" in parts and "0 collisions" in parts
+    assert app.scene().status_parts == parts  # the window (and every student) can drop parts from the end
+
+
+@pytest.mark.parametrize(
+    "name, message",
+    [
+        ("no_folder/shot.png", "there is no folder"),
+        (".", "that is a folder"),
+    ],
+)
+def test_an_unwritable_screenshot_path_is_one_line_and_exit_1(name, message, tmp_path, capsys):
+    assert main(["--headless", "--no-server", "--seconds", "0.1", "--screenshot", str(tmp_path / name)]) == 1
+    err = capsys.readouterr().err
+    assert message in err and len(err.strip().splitlines()) == 1 and "Traceback" not in err
+
+
+def test_no_display_is_one_line_naming_headless_and_exit_1():
+    env = {k: v for k, v in os.environ.items() if k not in ("DISPLAY", "WAYLAND_DISPLAY", "SDL_VIDEODRIVER")}
+    done = subprocess.run(
+        [sys.executable, "-m", "airtable", "--no-server"], capture_output=True, text=True, timeout=30, env=env
+    )
+    assert done.returncode == 1
+    (line,) = done.stderr.strip().splitlines()
+    assert "--headless" in line and "display" in line

@@ -14,6 +14,7 @@ import sys
 import time
 from pathlib import Path
 
+import numpy as np
 import pygame
 
 from airtable.app import aids, controls
@@ -31,6 +32,10 @@ MESSAGE_S = 4.0
 QUIT_CONFIRM_S = 4.0  # a second Esc within this time quits while students are connected
 DEFAULT_FPS = 60.0  # when the display does not say its refresh rate
 MAX_FPS = 240.0
+# A still table (paused, or nothing moving) with nobody at it redraws this often,
+# and wakes at once on input: a laptop projecting all lesson stays quiet.
+IDLE_FPS = 12.0
+IDLE_AFTER_S = 1.0  # input this recent keeps the full frame rate
 ERROR_TITLES = {
     "load": "Demo {key} could not be loaded",
     "build": "Demo {key} could not be built",
@@ -120,6 +125,9 @@ class App:
         self.message_until = 0.0
         self.clock_s = 0.0  # time the app has run (sum of frame times)
         self.frame_dt_s = 0.0  # the current frame's time (held keys act in proportion)
+        self.last_input_s = 0.0  # clock_s of the last input, local or a student's
+        self._students_seen: tuple = ()  # the students' cursors when last looked at
+        self.loop: FrameLoop | None = None  # while run() runs
         self.demo_key = ""
         self.demo_path: Path | None = None
         self.build_error: DemoError | None = None  # shown instead of the demo while set
@@ -317,6 +325,7 @@ class App:
         self.frame_dt_s = frame_dt_s
         for event in pygame.event.get():
             self.handle_event(event)
+            self.last_input_s = self.clock_s
         controls.run_held(self)
         # Recomputed every frame: zooming moves the world under a still mouse.
         self.local.set_input(self.table, self.env.to_world(self.mouse_px), self.mouse_button)
@@ -405,17 +414,42 @@ class App:
         elif panel == "notes":
             w.draw_panel(self.demo.label(self.variation), [self.demo.notes or "(no notes)"], large=True)
 
+    def still(self) -> bool:
+        """Nothing to show that changes quickly: paused or motionless, and no input
+        (keys, mouse, or a student's cursor) for a second."""
+        students = tuple((*c.cursor_m, c.button, c.active) for c in self.clients[1:])
+        if students != self._students_seen:
+            self._students_seen, self.last_input_s = students, self.clock_s
+        if self.keys_down or self.mouse_button or self.clock_s - self.last_input_s < IDLE_AFTER_S:
+            return False
+        return self.paused or not np.any(self.table.vel_mps)
+
     def run(self, seconds: float | None = None, max_frames: int | None = None, frame_dt_s: float | None = None) -> int:
         """Run until Esc / window close, `seconds` or `max_frames` frames; returns the frames run.
 
         With `frame_dt_s` every frame is that long and nothing sleeps: `seconds`
         is then simulated time (tests and headless runs use it, so they never
         depend on timing). Without it, frames follow the clock, at most at the
-        display's refresh rate, sleeping in between.
+        display's refresh rate, sleeping in between; a still table runs at
+        IDLE_FPS and wakes on input.
         """
-        loop = FrameLoop(fps=display_rate_hz(), fixed_dt_s=frame_dt_s)
-        return loop.run(self._frame_running, max_frames=max_frames, max_time_s=seconds)
+        self._full_period_s = 1.0 / display_rate_hz()
+        self.loop = FrameLoop(fps=1.0 / self._full_period_s, fixed_dt_s=frame_dt_s, sleep=self._sleep)
+        try:
+            return self.loop.run(self._frame_running, max_frames=max_frames, max_time_s=seconds)
+        finally:
+            self.loop = None
 
     def _frame_running(self, dt_s: float) -> bool:
         self.frame(dt_s)
+        self.loop.period_s = 1.0 / IDLE_FPS if self.still() else self._full_period_s
         return self.running
+
+    def _sleep(self, seconds: float) -> None:
+        """Between frames: a plain sleep, or while idle a wait that ends early on input."""
+        if self.window.headless or self.loop.period_s == self._full_period_s:
+            self.loop.stop.wait(seconds)
+            return
+        event = pygame.event.wait(max(1, int(seconds * 1000)))
+        if event.type != pygame.NOEVENT:
+            pygame.event.post(event)  # back in the queue, for the frame it woke
