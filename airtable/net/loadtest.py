@@ -40,11 +40,11 @@ import statistics
 import sys
 import threading
 import time
-from collections import deque
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 
 from airtable.app.client import Client, cursor_pulls
+from airtable.app.loop import FixedStep, FpsCounter, FrameLoop
 from airtable.app.scene import Scene
 from airtable.net import protocol as proto
 from airtable.net.rawplayer import WorkerReport, WorkerSpec, play
@@ -189,11 +189,12 @@ def grid_table(columns: int = 6, rows: int = 5) -> AirTable:
 
 
 class TableLoop:
-    """A headless game loop in a thread: inputs, fixed physics steps, snapshots.
+    """A headless game loop in a thread: the app's fixed-step loop (loop.py) without a window.
 
-    Each frame, under `lock`: `server.apply_inputs(clients, table)` and `table.step(dt_s, pulls)`
-    for each physics step, then `server.publish(...)` with the measured frame
-    rate. Hold `lock` to look at or step the table from another thread.
+    Each frame, under `lock`: `server.apply_inputs(clients, table)` once, as many
+    fixed physics steps as the frame's time allows, then `server.publish(...)`
+    with the measured frame rate. Hold `lock` to look at or step the table from
+    another thread.
     """
 
     def __init__(
@@ -207,53 +208,37 @@ class TableLoop:
         self.server = server
         self.table = table if table is not None else grid_table()
         self.clients = [Client(name="local", active=False)]  # the server adds the players
-        self.period_s = 1.0 / fps
         self.dt_s = dt_s
-        self.steps_per_frame = max(1, round(self.period_s / dt_s))
         self.title = title
         self.fps = 0.0
         self.frames = 0
-        self._frame_times: deque[float] = deque()
         self.lock = threading.RLock()
-        self._stop = threading.Event()
+        self._stepper = FixedStep(dt_s)
+        self._fps = FpsCounter()
+        self._loop = FrameLoop(fps=fps)
         self._thread: threading.Thread | None = None
 
-    def frame(self) -> None:
+    def frame(self, frame_dt_s: float) -> None:
+        """One frame of `frame_dt_s` seconds."""
         with self.lock:
-            for _ in range(self.steps_per_frame):
-                self.server.apply_inputs(self.clients, self.table)
+            self.server.apply_inputs(self.clients, self.table)
+            for _ in range(self._stepper.steps(frame_dt_s)):
                 self.table.step(self.dt_s, cursor_pulls(self.clients))
-            # Frames counted over the last second: an average of 1/dt would favour short frames.
-            now = time.monotonic()
-            times = self._frame_times
-            times.append(now)
-            while now - times[0] > 1.0:
-                times.popleft()
-            if len(times) > 1:
-                self.fps = (len(times) - 1) / (times[-1] - times[0])
+            self.fps = self._fps.tick(time.monotonic())
             t = self.table
             status = f"{len(t.pos_m)} pucks   {len(self.server.player_names())} players   t = {t.time_s:.2f} s"
             self.server.publish(Scene.from_table(t, self.clients, title=self.title, status=status, fps=self.fps))
             self.frames += 1
 
-    def _run(self) -> None:
-        next_t = time.monotonic()
-        while not self._stop.is_set():
-            self.frame()
-            next_t += self.period_s
-            delay = next_t - time.monotonic()
-            if delay > 0:
-                self._stop.wait(delay)
-            else:
-                next_t = time.monotonic()
-
     def start(self) -> TableLoop:
-        self._thread = threading.Thread(target=self._run, name="airtable-table-loop", daemon=True)
+        self._thread = threading.Thread(
+            target=self._loop.run, args=(self.frame,), name="airtable-table-loop", daemon=True
+        )
         self._thread.start()
         return self
 
     def stop(self) -> None:
-        self._stop.set()
+        self._loop.stop.set()
         if self._thread is not None:
             self._thread.join(timeout=5.0)
             self._thread = None
