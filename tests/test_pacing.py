@@ -22,9 +22,10 @@ def test_a_student_whose_bytes_are_not_taken_is_held_back():
         sender = socket.create_connection(listener.getsockname(), timeout=5)
         receiver, _ = listener.accept()
         with sender, receiver:
-            pacing.tune(sender)
             assert pacing.queued_bytes(sender) == 0
             assert pacing.may_send(sender, 1000)
+            smoothed, lowest = pacing.round_trip_s(sender)
+            assert 0 <= lowest <= smoothed < 1.0
             sender.setblocking(False)
             sent = 0
             for _ in range(10_000):  # bounded: fill both buffers until the socket says stop
