@@ -18,3 +18,21 @@ def demos():
     found, errors = discover([BUILTIN_DIR])
     assert not errors
     return found
+
+
+WAIT_S = 5.0
+
+
+def wait_until(condition, timeout_s: float = WAIT_S, what: str = "condition"):
+    """Poll `condition` until it returns something truthy, and return that; fail after
+    `timeout_s` (generous: a wait is a bound, never a measurement)."""
+    import time
+
+    deadline = time.monotonic() + timeout_s
+    while True:
+        value = condition()
+        if value:
+            return value
+        if time.monotonic() > deadline:
+            pytest.fail(f"timed out after {timeout_s} s waiting for {what}")
+        time.sleep(0.005)

@@ -9,13 +9,14 @@ import time
 import numpy as np
 import pygame
 import pytest
-from test_server import RawClient, wait_until
+from conftest import wait_until
+from test_server import RawClient
 
 from airtable.app.scene import CursorView
 from airtable.app.window import background_for
 from airtable.net import protocol as proto
 from airtable.net.loadtest import TableLoop, grid_table
-from airtable.net.player import InputThrottle, NetPlayer, PlayerApp, PlayerError, _own_cursor_live, main
+from airtable.net.player import InputThrottle, NetPlayer, PlayerApp, PlayerError, main, own_cursor_live
 from airtable.net.server import GameServer
 
 
@@ -107,10 +108,10 @@ def test_own_cursor_is_drawn_at_the_live_mouse_position_with_its_string():
     welcome = proto.Welcome("C2", (210, 180, 140), 10.0, 8.7556)
     other = CursorView("C1", (255, 52, 179), (1.0, 1.0), 1, 0)
     mine = CursorView("C2", (210, 180, 140), (2.0, 2.0), 1, 3)
-    cursors, extra = _own_cursor_live((mine, other), welcome, np.array([2.5, 2.25]), 1, focused=True)
+    cursors, extra = own_cursor_live((mine, other), welcome.client, np.array([2.5, 2.25]), 1, focused=True)
     assert cursors == (other, CursorView("C2", (210, 180, 140), (2.5, 2.25), 1, 3)) and not extra
-    assert _own_cursor_live((other,), welcome, (2.5, 2.25), 0, focused=True) == ((other,), True)
-    assert _own_cursor_live((mine, other), welcome, (2.5, 2.25), 0, focused=False) == ((other, mine), False)
+    assert own_cursor_live((other,), welcome.client, (2.5, 2.25), 0, focused=True) == ((other,), True)
+    assert own_cursor_live((mine, other), welcome.client, (2.5, 2.25), 0, focused=False) == ((other, mine), False)
 
 
 # ---------------------------------------------------------------- NetPlayer
@@ -143,7 +144,10 @@ def test_update_input_clamps_what_the_server_would_refuse(cleanup):
     net = player(cleanup, server.port)
     net.connect()
     assert net.update_input((1e300, -1e300), 7, ["ok", "x" * 40])
-    time.sleep(0.2)
+    # The server took it: the cursor shows up in the snapshots, where the clamp put it.
+    x0, y0, x1, y1 = proto.cursor_limits(10.0, 8.7556)
+    mine = wait_until(lambda: net.latest() and net.latest().cursors, what="our cursor in a snapshot")
+    assert mine[0].cursor_m == (x1, y0) and mine[0].button == 0
     assert net.state == net.CONNECTED and server.player_names() == ["C1"]
 
 
@@ -157,7 +161,8 @@ def test_player_reconnects_when_the_server_comes_back(cleanup):
     server.stop()
     wait_until(lambda: net.state == net.RETRYING, what="server gone, retrying")
     assert net.status_text == "server gone, retrying..."
-    time.sleep(0.5)  # a few refused attempts while the server is away
+    first_try = net.next_try
+    wait_until(lambda: net.next_try > first_try, what="a refused attempt while the server is away")
     assert net.state == net.RETRYING
     server2, _ = start_table(cleanup, port=port)
     wait_until(lambda: net.state == net.CONNECTED, what="the reconnect")
@@ -180,13 +185,20 @@ def test_connection_refused(capsys):
     assert "is the server running?" in line and f"is port {port} open in its firewall?" in line
 
 
-def test_server_full(capsys, cleanup):
+def test_a_full_table_is_waited_for_on_screen_and_joined_when_a_place_frees(capsys, cleanup):
     server, _ = start_table(cleanup, max_clients=1)
     first = RawClient(server.port)
     cleanup(first.close)
     first.hello()
-    line = one_line_error(capsys, [f"127.0.0.1:{server.port}"])
-    assert "server full" in line
+    assert main([f"127.0.0.1:{server.port}", "--headless", "--seconds", "0.3"]) == 0
+    out = capsys.readouterr().out
+    assert "server full" in out and "waiting for a place" in out
+    net = player(cleanup, server.port, max_backoff_s=0.5)
+    assert net.connect() is None and net.state == net.WAITING
+    assert net.banner_text.startswith("the table is full: asking again in")
+    first.send(proto.encode_bye())
+    wait_until(lambda: net.state == net.CONNECTED, what="a place at the table")
+    assert net.welcome.client == "C1" and net.reconnects == 0
 
 
 def test_wrong_and_missing_password(capsys, cleanup):
@@ -232,7 +244,7 @@ def test_headless_app_draws_the_table_and_says_bye(cleanup, tmp_path):
     app = PlayerApp(net, headless=True)
     cleanup(pygame.quit)
     shot = tmp_path / "player.png"
-    assert app.run(seconds=0.5, screenshot=str(shot)) == 0
+    assert app.run(seconds=10, screenshot=str(shot), until=lambda: app.frames >= 10) == 0
     assert shot.exists() and app.frames > 0
     surface, env = app.window.surface, app.window.env
     scene = net.latest()
@@ -252,17 +264,17 @@ def test_headless_app_survives_a_server_restart(cleanup):
     cleanup(pygame.quit)
 
     def restart():
-        time.sleep(0.4)
+        wait_until(lambda: app.frames > 5, what="the window to run")
         loop.stop()
         server.stop()
-        time.sleep(0.6)
+        wait_until(lambda: net.RETRYING in app.states_seen, what="the window to show the retry")
         start_table(cleanup, port=port)
 
+    app = PlayerApp(net, headless=True)
     t = threading.Thread(target=restart)
     t.start()
-    app = PlayerApp(net, headless=True)
     try:
-        status = app.run(seconds=2.5)
+        status = app.run(seconds=10, until=lambda: net.reconnects == 1 and net.state == net.CONNECTED)
     finally:
         t.join()
     assert status == 0

@@ -7,10 +7,10 @@ import socket
 import struct
 import threading
 import time
-from collections.abc import Callable
 
 import numpy as np
 import pytest
+from conftest import WAIT_S, wait_until
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
@@ -19,22 +19,9 @@ from airtable.app.client import LOCAL_COLOR
 from airtable.app.scene import Scene
 from airtable.colors import rgb
 from airtable.net import protocol as proto
+from airtable.net.events import MAX_QUEUED_INPUTS, EventQueue, PlayerInput, PlayerJoined, PlayerLeft
 from airtable.net.loadtest import TableLoop, grid_table, run_load
 from airtable.net.server import COURSE_COLORS, GameServer, client_color, lan_addresses
-
-WAIT_S = 5.0
-
-
-def wait_until(condition: Callable[[], object], timeout_s: float = WAIT_S, what: str = "condition") -> object:
-    """Poll `condition` until it is truthy; fail after a generous timeout."""
-    deadline = time.monotonic() + timeout_s
-    while True:
-        value = condition()
-        if value:
-            return value
-        if time.monotonic() > deadline:
-            pytest.fail(f"timed out after {timeout_s} s waiting for {what}")
-        time.sleep(0.005)
 
 
 def frame(frame_type: int, payload: bytes) -> bytes:
@@ -287,17 +274,38 @@ def test_input_drags_the_puck_and_disconnect_lets_go(make_server, make_loop, cli
     assert [cl.name for cl in table.clients] == ["local"]
 
 
+class GameLoop:
+    """This test is the game loop: it owns the list of clients (index 0 the local user)."""
+
+    def __init__(self, server: GameServer, table: AirTable) -> None:
+        self.server, self.table = server, table
+        self.clients: list[Client] = [Client()]
+
+    def update(self) -> list[Client]:
+        """One frame's update_clients (no physics step, as while paused); the players."""
+        self.server.update_clients(self.clients, self.table)
+        return self.clients[1:]
+
+    def step(self, dt_s: float) -> None:
+        step_with(self.table, self.clients, dt_s)
+
+
+def step_with(table: AirTable, clients: list[Client], dt_s: float) -> None:
+    """One physics step with these clients' cursor strings."""
+    table.clients = clients
+    table.step(dt_s)
+
+
 def test_two_players_on_one_puck_add_their_forces(make_server, clients):
     server = make_server()
-    table = one_puck_table()
+    game = GameLoop(server, one_puck_table())
     a, b = clients(server.port), clients(server.port)
     a.hello(), b.hello()
     for c in (a, b):
         c.send(proto.encode_input((5.1, 4.0), 1))
 
     def both(cursor_x: float) -> bool:
-        server.apply_inputs(table)  # this test is the game loop
-        players = table.clients[1:]
+        players = game.update()
         return len(players) == 2 and all(p.held is not None and p.cursor_m[0] == cursor_x for p in players)
 
     wait_until(lambda: both(5.1), what="both players to grab the puck")
@@ -308,15 +316,17 @@ def test_two_players_on_one_puck_add_their_forces(make_server, clients):
     def pulled_by_local_clients(n: int) -> float:
         """The same pull made by n Clients on a table without any network."""
         ref = one_puck_table()
+        local = []
         for _ in range(n):
             c = Client()
             c.set_input(ref, (5.1, 4.0), 1)
             c.set_input(ref, (6.0, 4.0), 1)
-            ref.clients.append(c)
-        ref.step(1 / 240)
+            local.append(c)
+        step_with(ref, local, 1 / 240)
         return ref.vel_mps[0, 0]
 
-    table.step(1 / 240)
+    game.step(1 / 240)
+    table = game.table
     assert table.vel_mps[0, 0] == pulled_by_local_clients(2)
     assert table.vel_mps[0, 0] > 1.5 * pulled_by_local_clients(1) > 0
     assert table.vel_mps[0, 1] == pytest.approx(0.0, abs=1e-12)
@@ -324,29 +334,71 @@ def test_two_players_on_one_puck_add_their_forces(make_server, clients):
 
 def test_a_grab_and_a_move_within_one_frame_still_grab(make_server, clients):
     server = make_server()
-    table = one_puck_table()
+    game = GameLoop(server, one_puck_table())
     c = clients(server.port)
     c.hello()
     # Press over the puck and move away at once: both arrive before the next frame.
     c.send(proto.encode_input((5.1, 4.0), 1) + proto.encode_input((6.0, 4.0), 1) + proto.encode_input((7.0, 4.0), 1))
 
-    def moved() -> bool:
-        server.apply_inputs(table)  # this test is the game loop
-        return len(table.clients) == 2 and table.clients[1].cursor_m[0] == 7.0
+    def moved():
+        players = game.update()
+        return len(players) == 1 and players[0].cursor_m[0] == 7.0 and players[0]
 
-    wait_until(moved, what="the last input")
-    assert table.clients[1].held is table.pucks[0]
+    assert wait_until(moved, what="the last input").held is game.table.pucks[0]
 
 
 def test_bye_frees_the_name_and_removes_the_client(make_server, clients):
     server = make_server()
-    table = one_puck_table()
+    game = GameLoop(server, one_puck_table())
     c = clients(server.port)
     c.hello()
-    wait_until(lambda: (server.apply_inputs(table), len(table.clients) == 2)[1], what="the join")
+    wait_until(lambda: len(game.update()) == 1, what="the join")
     c.send(proto.encode_bye())
-    wait_until(lambda: (server.apply_inputs(table), len(table.clients) == 1)[1], what="the leave")
-    assert server.player_names() == []
+    wait_until(lambda: len(game.update()) == 0, what="the leave")
+    assert server.player_names() == [] and [cl.name for cl in game.clients] == ["local"]
+
+
+def test_joins_leaves_and_cursors_are_applied_every_frame_even_without_steps(make_server, clients):
+    """While the teacher pauses, no step runs, yet students appear, move and go."""
+    server = make_server()
+    game = GameLoop(server, one_puck_table())
+    c = clients(server.port)
+    name = c.hello("Ann").client
+    c.send(proto.encode_input((2.0, 3.0), 0))
+    player = wait_until(lambda: (p := game.update()) and p[0].active and p[0], what="the join and first input")
+    assert player.name == name and tuple(player.cursor_m) == (2.0, 3.0)
+    c.send(proto.encode_input((4.0, 1.0), 0))
+    wait_until(lambda: game.update() and tuple(player.cursor_m) == (4.0, 1.0), what="the cursor to move")
+    c.close()
+    wait_until(lambda: not game.update(), what="the leave")
+    assert game.table.time_s == 0.0, "no physics step ran"
+
+
+def test_the_event_queue_stays_bounded_while_nobody_takes_it(make_server):
+    """20,000 join/leave cycles while the game loop never calls update_clients."""
+    server = make_server(max_clients=30)
+    for i in range(20_000):
+        with socket.create_connection(("127.0.0.1", server.port), timeout=WAIT_S) as s:
+            s.sendall(proto.encode_hello() + proto.encode_input((1, 1), 0) + proto.encode_bye())
+            s.settimeout(WAIT_S)
+            while s.recv(65536):  # the server closes after the BYE
+                pass
+        if i % 2000 == 0:
+            assert server.pending_events <= 2 * 30 + 30 * MAX_QUEUED_INPUTS
+    wait_until(lambda: server.player_count == 0, what="the last leave")
+    assert server.pending_events == 0, "every join was withdrawn by its leave"
+
+
+def test_event_records_are_typed_and_a_leave_withdraws_an_unseen_join():
+    queue = EventQueue()
+    record = proto.InputRecord((1.0, 2.0), 1)
+    queue.join(1, "C1", (1, 2, 3))
+    queue.input(1, record)
+    queue.join(2, "C2", (4, 5, 6))
+    queue.leave(2)
+    assert queue.take() == [PlayerJoined(1, "C1", (1, 2, 3)), PlayerInput(1, record)]
+    queue.leave(1)
+    assert queue.take() == [PlayerLeft(1)] and len(queue) == 0
 
 
 # ---------------------------------------------------------------- bad clients
@@ -363,7 +415,7 @@ def _input(cursor="[1, 2]", button="1", keys="[]") -> bytes:
 BAD_CLIENTS = {
     "garbage bytes": ([b"\xde\xad\xbe\xef" * 8], ["limit", "airtable-client"]),
     "a web browser": ([b"GET / HTTP/1.1\r\nHost: teacher\r\n\r\n"], ["web browser", "airtable-client"]),
-    "a frame over 64 KiB": ([struct.pack(">IB", 64 * 1024 + 1, 1) + b"x" * 1000], ["65536 byte limit"]),
+    "a frame over 1 KiB": ([struct.pack(">IB", 1024 + 1, 1) + b"x" * 1000], ["1024 byte limit"]),
     "an empty frame": ([b"\0\0\0\0"], ["empty"]),
     "invalid UTF-8": ([frame(proto.HELLO, b'{"protocol": 1, "name": "\xff"}')], ["UTF-8"]),
     "invalid JSON": ([frame(proto.HELLO, b'{"protocol": 1,')], ["not valid JSON", '{"protocol": 1']),
@@ -457,7 +509,7 @@ def test_half_a_frame_then_silence_is_dropped_after_the_timeout(make_server, cli
 
 
 def test_password(make_server, clients):
-    server = make_server(password="sesame")
+    server = make_server(password="sesame", password_wait_s=0.2)
     c = clients(server.port)
     c.send(proto.encode_hello("Ann"))
     assert "needs a password" in c.expect_error()
@@ -465,7 +517,18 @@ def test_password(make_server, clients):
     c.send(proto.encode_hello("Ann", "open sesame"))
     sentence = c.expect_error()
     assert "wrong password" in sentence and "--password" in sentence and "sesame" not in sentence
-    assert clients(server.port).hello("Ann", "sesame").client == "C1 Ann"
+    # Right after a wrong guess even the right password waits, so guessing is slow.
+    c = clients(server.port)
+    c.send(proto.encode_hello("Ann", "sesame"))
+    assert "wait 1 s" in c.expect_error()
+
+    def joined():
+        c = clients(server.port)
+        c.send(proto.encode_hello("Ann", "sesame"))
+        got = c.next_frame()
+        return got is not None and got[0] == proto.WELCOME and proto.parse_welcome(got[1])
+
+    assert wait_until(joined, what="the wait after a wrong password to end").client == "C1 Ann"
 
 
 def test_server_full_then_a_freed_name_is_reused(make_server, clients):
@@ -507,8 +570,13 @@ def test_a_stalled_client_only_misses_snapshots(make_server, make_loop, clients)
         assert received >= 10, "the reading client still gets snapshots"
         assert loop.frames - frames0 >= 0.5 * 60 * elapsed, "the game loop never waited for the stalled client"
         assert server.connection_count == 2
-        # The stalled socket really is full: the server holds a part-sent snapshot for it.
-        assert any(conn.out_cur is not None for conn in server._conns.values())
+
+        # The stalled socket really is full: the roster shows it missing snapshots.
+        def missing() -> bool:
+            seats = {seat.name: seat for seat in server.roster()}
+            return seats["C1"].snapshots_per_s < 0.5 * seats["C2"].snapshots_per_s
+
+        wait_until(missing, what="the stalled player to miss snapshots")
     finally:
         sock.close()
 
