@@ -171,6 +171,25 @@ def test_player_reconnects_when_the_server_comes_back(cleanup):
     assert net.reconnects == 1 and server2.player_names() == ["C1"]
 
 
+def test_a_player_cut_off_by_a_restart_waits_when_the_table_is_now_full(cleanup):
+    server, loop = start_table(cleanup)
+    port = server.port
+    net = player(cleanup, port, max_backoff_s=0.5)
+    net.connect()
+    loop.stop()
+    server.stop()
+    wait_until(lambda: net.state == net.RETRYING, what="server gone")
+    server2, _ = start_table(cleanup, port=port, max_clients=1)
+    squatter = RawClient(port)
+    cleanup(squatter.close)
+    squatter.hello()
+    wait_until(lambda: net.state == net.WAITING, what="the player to wait for a place, not give up")
+    assert "server full" in net.waiting_because
+    squatter.send(proto.encode_bye())
+    wait_until(lambda: net.state == net.CONNECTED, what="the place to be taken")
+    assert net.reconnects == 1 and server2.player_names() == ["C1"]
+
+
 # ---------------------------------------------------------------- one-line errors
 
 

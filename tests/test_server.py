@@ -31,8 +31,10 @@ def frame(frame_type: int, payload: bytes) -> bytes:
 class RawClient:
     """A bare protocol client for tests: send bytes, read frames with deadlines."""
 
-    def __init__(self, port: int) -> None:
-        self.sock = socket.create_connection(("127.0.0.1", port), timeout=WAIT_S)
+    def __init__(self, port: int, source: str | None = None) -> None:
+        """`source` picks this client's own address (127.0.0.2 is another loopback computer)."""
+        where = None if source is None else (source, 0)
+        self.sock = socket.create_connection(("127.0.0.1", port), timeout=WAIT_S, source_address=where)
         self.sock.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
         self.reader = proto.FrameReader(proto.MAX_SERVER_FRAME, sender="the server")
         self.pending: list[tuple[int, bytes]] = []
@@ -149,8 +151,8 @@ def clients():
     """Make RawClients that are closed after the test."""
     made: list[RawClient] = []
 
-    def make(port: int) -> RawClient:
-        c = RawClient(port)
+    def make(port: int, source: str | None = None) -> RawClient:
+        c = RawClient(port, source)
         made.append(c)
         return c
 
@@ -542,6 +544,74 @@ def test_server_full_then_a_freed_name_is_reused(make_server, clients):
     players[6].send(proto.encode_bye())
     wait_until(lambda: len(server.player_names()) == 29, what="C7 to leave")
     assert clients(server.port).hello().client == "C7"
+
+
+# ---------------------------------------------------------------- joining: handshakes and seats
+
+
+def test_handshakes_have_their_own_cap_and_the_refusal_says_busy_not_full(make_server, clients):
+    server = make_server(max_clients=30, max_handshakes=4, hello_timeout_s=30)
+    idle = [clients(server.port) for _ in range(4)]  # connect and never say HELLO
+    wait_until(lambda: server.connection_count == 4, what="the idle handshakes")
+    late = clients(server.port)
+    sentence = late.expect_error()
+    assert "busy" in sentence and "tries again" in sentence and "full" not in sentence
+    idle[0].hello()  # a handshake that finishes frees its slot for the next
+    assert clients(server.port).hello().client == "C2"
+
+
+def test_a_handshake_that_says_nothing_is_dropped_after_its_deadline(make_server, clients):
+    server = make_server(hello_timeout_s=0.3, timeout_s=30)
+    c = clients(server.port)
+    sentence = c.expect_error()
+    assert "no HELLO came within 0.3 s" in sentence
+    wait_until(lambda: server.connection_count == 0, what="the silent handshake to be gone")
+
+
+def test_one_computer_cannot_keep_others_from_joining(make_server, clients):
+    """A squatter at 127.0.0.2 reopens idle sockets as fast as it can; 20 students still join."""
+    server = make_server(max_clients=30, limit_loopback=True, players_per_address=30, hello_timeout_s=1.0)
+    stop = threading.Event()
+    refused = []
+
+    def squat():
+        held: list[RawClient] = []  # idle sockets, the oldest closed when over 64
+        while not stop.is_set():
+            try:
+                c = RawClient(server.port, source="127.0.0.2")
+            except OSError:
+                continue
+            c.sock.settimeout(0.05)
+            try:
+                refused.append(c.sock.recv(65536))
+                c.close()
+            except (TimeoutError, OSError):
+                held.append(c)  # accepted: keep it idle
+            if len(held) > 64:
+                held.pop(0).close()
+        for c in held:
+            c.close()
+
+    squatter = threading.Thread(target=squat, daemon=True)
+    squatter.start()
+    try:
+        wait_until(lambda: len(refused) >= 10, what="the squatter to be refused")
+        names = [clients(server.port).hello().client for _ in range(20)]
+    finally:
+        stop.set()
+        squatter.join(timeout=WAIT_S)
+    assert names == [f"C{n}" for n in range(1, 21)]
+    assert "your computer already has 4 connections joining" in proto.parse_error(refused[0][5:])
+
+
+def test_seats_per_computer_are_limited_with_a_clear_sentence(make_server, clients):
+    server = make_server(limit_loopback=True, players_per_address=2)
+    clients(server.port).hello()
+    clients(server.port).hello()
+    third = clients(server.port)
+    third.send(proto.encode_hello())
+    assert "your computer already plays with 2 windows" in third.expect_error()
+    assert clients(server.port, source="127.0.0.2").hello().client == "C3"
 
 
 # ---------------------------------------------------------------- slow clients and rates

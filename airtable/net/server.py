@@ -636,12 +636,12 @@ class GameServer:
         self._gate.players[conn.host] += 1
         conn.number, conn.name, conn.state = number, name, State.PLAYING
         self._numbers[number] = conn.cid
-        width_m, height_m = self._table_size_m
-        conn.send_control(proto.encode_welcome(name, color, width_m, height_m))
         with self._lock:
             self._names[number] = name
             snapshot = self._snapshot
         self._events.join(conn.cid, name, color)
+        width_m, height_m = self._table_size_m
+        conn.send_control(proto.encode_welcome(name, color, width_m, height_m))
         conn.offer_snapshot(snapshot, now)  # the newest picture straight away, if there is one
         log.info("%s joined from %s", name, conn.peer)
 
