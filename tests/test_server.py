@@ -414,6 +414,18 @@ def _input(cursor="[1, 2]", button="1", keys="[]") -> bytes:
     return frame(proto.INPUT, f'{{"cursor_m": {cursor}, "button": {button}, "keys": {keys}}}'.encode())
 
 
+def fat_input() -> bytes:
+    """The most expensive valid INPUT: just under the frame cap, long numbers, escaped keys."""
+    keys = "[" + ", ".join(f'"k{i:x}' + "\\u00e9" * 5 + '"' for i in range(proto.MAX_KEYS)) + "]"
+    head = '{"cursor_m": [1.%s1, 1.%s1], "button": 1, "keys": %s}'
+    room = proto.MAX_CLIENT_FRAME - 1 - len(head % ("", "", keys))
+    zeros = "0" * (room // 2)
+    payload = (head % (zeros, zeros, keys)).encode()
+    assert proto.MAX_CLIENT_FRAME - 4 < len(payload) + 1 <= proto.MAX_CLIENT_FRAME
+    assert len(proto.parse_input(payload).keys) == proto.MAX_KEYS  # valid
+    return frame(proto.INPUT, payload)
+
+
 BAD_CLIENTS = {
     "garbage bytes": ([b"\xde\xad\xbe\xef" * 8], ["limit", "airtable-client"]),
     "a web browser": ([b"GET / HTTP/1.1\r\nHost: teacher\r\n\r\n"], ["web browser", "airtable-client"]),
@@ -440,6 +452,11 @@ BAD_CLIENTS = {
     "INPUT missing a field": (_after_hello(frame(proto.INPUT, b'{"cursor_m": [1, 2]}')), ["missing"]),
     "INPUT that is a list": (_after_hello(frame(proto.INPUT, b"[1, 2, 1]")), ["JSON object"]),
     "a flood of inputs": (_after_hello(proto.encode_input((1, 2), 0) * 2000), ["messages a second"]),
+    "a duplicated field": (
+        _after_hello(frame(proto.INPUT, b'{"cursor_m": [1, 2], "button": 1, "keys": [], "keys": []}')),
+        ["twice"],
+    ),
+    "a flood of bytes": (_after_hello(fat_input() * 60), ["KiB a second"]),
 }
 
 
