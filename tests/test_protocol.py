@@ -122,6 +122,36 @@ def test_bad_hello(payload, hints):
     assert_sentence(str(err.value), *hints)
 
 
+@pytest.mark.parametrize(
+    "name, hints",
+    [
+        ("\u3164", ["no visible letter or digit", "like Ann"]),  # Hangul filler: a letter that draws nothing
+        ("\u3164\u3164 \uffa0", ["no visible letter or digit"]),
+        ("\u2800\u2800", ["no visible letter or digit"]),  # Braille blank
+        ("...", ["no visible letter or digit"]),
+        ("C7 C1", ["looks like a player label", "C7"]),
+        ("c12", ["player label"]),
+        ("Ann C3", ["player label"]),
+        ("a\u0007b", ["U+0007", "not printable", "letters, digits"]),
+        ("Ann\u200b", ["U+200B", "not printable"]),
+        ("line\nbreak", ["U+000A", "not printable"]),
+        ("x" * 21, ["over 20 characters", "shorter"]),
+        ("  ", ["empty"]),
+    ],
+)
+def test_names_need_a_visible_letter_or_digit_and_may_not_imitate_a_player(name, hints):
+    with pytest.raises(proto.ProtocolError) as err:
+        proto.check_name(name)
+    assert_sentence(str(err.value), *hints)
+    if "printable" in hints:
+        assert "shorter" not in str(err.value)
+
+
+@pytest.mark.parametrize("name", ["Ann", "Zoë", "李雷", "Ωmega 2", "C3PO", "Claire 2", "דנה", "  Bo  "])
+def test_ordinary_names_in_any_script_are_welcome(name):
+    assert proto.check_name(name) == name.strip()
+
+
 # ---------------------------------------------------------------- INPUT
 
 

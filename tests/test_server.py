@@ -438,6 +438,8 @@ BAD_CLIENTS = {
     "unknown HELLO field": ([frame(proto.HELLO, b'{"protocol": 1, "admin": true}')], ["unknown field"]),
     "a 21 character name": ([proto.encode_hello("x" * 21)], ["name", "20"]),
     "a name with a bell": ([proto.encode_hello("a\x07")], ["printable"]),
+    "a blank-looking name": ([proto.encode_hello("\u3164")], ["no visible letter or digit"]),
+    "a name imitating players": ([proto.encode_hello("C7 C1")], ["looks like a player label"]),
     "INPUT before HELLO": ([proto.encode_input((1, 2), 1)], ["before HELLO", "HELLO"]),
     "HELLO twice": (_after_hello(proto.encode_hello()), ["twice"]),
     "unknown frame type": (_after_hello(frame(9, b"{}")), ["unknown message type 9"]),
