@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import logging
 import socket
 import struct
 import threading
@@ -550,6 +551,33 @@ def test_password(make_server, clients):
         return got is not None and got[0] == proto.WELCOME and proto.parse_welcome(got[1])
 
     assert wait_until(joined, what="the wait after a wrong password to end").client == "C1 Ann"
+
+
+def test_wrong_passwords_earn_a_growing_wait_then_a_lockout_and_few_log_lines(make_server, clients, caplog):
+    server = make_server(password="sesame", password_wait_s=0.05)
+    answers = []
+
+    def guess(password: str) -> str:
+        c = clients(server.port)
+        c.send(proto.encode_hello("Eve", password))
+        got = c.next_frame()
+        c.close()
+        sentence = proto.parse_error(got[1]) if got and got[0] == proto.ERROR else "welcome"
+        answers.append(sentence)
+        return sentence
+
+    caplog.set_level(logging.INFO, logger="airtable.net")
+    # Guess as fast as the server answers until it locks us out: only 5 guesses are ever checked.
+    wait_until(lambda: "wait 60 s" in guess("guess"), what="the lockout")
+    checked = [a for a in answers if a.startswith("wrong password")]
+    waits = [a for a in answers if a.startswith("too many wrong passwords")]
+    assert len(checked) == 5 and waits, answers
+    for _ in range(200):
+        guess("guess")
+    assert guess("sesame").startswith("too many wrong passwords"), "locked out: even the right password waits"
+    lines = [r.getMessage() for r in caplog.records if "password" in r.getMessage()]
+    assert len(lines) <= 3, lines
+    assert any("locked out" in line for line in lines)
 
 
 def test_server_full_then_a_freed_name_is_reused(make_server, clients):

@@ -115,16 +115,19 @@ class Gate:
 
 
 class QuietLog:
-    """Logs the first line of a kind at once, then one summary every SUMMARY_EVERY_S."""
+    """Logs the first line of a kind at once, then one summary every SUMMARY_EVERY_S,
+    so a flood of refusals cannot flood the teacher's log."""
 
     def __init__(self, log: logging.Logger) -> None:
         self.log = log
         self._counts: Counter[str] = Counter()
+        self._levels: dict[str, int] = {}
         self._since = time.monotonic()
 
-    def note(self, kind: str, line: str, *args) -> None:
+    def note(self, kind: str, line: str, *args, level: int = logging.WARNING) -> None:
         if self._counts[kind] == 0:
-            self.log.warning(line, *args)
+            self.log.log(level, line, *args)
+            self._levels[kind] = level
         self._counts[kind] += 1
 
     def flush(self, now: float) -> None:
@@ -132,6 +135,7 @@ class QuietLog:
             return
         for kind, count in self._counts.items():
             if count > 1:
-                self.log.warning("%d times in %.0f s: %s", count - 1, now - self._since, kind)
+                self.log.log(self._levels[kind], "%d more in %.0f s: %s", count - 1, now - self._since, kind)
         self._counts.clear()
+        self._levels.clear()
         self._since = now

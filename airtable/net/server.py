@@ -543,7 +543,7 @@ class GameServer:
             except OSError:
                 pass
             sock.close()
-            self._quiet.note("refused connections", "refused %s: %s", host, refusal)
+            self._quiet.note(f"connections refused from {host}", "refused %s: %s", host, refusal)
             return
         assert self._selector is not None
         now = time.monotonic()
@@ -584,7 +584,7 @@ class GameServer:
             frames = conn.receive(now)
             if frames is None:
                 if conn.state != State.CLOSING:
-                    log.info("%s left", conn.who)
+                    self._log_seat(conn, "%s left", conn.who)
                 conn.close()
                 return
             for frame_type, payload in frames:
@@ -596,7 +596,7 @@ class GameServer:
 
     def _handle(self, conn: Connection, frame_type: int, payload: bytes, now: float) -> None:
         if frame_type == proto.BYE:
-            log.info("%s said goodbye", conn.who)
+            self._log_seat(conn, "%s said goodbye", conn.who)
             conn.close()
         elif frame_type == proto.HELLO:
             if conn.state != State.HELLO:
@@ -643,13 +643,17 @@ class GameServer:
         width_m, height_m = self._table_size_m
         conn.send_control(proto.encode_welcome(name, color, width_m, height_m))
         conn.offer_snapshot(snapshot, now)  # the newest picture straight away, if there is one
-        log.info("%s joined from %s", name, conn.peer)
+        self._log_seat(conn, "%s joined from %s", name, conn.peer)
+
+    def _log_seat(self, conn: Connection, line: str, *args) -> None:
+        """Joins and leaves, one line each, but summarised when one computer churns."""
+        self._quiet.note(f"joins and leaves from {conn.host}", line, *args, level=logging.INFO)
 
     def _password_ok(self, conn: Connection, hello: proto.Hello, now: float) -> bool:
         if self.password is None:
             return True
         if hello.password is None:
-            self._fail(conn, "this table needs a password: ask the teacher for it and join with --password")
+            self._fail(conn, "this table needs a password: ask the teacher for it and join with --password", quiet=True)
             return False
         wait = self._gate.password_wait(conn.host, now)
         if wait > 0:
@@ -672,9 +676,13 @@ class GameServer:
         return True
 
     def _fail(self, conn: Connection, sentence: str, retry: bool = False, quiet: bool = False) -> None:
-        """Send ERROR `sentence`, then close once it is out (or after LINGER_S)."""
+        """Send ERROR `sentence`, then close once it is out (or after LINGER_S).
+
+        Logged once per address and summarised after that (`quiet`: not at all)."""
         if not quiet:
-            log.info("dropped %s: %s", conn.who, sentence)
+            self._quiet.note(
+                f"connections dropped from {conn.host}", "dropped %s: %s", conn.who, sentence, level=logging.INFO
+            )
         self._release_slot(conn)
         conn.fail(sentence, time.monotonic(), retry=retry)
 
