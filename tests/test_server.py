@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import json
 import logging
+import os
+import selectors
 import socket
 import struct
 import threading
@@ -22,7 +24,15 @@ from airtable.colors import rgb
 from airtable.net import protocol as proto
 from airtable.net.events import MAX_QUEUED_INPUTS, EventQueue, PlayerInput, PlayerJoined, PlayerLeft
 from airtable.net.loadtest import TableLoop, grid_table, run_load
-from airtable.net.server import COURSE_COLORS, GameServer, client_color, lan_addresses
+from airtable.net.server import (
+    COURSE_COLORS,
+    RESERVED_FDS,
+    SELECT_SOCKETS,
+    GameServer,
+    client_color,
+    connection_room,
+    lan_addresses,
+)
 
 
 def frame(frame_type: int, payload: bytes) -> bytes:
@@ -659,6 +669,63 @@ def test_seats_per_computer_are_limited_with_a_clear_sentence(make_server, clien
     third.send(proto.encode_hello())
     assert "your computer already plays with 2 windows" in third.expect_error()
     assert clients(server.port, source="127.0.0.2").hello().client == "C3"
+
+
+# ---------------------------------------------------------------- the network thread
+
+
+def test_a_failing_network_thread_is_logged_shown_and_stops_cleanly(make_server, clients, caplog, monkeypatch):
+    server = make_server()
+    c = clients(server.port)
+    c.hello()
+
+    def broken(now):
+        raise ValueError("filedescriptor out of range in select()")
+
+    caplog.set_level(logging.ERROR, logger="airtable.net")
+    monkeypatch.setattr(server, "_check_timeouts", broken)  # stands in for a select() that fails
+    wait_until(lambda: server.failure, what="the failure to be reported")
+    assert server.failure.startswith("students can no longer join: ")
+    assert "ValueError: filedescriptor out of range" in server.failure
+    assert not server.running
+    assert any(r.exc_info and r.exc_info[0] is ValueError for r in caplog.records), "logged with its traceback"
+    while (got := c.next_frame()) is not None:  # the player is let go, not left hanging
+        assert got[0] in (proto.SNAPSHOT, proto.BYE)
+    server.stop()
+
+
+def test_the_player_cap_stays_below_what_the_selector_can_watch():
+    assert connection_room(selectors.SelectSelector, None) == SELECT_SOCKETS < 512
+    assert connection_room(selectors.SelectSelector, 256) == 256 - RESERVED_FDS
+    assert connection_room(selectors.EpollSelector, None) is None
+
+
+@pytest.mark.skipif(not hasattr(selectors, "EpollSelector"), reason="needs setrlimit and epoll (Linux)")
+def test_more_players_than_descriptors_gives_one_warning_not_a_flood(caplog):
+    resource = pytest.importorskip("resource")
+    soft, hard = resource.getrlimit(resource.RLIMIT_NOFILE)
+    in_use = len(os.listdir("/proc/self/fd"))
+    caplog.set_level(logging.INFO, logger="airtable.net")
+    resource.setrlimit(resource.RLIMIT_NOFILE, (in_use + 120, hard))
+    server = GameServer(host="127.0.0.1", port=0, max_clients=1000)
+    held = []
+    try:
+        server.start()
+        assert server.max_clients + server.max_handshakes <= in_use + 120 - RESERVED_FDS
+        for _ in range(300):  # both ends of each connection live in this process
+            try:
+                held.append(socket.create_connection(("127.0.0.1", server.port), timeout=WAIT_S))
+            except OSError:
+                break
+        wait_until(lambda: server.connection_count > 0, what="some connections")
+    finally:
+        for sock in held:
+            sock.close()
+        server.stop()
+        resource.setrlimit(resource.RLIMIT_NOFILE, (soft, hard))
+    warnings = [r.getMessage() for r in caplog.records if r.levelno >= logging.WARNING]
+    assert len(warnings) <= 3, warnings
+    assert any("only" in w and "ulimit" in w for w in warnings)
 
 
 # ---------------------------------------------------------------- slow clients and rates
