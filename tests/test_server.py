@@ -32,6 +32,7 @@ from airtable.net.server import (
     client_color,
     connection_room,
     lan_addresses,
+    validate_server_options,
 )
 
 
@@ -726,6 +727,26 @@ def test_more_players_than_descriptors_gives_one_warning_not_a_flood(caplog):
     warnings = [r.getMessage() for r in caplog.records if r.levelno >= logging.WARNING]
     assert len(warnings) <= 3, warnings
     assert any("only" in w and "ulimit" in w for w in warnings)
+
+
+@pytest.mark.parametrize(
+    "options, hint",
+    [
+        ({"max_clients": 5000}, "--max-clients must be 1-1000, not 5000"),
+        ({"max_clients": 0}, "--max-clients must be 1-1000"),
+        ({"snapshot_hz": 2000.0}, "--snapshot-hz must be above 0 and at most 1000, not 2000.0"),
+        ({"snapshot_hz": float("nan")}, "--snapshot-hz"),
+        ({"port": 70000}, "port must be 0-65535"),
+    ],
+)
+def test_the_command_line_can_refuse_what_the_server_would_with_the_same_sentence(options, hint):
+    with pytest.raises(ValueError) as by_server:
+        GameServer(**options)
+    said = []
+    validate_server_options(**options, error=said.append)
+    assert said == [str(by_server.value)] and hint in said[0] and "\n" not in said[0]
+    with pytest.raises(ValueError):
+        validate_server_options(**options)
 
 
 # ---------------------------------------------------------------- slow clients and rates

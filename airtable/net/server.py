@@ -135,8 +135,21 @@ def validate_server_options(
     max_clients: int = 30,
     snapshot_hz: float = 30.0,
     timeout_s: float = 10.0,
+    error: Callable[[str], object] | None = None,
 ) -> None:
-    """Raise ValueError with a one-line sentence if GameServer would refuse these."""
+    """Raise ValueError with a one-line sentence if GameServer would refuse these.
+
+    With `error` (e.g. an ArgumentParser's error), call it with the sentence instead,
+    so a command line refuses exactly what the server would."""
+    try:
+        _check_options(port, max_clients, snapshot_hz, timeout_s)
+    except ValueError as e:
+        if error is None:
+            raise
+        error(str(e))
+
+
+def _check_options(port: int, max_clients: int, snapshot_hz: float, timeout_s: float) -> None:
     if not 0 <= int(port) <= 65535:
         raise ValueError(f"the port must be 0-65535, not {port!r}")
     if not 1 <= int(max_clients) <= MAX_PLAYERS:
@@ -457,6 +470,8 @@ class GameServer:
             self._serve()
         except Exception as exc:
             log.exception("the network thread failed")
+            if self._listener is not None:  # new students get "refused" at once, not a hang
+                self._listener.close()
             self.failure = (
                 f"students can no longer join: the network thread failed ({type(exc).__name__}: {exc}); "
                 "restart the app to let them in again"
