@@ -314,7 +314,7 @@ def scenes(draw) -> Scene:
     s = draw(st.integers(0, 10)) if n else 0
     c = draw(st.integers(0, 5))
     width_m = draw(st.floats(0.1, 1000))
-    height_m = draw(st.floats(max(0.1, width_m / 100), min(1000, width_m * 100)))
+    height_m = draw(st.floats(max(0.1, width_m / 99), min(1000, width_m * 99)))
     size = max(width_m, height_m)
     x = st.floats(-size, width_m + size)
     y = st.floats(-size, height_m + size)

@@ -18,7 +18,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from airtable import AirTable, Client
-from airtable.app.client import LOCAL_COLOR
+from airtable.app.client import LOCAL_COLOR, cursor_pulls
 from airtable.app.scene import Scene
 from airtable.colors import rgb
 from airtable.net import protocol as proto
@@ -223,7 +223,6 @@ def arena(request):
 def one_puck_table() -> AirTable:
     table = AirTable()
     table.add_puck((5.0, 4.0), radius_m=0.5)
-    table.clients.append(Client())  # the local user
     return table
 
 
@@ -278,14 +277,14 @@ def test_input_drags_the_puck_and_disconnect_lets_go(make_server, make_loop, cli
 
     def holder() -> Client | None:
         with loop.lock:
-            return next((cl for cl in table.clients if cl.name == name and cl.held is not None), None)
+            return next((cl for cl in loop.clients if cl.name == name and cl.held is not None), None)
 
     client = wait_until(holder, what="the player to grab the puck")
     c.send(proto.encode_input((8.0, 4.0), 1))
     wait_until(lambda: table.pos_m[0, 0] > 6.0, what="the puck to follow the cursor")
     c.close()  # no BYE: the connection just goes away
-    wait_until(lambda: client not in table.clients and client.held is None, what="the puck to be let go")
-    assert [cl.name for cl in table.clients] == ["local"]
+    wait_until(lambda: client not in loop.clients and client.held is None, what="the puck to be let go")
+    assert [cl.name for cl in loop.clients] == ["local"]
 
 
 class GameLoop:
@@ -306,8 +305,7 @@ class GameLoop:
 
 def step_with(table: AirTable, clients: list[Client], dt_s: float) -> None:
     """One physics step with these clients' cursor strings."""
-    table.clients = clients
-    table.step(dt_s)
+    table.step(dt_s, cursor_pulls(clients))
 
 
 def test_two_players_on_one_puck_add_their_forces(make_server, clients):

@@ -36,7 +36,6 @@ HEARTBEAT_S = 1.0
 FIRST_BACKOFF_S = 0.25
 FIRST_FULL_BACKOFF_S = 1.0  # the table is full: ask again after this, then less and less often
 MAX_BACKOFF_S = 4.0
-DEFAULT_TABLE_SIZE_M = (10.0, 8.7556)  # until a WELCOME says the real size
 
 
 class PlayerError(Exception):
@@ -407,7 +406,7 @@ class NetPlayer:
 
     def _record(self, cursor_m: Sequence[float], button: int, keys: Iterable[str]) -> proto.InputRecord:
         welcome = self.welcome
-        size = (welcome.width_m, welcome.height_m) if welcome else DEFAULT_TABLE_SIZE_M
+        size = (welcome.width_m, welcome.height_m) if welcome else proto.DEFAULT_TABLE_SIZE_M
         return proto.make_input(cursor_m, button, keys, size)  # only what the server accepts
 
     def _send(self, record: proto.InputRecord, now: float) -> bool:
@@ -514,7 +513,7 @@ class PlayerApp:
 
     def _table_size(self) -> tuple[float, float]:
         w = self._welcome
-        return (w.width_m, w.height_m) if w is not None else DEFAULT_TABLE_SIZE_M
+        return (w.width_m, w.height_m) if w is not None else proto.DEFAULT_TABLE_SIZE_M
 
     def _new_env(self):
         from airtable.app.environment import DEFAULT_SIZE_PX, Environment

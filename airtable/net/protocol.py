@@ -24,9 +24,11 @@ from dataclasses import dataclass
 import numpy as np
 
 from airtable.app.scene import CursorView, Scene
+from airtable.physics.table import TABLE_HEIGHT_M, TABLE_WIDTH_M
 
 PROTOCOL_VERSION = 1
 DEFAULT_PORT = 8888
+DEFAULT_TABLE_SIZE_M = (TABLE_WIDTH_M, TABLE_HEIGHT_M)  # until the game loop (or a WELCOME) says otherwise
 
 HELLO = 1
 WELCOME = 2
@@ -425,7 +427,7 @@ def encode_input(cursor_m: Sequence[float], button: int = 0, keys: Iterable[str]
     )
 
 
-def validate_input(message: dict, table_size_m: Sequence[float] = (10.0, 8.7556)) -> InputRecord:
+def validate_input(message: dict, table_size_m: Sequence[float] = DEFAULT_TABLE_SIZE_M) -> InputRecord:
     """Check an INPUT object against the table size (width_m, height_m)."""
     try:
         return _validate_input(message, table_size_m)
@@ -458,7 +460,7 @@ def _validate_input(message: dict, table_size_m: Sequence[float]) -> InputRecord
     return InputRecord((x, y), button, frozenset(keys))
 
 
-def parse_input(payload: bytes, table_size_m: Sequence[float] = (10.0, 8.7556)) -> InputRecord:
+def parse_input(payload: bytes, table_size_m: Sequence[float] = DEFAULT_TABLE_SIZE_M) -> InputRecord:
     return validate_input(parse_json(payload, "INPUT", INPUT_EXAMPLE), table_size_m)
 
 

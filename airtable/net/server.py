@@ -56,7 +56,6 @@ COURSE_COLORS = (
     "rosybrown3",
 )
 
-DEFAULT_TABLE_SIZE_M = (10.0, 8.7556)  # until the game loop tells us the real size
 HELLO_TIMEOUT_S = 3.0  # a connection must be welcomed this soon after it opens
 MAX_HANDSHAKES = 32  # connections still saying HELLO, beyond the players
 MAX_PLAYERS = 1000
@@ -217,7 +216,7 @@ class GameServer:
         self._names: dict[int, str] = {}  # player number -> name, for player_names()
         self._roster: tuple[Seat, ...] = ()
         self._commands: list[Callable[[], None]] = []  # from the game loop, run by the network thread
-        self._table_size_m: tuple[float, float] = DEFAULT_TABLE_SIZE_M  # plain tuple: replaced, never mutated
+        self._table_size_m: tuple[float, float] = proto.DEFAULT_TABLE_SIZE_M  # plain tuple: replaced, never mutated
 
         # Game loop only.
         self._clients: dict[int, Client] = {}
@@ -423,16 +422,17 @@ class GameServer:
                     if client is not None:
                         client.release()
                         client.active = False
-                        _remove_identical(clients, client)
+                        if client in clients:  # by identity: Client has eq=False
+                            clients.remove(client)
                 case PlayerInput(cid, record):
                     client = self._clients.get(cid)
                     if client is not None:
                         client.set_input(table, record.cursor_m, record.button, record.keys)
                         client.active = True
 
-    def apply_inputs(self, table) -> None:
-        """The old name: update_clients(table.clients, table), for loops not yet moved over."""
-        self.update_clients(table.clients, table)
+    def apply_inputs(self, clients: list[Client], table) -> None:
+        """The old name of update_clients, for game loops not yet moved over."""
+        self.update_clients(clients, table)
 
     def publish(self, scene: Scene) -> None:
         """Game loop, after the frame's physics steps: at most snapshot_hz times a second,
@@ -789,11 +789,3 @@ class GameServer:
         """Best effort: tell players the server is going, so they show 'server gone'."""
         for conn in list(self._conns.values()):
             conn.say_bye()
-
-
-def _remove_identical(items: list, obj: object) -> None:
-    """Remove `obj` by identity (Client == compares numpy arrays, which is ambiguous)."""
-    for i, item in enumerate(items):
-        if item is obj:
-            del items[i]
-            return
