@@ -36,6 +36,10 @@ HEARTBEAT_S = 1.0
 FIRST_BACKOFF_S = 0.25
 FIRST_FULL_BACKOFF_S = 1.0  # the table is full: ask again after this, then less and less often
 MAX_BACKOFF_S = 4.0
+# Drawing budgets for one frame (see fit_drawing_budget).
+MAX_PUCK_AREA_SCREENS = 40.0
+MAX_PUCK_LOOKS = 1024
+MAX_SPRING_SPAN_PX = 20_000_000
 
 
 class PlayerError(Exception):
@@ -569,7 +573,7 @@ class PlayerApp:
         self.states_seen.add(net.state)
         self.frames += 1
         try:
-            self._draw(scene, cursor_m, bool(pygame.mouse.get_focused()))
+            self._draw(fit_drawing_budget(scene, env), cursor_m, bool(pygame.mouse.get_focused()))
         except Exception as exc:  # a scene this window cannot draw must not end the student's session
             if self.draw_error is None:
                 self.draw_error = f"{type(exc).__name__}: {exc}"
@@ -589,6 +593,82 @@ class PlayerApp:
         if extra and me:  # not in the snapshots yet: the arrow alone
             win.draw_cursor(me, color, cursor_m)
         win.present()
+
+
+def fit_drawing_budget(scene: Scene, env) -> Scene:
+    """The scene cut down, if needed, so that one frame stays cheap to draw.
+
+    A server could send thousands of pucks or springs each as big as the
+    window, or every puck in its own colour; drawing them would take minutes a
+    frame. Honest scenes are far inside these budgets and come back unchanged:
+    - pucks in view cover the window at most MAX_PUCK_AREA_SCREENS times over,
+      and none is drawn wider than the window's diagonal;
+    - at most MAX_PUCK_LOOKS distinct colours (beyond that, colours are rounded);
+    - springs span at most MAX_SPRING_SPAN_PX pixels in all (the longest go
+      first), and so do cursor strings.
+    """
+    changes: dict = {}
+    if len(scene.radius_m):
+        changes.update(_fit_pucks(scene, env))
+    if len(scene.spring_pairs):
+        changes.update(_fit_springs(scene, env))
+    if scene.cursors:
+        changes.update(_fit_cursor_strings(scene, env))
+    return dataclasses.replace(scene, **changes) if changes else scene
+
+
+def _fit_pucks(scene: Scene, env) -> dict:
+    w, h = env.size_px
+    px_per_m = float(env.length_to_px(1.0))
+    r_px = scene.radius_m * px_per_m
+    centers = env.to_screen(scene.pos_m)
+    visible = (
+        (centers[:, 0] + r_px >= 0)
+        & (centers[:, 0] - r_px <= w)
+        & (centers[:, 1] + r_px >= 0)
+        & (centers[:, 1] - r_px <= h)
+    )
+    changes: dict = {}
+    colors = scene.color_rgb
+    if len(np.unique(colors[visible], axis=0)) > MAX_PUCK_LOOKS:
+        changes["color_rgb"] = (colors & 0xE0) | 0x10  # 512 colours at most
+    area_px = float(np.minimum(np.pi * r_px[visible] ** 2, w * h).sum())
+    budget_px = MAX_PUCK_AREA_SCREENS * w * h
+    largest_m = math.hypot(w, h) / px_per_m
+    if area_px > budget_px or float(scene.radius_m.max()) > largest_m:
+        shrink = math.sqrt(budget_px / area_px) if area_px > budget_px else 1.0
+        changes["radius_m"] = np.minimum(scene.radius_m, largest_m) * shrink
+    return changes
+
+
+def _fit_springs(scene: Scene, env) -> dict:
+    d = scene.pos_m[scene.spring_pairs[:, 0]] - scene.pos_m[scene.spring_pairs[:, 1]]
+    # Drawing a spring costs about its length in pixels, even where it is off screen.
+    span_px = (np.abs(d[:, 0]) + np.abs(d[:, 1])) * float(env.length_to_px(1.0))
+    if float(span_px.sum()) <= MAX_SPRING_SPAN_PX:
+        return {}
+    order = np.argsort(span_px, kind="stable")
+    keep = np.sort(order[np.cumsum(span_px[order]) <= MAX_SPRING_SPAN_PX])
+    return {
+        "spring_pairs": scene.spring_pairs[keep],
+        "spring_length_m": scene.spring_length_m[keep],
+        "spring_width_m": scene.spring_width_m[keep],
+        "spring_color_rgb": scene.spring_color_rgb[keep],
+    }
+
+
+def _fit_cursor_strings(scene: Scene, env) -> dict:
+    held = [i for i, c in enumerate(scene.cursors) if 0 <= c.held < len(scene.pos_m)]
+    if not held:
+        return {}
+    ends = np.array([scene.cursors[i].cursor_m for i in held]) - scene.pos_m[[scene.cursors[i].held for i in held]]
+    span_px = (np.abs(ends[:, 0]) + np.abs(ends[:, 1])) * float(env.length_to_px(1.0))
+    if float(span_px.sum()) <= MAX_SPRING_SPAN_PX:
+        return {}
+    order = np.argsort(span_px, kind="stable")
+    dropped = {held[i] for i in order[np.cumsum(span_px[order]) > MAX_SPRING_SPAN_PX]}
+    cursors = tuple(dataclasses.replace(c, held=-1) if i in dropped else c for i, c in enumerate(scene.cursors))
+    return {"cursors": cursors}
 
 
 def own_cursor_live(

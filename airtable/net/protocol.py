@@ -62,10 +62,11 @@ MIN_TABLE_M = 0.01
 MAX_TABLE_M = 1e4
 MAX_TABLE_ASPECT = 100.0
 MAX_DRAWN_PUCKS = 20_000
-MAX_DRAWN_SPRINGS = 20_000
+MAX_DRAWN_SPRINGS = 10_000
 MAX_DRAWN_CURSORS = 1_000
 MIN_VIEW_ZOOM = 0.01
 MAX_VIEW_ZOOM = 1000.0
+MAX_DRAWN_TEXT_CHARS = 300  # a title or status line longer than this is cut, not drawn a mile wide
 
 _HEADER = struct.Struct(">IB")
 
@@ -811,7 +812,8 @@ def decode_snapshot(payload: bytes) -> Scene:
     bodies = _read_bodies(cut, h)
     cursor_arrays = _read_cursors(cut, h)
     title, status, correction = cut.text("title"), cut.text("status"), cut.text("puck correction mode")
-    names = [cut.text("cursor names") for _ in range(h.c)]
+    names = [cut.text("cursor names")[: 2 * MAX_NAME_CHARS + 8] for _ in range(h.c)]
+    title, status = title[:MAX_DRAWN_TEXT_CHARS], status[:MAX_DRAWN_TEXT_CHARS]
     if cut.offset != len(payload):
         raise _bad(f"{len(payload) - cut.offset} bytes too many at its end")
     if not all(t.isprintable() for t in (title, status, correction, *names)):
