@@ -670,6 +670,44 @@ def test_seats_per_computer_are_limited_with_a_clear_sentence(make_server, clien
     assert clients(server.port, source="127.0.0.2").hello().client == "C3"
 
 
+# ---------------------------------------------------------------- the teacher's view: roster and remove
+
+
+def test_the_roster_shows_each_seat_and_flags_squatters(make_server, make_loop, clients):
+    server = make_server()
+    make_loop(server, grid_table(), fps=60)
+    squatter = clients(server.port)
+    squatter.hello("\u3164x")
+    squatter.send(proto.encode_input((-40.0, -40.0), 0))
+    honest = Honest(server.port, (5.0, 4.0))
+    try:
+        assert server.player_count == 2
+
+        def both_seen():
+            seats = server.roster()
+            return len(seats) == 2 and seats[0].far_off and seats[1].snapshots_per_s > 10 and seats
+
+        squat, seat = wait_until(both_seen, what="both seats in the roster")
+        assert (squat.number, squat.name, squat.color) == (1, "C1 \u3164x", client_color(1))
+        assert (seat.number, seat.name, seat.far_off) == (2, "C2 honest", False)
+        assert squat.address.startswith("127.0.0.1:") and 0 <= seat.lag_s < 1.0
+        wait_until(lambda: server.roster()[0].idle_s > 0.3 > server.roster()[1].idle_s, what="the squatter idle")
+    finally:
+        honest.close()
+
+
+def test_the_teacher_can_remove_a_player_who_is_told_why(make_server, clients):
+    server = make_server()
+    keep, go = clients(server.port), clients(server.port)
+    keep.hello("Ann"), go.hello("Bo")
+    assert server.remove(2, "please use your own name") is True
+    sentence = go.expect_error()
+    assert sentence == "the teacher removed you from the table: please use your own name"
+    wait_until(lambda: server.player_names() == ["C1 Ann"], what="the seat to be free")
+    assert server.remove(2) is False and server.remove(99) is False
+    assert clients(server.port).hello().client == "C2"
+
+
 # ---------------------------------------------------------------- the network thread
 
 
