@@ -662,12 +662,16 @@ def test_one_computer_cannot_keep_others_from_joining(make_server, clients):
 
 def test_seats_per_computer_are_limited_with_a_clear_sentence(make_server, clients):
     server = make_server(limit_loopback=True, players_per_address=2)
-    clients(server.port).hello()
+    first = clients(server.port)
+    first.hello()
     clients(server.port).hello()
     third = clients(server.port)
     third.send(proto.encode_hello())
     assert "your computer already plays with 2 windows" in third.expect_error()
     assert clients(server.port, source="127.0.0.2").hello().client == "C3"
+    first.send(proto.encode_bye())  # a freed seat can be taken again from the same computer
+    wait_until(lambda: server.player_count == 2, what="the BYE")
+    assert clients(server.port).hello().client == "C1"
 
 
 # ---------------------------------------------------------------- the teacher's view: roster and remove

@@ -79,6 +79,18 @@ class Gate:
             )
         return None
 
+    def handshake_started(self, host: str) -> None:
+        self.handshakes[host] += 1
+
+    def handshake_ended(self, host: str, seated: bool) -> None:
+        """A handshake finished: welcomed into a seat (`seated`) or dropped."""
+        _down(self.handshakes, host)
+        if seated:
+            self.players[host] += 1
+
+    def seat_freed(self, host: str) -> None:
+        _down(self.players, host)
+
     # ------------------------------------------------------------ passwords
 
     def password_wait(self, host: str, now: float) -> float:
@@ -112,6 +124,12 @@ class Gate:
                 guesses.refused = 0
             if now > guesses.next_try + LOCKOUT_S:
                 del self._guesses[host]
+
+
+def _down(counter: Counter[str], host: str) -> None:
+    counter[host] -= 1
+    if counter[host] <= 0:
+        del counter[host]
 
 
 class QuietLog:

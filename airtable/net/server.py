@@ -566,7 +566,7 @@ class GameServer:
         conn.deadline = now + self.hello_timeout_s
         self._next_cid += 1
         self._conns[conn.cid] = conn
-        self._gate.handshakes[host] += 1
+        self._gate.handshake_started(host)
 
     def _drain_wake(self) -> None:
         assert self._wake_r is not None
@@ -647,8 +647,7 @@ class GameServer:
             number += 1
         name = f"C{number}" + (f" {hello.name}" if hello.name else "")
         color = client_color(number)
-        self._gate.handshakes[conn.host] -= 1
-        self._gate.players[conn.host] += 1
+        self._gate.handshake_ended(conn.host, seated=True)
         conn.number, conn.name, conn.state = number, name, State.PLAYING
         self._numbers[number] = conn.cid
         with self._lock:
@@ -711,11 +710,11 @@ class GameServer:
     def _release_slot(self, conn: Connection) -> None:
         """Forget the seat or handshake behind `conn` (its Client goes at the next update_clients)."""
         if conn.state == State.HELLO:
-            self._gate.handshakes[conn.host] -= 1
+            self._gate.handshake_ended(conn.host, seated=False)
             conn.state = State.CLOSING
         if conn.number and self._numbers.get(conn.number) == conn.cid:
             del self._numbers[conn.number]
-            self._gate.players[conn.host] -= 1
+            self._gate.seat_freed(conn.host)
             with self._lock:
                 self._names.pop(conn.number, None)
                 if not self._names:
@@ -724,9 +723,6 @@ class GameServer:
                     self._snapshot = None
             self._events.leave(conn.cid)
         conn.number = 0
-        for counter in (self._gate.handshakes, self._gate.players):
-            if counter[conn.host] <= 0:
-                del counter[conn.host]
 
     def _settle(self, conn: Connection) -> None:
         """Bookkeeping after a connection closed itself (or was closed)."""
