@@ -19,7 +19,7 @@ import numpy as np
 import pygame
 
 from airtable.app import aids
-from airtable.app.client import LOCAL_COLOR, Client
+from airtable.app.client import LOCAL_COLOR, Client, cursor_pulls
 from airtable.app.demo_loader import Demo, DemoError, error_from_exception, key_label
 from airtable.app.environment import Environment
 from airtable.app.scene import Scene
@@ -119,7 +119,7 @@ class App:
         self.env = Environment()
         self.table = AirTable(self.env.size_px[0] / self.env.base_px_per_m, self.env.view_height_m)
         self.local = Client(name="local", color=LOCAL_COLOR)
-        self.table.clients.append(self.local)
+        self.clients = [self.local]  # index 0 is the local user; the server adds players
         self.window = GameWindow(self.env, headless=headless)
         self.painter = AidsPainter(self.window)
         if not headless:
@@ -167,7 +167,7 @@ class App:
         self.variation = variation % len(demo.variations) if demo.variations else 0
         self.table.clear()
         self.table.reset_settings()
-        for client in self.table.clients:
+        for client in self.clients:
             client.held = None
         self.build_error = None
         try:
@@ -336,9 +336,9 @@ class App:
 
     def physics_step(self) -> None:
         if self.server is not None:
-            self.server.apply_inputs(self.table)
+            self.server.apply_inputs(self.clients, self.table)
         try:
-            self.table.step(self.dt_s)
+            self.table.step(self.dt_s, cursor_pulls(self.clients))
         except Exception as exc:  # a demo's timed event (teacher's code) failed
             self.build_error = self._demo_error(exc)
             self.paused = True
@@ -380,7 +380,7 @@ class App:
     def scene(self) -> Scene:
         return Scene.from_table(
             self.table,
-            self.table.clients,
+            self.clients,
             title=self.demo.label(self.variation),
             status=self.status_line(),
             fps=self.fps,
@@ -474,7 +474,7 @@ class App:
         paint.marker(com, COM_COLOR, f"centre of mass, {np.hypot(*com_v):.2f} m/s")
         held = self.local.held
         if held is not None and held.alive:
-            forces = t.forces_on(held, self.dt_s)
+            forces = t.forces_on(held, self.dt_s, cursor_pulls(self.clients))
             if forces:
                 biggest = max(float(np.hypot(*f)) for f in forces.values())
                 newtons, m_per_n = aids.nice_scale(biggest, target_m=1.5)
