@@ -11,6 +11,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from airtable.app import aids
+from airtable.app.client import cursor_pulls
 
 if TYPE_CHECKING:
     from airtable.app.app import App
@@ -62,7 +63,7 @@ def _draw_vectors(app: App) -> None:
     paint.marker(com, COM_COLOR, f"centre of mass, {np.hypot(*com_v):.2f} m/s")
     held = app.local.held
     if held is not None and held.alive:
-        forces = t.forces_on(held, app.dt_s)
+        forces = t.forces_on(held, app.dt_s, cursor_pulls(app.clients))
         if forces:
             biggest = max(float(np.hypot(*f)) for f in forces.values())
             newtons, m_per_n = aids.nice_scale(biggest, target_m=1.5)

@@ -19,7 +19,7 @@ import pygame
 
 from airtable.app import aids, controls
 from airtable.app.aids_view import draw_aids
-from airtable.app.client import LOCAL_COLOR, Client
+from airtable.app.client import LOCAL_COLOR, Client, cursor_pulls
 from airtable.app.demo_loader import Demo, DemoError, DemoShelf, error_from_exception, key_label
 from airtable.app.environment import Environment
 from airtable.app.loop import FixedStep, FpsCounter, FrameLoop
@@ -85,8 +85,7 @@ class App:
         self.table = AirTable(self.env.size_px[0] / self.env.base_px_per_m, self.env.view_height_m)
         self.local = Client(name="local", color=LOCAL_COLOR)
         # The loop owns the clients (index 0 is the local user); the server adds the students.
-        self.clients: list[Client] = self.table.clients
-        self.clients.append(self.local)
+        self.clients: list[Client] = [self.local]
         self.window = GameWindow(self.env, headless=headless)
         self.painter = AidsPainter(self.window)
         if not headless:
@@ -309,7 +308,7 @@ class App:
     def physics_step(self) -> bool:
         """One fixed step; False if a demo's timed event failed (the app pauses on it)."""
         try:
-            self.table.step(self.dt_s)
+            self.table.step(self.dt_s, cursor_pulls(self.clients))
         except Exception as exc:  # a demo's timed event (teacher's code) failed
             self._demo_failed(exc, "event")
             self.paused = True
@@ -330,7 +329,7 @@ class App:
         # Recomputed every frame: zooming moves the world under a still mouse.
         self.local.set_input(self.table, self.env.to_world(self.mouse_px), self.mouse_button)
         if self.server is not None:
-            self.server.apply_inputs(self.table)  # joins, leaves and inputs, even while paused
+            self.server.apply_inputs(self.clients, self.table)  # joins, leaves and inputs, even while paused
         if not self.paused:
             for _ in range(self.stepper.steps(frame_dt_s, self.speed)):
                 if not self.physics_step():
