@@ -338,7 +338,7 @@ class GameServer:
             client = self._clients.get(cid)
             if client is not None:
                 for record in records:
-                    client.set_input(table, record.cursor_m, record.button, record.keys)
+                    client.set_input(table, record.cursor_m, record.button)  # INPUT's keys are not used
                 client.active = True
 
     def publish(self, scene: Scene) -> None:
