@@ -116,6 +116,9 @@ def test_the_demo_menu_lists_every_demo_and_starts_the_one_picked(tmp_path):
     press(app, pygame.K_TAB)
     press(app, pygame.K_ESCAPE)  # closes the menu, quits nothing
     assert app.panel() is None and app.running and app.demo_key == "t2"
+    press(app, pygame.K_TAB)
+    press(app, pygame.K_TAB)  # Tab again closes it too
+    assert app.panel() is None
 
 
 # ---------------------------------------------------------------- errors reach the terminal

@@ -259,7 +259,9 @@ class App:
         panel = self.panel()
         if event.key == pygame.K_ESCAPE or panel not in ("quit", "menu", "notice"):
             return False
-        if panel == "menu":
+        if panel == "menu" and event.key == pygame.K_TAB:
+            self.menu = None
+        elif panel == "menu":
             picked = self.menu.press(pygame.key.name(event.key), getattr(event, "unicode", ""))
             if picked is not None:
                 self.menu = None
