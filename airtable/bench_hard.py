@@ -24,6 +24,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from airtable.physics import broadphase, vectors
 from airtable.physics.table import AirTable, kinetic_energy_J
 
 DT_S = 1.0 / 240.0
@@ -236,12 +237,10 @@ def pile_case(engine_name: str, seconds: float = 10.0) -> str:
     _run(engine, int(seconds / DT_S), DT_S)
     ms = _run(engine, 120, DT_S)
     pos, vel = engine.pos_m, engine.vel_mps
-    from airtable.physics import collisions
-
-    i, j = collisions.find_overlapping_pairs(pos, radius)
+    i, j = broadphase.find_overlapping_pairs(pos, radius)
     over = 0.0
     if len(i):
-        over = float(-(collisions.lengths(pos[i] - pos[j]) - radius[i] - radius[j]).min())
+        over = float(-(vectors.lengths(pos[i] - pos[j]) - radius[i] - radius[j]).min())
     return (
         f"KE after {seconds:g} s {kinetic_energy_J(mass, vel):.2g} J, deepest overlap {1e3 * over:.3g} mm,"
         f" step on the pile {ms:.3g} ms"
