@@ -26,6 +26,7 @@ def build_parser() -> argparse.ArgumentParser:
     p = argparse.ArgumentParser(
         prog="python -m airtable",
         description="The air table: pucks, springs and cursor strings. Students join with airtable-client HOST.",
+        epilog="In the window: F1 lists the keys, Tab opens the demo menu, Esc closes what is open or quits.",
     )
     p.add_argument("--demo", default="1", metavar="KEY", help="demo to start with (see --list-demos); default 1")
     p.add_argument("--variation", type=_non_negative_int, default=0, metavar="N", help="variation of that demo")
