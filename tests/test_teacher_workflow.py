@@ -59,6 +59,9 @@ def test_pressing_a_demo_key_reads_its_file_again_after_an_edit(tmp_path, capsys
     assert len(app.table.pucks) == 0  # not the built-in demo 5 in its place
     assert f"{mine}:3: syntax error" in capsys.readouterr().err
 
+    press(app, pygame.K_6)
+    press(app, pygame.K_5)  # from another demo, too: the error, not the built-in 5
+    assert app.panel() == "error" and len(app.table.pucks) == 0
     mine.write_text(demo_source("5", pucks=4, build_line=RAISES))
     press(app, pygame.K_5)
     assert app.build_error is not None and app.build_error.stage == "build"

@@ -157,7 +157,7 @@ class App:
         """
         for error in self.shelf.refresh():
             self.report(error)
-        broken = self.shelf.error_for(self.demo_path) if key == self.demo_key else None
+        broken = self.shelf.broken(key)  # its file failed since it last loaded: show why
         if broken is None and key not in self.demos:
             self.say(f"no demo on key {key_label(key)}")
             return
