@@ -102,6 +102,7 @@ class GameWindow:
         self._labels: dict[tuple, pygame.Surface] = {}
         self._status_bar: pygame.Surface | None = None
         self.hud_bottom_px = 0  # below the title and HUD lines: panels start under it
+        self.label_boxes: list[pygame.Rect] = []  # text drawn this frame; the aids place labels around it
         self.status_top_px = 0
         if headless:
             self.windowed_size_px = tuple(int(v) for v in (size_px or env.size_px))
@@ -229,6 +230,7 @@ class GameWindow:
         crisp on top.
         """
         self.follow_display()
+        self.label_boxes = []
         surf = self.surface
         surf.fill(MARGIN_COLOR)
         surf.fill(background_for(scene), self._table_rect(scene))
@@ -356,15 +358,17 @@ class GameWindow:
         pygame.draw.rect(self.surface, (0, 0, 0), box)
         pygame.draw.rect(self.surface, DIM_TEXT, box, 1)
         self.surface.blit(fps, fps.get_rect(center=box.center))
+        self.label_boxes.append(box)
         y = pad
         line_h = self.font.get_linesize()
         if scene.title:
             title = fit_parts(self.font, [scene.title], box.left - 2 * pad)
-            self.surface.blit(self.font.render(title, True, TEXT_COLOR), (pad, y))
+            self.label_boxes.append(self.surface.blit(self.font.render(title, True, TEXT_COLOR), (pad, y)))
             y += line_h
         for k, line in enumerate(hud):
             color = tuple(hud_color) if (k == 0 and hud_color is not None) else DIM_TEXT
-            self.surface.blit(self.font.render(fit_parts(self.font, [line], w - 2 * pad), True, color), (pad, y))
+            text = self.font.render(fit_parts(self.font, [line], w - 2 * pad), True, color)
+            self.label_boxes.append(self.surface.blit(text, (pad, y)))
             y += line_h
         self.hud_bottom_px = y
         parts = status_parts(scene.status)
@@ -377,7 +381,7 @@ class GameWindow:
             if self._status_bar is None or self._status_bar.get_size() != (w, bar_h):
                 self._status_bar = pygame.Surface((w, bar_h), pygame.SRCALPHA)
                 self._status_bar.fill((0, 0, 0, 150))
-            self.surface.blit(self._status_bar, (0, h - bar_h))
+            self.label_boxes.append(self.surface.blit(self._status_bar, (0, h - bar_h)))
             text = fit_parts(self.font, parts, w - 2 * pad)
             self.surface.blit(self.font.render(text, True, TEXT_COLOR), (pad, h - bar_h + pad // 2))
         if paused:
@@ -392,6 +396,7 @@ class GameWindow:
         pygame.draw.rect(self.surface, (0, 0, 0), box)
         pygame.draw.rect(self.surface, PAUSED_COLOR, box, self.line_px(3))
         self.surface.blit(label, label.get_rect(center=box.center))
+        self.label_boxes.append(box)
 
     def draw_banner(self, text: str) -> None:
         """A big message across the middle of the window."""
