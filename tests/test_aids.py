@@ -414,3 +414,23 @@ def test_the_chart_moves_between_corners_and_shrinks(demos):
     small = app.painter.chart_rect()
     assert small.width < big.width and small.height < big.height
     app.frame(FRAME_S)  # draws in its small size without trouble
+
+
+def test_demo_5_motion_matches_its_notes(demos):
+    # Damper: the bouncing dies within a couple of seconds, the pair drifts on at 0.22 m/s.
+    app = make_app(demos, "5")
+    start = app.table.center_of_mass_m().copy()
+    for _ in range(3 * 60):
+        app.frame(FRAME_S)
+    (a, b) = app.table.pucks
+    assert np.hypot(*(a.pos_m - b.pos_m)) == pytest.approx(1.5, abs=0.02)  # relaxed: no more bouncing
+    moved = app.table.center_of_mass_m() - start
+    np.testing.assert_allclose(moved / app.table.time_s, (0.2, 0.1), atol=1e-6)  # still drifting
+    assert app.chart.euler_wiggle_note(app.table) is None  # no "swings without drifting" claim here
+    # No damper (Right): the bouncing goes on and the total swings by about 3 % (omega dt / 2).
+    press(app, pygame.K_RIGHT)
+    assert "no damper" in app.window.caption
+    for _ in range(3 * 60):
+        app.frame(FRAME_S)
+    assert 0.03 < app.chart.total_wiggle(2.0) < 0.04
+    assert "does not drift" in app.chart.euler_wiggle_note(app.table)

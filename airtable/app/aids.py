@@ -202,12 +202,21 @@ class EnergyChart:
     def euler_wiggle_note(self, table: AirTable) -> str | None:
         """One line explaining the swing of the total, when springs make it visible."""
         wiggle = self.total_wiggle(WIGGLE_WINDOW_S)
-        if table.spring_pairs.size == 0 or not (1e-4 < wiggle < 0.2):
+        if table.spring_pairs.size == 0 or not (2e-3 < wiggle < 0.2) or self.total_drifts(WIGGLE_WINDOW_S):
             return None
         return (
             f"The total swings by {100 * wiggle:.2g} % but does not drift: semi-implicit Euler "
             "keeps a nearby energy exactly, so E wiggles by about omega dt / 2."
         )
+
+    def total_drifts(self, window_s: float = CHART_WINDOW_S) -> bool:
+        """True when the total moves on (a damper, friction) rather than only swinging about a level."""
+        total = self.series(window_s)["total_J"]
+        if len(total) < 6:
+            return False
+        third = len(total) // 3
+        trend = abs(float(np.mean(total[-third:]) - np.mean(total[:third])))
+        return trend > 0.2 * float(total.max() - total.min())
 
     def total_wiggle(self, window_s: float = CHART_WINDOW_S) -> float:
         """(max - min) / (2 mean) of the total energy over the window: its relative amplitude."""
