@@ -4,11 +4,6 @@
 pygame; the window lives in `airtable.app.window`.
 """
 
-import os
-
-# pygame-ce prints a banner on import; the app has its own window title.
-os.environ.setdefault("PYGAME_HIDE_SUPPORT_PROMPT", "1")
-
 from airtable.app.client import Client
 from airtable.app.environment import Environment
 from airtable.physics.bodies import Puck, Spring

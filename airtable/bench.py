@@ -11,9 +11,9 @@ this machine is shared and noisy, and the minimum is the least disturbed
 estimate of what the code itself costs. Garbage collection is off while
 timing, as `timeit` does.
 
-Sections are listed in `SECTIONS`; add one (for example whole-frame timings
-with drawing) by writing a function that takes the parsed arguments and
-registering it there. `--only` picks sections by name.
+The "frames" section times whole frames of the app (physics plus drawing,
+headless). Sections are listed in `SECTIONS`; a new one is a function that
+takes the parsed arguments, registered there. `--only` picks sections by name.
 """
 
 from __future__ import annotations
@@ -28,7 +28,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from airtable.physics import collisions
+from airtable.bench_cpu import cpu_section
+from airtable.memory import keep_freed_memory
+from airtable.physics import broadphase, vectors
 from airtable.physics.table import AirTable, kinetic_energy_J
 
 # The gas scene (units in the names).
@@ -99,10 +101,10 @@ def gas_scene(
 
 def deepest_overlap_m(pos_m: np.ndarray, radius_m: np.ndarray) -> float:
     """The largest overlap between any two pucks (m), 0 if none touch."""
-    i, j = collisions.find_overlapping_pairs(pos_m, radius_m)
+    i, j = broadphase.find_overlapping_pairs(pos_m, radius_m)
     if len(i) == 0:
         return 0.0
-    gaps = collisions.lengths(pos_m[i] - pos_m[j]) - collisions.pair_reach(radius_m, i, j)
+    gaps = vectors.lengths(pos_m[i] - pos_m[j]) - broadphase.pair_reach(radius_m, i, j)
     return float(-gaps.min())
 
 
@@ -313,10 +315,8 @@ def _verdict(n: int, ours: Run, ratio: float | None) -> tuple[str, str]:
     return ", ".join(targets), "PASS" if ok else "MISS"
 
 
-def physics_section(args: argparse.Namespace) -> bool:
-    """ms per step of the gas scene for several N, ours beside pymunk; True if every row passes."""
-    counts = (10, 100, 1000) if args.quick else (10, 100, 1000, 10000)
-    version = None if args.no_pymunk else pymunk_version()
+def _print_physics_setup(args: argparse.Namespace, version: str | None) -> None:
+    """What the physics section measures, and against what."""
     print(
         f"physics: gas of r = {RADIUS_M:g} m pucks covering {COVERAGE:.0%} of an 8:7 table, {SPEED_MPS:g} m/s"
         f" in random directions, restitution 1, no gravity, dt = 1/{1 / DT_S:.0f} s"
@@ -341,22 +341,30 @@ def physics_section(args: argparse.Namespace) -> bool:
         f" our overlaps under {TARGET_OVERLAP_MM:g} mm"
     )
     print()
-    out = TextTable(
-        [
-            ("N", 6, ">"),
-            ("table m", 11, ">"),
-            ("steps", 5, ">"),
-            ("ours ms", 8, ">"),
-            ("pymunk ms", 9, ">"),
-            ("ours/pm", 7, ">"),
-            ("ours ov mm", 10, ">"),
-            ("pm ov mm", 8, ">"),
-            ("ours drift", 10, ">"),
-            ("pm drift", 9, ">"),
-            ("targets", 32, "<"),
-            ("result", 6, "<"),
-        ]
-    )
+
+
+PHYSICS_COLUMNS = [
+    ("N", 6, ">"),
+    ("table m", 11, ">"),
+    ("steps", 5, ">"),
+    ("ours ms", 8, ">"),
+    ("pymunk ms", 9, ">"),
+    ("ours/pm", 7, ">"),
+    ("ours ov mm", 10, ">"),
+    ("pm ov mm", 8, ">"),
+    ("ours drift", 10, ">"),
+    ("pm drift", 9, ">"),
+    ("targets", 32, "<"),
+    ("result", 6, "<"),
+]
+
+
+def physics_section(args: argparse.Namespace) -> bool:
+    """ms per step of the gas scene for several N, ours beside pymunk; True if every row passes."""
+    counts = (10, 100, 1000) if args.quick else (10, 100, 1000, 10000)
+    version = None if args.no_pymunk else pymunk_version()
+    _print_physics_setup(args, version)
+    out = TextTable(PHYSICS_COLUMNS)
     out.header()
     all_ok = True
     for n in counts:
@@ -465,6 +473,7 @@ def frames_section(args: argparse.Namespace) -> bool:
 SECTIONS: dict[str, Callable[[argparse.Namespace], bool]] = {
     "physics": physics_section,
     "frames": frames_section,
+    "cpu": cpu_section,
 }
 
 
@@ -484,6 +493,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     parser.add_argument("--no-pymunk", action="store_true", help="skip the pymunk comparison")
     parser.add_argument("--seed", type=int, default=0, help="random seed of the scenes (default 0)")
     args = parser.parse_args(argv)
+    keep_freed_memory()  # as the app does (cli.main): a 10000-puck step is 35 % slower without
     t0 = time.perf_counter()
     ok = True
     for name in args.only or list(SECTIONS):

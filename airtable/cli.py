@@ -10,15 +10,16 @@ from __future__ import annotations
 import argparse
 import logging
 import math
+import os
 import sys
 from collections.abc import Sequence
 from pathlib import Path
 
-import pygame
-
-from airtable.app.app import App
-from airtable.app.demo_loader import BUILTIN_DIR, Demo, DemoError, discover, key_order
+from airtable.app.demo_loader import BUILTIN_DIR, Demo, DemoError, DemoShelf
 from airtable.assets import ASSETS_DIR
+from airtable.memory import keep_freed_memory
+
+HEADLESS_FRAME_S = 1 / 60  # a headless run with no server: simulated frames of this length
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -36,8 +37,20 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--snapshot-hz", type=_positive_float, default=30.0, metavar="HZ", help="snapshots per second")
     p.add_argument("--no-server", action="store_true", help="do not accept students over the network")
     p.add_argument("--headless", action="store_true", help="run the same loop without a window")
-    p.add_argument("--seconds", type=_positive_float, default=None, metavar="S", help="quit after S seconds")
-    p.add_argument("--screenshot", default=None, metavar="FILE.png", help="save the last frame to FILE.png at exit")
+    p.add_argument(
+        "--seconds",
+        type=_positive_float,
+        default=None,
+        metavar="S",
+        help="quit after S seconds; with --headless --no-server these are S seconds of simulated time, run as"
+        " fast as the machine can (frames of 1/60 s); with a server, students need real time, so real seconds",
+    )
+    p.add_argument(
+        "--screenshot",
+        default=None,
+        metavar="FILE.png",
+        help="save the last frame to FILE.png at exit (.png is added if the name lacks it)",
+    )
     p.add_argument(
         "--demos",
         action="append",
@@ -123,9 +136,67 @@ def start_server(args):
     return server
 
 
+def screenshot_path(text: str) -> Path:
+    """Where --screenshot saves: `.png` added if missing; ValueError if it cannot be written."""
+    path = Path(text)
+    if path.is_dir():
+        raise ValueError(f"--screenshot {text}: that is a folder; give a file name like shot.png")
+    if path.suffix.lower() != ".png":
+        path = path.with_name(path.name + ".png")
+    folder = path.parent
+    if not folder.is_dir():
+        raise ValueError(f"--screenshot {path}: there is no folder {folder}")
+    if path.is_dir() or not os.access(folder, os.W_OK) or (path.exists() and not os.access(path, os.W_OK)):
+        raise ValueError(f"--screenshot {path}: cannot write there; choose a file in a folder you may write to")
+    return path
+
+
+NO_DISPLAY = "no display to open a window on (is DISPLAY set?); run with --headless to run without one"
+
+
+def check_display() -> str | None:
+    """None if a window can open; else a sentence saying why not and what to do."""
+    asked = os.environ.get("SDL_VIDEODRIVER", "")
+    if (
+        sys.platform.startswith("linux")
+        and not asked
+        and not (os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY"))
+    ):
+        return NO_DISPLAY  # asking SDL would only add its own messages
+    import pygame
+
+    try:
+        pygame.display.init()
+    except pygame.error as exc:
+        return f"no display to open a window on ({exc}); run with --headless to run without one"
+    if pygame.display.get_driver() in ("offscreen", "dummy") and asked not in ("offscreen", "dummy"):
+        return NO_DISPLAY
+    return None
+
+
+def load_demos(parser: argparse.ArgumentParser, args: argparse.Namespace) -> DemoShelf:
+    for directory in args.demos:
+        if not Path(directory).is_dir():
+            parser.error(f"--demos {directory}: no such folder")
+    shelf = DemoShelf([BUILTIN_DIR, *map(Path, args.demos)])
+    if args.list_demos:
+        return shelf
+    if args.demo not in shelf.demos:
+        for error in shelf.errors:
+            print(error.one_line(), file=sys.stderr)
+        parser.error(f"there is no demo {args.demo!r}; choose one of: {', '.join(shelf.demos)}")
+    variations = shelf.demos[args.demo].variations
+    if args.variation and args.variation >= max(1, len(variations)):
+        parser.error(f"demo {args.demo} has {len(variations) or 'no'} variations; --variation must be below that")
+    return shelf
+
+
 def main(argv: Sequence[str] | None = None) -> int:
+    # pygame-ce prints a banner when imported; the app has its own window title.
+    os.environ.setdefault("PYGAME_HIDE_SUPPORT_PROMPT", "1")
     parser = build_parser()
     args = parser.parse_args(argv)
+    keep_freed_memory()  # the step's big temporary arrays are reused, not re-faulted (35 % at 10000 pucks)
     if args.new_demo:
         try:
             path = write_starter_demo(Path(args.new_demo))
@@ -133,33 +204,51 @@ def main(argv: Sequence[str] | None = None) -> int:
             parser.error(str(exc))
         print(f"wrote {path}; edit it, then run: python -m airtable --demos {path.parent}")
         return 0
-    for directory in args.demos:
-        if not Path(directory).is_dir():
-            parser.error(f"--demos {directory}: no such folder")
-    demos, errors = discover([BUILTIN_DIR, *map(Path, args.demos)])
+    shelf = load_demos(parser, args)
     if args.list_demos:
-        print(list_demos(demos, errors))
+        print(list_demos(shelf.demos, shelf.errors))
         return 0
-    if args.demo not in demos:
-        parser.error(f"there is no demo {args.demo!r}; choose one of: {', '.join(sorted(demos, key=key_order))}")
-    variations = demos[args.demo].variations
-    if args.variation and args.variation >= max(1, len(variations)):
-        parser.error(f"demo {args.demo} has {len(variations) or 'no'} variations; --variation must be below that")
+    shot = None
+    try:
+        shot = screenshot_path(args.screenshot) if args.screenshot else None
+    except ValueError as exc:
+        print(f"airtable: {exc}", file=sys.stderr)
+        return 1
+    problem = None if args.headless else check_display()
+    if problem:
+        print(f"airtable: {problem}", file=sys.stderr)
+        return 1
+    return run_app(args, shelf, shot)
+
+
+def run_app(args: argparse.Namespace, shelf: DemoShelf, shot: Path | None) -> int:
+    """Start the server and the app; returns the exit status (1 if a demo failed in a headless run)."""
+    import pygame
+
+    from airtable.app.app import App
+
     # The server logs who joins and who is dropped (and why) for the teacher.
     logging.basicConfig(level=logging.INFO, format="%(message)s")
     server = None if args.no_server else start_server(args)
-    app = App(
-        demos, demo_key=args.demo, variation=args.variation, headless=args.headless, server=server, demo_errors=errors
-    )
+    # A timed headless run with nobody to serve simulates its time: it takes as long as the machine needs.
+    simulated = args.headless and server is None and args.seconds is not None
+    frame_dt_s = HEADLESS_FRAME_S if simulated else None
+    status = 0
     try:
-        app.run(seconds=args.seconds)
-        if args.screenshot:
-            path = app.window.save_screenshot(args.screenshot)
-            print(f"screenshot saved to {path}")
+        app = App(shelf, demo_key=args.demo, variation=args.variation, headless=args.headless, server=server)
+        app.run(seconds=args.seconds, frame_dt_s=frame_dt_s)
+        if shot is not None:
+            try:
+                print(f"screenshot saved to {app.window.save_screenshot(shot)}")
+            except (OSError, pygame.error) as exc:
+                print(f"airtable: could not save the screenshot {shot}: {exc}", file=sys.stderr)
+                status = 1
+        if args.headless and any(e.stage != "load" for e in app.errors):
+            status = 1
     except KeyboardInterrupt:
         pass
     finally:
         if server is not None:
             server.stop()
         pygame.quit()
-    return 0
+    return status

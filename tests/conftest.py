@@ -1,4 +1,4 @@
-"""Test set-up: every test runs headless unless it asks for a real X display."""
+"""Test set-up: every test runs headless unless it asks for a real X display; shared helpers."""
 
 import os
 
@@ -6,8 +6,12 @@ os.environ.setdefault("SDL_VIDEODRIVER", "dummy")
 os.environ.setdefault("SDL_AUDIODRIVER", "dummy")
 os.environ.setdefault("PYGAME_HIDE_SUPPORT_PROMPT", "1")
 
+import time  # noqa: E402  (after the SDL settings above, which must come first)
+from collections.abc import Callable  # noqa: E402
 
-import pytest  # noqa: E402  (after the SDL settings above, which must come first)
+import pytest  # noqa: E402
+
+FRAME_S = 1 / 60  # one frame of the app in tests: simulated time, never the clock
 
 
 @pytest.fixture(scope="session")
@@ -18,3 +22,31 @@ def demos():
     found, errors = discover([BUILTIN_DIR])
     assert not errors
     return found
+
+
+def post_key(key: int, down: bool = True, mod: int = 0, unicode: str = "") -> None:
+    """Post a real KEYDOWN (or KEYUP) event, as the keyboard would."""
+    import pygame
+
+    kind = pygame.KEYDOWN if down else pygame.KEYUP
+    pygame.event.post(pygame.event.Event(kind, key=key, mod=mod, unicode=unicode, scancode=0))
+
+
+def press(app, key: int, mod: int = 0, frames: int = 1, unicode: str = "") -> None:
+    """Press and release `key`, then run `frames` frames of the app."""
+    post_key(key, mod=mod, unicode=unicode)
+    post_key(key, down=False, mod=mod, unicode=unicode)
+    for _ in range(frames):
+        app.frame(FRAME_S)
+
+
+def wait_until(condition: Callable[[], object], timeout_s: float = 5.0, what: str = "condition") -> object:
+    """Poll `condition` until it is truthy and return it; fail after `timeout_s` (a bound, not a delay)."""
+    deadline = time.monotonic() + timeout_s
+    while True:
+        value = condition()
+        if value:
+            return value
+        if time.monotonic() > deadline:
+            pytest.fail(f"timed out after {timeout_s} s waiting for {what}")
+        time.sleep(0.005)

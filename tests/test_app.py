@@ -5,11 +5,10 @@ from __future__ import annotations
 import numpy as np
 import pygame
 import pytest
+from conftest import FRAME_S, press
 
 from airtable.app.app import App
 from airtable.cli import main
-
-FRAME_S = 1 / 60
 
 
 @pytest.fixture
@@ -18,13 +17,6 @@ def app(demos):
     pygame.event.clear()
     yield a
     pygame.event.clear()
-
-
-def press(app: App, key: int, mod: int = 0, frames: int = 1) -> None:
-    pygame.event.post(pygame.event.Event(pygame.KEYDOWN, key=key, mod=mod, unicode="", scancode=0))
-    pygame.event.post(pygame.event.Event(pygame.KEYUP, key=key, mod=mod, unicode="", scancode=0))
-    for _ in range(frames):
-        app.frame(FRAME_S)
 
 
 def to_px(app: App, point_m) -> tuple[int, int]:

@@ -9,7 +9,7 @@ import pytest
 
 from airtable import AirTable
 from airtable.bench import gas_scene, main
-from airtable.physics import collisions
+from airtable.physics import broadphase
 
 
 def test_gas_scene_covers_30_percent_without_overlaps() -> None:
@@ -18,7 +18,7 @@ def test_gas_scene_covers_30_percent_without_overlaps() -> None:
     coverage = np.sum(math.pi * table.radius_m**2) / (table.width_m * table.height_m)
     assert coverage == pytest.approx(0.30, rel=1e-9)
     assert table.width_m / table.height_m == pytest.approx(8 / 7)
-    i, _ = collisions.brute_force_pairs(table.pos_m, table.radius_m)
+    i, _ = broadphase.brute_force_pairs(table.pos_m, table.radius_m)
     assert len(i) == 0, "pucks start overlapping"
     r = table.radius_m[:, None]
     assert np.all(table.pos_m > r) and np.all(table.pos_m < table.size_m - r)
@@ -38,7 +38,7 @@ def test_gas_scene_fills_a_given_table() -> None:
     table.add_puck()
     assert gas_scene(table) is table
     assert len(table.pucks) == round(0.3 * 4.0 * 3.5 / (math.pi * 0.1**2))
-    i, _ = collisions.brute_force_pairs(table.pos_m, table.radius_m)
+    i, _ = broadphase.brute_force_pairs(table.pos_m, table.radius_m)
     assert len(i) == 0
 
 

@@ -15,16 +15,16 @@ from hypothesis import strategies as st
 
 from airtable import AirTable
 from airtable.bench import gas_scene
-from airtable.physics import collisions
+from airtable.physics import broadphase, pairs
 
-MODES = collisions.CORRECTION_MODES
+MODES = pairs.CORRECTION_MODES
 
 
 def mass_of(radius_m: float, density_kgpm2: float = 0.3) -> float:
     return density_kgpm2 * math.pi * radius_m**2
 
 
-def step_until_collision(table: AirTable, dt_s: float, max_steps: int = 100) -> collisions.Collisions:
+def step_until_collision(table: AirTable, dt_s: float, max_steps: int = 100) -> pairs.Collisions:
     """Step until a step reports a collision; return that step's collisions."""
     for _ in range(max_steps):
         table.step(dt_s)
@@ -223,7 +223,7 @@ def test_gas_conserves_energy_and_keeps_pucks_apart(mode: str, tight: bool) -> N
         table.step(1 / 120)
         assert_inside_walls(table)
         if k % 10 == 0:
-            i, j = collisions.brute_force_pairs(table.pos_m, table.radius_m)
+            i, j = broadphase.brute_force_pairs(table.pos_m, table.radius_m)
             d = np.hypot(*(table.pos_m[i] - table.pos_m[j]).T)
             deepest.append(float(np.max(2 * r - d)) / r if len(i) else 0.0)
     assert table.collision_count > 5000
@@ -241,8 +241,8 @@ def puck_sets(draw) -> tuple[np.ndarray, np.ndarray]:
     """Positions and radii: mixed radii, maybe one giant, sparse to piled up, on a lattice or on the walls."""
     n = draw(
         st.one_of(
-            st.integers(0, collisions.BRUTE_FORCE_MAX_PUCKS),
-            st.integers(collisions.BRUTE_FORCE_MAX_PUCKS + 1, 400),
+            st.integers(0, broadphase.BRUTE_FORCE_MAX_PUCKS),
+            st.integers(broadphase.BRUTE_FORCE_MAX_PUCKS + 1, 400),
         )
     )
     rng = np.random.default_rng(draw(st.integers(0, 2**32 - 1)))
@@ -276,8 +276,8 @@ def puck_sets(draw) -> tuple[np.ndarray, np.ndarray]:
 @given(puck_sets())
 def test_broadphase_finds_exactly_the_brute_force_pairs(pucks: tuple[np.ndarray, np.ndarray]) -> None:
     pos, radius = pucks
-    i, j = collisions.find_overlapping_pairs(pos, radius)
-    bi, bj = collisions.brute_force_pairs(pos, radius)
+    i, j = broadphase.find_overlapping_pairs(pos, radius)
+    bi, bj = broadphase.brute_force_pairs(pos, radius)
     assert np.array_equal(i, bi) and np.array_equal(j, bj)
 
 
@@ -289,8 +289,8 @@ def test_broadphase_grid_span_an_exact_multiple_of_the_cell() -> None:
     pos = np.column_stack([rng.uniform(0.0, 0.6, n), rng.uniform(0.0, 5.0, n)])
     pos[0, 0], pos[1, 0] = 0.0, 0.6
     radius = np.full(n, 0.1)
-    i, j = collisions.find_overlapping_pairs(pos, radius)
-    bi, bj = collisions.brute_force_pairs(pos, radius)
+    i, j = broadphase.find_overlapping_pairs(pos, radius)
+    bi, bj = broadphase.brute_force_pairs(pos, radius)
     assert np.array_equal(i, bi) and np.array_equal(j, bj)
 
 
@@ -301,8 +301,8 @@ def test_broadphase_lattice_of_touching_pucks(r: float) -> None:
     k = np.arange(12) * (2.0 * r)
     pos = np.stack(np.meshgrid(k, k), axis=-1).reshape(-1, 2)
     radius = np.full(len(pos), r)
-    i, j = collisions.find_overlapping_pairs(pos, radius)
-    bi, bj = collisions.brute_force_pairs(pos, radius)
+    i, j = broadphase.find_overlapping_pairs(pos, radius)
+    bi, bj = broadphase.brute_force_pairs(pos, radius)
     assert np.array_equal(i, bi) and np.array_equal(j, bj)
 
 
@@ -320,7 +320,7 @@ def pairs_closer_than(pos: np.ndarray, radius: np.ndarray, margin_m: float) -> s
 @given(puck_sets(), st.floats(0.0, 1.0))
 def test_broadphase_with_a_margin_finds_every_pair_within_it(pucks: tuple[np.ndarray, np.ndarray], margin: float):
     pos, radius = pucks
-    i, j = collisions.find_candidate_pairs(pos, radius, margin_m=margin)
+    i, j = broadphase.find_candidate_pairs(pos, radius, margin_m=margin)
     assert np.all(i < j) and len(set(zip(i.tolist(), j.tolist(), strict=True))) == len(i)  # each pair once
     assert pairs_closer_than(pos, radius, margin) <= set(zip(i.tolist(), j.tolist(), strict=True))
 
@@ -330,12 +330,12 @@ def test_neighbour_list_finds_every_overlap_as_pucks_drift_jump_and_grow() -> No
     n, r = 400, 0.1
     pos = rng.uniform(0.0, 6.0, (n, 2))
     radius = np.full(n, r)
-    neighbours = collisions.NeighbourList()
-    skin = collisions.SKIN_RADII * r
+    neighbours = broadphase.NeighbourList()
+    skin = broadphase.SKIN_RADII * r
 
     def check() -> None:
-        i, j = collisions.overlapping_pairs(pos, *neighbours.pairs(pos, radius))
-        bi, bj = collisions.brute_force_pairs(pos, radius)
+        i, j = broadphase.overlapping_pairs(pos, *neighbours.pairs(pos, radius))
+        bi, bj = broadphase.brute_force_pairs(pos, radius)
         assert np.array_equal(i, bi) and np.array_equal(j, bj)
 
     check()
@@ -361,8 +361,8 @@ def test_a_puck_added_onto_another_collides_at_once() -> None:
     table.step(1 / 120)
     hit = table.add_puck(pos_m=(0.5, 0.8), radius_m=0.2, vel_mps=(0.0, -1.0))  # 0.1 m into puck 0
     table.step(1 / 120)
-    pairs = set(zip(table.last_collisions.i.tolist(), table.last_collisions.j.tolist(), strict=True))
-    assert (0, hit.index) in pairs
+    hit_pairs = set(zip(table.last_collisions.i.tolist(), table.last_collisions.j.tolist(), strict=True))
+    assert (0, hit.index) in hit_pairs
 
 
 @st.composite
@@ -376,9 +376,9 @@ def pair_lists(draw) -> tuple[np.ndarray, np.ndarray, int]:
 
 @settings(max_examples=300, deadline=None, derandomize=True)
 @given(pair_lists())
-def test_disjoint_rounds_keep_order_and_never_repeat_a_puck(pairs: tuple[np.ndarray, np.ndarray, int]) -> None:
-    i, j, n = pairs
-    rounds = collisions.disjoint_rounds(i, j, n)
+def test_disjoint_rounds_keep_order_and_never_repeat_a_puck(pair_list: tuple[np.ndarray, np.ndarray, int]) -> None:
+    i, j, n = pair_list
+    rounds = pairs.disjoint_rounds(i, j, n)
     round_of = np.full(len(i), -1)
     for number, members in enumerate(rounds):
         pucks = np.concatenate([i[members], j[members]])
@@ -395,4 +395,4 @@ def test_disjoint_rounds_keep_order_and_never_repeat_a_puck(pairs: tuple[np.ndar
 @pytest.mark.parametrize("n_cells", [10, 1 << 16, (1 << 16) + 1, 5_000_000])
 def test_cell_sort_matches_a_stable_argsort(n_cells: int) -> None:
     keys = np.random.default_rng(n_cells).integers(0, n_cells, 5000)
-    np.testing.assert_array_equal(collisions._argsort_cells(keys, n_cells), np.argsort(keys, kind="stable"))
+    np.testing.assert_array_equal(broadphase._argsort_cells(keys, n_cells), np.argsort(keys, kind="stable"))

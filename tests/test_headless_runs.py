@@ -1,4 +1,8 @@
-"""`python -m airtable --headless --seconds 2 --screenshot x.png` for every demo shows its pucks."""
+"""`python -m airtable --headless --seconds 2 --screenshot x.png` for every demo shows its pucks.
+
+With --headless and --no-server, --seconds counts simulated time (frames of 1/60 s run
+back to back), so these runs take as long as the machine needs, not two seconds each.
+"""
 
 from __future__ import annotations
 
@@ -15,7 +19,7 @@ DEMOS, _ = discover([BUILTIN_DIR])
 HUD_PX = 30  # title line at the top, status bar at the bottom
 
 
-def puck_colors(key: str) -> np.ndarray:
+def puck_colors(key: str) -> tuple[np.ndarray, int]:
     """The distinct RGB colours of the demo's pucks (each puck's ring is drawn in it)."""
     table = AirTable(10.0, Environment().view_height_m)
     DEMOS[key].build(table, 0)
@@ -28,7 +32,6 @@ def test_headless_screenshot_shows_the_pucks(key, tmp_path):
     assert main(["--no-server", "--headless", "--seconds", "2", "--demo", key, "--screenshot", str(shot)]) == 0
     pygame.display.init()
     image = pygame.surfarray.array3d(pygame.image.load(str(shot)))  # (w, h, 3)
-    assert image.shape[:2] == (900, 788)
     table_area = image[:, HUD_PX:-HUD_PX].reshape(-1, 3)
     colors, n_pucks = puck_colors(key)
     in_puck_color = np.any(np.all(table_area[:, None, :] == colors[None], axis=2), axis=1)

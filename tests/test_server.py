@@ -15,7 +15,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from airtable import AirTable, Client
-from airtable.app.client import LOCAL_COLOR
+from airtable.app.client import LOCAL_COLOR, cursor_pulls
 from airtable.app.scene import Scene
 from airtable.colors import rgb
 from airtable.net import protocol as proto
@@ -222,7 +222,6 @@ def arena(request):
 def one_puck_table() -> AirTable:
     table = AirTable()
     table.add_puck((5.0, 4.0), radius_m=0.5)
-    table.clients.append(Client())  # the local user
     return table
 
 
@@ -277,27 +276,28 @@ def test_input_drags_the_puck_and_disconnect_lets_go(make_server, make_loop, cli
 
     def holder() -> Client | None:
         with loop.lock:
-            return next((cl for cl in table.clients if cl.name == name and cl.held is not None), None)
+            return next((cl for cl in loop.clients if cl.name == name and cl.held is not None), None)
 
     client = wait_until(holder, what="the player to grab the puck")
     c.send(proto.encode_input((8.0, 4.0), 1))
     wait_until(lambda: table.pos_m[0, 0] > 6.0, what="the puck to follow the cursor")
     c.close()  # no BYE: the connection just goes away
-    wait_until(lambda: client not in table.clients and client.held is None, what="the puck to be let go")
-    assert [cl.name for cl in table.clients] == ["local"]
+    wait_until(lambda: client not in loop.clients and client.held is None, what="the puck to be let go")
+    assert [cl.name for cl in loop.clients] == ["local"]
 
 
 def test_two_players_on_one_puck_add_their_forces(make_server, clients):
     server = make_server()
     table = one_puck_table()
+    people = [Client()]  # the game loop's list; index 0 is the local user
     a, b = clients(server.port), clients(server.port)
     a.hello(), b.hello()
     for c in (a, b):
         c.send(proto.encode_input((5.1, 4.0), 1))
 
     def both(cursor_x: float) -> bool:
-        server.apply_inputs(table)  # this test is the game loop
-        players = table.clients[1:]
+        server.apply_inputs(people, table)  # this test is the game loop
+        players = people[1:]
         return len(players) == 2 and all(p.held is not None and p.cursor_m[0] == cursor_x for p in players)
 
     wait_until(lambda: both(5.1), what="both players to grab the puck")
@@ -308,15 +308,16 @@ def test_two_players_on_one_puck_add_their_forces(make_server, clients):
     def pulled_by_local_clients(n: int) -> float:
         """The same pull made by n Clients on a table without any network."""
         ref = one_puck_table()
+        pullers = []
         for _ in range(n):
             c = Client()
             c.set_input(ref, (5.1, 4.0), 1)
             c.set_input(ref, (6.0, 4.0), 1)
-            ref.clients.append(c)
-        ref.step(1 / 240)
+            pullers.append(c)
+        ref.step(1 / 240, cursor_pulls(pullers))
         return ref.vel_mps[0, 0]
 
-    table.step(1 / 240)
+    table.step(1 / 240, cursor_pulls(people))
     assert table.vel_mps[0, 0] == pulled_by_local_clients(2)
     assert table.vel_mps[0, 0] > 1.5 * pulled_by_local_clients(1) > 0
     assert table.vel_mps[0, 1] == pytest.approx(0.0, abs=1e-12)
@@ -325,27 +326,29 @@ def test_two_players_on_one_puck_add_their_forces(make_server, clients):
 def test_a_grab_and_a_move_within_one_frame_still_grab(make_server, clients):
     server = make_server()
     table = one_puck_table()
+    people = [Client()]
     c = clients(server.port)
     c.hello()
     # Press over the puck and move away at once: both arrive before the next frame.
     c.send(proto.encode_input((5.1, 4.0), 1) + proto.encode_input((6.0, 4.0), 1) + proto.encode_input((7.0, 4.0), 1))
 
     def moved() -> bool:
-        server.apply_inputs(table)  # this test is the game loop
-        return len(table.clients) == 2 and table.clients[1].cursor_m[0] == 7.0
+        server.apply_inputs(people, table)  # this test is the game loop
+        return len(people) == 2 and people[1].cursor_m[0] == 7.0
 
     wait_until(moved, what="the last input")
-    assert table.clients[1].held is table.pucks[0]
+    assert people[1].held is table.pucks[0]
 
 
 def test_bye_frees_the_name_and_removes_the_client(make_server, clients):
     server = make_server()
     table = one_puck_table()
+    people = [Client()]
     c = clients(server.port)
     c.hello()
-    wait_until(lambda: (server.apply_inputs(table), len(table.clients) == 2)[1], what="the join")
+    wait_until(lambda: (server.apply_inputs(people, table), len(people) == 2)[1], what="the join")
     c.send(proto.encode_bye())
-    wait_until(lambda: (server.apply_inputs(table), len(table.clients) == 1)[1], what="the leave")
+    wait_until(lambda: (server.apply_inputs(people, table), len(people) == 1)[1], what="the leave")
     assert server.player_names() == []
 
 

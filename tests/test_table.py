@@ -13,7 +13,9 @@ import numpy as np
 import pytest
 
 from airtable import AirTable, Client
+from airtable.app.client import cursor_pulls
 from airtable.bench import gas_scene
+from airtable.physics.forces import Pull
 from airtable.physics.table import GRAVITY_MPS2
 
 
@@ -97,13 +99,12 @@ def test_cursor_string_pulls_the_held_puck() -> None:
     table = AirTable()
     puck = table.add_puck(pos_m=(3.0, 4.0), radius_m=0.25, vel_mps=(0.5, -0.2))
     client = Client()
-    table.clients.append(client)
     client.set_input(table, cursor_m=(3.1, 4.05), button=1)  # press over the puck
     assert client.held is puck
     client.set_input(table, cursor_m=(4.0, 5.0), button=1)  # drag
     dt = 1 / 120
     x0, v0, m = puck.pos_m, puck.vel_mps, puck.mass_kg
-    table.step(dt)
+    table.step(dt, cursor_pulls([client]))
     # Button 1: k = 60 N/m, c = 2 N s/m; F = k (cursor - x) - c v, with the drag
     # taken at the end of the step: v1 = v0 + (k (cursor - x0) - c v1) dt / m.
     v1 = (v0 + 60.0 * (np.array([4.0, 5.0]) - x0) / m * dt) / (1.0 + 2.0 * dt / m)
@@ -112,8 +113,9 @@ def test_cursor_string_pulls_the_held_puck() -> None:
 
     client.set_input(table, cursor_m=(4.0, 5.0), button=0)  # release: no more pull
     assert client.held is None
+    assert cursor_pulls([client]) == []
     v1 = puck.vel_mps
-    table.step(dt)
+    table.step(dt, cursor_pulls([client]))
     np.testing.assert_array_equal(puck.vel_mps, v1)
 
 
@@ -121,12 +123,12 @@ def test_clicking_empty_table_grabs_nothing() -> None:
     table = AirTable()
     puck = table.add_puck(pos_m=(3.0, 4.0), radius_m=0.25)
     client = Client()
-    table.clients.append(client)
     client.set_input(table, cursor_m=(6.0, 4.0), button=1)
     assert client.held is None
     client.set_input(table, cursor_m=(3.0, 4.0), button=1)  # dragging over it later does not grab
     assert client.held is None
-    table.step(1 / 60)
+    assert cursor_pulls([client]) == []
+    table.step(1 / 60, cursor_pulls([client]))
     np.testing.assert_array_equal(puck.vel_mps, (0.0, 0.0))
 
 
@@ -201,14 +203,14 @@ def _puck_wider_than_table(t: AirTable) -> None:
     t.add_puck(pos_m=(5.0, 4.0), radius_m=0.25, vel_mps=(2.0, 1.0))
 
 
-def _stiff_springs_and_cursor(t: AirTable) -> None:
+def _stiff_springs_and_cursor(t: AirTable) -> list[Pull]:
     a = t.add_puck(pos_m=(5.0, 4.0), radius_m=0.05, density_kgpm2=0.01)
     b = t.add_puck(pos_m=(6.0, 4.0), radius_m=0.05, density_kgpm2=0.01)
     t.add_spring(a, b, length_m=0.0, k_Npm=1e9, damper_Nspm=1e6)
     client = Client()
-    t.clients.append(client)
     client.set_input(t, cursor_m=(5.0, 4.0), button=3)
     client.set_input(t, cursor_m=(1e4, -1e4), button=3)
+    return cursor_pulls([client])
 
 
 DEGENERATE = {
@@ -229,9 +231,9 @@ def test_degenerate_scenes_stay_finite_and_inside(build, mode: str, dt: float) -
     table = AirTable()
     table.gravity_on = True
     table.puck_correction = mode
-    build(table)
+    pulls = build(table) or ()  # only the cursor scene pulls
     for _ in range(20):
-        table.step(dt)
+        table.step(dt, pulls)
         assert_sane(table)
         assert np.isfinite(table.kinetic_energy_J()) and np.all(np.isfinite(table.momentum_Ns()))
 
@@ -267,7 +269,7 @@ def test_removing_a_puck_removes_its_springs() -> None:
 # ---------------------------------------------------------------- determinism
 
 
-def _busy_scene() -> AirTable:
+def _busy_scene() -> tuple[AirTable, list[Pull]]:
     table = gas_scene(300, seed=7)
     table.gravity_on = True
     table.cr_puck, table.cr_wall = 0.9, 0.8
@@ -275,19 +277,18 @@ def _busy_scene() -> AirTable:
     for k in range(0, 60, 2):
         table.add_spring(pucks[k], pucks[k + 1], length_m=0.3, k_Npm=5.0, damper_Nspm=0.1)
     client = Client()
-    table.clients.append(client)
     client.set_input(table, cursor_m=pucks[100].pos_m, button=1)
     client.set_input(table, cursor_m=(1.0, 1.0), button=1)
     assert client.held is pucks[100]
-    return table
+    return table, cursor_pulls([client])
 
 
 def test_same_scene_gives_bit_identical_state() -> None:
     runs = []
     for _ in range(2):
-        table = _busy_scene()
+        table, pulls = _busy_scene()
         for _ in range(300):
-            table.step(1 / 120)
+            table.step(1 / 120, pulls)
         runs.append(table)
     a, b = runs
     assert a.collision_count == b.collision_count > 0
@@ -298,13 +299,15 @@ def test_same_scene_gives_bit_identical_state() -> None:
 # ---------------------------------------------------------------- imports
 
 
-def test_physics_modules_do_not_import_pygame() -> None:
+def test_physics_modules_do_not_import_pygame_or_tune_malloc() -> None:
     code = (
         "import sys\n"
-        "import airtable, airtable.physics.table, airtable.physics.collisions, airtable.app.environment\n"
+        "import airtable, airtable.physics.table, airtable.physics.pairs, airtable.app.environment\n"
         "import airtable.physics.bodies, airtable.app.client, airtable.app.scene\n"
         "bad = sorted(m for m in sys.modules if m == 'pygame' or m.startswith('pygame.'))\n"
         "assert not bad, bad\n"
+        "airtable.AirTable().step(0.01)\n"
+        "assert 'airtable.memory' not in sys.modules, 'building a table must not tune the allocator'\n"
     )
     subprocess.run([sys.executable, "-c", code], check=True, timeout=60)
 

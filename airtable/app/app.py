@@ -1,103 +1,68 @@
-"""The teacher's app: game loop, keys, demo switching, teaching aids (see cli.py for the options).
+"""The teacher's app: one table, its clients, a window, and the frame that ties them together.
 
-The loop runs the physics at a fixed step with an accumulator (so results do
-not depend on the frame rate) and draws at the display's rate. App-level keys
-live in one table, `BINDINGS`, that drives both the dispatch and the F1 help
-screen; demo scenes come from the demo files (demo_loader.py).
+Each frame (`App.frame`): input (controls.py), the network's joins and inputs,
+as many fixed physics steps as the frame's time allows (loop.py), a snapshot
+for the students, then drawing. `App.run` repeats frames with a FrameLoop.
+Demo scenes come from demo files (demo_loader.py), read again when they
+change; the panels over the table (help, notes, the demo menu, errors) are
+opened and closed here.
 """
 
 from __future__ import annotations
 
-import math
+import sys
 import time
-from collections import deque
-from collections.abc import Sequence
-from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 import pygame
 
-from airtable.app import aids
-from airtable.app.client import LOCAL_COLOR, Client
-from airtable.app.demo_loader import Demo, DemoError, error_from_exception, key_label
+from airtable.app import aids, controls
+from airtable.app.aids_view import draw_aids
+from airtable.app.client import LOCAL_COLOR, Client, cursor_pulls
+from airtable.app.demo_loader import Demo, DemoError, DemoShelf, error_from_exception, key_label
 from airtable.app.environment import Environment
-from airtable.app.scene import Scene
+from airtable.app.loop import FixedStep, FpsCounter, FrameLoop
+from airtable.app.menu import DemoMenu
+from airtable.app.scene import STATUS_SEPARATOR, Scene
 from airtable.app.window import AidsPainter, GameWindow
 from airtable.physics.table import AirTable
 
-# A stalled frame (window dragged, laptop busy) runs at most this much
-# simulated time; the rest is dropped rather than exploding the physics.
-MAX_SIM_PER_FRAME_S = 0.1
-MAX_FPS = 120
-ZOOM_RATE_PER_S = 1.5  # held h / n: zoom factor e**1.5 per second
-WHEEL_ZOOM = 1.1
 MESSAGE_S = 4.0
-DIM_FORCE = (200, 200, 200)
-COM_COLOR = (255, 255, 255)
-FORCE_COLORS = {"cursor strings": (255, 120, 80), "springs": (255, 215, 0), "gravity": (90, 160, 255)}
+QUIT_CONFIRM_S = 4.0  # a second Esc within this time quits while students are connected
+DEFAULT_FPS = 60.0  # when the display does not say its refresh rate
+MAX_FPS = 240.0
+# A still table (paused, or nothing moving) with nobody at it redraws this often,
+# and wakes at once on input: a laptop projecting all lesson stays quiet.
+IDLE_FPS = 12.0
+IDLE_AFTER_S = 1.0  # input this recent keeps the full frame rate
+ERROR_TITLES = {
+    "load": "Demo {key} could not be loaded",
+    "build": "Demo {key} could not be built",
+    "event": "Demo {key}: a timed event failed",
+}
+
+# Kept importable from here: the key table lives in controls.py.
+BINDINGS = controls.BINDINGS
 
 
-@dataclass(frozen=True)
-class Binding:
-    """One row of the key table: which keys, what the help screen says, what runs."""
-
-    label: str
-    help: str
-    keys: tuple[int, ...] = ()
-    action: str | None = None  # App method taking the KEYDOWN event
-    held: bool = False  # acts every frame while held, not on the press
-
-
-DIGIT_KEYS = (
-    pygame.K_1,
-    pygame.K_2,
-    pygame.K_3,
-    pygame.K_4,
-    pygame.K_5,
-    pygame.K_6,
-    pygame.K_7,
-    pygame.K_8,
-    pygame.K_9,
-    pygame.K_0,
-)
-
-BINDINGS: tuple[Binding, ...] = (
-    Binding("1-9, 0", "start that demo (press again to restart it)", DIGIT_KEYS, "key_demo"),
-    Binding("Shift+1/2/3", "correction comparison: off, two-step, perfect kiss"),
-    Binding("Left / Right", "previous / next variation", (pygame.K_LEFT, pygame.K_RIGHT), "key_variation"),
-    Binding("PageUp / PageDown", "previous / next demo", (pygame.K_PAGEUP, pygame.K_PAGEDOWN), "key_page"),
-    Binding("Space", "pause / resume", (pygame.K_SPACE,), "key_pause"),
-    Binding(".", "one step while paused", (pygame.K_PERIOD,), "key_single_step"),
-    Binding("f", "freeze: all velocities to zero", (pygame.K_f,), "key_freeze"),
-    Binding("g", "gravity on/off (restitution 0.9 with gravity, 1.0 without)", (pygame.K_g,), "key_gravity"),
-    Binding("p", "puck penetration correction off / two-step", (pygame.K_p,), "key_correction"),
-    Binding("z", "perfect kiss on/off", (pygame.K_z,), "key_perfect_kiss"),
-    Binding("h / n (hold)", "zoom in / out about the cursor", (pygame.K_h, pygame.K_n), "hold_zoom", held=True),
-    Binding("mouse wheel", "zoom in / out about the cursor"),
-    Binding("Ctrl + mouse drag", "pan the view"),
-    Binding("q", "reset the view", (pygame.K_q,), "key_reset_view"),
-    Binding("mouse buttons 1 / 2 / 3", "grab a puck with the medium / soft / stiff cursor string"),
-    Binding("e", "trails: stop erasing, so each frame's pucks stay on screen", (pygame.K_e,), "key_trails"),
-    Binding("s", "slow motion: 1, 1/2, 1/4, 1/8, 1/16 of real time", (pygame.K_s,), "key_slow_motion"),
-    Binding("r", "reverse time: flip every velocity", (pygame.K_r,), "key_reverse"),
-    Binding("a", "collision annotations: axes, overlap, separation, angle", (pygame.K_a,), "key_annotations"),
-    Binding("v", "vectors: velocity / momentum arrows, forces, centre of mass", (pygame.K_v,), "key_vectors"),
-    Binding("c", "energy and momentum chart", (pygame.K_c,), "key_chart"),
-    Binding("i (hold)", "inspect the puck under the cursor", (pygame.K_i,), "hold_inspect", held=True),
-    Binding("l", "lecture notes for this demo", (pygame.K_l,), "key_notes"),
-    Binding("F1", "this help screen", (pygame.K_F1,), "key_help"),
-    Binding("F12", "save a screenshot PNG", (pygame.K_F12,), "key_screenshot"),
-    Binding("Esc", "quit", (pygame.K_ESCAPE,), "key_quit"),
-)
+def display_rate_hz() -> float:
+    """The refresh rate of the display the app shows on (DEFAULT_FPS if it does not say)."""
+    try:
+        rates = pygame.display.get_desktop_refresh_rates()
+    except (AttributeError, pygame.error):
+        rates = []
+    rate = max((r for r in rates if r > 0), default=0)
+    return float(min(rate, MAX_FPS)) if rate else DEFAULT_FPS
 
 
-def _ctrl_held(keys_down: set[int]) -> bool:
-    return bool(keys_down & {pygame.K_LCTRL, pygame.K_RCTRL}) or bool(pygame.key.get_mods() & pygame.KMOD_CTRL)
-
-
-def _shift_held(event: pygame.event.Event) -> bool:
-    return bool(getattr(event, "mod", 0) & pygame.KMOD_SHIFT)
+def unused_path(folder: Path, stem: str, suffix: str = ".png") -> Path:
+    """`folder/stem.png`, or `stem-2.png`, `stem-3.png`, ... if taken: never overwrites."""
+    path, n = folder / f"{stem}{suffix}", 1
+    while path.exists():
+        n += 1
+        path = folder / f"{stem}-{n}{suffix}"
+    return path
 
 
 class App:
@@ -105,181 +70,224 @@ class App:
 
     def __init__(
         self,
-        demos: dict[str, Demo],
+        demos: dict[str, Demo] | DemoShelf,
         *,
         demo_key: str = "1",
         variation: int = 0,
         headless: bool = False,
         server=None,
-        demo_errors: Sequence[DemoError] = (),
+        demo_errors=(),
     ) -> None:
-        if not demos:
+        self.shelf = demos if isinstance(demos, DemoShelf) else DemoShelf.from_demos(demos)
+        if not self.shelf.demos:
             raise ValueError("no demos found")
-        self.demos = demos
         self.env = Environment()
         self.table = AirTable(self.env.size_px[0] / self.env.base_px_per_m, self.env.view_height_m)
         self.local = Client(name="local", color=LOCAL_COLOR)
-        self.table.clients.append(self.local)
+        # The loop owns the clients (index 0 is the local user); the server adds the students.
+        self.clients: list[Client] = [self.local]
         self.window = GameWindow(self.env, headless=headless)
         self.painter = AidsPainter(self.window)
         if not headless:
             pygame.mouse.set_visible(False)  # the local client's arrow is the pointer
         self.server = server
+        self._init_state()
+        self.errors: list[DemoError] = []  # every error reported, in order
+        for error in [*demo_errors, *self.shelf.errors]:
+            self.report(error)
+        self.notice: list[str] = [f"could not load {e}" for e in self.errors]
+        self.start_demo(demo_key if demo_key in self.demos else next(iter(self.demos)), variation)
+
+    def _init_state(self) -> None:
         self.running = True
         self.paused = False
-        self.show_help = False
         self.trails = False
         self.speed = 1.0
-        self.show_annotations = False
-        self.vectors = 0  # 0 off, 1 velocity, 2 momentum
-        self.show_chart = False
+        self.show_help = False
         self.show_notes = False
+        self.show_annotations = False
+        self.show_chart = False
+        self.vectors = 0  # 0 off, 1 velocity, 2 momentum
         self.inspecting = False
+        self.menu: DemoMenu | None = None
+        self.quit_armed_until = -1.0  # clock_s until which a second Esc quits
         self.collision_log = aids.CollisionLog()
         self.chart = aids.EnergyChart()
-        self.notice: list[str] = [f"could not load {e}" for e in demo_errors]
         self.keys_down: set[int] = set()
         self.mouse_px = (self.env.size_px[0] / 2, self.env.size_px[1] / 2)
         self.mouse_button = 0
         self.panning = False
         self.fps = 0.0
-        self._frame_times: deque[float] = deque()
-        self.accumulator_s = 0.0
+        self._fps_counter = FpsCounter()
+        self.stepper = FixedStep(1 / 240)
         self.message = ""
         self.message_until = 0.0
-        self.clock_s = 0.0  # real time the app has run (sum of frame times)
-        self._dispatch = {k: b for b in BINDINGS for k in b.keys}
+        self.clock_s = 0.0  # time the app has run (sum of frame times)
+        self.frame_dt_s = 0.0  # the current frame's time (held keys act in proportion)
+        self.last_input_s = 0.0  # clock_s of the last input, local or a student's
+        self._students_seen: tuple = ()  # the students' cursors when last looked at
+        self.loop: FrameLoop | None = None  # while run() runs
+        self.demo_key = ""
+        self.demo_path: Path | None = None
         self.build_error: DemoError | None = None  # shown instead of the demo while set
-        self.start_demo(demo_key if demo_key in demos else next(iter(demos)), variation)
 
     # ------------------------------------------------------------ demos
 
     @property
+    def demos(self) -> dict[str, Demo]:
+        return self.shelf.demos
+
+    @property
     def demo(self) -> Demo:
-        return self.demos[self.demo_key]
+        return self.demos.get(self.demo_key) or next(iter(self.demos.values()))
+
+    @property
+    def dt_s(self) -> float:
+        return self.stepper.dt_s
+
+    def report(self, error: DemoError) -> None:
+        """Note a demo error and print it to the terminal as `file:line: message`."""
+        self.errors.append(error)
+        print(error.one_line(), file=sys.stderr, flush=True)
 
     def start_demo(self, key: str, variation: int = 0) -> None:
-        """Clear the table and build demo `key` (a demo that fails shows its error)."""
-        demo = self.demos[key]
+        """Clear the table and build demo `key`, re-reading demo files that changed on disk.
+
+        A demo whose file does not load, or whose build fails, shows its error instead.
+        """
+        for error in self.shelf.refresh():
+            self.report(error)
+        broken = self.shelf.error_for(self.demo_path) if key == self.demo_key else None
+        if broken is None and key not in self.demos:
+            self.say(f"no demo on key {key_label(key)}")
+            return
+        demo = self.demos.get(key) if broken is None else None
         if self.build_error is not None:
             self.paused = False  # the pause came with the error; a new start runs
-        self.demo_key = key
-        self.variation = variation % len(demo.variations) if demo.variations else 0
+        self.demo_key, self.demo_path = key, (demo.path if demo else broken.path)
+        self.variation = variation % len(demo.variations) if demo and demo.variations else 0
+        self._clear_table()
+        self.build_error = broken
+        if demo is not None:
+            try:
+                demo.build(self.table, self.variation)
+            except Exception as exc:  # a teacher's demo may fail in any way; the app goes on
+                self._demo_failed(exc, "build")
+                self.table.clear()
+        self.stepper.reset(demo.dt_s if demo else self.stepper.dt_s)
+        self.trails = demo.trails if demo else False
+        self.chart.sample(self.table)
+        self.window.set_caption(f"Air Table - {self.caption()}")
+
+    def _clear_table(self) -> None:
         self.table.clear()
         self.table.reset_settings()
-        for client in self.table.clients:
+        for client in self.clients:
             client.held = None
-        self.build_error = None
-        try:
-            demo.build(self.table, self.variation)
-        except Exception as exc:  # a teacher's demo may fail in any way; the app goes on
-            self.build_error = self._demo_error(exc)
-            self.table.clear()
-        self.dt_s = demo.dt_s
-        self.trails = demo.trails
-        self.accumulator_s = 0.0
         self.window.clear_trails()
         self.collision_log.clear()
         self.chart.clear()
-        self.chart.sample(self.table)
-        self.window.set_caption(f"Air Table - {demo.label(self.variation)}")
 
-    def _demo_error(self, exc: BaseException) -> DemoError:
-        """Where in the current demo's file `exc` happened (its build or a timed event)."""
-        return error_from_exception(self.demo.path or Path(f"demo {self.demo_key}"), exc)
+    def _demo_failed(self, exc: BaseException, stage: str) -> None:
+        path = self.demo_path or Path(f"demo {self.demo_key}")
+        self.build_error = error_from_exception(path, exc, stage)
+        self.report(self.build_error)
 
-    def key_demo(self, event: pygame.event.Event) -> None:
-        digit = DIGIT_KEYS.index(event.key)
-        key = str((digit + 1) % 10)
-        if _shift_held(event):
-            key += "p"
-        if key in self.demos:
-            self.start_demo(key)
-        else:
-            self.say(f"no demo on key {key_label(key)}")
+    def caption(self) -> str:
+        if self.build_error is not None and self.build_error.stage == "load":
+            return f"Demo {self.demo_key}: {self.build_error.path.name}"
+        return self.demo.label(self.variation)
 
-    def key_variation(self, event: pygame.event.Event) -> None:
+    def press_demo_key(self, key: str) -> None:
+        self.start_demo(key)
+
+    def next_variation(self, step: int) -> None:
         if not self.demo.variations:
             self.say("this demo has no variations")
             return
-        step = 1 if event.key == pygame.K_RIGHT else -1
         self.start_demo(self.demo_key, self.variation + step)
 
-    def key_page(self, event: pygame.event.Event) -> None:
+    def next_demo(self, step: int) -> None:
+        self.shelf.refresh()
         keys = list(self.demos)
-        step = 1 if event.key == pygame.K_PAGEDOWN else -1
-        self.start_demo(keys[(keys.index(self.demo_key) + step) % len(keys)])
+        here = keys.index(self.demo_key) if self.demo_key in keys else -step
+        self.start_demo(keys[(here + step) % len(keys)])
 
-    # ------------------------------------------------------------ controls
+    # ------------------------------------------------------------ panels and keys
 
-    def key_pause(self, event) -> None:
-        self.paused = not self.paused
+    def open_menu(self) -> None:
+        for error in self.shelf.refresh():
+            self.report(error)
+        items = [(key, demo.title) for key, demo in self.demos.items()]
+        self.menu = DemoMenu(items, current=self.demo_key)
 
-    def key_single_step(self, event) -> None:
-        if self.paused:
-            self.physics_step()
+    def panel(self) -> str | None:
+        """Which panel is on top of the table now, if any."""
+        if self.clock_s < self.quit_armed_until:
+            return "quit"
+        if self.menu is not None:
+            return "menu"
+        if self.build_error is not None:
+            return "error"
+        if self.notice:
+            return "notice"
+        if self.show_help:
+            return "help"
+        if self.show_notes:
+            return "notes"
+        return None
+
+    def close_panel(self) -> bool:
+        """Close the panel on top; False if none was open."""
+        closing = self.panel()
+        if closing == "quit":
+            self.quit_armed_until = -1.0
+        elif closing == "menu":
+            self.menu = None
+        elif closing == "error":
+            self.build_error = None
+        elif closing == "notice":
+            self.notice = []
+        elif closing == "help":
+            self.show_help = False
+        elif closing == "notes":
+            self.show_notes = False
+        return closing is not None
+
+    def take_key_for_overlay(self, event: pygame.event.Event) -> bool:
+        """A panel that waits for a key takes it first; True if it did."""
+        panel = self.panel()
+        if event.key == pygame.K_ESCAPE or panel not in ("quit", "menu", "notice"):
+            return False
+        if panel == "menu":
+            picked = self.menu.press(pygame.key.name(event.key), getattr(event, "unicode", ""))
+            if picked is not None:
+                self.menu = None
+                self.start_demo(picked)
         else:
-            self.say("'.' steps once while paused (Space pauses)")
+            self.close_panel()  # "press any key to go on"; any key but Esc keeps the table running
+        return True
 
-    def key_freeze(self, event) -> None:
-        self.table.vel_mps[:] = 0.0
+    def student_count(self) -> int:
+        return len(self.clients) - 1
 
-    def key_gravity(self, event) -> None:
-        self.table.gravity_on = not self.table.gravity_on
-        restitution = 0.9 if self.table.gravity_on else 1.0
-        self.table.cr_puck = self.table.cr_wall = restitution
-
-    def key_correction(self, event) -> None:
-        self.table.puck_correction = "two-step" if self.table.puck_correction == "off" else "off"
-
-    def key_perfect_kiss(self, event) -> None:
-        self.table.puck_correction = "two-step" if self.table.puck_correction == "perfect-kiss" else "perfect-kiss"
-
-    def hold_zoom(self, key: int, frame_dt_s: float) -> None:
-        rate = ZOOM_RATE_PER_S if key == pygame.K_h else -ZOOM_RATE_PER_S
-        self.zoom(math.exp(rate * frame_dt_s))
+    def escape(self) -> None:
+        """Esc: close the panel on top; else quit, asking twice while students are connected."""
+        if self.panel() == "quit":
+            self.running = False
+        elif self.close_panel():
+            pass
+        elif self.student_count() > 0:
+            self.quit_armed_until = self.clock_s + QUIT_CONFIRM_S
+        else:
+            self.running = False
 
     def zoom(self, factor: float) -> None:
         self.env.zoom_about(self.mouse_px, factor)
         self.window.clear_trails()
 
-    def key_reset_view(self, event) -> None:
-        self.env.reset()
-        self.window.clear_trails()
-
-    def key_trails(self, event) -> None:
-        self.trails = not self.trails
-        self.window.clear_trails()
-
-    def key_slow_motion(self, event) -> None:
-        factors = aids.SLOW_MOTION_FACTORS
-        self.speed = factors[(factors.index(self.speed) + 1) % len(factors)] if self.speed in factors else 1.0
-
-    def key_reverse(self, event) -> None:
-        self.table.vel_mps[:] *= -1.0
-        self.say("time reversed: every velocity flipped")
-
-    def key_annotations(self, event) -> None:
-        self.show_annotations = not self.show_annotations
-        self.collision_log.clear()
-
-    def key_vectors(self, event) -> None:
-        self.vectors = (self.vectors + 1) % 3
-
-    def key_chart(self, event) -> None:
-        self.show_chart = not self.show_chart
-
-    def key_notes(self, event) -> None:
-        self.show_notes = not self.show_notes
-
-    def hold_inspect(self, key: int, frame_dt_s: float) -> None:
-        self.inspecting = True
-
-    def key_help(self, event) -> None:
-        self.show_help = not self.show_help
-
-    def key_screenshot(self, event) -> None:
-        path = Path("screenshots") / time.strftime("airtable-%Y%m%d-%H%M%S.png")
+    def save_screenshot(self) -> None:
+        path = unused_path(Path("screenshots"), time.strftime("airtable-%Y%m%d-%H%M%S"))
         try:
             saved = self.window.save_screenshot(path)
         except (OSError, pygame.error) as exc:
@@ -287,122 +295,83 @@ class App:
         else:
             self.say(f"screenshot saved to {saved.resolve()}")
 
-    def key_quit(self, event) -> None:
-        self.running = False
-
     def say(self, text: str) -> None:
         """Show a one-line message on screen for a few seconds."""
         self.message = text
         self.message_until = self.clock_s + MESSAGE_S
 
-    # ------------------------------------------------------------ input
-
     def handle_event(self, event: pygame.event.Event) -> None:
-        if event.type == pygame.QUIT:
-            self.running = False
-        elif event.type == pygame.KEYDOWN:
-            self.notice = []  # any key dismisses the start-up notice
-            self.keys_down.add(event.key)
-            binding = self._dispatch.get(event.key)
-            if binding is not None and not binding.held:
-                getattr(self, binding.action)(event)
-        elif event.type == pygame.KEYUP:
-            self.keys_down.discard(event.key)
-        elif event.type == pygame.MOUSEMOTION:
-            if self.panning:
-                self.env.pan(event.rel)
-                self.window.clear_trails()
-            self.mouse_px = event.pos
-        elif event.type == pygame.MOUSEBUTTONDOWN and event.button in (1, 2, 3):
-            self.mouse_px = event.pos
-            if _ctrl_held(self.keys_down):
-                self.panning = True
-            else:
-                self.mouse_button = event.button
-        elif event.type == pygame.MOUSEBUTTONUP and event.button in (1, 2, 3):
-            self.mouse_px = event.pos
-            self.panning = False
-            if event.button == self.mouse_button:
-                self.mouse_button = 0
-        elif event.type == pygame.MOUSEWHEEL:
-            self.zoom(WHEEL_ZOOM**event.y)
+        controls.handle_event(self, event)
 
-    def _update_local_client(self) -> None:
-        # Recomputed every frame: zooming moves the world under a still mouse.
-        held = frozenset(pygame.key.name(k) for k in self.keys_down)
-        self.local.set_input(self.table, self.env.to_world(self.mouse_px), self.mouse_button, held)
+    # ------------------------------------------------------------ the frame
 
-    # ------------------------------------------------------------ loop
-
-    def physics_step(self) -> None:
-        if self.server is not None:
-            self.server.apply_inputs(self.table)
+    def physics_step(self) -> bool:
+        """One fixed step; False if a demo's timed event failed (the app pauses on it)."""
         try:
-            self.table.step(self.dt_s)
+            self.table.step(self.dt_s, cursor_pulls(self.clients))
         except Exception as exc:  # a demo's timed event (teacher's code) failed
-            self.build_error = self._demo_error(exc)
+            self._demo_failed(exc, "event")
             self.paused = True
-            return
+            return False
         self.chart.sample(self.table)
         if self.show_annotations:
             self.collision_log.add(self.table, self.clock_s)
+        return True
 
     def frame(self, frame_dt_s: float) -> None:
-        """One frame: input, as many fixed physics steps as time allows, drawing."""
+        """One frame: input, clients, as many fixed physics steps as time allows, snapshot, drawing."""
         self.clock_s += frame_dt_s
+        self.frame_dt_s = frame_dt_s
         for event in pygame.event.get():
             self.handle_event(event)
-        self.inspecting = False
-        for key in self.keys_down:
-            binding = self._dispatch.get(key)
-            if binding is not None and binding.held:
-                getattr(self, binding.action)(key, frame_dt_s)
-        self._update_local_client()
+            self.last_input_s = self.clock_s
+        controls.run_held(self)
+        # Recomputed every frame: zooming moves the world under a still mouse.
+        self.local.set_input(self.table, self.env.to_world(self.mouse_px), self.mouse_button)
+        if self.server is not None:
+            self.server.apply_inputs(self.clients, self.table)  # joins, leaves and inputs, even while paused
         if not self.paused:
-            self.accumulator_s += frame_dt_s * self.speed
-            max_steps = max(1, int(MAX_SIM_PER_FRAME_S / self.dt_s))
-            steps = 0
-            while self.accumulator_s >= self.dt_s and steps < max_steps:
-                self.physics_step()
-                self.accumulator_s -= self.dt_s
-                steps += 1
-            if steps == max_steps:
-                self.accumulator_s = min(self.accumulator_s, self.dt_s)
-        # Frames counted over the last second: steadier than 1 / dt of one frame.
-        self._frame_times.append(self.clock_s)
-        while self._frame_times[0] < self.clock_s - 1.0:
-            self._frame_times.popleft()
-        span = self._frame_times[-1] - self._frame_times[0]
-        if span > 0:
-            self.fps = (len(self._frame_times) - 1) / span
-        self.draw()
+            for _ in range(self.stepper.steps(frame_dt_s, self.speed)):
+                if not self.physics_step():
+                    break
+        self.fps = self._fps_counter.tick(self.clock_s)
+        scene = self.scene()
+        if self.server is not None:
+            self.server.publish(scene)
+        self.draw(scene)
 
     def scene(self) -> Scene:
         return Scene.from_table(
             self.table,
-            self.table.clients,
-            title=self.demo.label(self.variation),
-            status=self.status_line(),
+            self.clients,
+            title=self.caption(),
+            status=STATUS_SEPARATOR.join(self.status_parts()),
             fps=self.fps,
             zoom=self.env.zoom,
             origin_m=(float(self.env.origin_m[0]), float(self.env.origin_m[1])),
         )
 
-    def status_line(self) -> str:
+    def status_parts(self) -> list[str]:
+        """The status line in parts, most important first (a narrow window drops the last)."""
         t = self.table
-        parts = []
-        if self.paused:
-            parts.append("PAUSED")
+        parts = ["PAUSED"] if self.paused else []
         if self.speed != 1.0:
             parts.append(f"slow motion x1/{round(1 / self.speed)}")
-        parts.append("gravity on" if t.gravity_on else "gravity off")
-        parts.append(f"correction: {t.puck_correction}")
-        parts.append(f"restitution: pucks {t.cr_puck:g}, walls {t.cr_wall:g}")
-        parts.append(f"{len(t.pos_m)} pucks")
-        parts.append(f"{t.collision_count} collisions")
         parts.append(f"t = {t.time_s:.2f} s")
         parts.append("F1: help")
-        return "   ".join(parts)
+        parts.append("gravity on" if t.gravity_on else "gravity off")
+        parts.append(f"correction: {t.puck_correction}")
+        n, hits = len(t.pos_m), t.collision_count
+        parts.append(f"{n} puck{'' if n == 1 else 's'}")
+        parts.append(f"{hits} collision{'' if hits == 1 else 's'}")
+        if t.cr_puck == t.cr_wall:
+            parts.append(f"restitution {t.cr_puck:g}")
+        else:
+            parts.append(f"restitution: pucks {t.cr_puck:g}, walls {t.cr_wall:g}")
+        return parts
+
+    def status_line(self) -> str:
+        return STATUS_SEPARATOR.join(self.status_parts())
 
     def hud_lines(self) -> list[str]:
         lines = []
@@ -412,103 +381,74 @@ class App:
             lines.append(self.message)
         return lines
 
-    def draw(self) -> None:
-        scene = self.scene()
-        self.window.draw(scene, trails=self.trails, hud=self.hud_lines())
-        self.draw_aids()
-        error = self.build_error
-        if self.notice:
-            self.window.draw_panel("Some demo files could not be loaded", [*self.notice, "Press any key to go on."])
-        elif error is not None:
-            self.window.draw_panel(
-                f"Demo {self.demo_key} could not be built", [str(error), "Fix the file and press its key again."]
-            )
-        elif self.show_help:
-            self.window.draw_panel(
-                "Keys", [(b.label, b.help) for b in BINDINGS], side_title="Demos", side_rows=self._demo_rows()
-            )
-        elif self.show_notes:
-            self.window.draw_panel(self.demo.label(self.variation), [self.demo.notes or "(no notes)"], large=True)
-        if self.server is not None:
-            self.server.publish(scene)
+    def draw(self, scene: Scene | None = None) -> None:
+        """Draw `scene` (by default the table as it is now), the aids and the panel on top."""
+        self.window.draw(scene or self.scene(), trails=self.trails, hud=self.hud_lines())
+        draw_aids(self)
+        self._draw_panel()
         self.window.present()
 
-    def draw_aids(self) -> None:
-        t, paint = self.table, self.painter
-        if self.show_annotations:
-            for annotation in self.collision_log.live(self.clock_s):
-                paint.annotation(annotation, self.clock_s)
-        if self.vectors and len(t.pos_m):
-            self._draw_vectors()
-        if self.show_chart:
-            note = self.chart.euler_wiggle_note(t)
-            paint.energy_chart(self.chart.series(), self.chart.latest(), note)
-        if self.inspecting:
-            puck = t.puck_at(self.env.to_world(self.mouse_px))
-            if puck is not None:
-                v = puck.vel_mps
-                speed = float(np.hypot(*v))
-                paint.inspector(
-                    puck.pos_m,
-                    [
-                        f"mass {puck.mass_kg:.4g} kg   radius {puck.radius_m:.4g} m",
-                        f"speed {speed:.4g} m/s",
-                        f"velocity ({v[0]:.3f}, {v[1]:.3f}) m/s",
-                        f"kinetic energy {0.5 * puck.mass_kg * speed**2:.4g} J",
-                    ],
-                )
+    def _draw_panel(self) -> None:
+        panel, w = self.panel(), self.window
+        if panel == "quit":
+            n = self.student_count()
+            w.draw_panel(
+                "Quit?",
+                [
+                    f"{n} student{'' if n == 1 else 's'} will be dropped.",
+                    "Press Esc again to quit, any other key to stay.",
+                ],
+            )
+        elif panel == "menu":
+            w.draw_panel("Demos", [*self.menu.rows(), self.menu.footer()])
+        elif panel == "error":
+            error = self.build_error
+            title = ERROR_TITLES[error.stage].format(key=key_label(self.demo_key))
+            w.draw_panel(title, [str(error), "Fix the file and press the demo's key again (Esc hides this)."])
+        elif panel == "notice":
+            w.draw_panel("Some demo files could not be loaded", [*self.notice, "Press any key to go on."])
+        elif panel == "help":
+            rows = [(key_label(k), d.title) for k, d in self.demos.items()]
+            w.draw_panel("Keys", [(b.label, b.help) for b in BINDINGS], side_title="Demos", side_rows=rows)
+        elif panel == "notes":
+            w.draw_panel(self.demo.label(self.variation), [self.demo.notes or "(no notes)"], large=True)
 
-    def _draw_vectors(self) -> None:
-        t, paint = self.table, self.painter
-        if self.vectors == 1:
-            name, unit, values, color = "velocity", "m/s", t.vel_mps, (120, 220, 255)
-        else:
-            name, unit, values, color = "momentum", "N s", t.vel_mps * t.mass_kg[:, None], (230, 120, 230)
-        amount, m_per_unit = aids.nice_scale(float(np.hypot(values[:, 0], values[:, 1]).max()), target_m=1.0)
-        paint.arrows(t.pos_m, values * m_per_unit, color)
-        legend = [(f"{name}: an arrow 1 m long is {amount:g} {unit}", color)]
-        # The centre of mass moves in a straight line while no outside force acts.
-        com, com_v = t.center_of_mass_m(), t.center_of_mass_vel_mps()
-        speed, m_per_mps = aids.nice_scale(float(np.hypot(t.vel_mps[:, 0], t.vel_mps[:, 1]).max()), target_m=1.0)
-        paint.arrow(com, com_v * m_per_mps, COM_COLOR, width=3)
-        paint.marker(com, COM_COLOR, f"centre of mass, {np.hypot(*com_v):.2f} m/s")
-        held = self.local.held
-        if held is not None and held.alive:
-            forces = t.forces_on(held, self.dt_s)
-            if forces:
-                biggest = max(float(np.hypot(*f)) for f in forces.values())
-                newtons, m_per_n = aids.nice_scale(biggest, target_m=1.5)
-                for source, f in forces.items():
-                    c = FORCE_COLORS[source]
-                    paint.arrow(held.pos_m, f * m_per_n, c, width=3)
-                    legend.append((f"force, {source}: {np.hypot(*f):.3g} N", c))
-                legend.append((f"forces: an arrow 1 m long is {newtons / 1.5:.3g} N", DIM_FORCE))
-        paint.legend(legend)
+    def still(self) -> bool:
+        """Nothing to show that changes quickly: paused or motionless, and no input
+        (keys, mouse, or a student's cursor) for a second."""
+        students = tuple((*c.cursor_m, c.button, c.active) for c in self.clients[1:])
+        if students != self._students_seen:
+            self._students_seen, self.last_input_s = students, self.clock_s
+        if self.keys_down or self.mouse_button or self.clock_s - self.last_input_s < IDLE_AFTER_S:
+            return False
+        return self.paused or not np.any(self.table.vel_mps)
 
-    def _demo_rows(self) -> list[tuple[str, str]]:
-        rows = []
-        for key, demo in self.demos.items():
-            rows.append((key_label(key), demo.title))
-        return rows
+    def run(self, seconds: float | None = None, max_frames: int | None = None, frame_dt_s: float | None = None) -> int:
+        """Run until Esc / window close, `seconds` or `max_frames` frames; returns the frames run.
 
-    def run(self, seconds: float | None = None, max_frames: int | None = None, frame_dt_s: float | None = None) -> None:
-        """Run until Esc / window close, `seconds` of real time or `max_frames` frames.
-
-        `frame_dt_s` fixes each frame's time step instead of reading the clock
-        (tests use it, so they never depend on timing).
+        With `frame_dt_s` every frame is that long and nothing sleeps: `seconds`
+        is then simulated time (tests and headless runs use it, so they never
+        depend on timing). Without it, frames follow the clock, at most at the
+        display's refresh rate, sleeping in between; a still table runs at
+        IDLE_FPS and wakes on input.
         """
-        clock = pygame.time.Clock()
-        start = time.monotonic()
-        frames = 0
-        clock.tick()
-        while self.running:
-            if frame_dt_s is None:
-                dt = min(clock.tick(MAX_FPS) / 1000.0, 0.25)
-            else:
-                dt = frame_dt_s
-            self.frame(dt)
-            frames += 1
-            if max_frames is not None and frames >= max_frames:
-                break
-            if seconds is not None and time.monotonic() - start >= seconds:
-                break
+        self._full_period_s = 1.0 / display_rate_hz()
+        self.loop = FrameLoop(fps=1.0 / self._full_period_s, fixed_dt_s=frame_dt_s, sleep=self._sleep)
+        try:
+            return self.loop.run(self._frame_running, max_frames=max_frames, max_time_s=seconds)
+        finally:
+            self.loop = None
+
+    def _frame_running(self, dt_s: float) -> bool:
+        self.frame(dt_s)
+        self.loop.period_s = 1.0 / IDLE_FPS if self.still() else self._full_period_s
+        return self.running
+
+    def _sleep(self, seconds: float) -> None:
+        """Between frames: a plain sleep, or while idle a wait that ends early on input."""
+        if self.window.headless or self.loop.period_s == self._full_period_s:
+            self.loop.stop.wait(seconds)
+            return
+        event = pygame.event.wait(max(1, int(seconds * 1000)))
+        if event.type != pygame.NOEVENT:
+            pygame.event.post(event)  # back in the queue, for the frame it woke

@@ -2,16 +2,19 @@
 
 A client holds its latest input: cursor position in world metres, which mouse
 button is down (0 none, 1-3 the three cursor strings) and the keys held. When a
-button goes down over a puck the client grabs it; the table then pulls that
-puck toward the cursor with the string's spring and drag every step, until the
-button is released. No pygame and no sockets here.
+button goes down over a puck the client grabs it; until the button is released,
+`cursor_pulls` turns it into a Pull (the string's spring and drag) that the game
+loop hands to every `AirTable.step`. No pygame and no sockets here.
 """
 
 from __future__ import annotations
 
+from collections.abc import Iterable
 from dataclasses import dataclass, field
 
 import numpy as np
+
+from airtable.physics.forces import Pull
 
 LOCAL_COLOR = (0, 255, 0)  # the teacher's own cursor; players get other colours
 
@@ -24,9 +27,9 @@ CURSOR_STRINGS: dict[int, tuple[float, float]] = {
 }
 
 
-@dataclass
+@dataclass(eq=False)
 class Client:
-    """One user's input state and the puck they hold."""
+    """One user's input state and the puck they hold (compared by identity)."""
 
     name: str = "local"
     color: tuple[int, int, int] = LOCAL_COLOR
@@ -55,3 +58,16 @@ class Client:
         """Let go of the puck (button up); used when a network client leaves."""
         self.button = 0
         self.held = None
+
+
+def cursor_pulls(clients: Iterable[Client]) -> list[Pull]:
+    """The cursor string of every client holding a puck, as forces for the next step."""
+    pulls = []
+    for client in clients:
+        puck = client.held
+        if puck is None or not puck.alive or client.button not in CURSOR_STRINGS:
+            continue
+        k, c = CURSOR_STRINGS[client.button]
+        anchor = (float(client.cursor_m[0]), float(client.cursor_m[1]))
+        pulls.append(Pull(row=puck.index, anchor_m=anchor, k_Npm=k, drag_Nspm=c))
+    return pulls

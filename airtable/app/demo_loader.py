@@ -11,12 +11,15 @@ A demo is one Python file that defines:
     def build(table, variation=0): ...   # adds pucks, springs, settings, events
 
 The list of demos comes from the files themselves, so the number keys, the
-help screen and `--list-demos` can never drift from what is on disk.
+help screen and `--list-demos` can never drift from what is on disk. A
+`DemoShelf` keeps them loaded and re-reads a file that changed on disk, so a
+teacher can edit a demo and press its key again.
 """
 
 from __future__ import annotations
 
 import importlib.util
+import re
 import sys
 import traceback
 from collections.abc import Callable, Iterable
@@ -50,14 +53,24 @@ class Demo:
 
 @dataclass(frozen=True)
 class DemoError:
-    """A demo file that could not be loaded or built: where and why."""
+    """A demo file that could not be loaded, built or run: where and why.
+
+    `stage` is "load" (importing the file), "build" (its build function) or
+    "event" (a timed event it scheduled).
+    """
 
     path: Path
     line: int | None
     message: str
+    stage: str = "load"
 
     def __str__(self) -> str:
         where = f"{self.path.name}, line {self.line}" if self.line else self.path.name
+        return f"{where}: {self.message}"
+
+    def one_line(self) -> str:
+        """`file:line: message`, the form editors and terminals jump to."""
+        where = f"{self.path}:{self.line}" if self.line else str(self.path)
         return f"{where}: {self.message}"
 
 
@@ -68,10 +81,11 @@ class DemoLoadError(Exception):
 
 
 def key_order(key: str) -> tuple:
-    """Sort keys as on the keyboard: 1..9, 0, then the rest (1p, 2p, ...)."""
+    """Sort keys as on the keyboard: 1..9, 0, then the rest naturally (1p, 2p, t1, t2, t10)."""
     if key.isdigit() and len(key) == 1:
-        return (0, (int(key) - 1) % 10, "")
-    return (1, 0, key)
+        return (0, (int(key) - 1) % 10, ())
+    parts = re.split(r"(\d+)", key.lower())
+    return (1, 0, tuple((0, int(p), "") if p.isdigit() else (1, 0, p) for p in parts if p))
 
 
 def key_label(key: str) -> str:
@@ -81,31 +95,37 @@ def key_label(key: str) -> str:
     return key
 
 
-def error_from_exception(path: Path, exc: BaseException) -> DemoError:
+def error_from_exception(path: Path, exc: BaseException, stage: str = "load") -> DemoError:
     """Point at the line of `path` where `exc` happened (or its syntax error)."""
-    if isinstance(exc, SyntaxError):
-        return DemoError(path, exc.lineno, f"syntax error: {exc.msg}")
+    if isinstance(exc, SyntaxError) and Path(exc.filename or "").resolve() == path.resolve():
+        return DemoError(path, exc.lineno, f"syntax error: {exc.msg}", stage)
     line = None
     for frame in traceback.extract_tb(exc.__traceback__):
         if Path(frame.filename).resolve() == path.resolve():
             line = frame.lineno
-    return DemoError(path, line, f"{type(exc).__name__}: {exc}")
+    return DemoError(path, line, f"{type(exc).__name__}: {exc}", stage)
 
 
-def load_demo_file(path: Path) -> Demo:
-    """Import one demo file; raises DemoLoadError on any problem."""
-    path = Path(path)
+def _import(path: Path):
+    """Run the file as a fresh module, from its source (no cached bytecode, so an edit
+    made within the same second is never missed and no __pycache__ lands beside it)."""
     name = f"airtable_demo_{abs(hash(str(path.resolve())))}_{path.stem}"
     try:
         spec = importlib.util.spec_from_file_location(name, path)
-        if spec is None or spec.loader is None:
+        if spec is None:
             raise ImportError(f"cannot import {path}")
         module = importlib.util.module_from_spec(spec)
+        code = compile(path.read_bytes(), str(path), "exec", dont_inherit=True)
         sys.modules[name] = module
-        spec.loader.exec_module(module)
+        exec(code, module.__dict__)  # the teacher's own demo file, never network data
     except Exception as exc:  # a teacher's file can fail in any way at all
         sys.modules.pop(name, None)
         raise DemoLoadError(error_from_exception(path, exc)) from exc
+    return module
+
+
+def _check(path: Path, module) -> float:
+    """Raise DemoLoadError unless `module` defines a demo; returns its time step."""
     missing = [attr for attr in ("KEY", "TITLE", "build") if not hasattr(module, attr)]
     if missing:
         raise DemoLoadError(DemoError(path, None, f"a demo file must define {', '.join(missing)}"))
@@ -118,16 +138,101 @@ def load_demo_file(path: Path) -> Demo:
         )
     if not str(module.KEY).strip():
         raise DemoLoadError(DemoError(path, None, 'KEY must name the key that starts the demo, like "7" or "t1"'))
+    return float(dt_s)
+
+
+def load_demo_file(path: Path) -> Demo:
+    """Import one demo file; raises DemoLoadError on any problem."""
+    path = Path(path)
+    module = _import(path)
+    dt_s = _check(path, module)
     return Demo(
         key=str(module.KEY),
         title=str(module.TITLE),
         notes=" ".join(str(getattr(module, "NOTES", "")).split()),
         build=module.build,
         variations=tuple(str(v) for v in getattr(module, "VARIATIONS", ())),
-        dt_s=float(dt_s),
+        dt_s=dt_s,
         trails=bool(getattr(module, "TRAILS", False)),
         path=path,
     )
+
+
+def demo_files(directories: Iterable[Path]) -> list[Path]:
+    """The demo files of `directories`, in order (files starting with "_" are helpers)."""
+    return [
+        path
+        for directory in directories
+        for path in sorted(Path(directory).glob("*.py"))
+        if not path.name.startswith("_")
+    ]
+
+
+def _stamp(path: Path) -> tuple[int, int] | None:
+    try:
+        st = path.stat()
+    except OSError:
+        return None
+    return (st.st_mtime_ns, st.st_size)
+
+
+class DemoShelf:
+    """The demos of some folders, kept loaded; a file that changed on disk is read again.
+
+    `refresh()` looks at every file (a stat each, cheap) and re-imports only
+    those whose time or size changed, or that are new; `demos` and `errors`
+    then describe the files as they are now. A shelf made `from_demos` knows
+    only the files of the demos it was given.
+    """
+
+    def __init__(self, directories: Iterable[Path] = ()) -> None:
+        self.directories = [Path(d) for d in directories]
+        self._extra: list[Path] = []  # files given one by one (from_demos)
+        self._fixed: dict[str, Demo] = {}  # demos with no file
+        self._loaded: dict[Path, tuple[tuple[int, int] | None, Demo | DemoError]] = {}
+        self.demos: dict[str, Demo] = {}
+        self.errors: list[DemoError] = []
+        self.refresh()
+
+    @classmethod
+    def from_demos(cls, demos: dict[str, Demo]) -> DemoShelf:
+        shelf = cls()
+        for key, demo in demos.items():
+            if demo.path is None:
+                shelf._fixed[key] = demo
+            else:
+                shelf._extra.append(Path(demo.path))
+                shelf._loaded[Path(demo.path)] = (_stamp(Path(demo.path)), demo)
+        shelf.refresh()
+        return shelf
+
+    def refresh(self) -> list[DemoError]:
+        """Re-read the files that changed; returns the errors that are new with this look."""
+        demos: dict[str, Demo] = dict(self._fixed)
+        errors: list[DemoError] = []
+        fresh: list[DemoError] = []
+        for path in [*self._extra, *demo_files(self.directories)]:
+            stamp = _stamp(path)
+            known = self._loaded.get(path)
+            if known is None or known[0] != stamp:
+                try:
+                    known = (stamp, load_demo_file(path))
+                except DemoLoadError as exc:
+                    known = (stamp, exc.error)
+                    fresh.append(exc.error)
+                self._loaded[path] = known
+            if isinstance(known[1], Demo):
+                demos[known[1].key] = known[1]
+            else:
+                errors.append(known[1])
+        self.demos = {k: demos[k] for k in sorted(demos, key=key_order)}
+        self.errors = errors
+        return fresh
+
+    def error_for(self, path: Path | None) -> DemoError | None:
+        """The load error of the file at `path` as it is now, if it has one."""
+        known = self._loaded.get(Path(path)) if path is not None else None
+        return known[1] if known is not None and isinstance(known[1], DemoError) else None
 
 
 def discover(directories: Iterable[Path]) -> tuple[dict[str, Demo], list[DemoError]]:
@@ -135,17 +240,5 @@ def discover(directories: Iterable[Path]) -> tuple[dict[str, Demo], list[DemoErr
 
     Returns the demos by key (in keyboard order) and the files that failed.
     """
-    demos: dict[str, Demo] = {}
-    errors: list[DemoError] = []
-    for directory in directories:
-        for path in sorted(Path(directory).glob("*.py")):
-            if path.name.startswith("_"):
-                continue
-            try:
-                demo = load_demo_file(path)
-            except DemoLoadError as exc:
-                errors.append(exc.error)
-                continue
-            demos[demo.key] = demo
-    ordered = {k: demos[k] for k in sorted(demos, key=key_order)}
-    return ordered, errors
+    shelf = DemoShelf(directories)
+    return shelf.demos, shelf.errors

@@ -11,6 +11,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+# Between the parts of `Scene.status` ("PAUSED", "t = 1.25 s", ...), most important first.
+STATUS_SEPARATOR = "   "
+
 
 @dataclass(frozen=True)
 class CursorView:
@@ -43,6 +46,11 @@ class Scene:
     fps: float = 0.0
     zoom: float = 1.0
     origin_m: tuple[float, float] = (0.0, 0.0)
+
+    @property
+    def status_parts(self) -> list[str]:
+        """The status line's parts, most important first: a narrow window drops from the end."""
+        return [part for part in self.status.split(STATUS_SEPARATOR) if part]
 
     @classmethod
     def from_table(cls, table, clients=(), **extra) -> Scene:

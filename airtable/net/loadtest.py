@@ -36,7 +36,7 @@ from collections import deque
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 
-from airtable.app.client import Client
+from airtable.app.client import Client, cursor_pulls
 from airtable.app.scene import Scene
 from airtable.net import protocol as proto
 from airtable.net.player import NetPlayer, PlayerError
@@ -139,7 +139,7 @@ class LoadResult:
 
 
 def grid_table(columns: int = 6, rows: int = 5) -> AirTable:
-    """A table with a grid of pucks and the local user at clients[0]."""
+    """A table with a grid of pucks."""
     table = AirTable()
     # Small enough that neighbours never touch, however many there are.
     radius_m = min(0.3, 0.4 * table.width_m / columns, 0.4 * table.height_m / rows)
@@ -148,14 +148,13 @@ def grid_table(columns: int = 6, rows: int = 5) -> AirTable:
             x = table.width_m * (i + 0.5) / columns
             y = table.height_m * (j + 0.5) / rows
             table.add_puck((x, y), radius_m=radius_m, color="orange")
-    table.clients.append(Client(name="local", active=False))
     return table
 
 
 class TableLoop:
     """A headless game loop in a thread: inputs, fixed physics steps, snapshots.
 
-    Each frame, under `lock`: `server.apply_inputs(table)` and `table.step(dt_s)`
+    Each frame, under `lock`: `server.apply_inputs(clients, table)` and `table.step(dt_s, pulls)`
     for each physics step, then `server.publish(...)` with the measured frame
     rate. Hold `lock` to look at or step the table from another thread.
     """
@@ -170,6 +169,7 @@ class TableLoop:
     ) -> None:
         self.server = server
         self.table = table if table is not None else grid_table()
+        self.clients = [Client(name="local", active=False)]  # the server adds the players
         self.period_s = 1.0 / fps
         self.dt_s = dt_s
         self.steps_per_frame = max(1, round(self.period_s / dt_s))
@@ -184,8 +184,8 @@ class TableLoop:
     def frame(self) -> None:
         with self.lock:
             for _ in range(self.steps_per_frame):
-                self.server.apply_inputs(self.table)
-                self.table.step(self.dt_s)
+                self.server.apply_inputs(self.clients, self.table)
+                self.table.step(self.dt_s, cursor_pulls(self.clients))
             # Frames counted over the last second: an average of 1/dt would favour short frames.
             now = time.monotonic()
             times = self._frame_times
@@ -196,7 +196,7 @@ class TableLoop:
                 self.fps = (len(times) - 1) / (times[-1] - times[0])
             t = self.table
             status = f"{len(t.pos_m)} pucks   {len(self.server.player_names())} players   t = {t.time_s:.2f} s"
-            self.server.publish(Scene.from_table(t, t.clients, title=self.title, status=status, fps=self.fps))
+            self.server.publish(Scene.from_table(t, self.clients, title=self.title, status=status, fps=self.fps))
             self.frames += 1
 
     def _run(self) -> None:

@@ -5,7 +5,7 @@ into validated, immutable `InputRecord`s and keeps only the newest one per
 player (plus any button change since the last frame, so a quick click is not
 lost); it never touches the table (STYLE.md item 12). The game loop calls
 
-    server.apply_inputs(table)   # before each step: joins, newest inputs, leaves
+    server.apply_inputs(clients, table)   # before each step: joins, newest inputs, leaves
     server.publish(scene)        # every frame: at most snapshot_hz snapshots a second
 
 and neither call ever waits on a socket. A snapshot is encoded once and the
@@ -311,8 +311,8 @@ class GameServer:
 
     # ---------------------------------------------------------------- game loop side
 
-    def apply_inputs(self, table) -> None:
-        """Main thread, before each step: add joined players' Clients to table.clients,
+    def apply_inputs(self, clients: list[Client], table) -> None:
+        """Main thread, before each step: add joined players' Clients to `clients`,
         apply each player's newest input (after any button change it skipped over),
         remove departed players' Clients. Never blocks on the network (the lock is
         only held to swap two containers)."""
@@ -320,7 +320,6 @@ class GameServer:
         with self._lock:
             events, self._events = self._events, []
             inputs, self._inputs = self._inputs, {}
-        clients = table.clients
         for event in events:
             if event[0] == "join":
                 _, cid, name, color = event
@@ -333,15 +332,8 @@ class GameServer:
                 if client is not None:
                     client.release()
                     client.active = False
-                    _remove_identical(clients, client)
-        if self._clients:
-            # The app may have swapped in a new table (demo change): bring our
-            # clients over, letting go of pucks that belong to the old table.
-            present = {id(c) for c in clients}
-            for client in self._clients.values():
-                if id(client) not in present:
-                    client.release()
-                    clients.append(client)
+                    if client in clients:  # by identity: Client has eq=False
+                        clients.remove(client)
         for cid, records in inputs.items():
             client = self._clients.get(cid)
             if client is not None:
@@ -654,11 +646,3 @@ class GameServer:
                     conn.sock.send(bye)
                 except OSError:
                     pass
-
-
-def _remove_identical(items: list, obj: object) -> None:
-    """Remove `obj` by identity (Client == compares numpy arrays, which is ambiguous)."""
-    for i, item in enumerate(items):
-        if item is obj:
-            del items[i]
-            return

@@ -4,13 +4,16 @@ State is kept as a structure of arrays, one row per puck (and per spring), so
 one step is a handful of numpy operations whatever the number of pucks. Puck
 and Spring objects are handles onto those rows (see bodies.py).
 
-One `step(dt_s)`, in the order of the course's game loop:
-1. forces: cursor strings, springs, gravity;
-2. semi-implicit Euler: v += F/m dt, then x += v dt;
-3. walls;
-4. puck pairs: the candidates from a neighbour list (a grid rebuilds it every
-   few steps), then sequential collision + position correction, then a second
-   look at the pairs the corrections pushed into overlap;
+`step(dt_s, pulls)` is the course's game loop; each stage is a method below,
+and the numpy work of each is in a module of its own:
+0. timed events (a demo's throw) that are due;
+1. forces: pulls (cursor strings) and springs (forces.py);
+2. integrate, semi-implicit Euler: v += (F/m + g) dt, the pulls' drag taken
+   implicitly, then x += v dt;
+3. walls: push pucks back inside and bounce them (walls.py);
+4. puck pairs: the candidates from a neighbour list (broadphase.py), then
+   collision + position correction one pair at a time (pairs.py), then a
+   second look at the pairs the corrections pushed into overlap;
 5. walls again, since pushing pairs apart can push a puck into a wall.
 """
 
@@ -23,18 +26,14 @@ from collections.abc import Callable, Sequence
 
 import numpy as np
 
-from airtable.app.client import CURSOR_STRINGS
 from airtable.colors import rgb
-from airtable.memory import keep_freed_memory
-from airtable.physics import collisions, rows
+from airtable.physics import broadphase, forces, pairs, vectors, walls
 from airtable.physics.bodies import Puck, Spring, as_vector
+from airtable.physics.forces import GRAVITY_MPS2, Pull
 
-GRAVITY_MPS2 = 9.8
-# Springs and cursor strings stiffer than a step can integrate are softened to
-# this fraction of the limit (k dt^2 / m, and a spring's c dt / m, at most
-# this), which keeps semi-implicit Euler stable for any mass the user picks.
-# The cursor strings' drag needs no limit: it is applied implicitly.
-STIFFNESS_LIMIT = 0.5
+# The table's size unless told otherwise: 10 m across, 8:7 like the window.
+TABLE_WIDTH_M = 10.0
+TABLE_HEIGHT_M = 8.7556
 # After the first pass over the overlapping pairs, up to this many more passes
 # over the pairs the corrections pushed into overlap: collisions again, then a
 # last pass that only pushes apart.
@@ -47,7 +46,7 @@ MAX_SPEED_MPS = 1e8
 
 def kinetic_energy_J(mass_kg: np.ndarray, vel_mps: np.ndarray) -> float:
     """Sum of m v^2 / 2 over the rows (einsum's row dot is five times slower here)."""
-    return float(0.5 * np.dot(mass_kg, collisions.squared_lengths(vel_mps)))
+    return float(0.5 * np.dot(mass_kg, vectors.squared_lengths(vel_mps)))
 
 
 def _positive(value, what: str) -> float:
@@ -72,9 +71,13 @@ class _Columns:
         self.n = 0
         self._cap = 0
         self._data = {name: np.zeros((0, *shape), dtype) for name, (shape, dtype) in specs.items()}
+        self._views: dict[str, np.ndarray] = {}  # the live rows of each column, until the row count changes
 
     def view(self, name: str) -> np.ndarray:
-        return self._data[name][: self.n]
+        v = self._views.get(name)
+        if v is None:
+            v = self._views[name] = self._data[name][: self.n]
+        return v
 
     def append(self, **values) -> int:
         if self.n == self._cap:
@@ -87,6 +90,7 @@ class _Columns:
         for name, value in values.items():
             self._data[name][row] = value
         self.n += 1
+        self._views = {}
         return row
 
     def delete(self, rows: np.ndarray) -> np.ndarray:
@@ -99,17 +103,18 @@ class _Columns:
             kept = self._data[name][: self.n][keep]
             self._data[name][: len(kept)] = kept
         self.n = int(keep.sum())
+        self._views = {}
         return remap
 
     def clear(self) -> None:
         self.n = 0
+        self._views = {}
 
 
 class AirTable:
     """A rectangular air table with walls at x = 0..width_m and y = 0..height_m."""
 
-    def __init__(self, width_m: float = 10.0, height_m: float = 8.7556) -> None:
-        keep_freed_memory()  # the step's temporary arrays are reused, not re-faulted (memory.py)
+    def __init__(self, width_m: float = TABLE_WIDTH_M, height_m: float = TABLE_HEIGHT_M) -> None:
         self.width_m = _positive(width_m, "width_m")
         self.height_m = _positive(height_m, "height_m")
         self._pucks = _Columns(
@@ -130,13 +135,10 @@ class AirTable:
             color=((3,), np.uint8),
         )
         self._puck_handles: list[Puck] = []
-        self._neighbours = collisions.NeighbourList()
+        self._neighbours = broadphase.NeighbourList()
         self._spring_handles: list[Spring] = []
         self._events: list[tuple[float, int, Callable[[AirTable], None]]] = []
         self._event_seq = itertools.count()
-        # Clients (airtable.app.client.Client) whose cursor strings pull on pucks;
-        # the app and the server share this list. Index 0 is the local user.
-        self.clients: list = []
         self.reset_settings()
         self.clear()
 
@@ -157,8 +159,8 @@ class AirTable:
 
     @puck_correction.setter
     def puck_correction(self, mode: str) -> None:
-        if mode not in collisions.CORRECTION_MODES:
-            raise ValueError(f"puck_correction must be one of {', '.join(collisions.CORRECTION_MODES)}, not {mode!r}")
+        if mode not in pairs.CORRECTION_MODES:
+            raise ValueError(f"puck_correction must be one of {', '.join(pairs.CORRECTION_MODES)}, not {mode!r}")
         self._puck_correction = mode
 
     @property
@@ -316,8 +318,8 @@ class AirTable:
         self.time_s = 0.0
         self.steps = 0
         self.collision_count = 0
-        self._collision_records: list[collisions.Collisions] = []
-        self._last_collisions: collisions.Collisions | None = None
+        self._collision_records: list[pairs.Collisions] = []
+        self._last_collisions: pairs.Collisions | None = None
 
     def schedule(self, t_s: float, fn: Callable[[AirTable], None]) -> None:
         """Run fn(table) at the start of the first step at or after simulation time t_s."""
@@ -334,7 +336,7 @@ class AirTable:
         if self._pucks.n == 0:
             return None
         d = self.pos_m - p
-        inside = np.flatnonzero(collisions.squared_lengths(d) <= self.radius_m**2)
+        inside = np.flatnonzero(vectors.squared_lengths(d) <= self.radius_m**2)
         return self._puck_handles[int(inside[-1])] if len(inside) else None
 
     def kinetic_energy_J(self) -> float:
@@ -344,9 +346,8 @@ class AirTable:
         """Elastic energy stored in the springs, sum of k (d - L)^2 / 2."""
         if self._springs.n == 0:
             return 0.0
-        pairs = self.spring_pairs
-        d = rows.take(self.pos_m, pairs[:, 0]) - rows.take(self.pos_m, pairs[:, 1])
-        stretch = collisions.lengths(d) - self.spring_length_m
+        d = vectors.take(self.pos_m, self._springs.view("i")) - vectors.take(self.pos_m, self._springs.view("j"))
+        stretch = vectors.lengths(d) - self.spring_length_m
         return float(0.5 * np.dot(self.spring_k_Npm, stretch * stretch))
 
     def gravity_energy_J(self) -> float:
@@ -370,130 +371,131 @@ class AirTable:
         return self.momentum_Ns() / self.mass_kg.sum()
 
     @property
-    def last_collisions(self) -> collisions.Collisions:
-        """What the puck-puck collisions of the last step did (collisions.Collisions)."""
+    def last_collisions(self) -> pairs.Collisions:
+        """What the puck-puck collisions of the last step did (pairs.Collisions)."""
         if self._last_collisions is None:  # joined on first read: most steps nobody asks
-            self._last_collisions = collisions.Collisions.concatenate(self._collision_records)
+            self._last_collisions = pairs.Collisions.concatenate(self._collision_records)
         return self._last_collisions
 
     # ------------------------------------------------------------ the step
 
-    def step(self, dt_s: float) -> None:
-        """Advance the simulation by dt_s seconds (see the module docstring)."""
+    def step(self, dt_s: float, pulls: Sequence[Pull] = ()) -> None:
+        """Advance the simulation by dt_s seconds, stage by stage (see the module docstring).
+
+        `pulls` are the cursor strings acting during this step (forces.Pull).
+        """
         dt = float(dt_s)
         if not (math.isfinite(dt) and dt >= 0.0):
             raise ValueError(f"dt_s must be zero or a positive number of seconds, not {dt_s!r}")
-        while self._events and self._events[0][0] <= self.time_s + 1e-9:
-            _, _, fn = heapq.heappop(self._events)
-            fn(self)
+        self._run_due_events()
         self._collision_records, self._last_collisions = [], None
         if self._pucks.n:
-            self._integrate(dt)
+            if dt > 0.0:
+                drag = self._add_forces(pulls, dt)  # 1. forces
+                self._integrate(drag, dt)  # 2. semi-implicit Euler
+            self.force_N[:] = 0.0  # the accumulators hold one step's forces
+            self._resolve_walls()  # 3. walls
+            if self.puck_collisions:
+                moved = self._resolve_pairs(dt)  # 4. puck pairs
+                if len(moved):
+                    self._resolve_walls(only=moved)  # 5. walls again, for the pucks pairs moved
         self.time_s += dt
         self.steps += 1
 
-    def _integrate(self, dt: float) -> None:
-        pos, vel, force = self.pos_m, self.vel_mps, self.force_N
-        mass, radius = self.mass_kg, self.radius_m
-        if dt > 0.0:
-            drag = np.zeros(len(mass)) if self.clients else None
-            self._add_cursor_forces(force, drag, dt)
-            self._add_spring_forces(force, dt)
-            if np.count_nonzero(force):  # usually nothing pushes: skip the (N, 2) update
-                vel += force * (dt / mass)[:, None]
-            if self.gravity_on:
-                vel[:, 1] -= GRAVITY_MPS2 * dt
-            if drag is not None and drag.any():
-                # The strings' drag -c v is taken at the end of the step
-                # (backward Euler), which stays stable for any c and mass.
-                vel /= (1.0 + drag * dt / mass)[:, None]
-            # A cheap bound first: a speed over the limit has a component over limit / sqrt(2).
-            if np.abs(vel).max() > MAX_SPEED_MPS / math.sqrt(2.0):
-                speed = np.hypot(vel[:, 0], vel[:, 1])  # not lengths(): v^2 may overflow here
-                vel *= np.minimum(1.0, MAX_SPEED_MPS / np.maximum(speed, 1e-300))[:, None]
-            pos += vel * dt
-        force[:] = 0.0
-        collisions.resolve_walls(pos, vel, radius, self.size_m, self.cr_wall, self.wall_correction)
-        if self.puck_collisions:
-            self._resolve_pucks(dt)
+    def _run_due_events(self) -> None:
+        """Run the scheduled events whose time has come, in time order."""
+        while self._events and self._events[0][0] <= self.time_s + 1e-9:
+            _, _, fn = heapq.heappop(self._events)
+            fn(self)
 
-    def _resolve_pucks(self, dt: float) -> None:
+    def _add_forces(self, pulls: Sequence[Pull], dt: float) -> np.ndarray | None:
+        """Add the pulls' and springs' forces to force_N; return the pulls' drag per puck (None: no pulls)."""
+        force = self.force_N
+        drag = None
+        if pulls:
+            drag = np.zeros(self._pucks.n)
+            forces.add_pull_forces(force, drag, pulls, self.pos_m, self.mass_kg, dt)
+        if self._springs.n:
+            a, b, f1 = self._spring_forces(dt)
+            forces.add_spring_forces(force, a, b, f1)
+        return drag
+
+    def _integrate(self, drag: np.ndarray | None, dt: float) -> None:
+        """Semi-implicit Euler: v += (F/m + g) dt, the drag taken implicitly, then x += v dt."""
+        pos, vel, force, mass = self.pos_m, self.vel_mps, self.force_N, self.mass_kg
+        if np.count_nonzero(force):  # usually nothing pushes: skip the (N, 2) update
+            vel += force * (dt / mass)[:, None]
+        if self.gravity_on:
+            vel[:, 1] -= GRAVITY_MPS2 * dt
+        if drag is not None and drag.any():
+            # The drag -c v is taken at the end of the step (backward Euler):
+            # v_new = v - c v_new dt / m, stable for any c and mass.
+            vel /= (1.0 + drag * dt / mass)[:, None]
+        # A last guard against runaway values; a cheap bound first: a speed
+        # over the limit has a component over limit / sqrt(2).
+        if np.abs(vel).max() > MAX_SPEED_MPS / math.sqrt(2.0):
+            speed = np.hypot(vel[:, 0], vel[:, 1])  # not lengths(): v^2 may overflow here
+            vel *= np.minimum(1.0, MAX_SPEED_MPS / np.maximum(speed, 1e-300))[:, None]
+        pos += vel * dt
+
+    def _resolve_walls(self, only: np.ndarray | None = None) -> None:
+        """Push pucks back inside the walls and bounce them (only the rows `only`, if given)."""
+        walls.resolve_walls(
+            self.pos_m, self.vel_mps, self.radius_m, self.size_m, self.cr_wall, self.wall_correction, only=only
+        )
+
+    def _resolve_pairs(self, dt: float) -> np.ndarray:
+        """Collide and part the overlapping pairs; return the rows they moved (a row may repeat)."""
         pos, vel, radius, mass = self.pos_m, self.vel_mps, self.radius_m, self.mass_kg
         ci, cj, reach = self._neighbours.pairs(pos, radius)
-        i, j = collisions.overlapping_pairs(pos, ci, cj, reach)
+        i, j = broadphase.overlapping_pairs(pos, ci, cj, reach)
         records, moved = [], []
         for attempt in range(1 + EXTRA_PASSES):
             if len(i) == 0:
                 break
             if attempt < EXTRA_PASSES:
-                records += collisions.resolve_pairs(
-                    pos, vel, radius, mass, i, j, self.cr_puck, self.puck_correction, dt
-                )
+                records += pairs.resolve_pairs(pos, vel, radius, mass, i, j, self.cr_puck, self.puck_correction, dt)
             else:
-                collisions.push_apart(pos, radius, mass, i, j)
+                pairs.push_apart(pos, radius, mass, i, j)
             moved += [i, j]
             if self.puck_correction == "off" or attempt == EXTRA_PASSES:
                 break  # with "off" overlaps stay: that is what it shows
             # Parting a pair can push one of its pucks into a third one that
             # was already handled: look again among the same candidates,
             # collide those pairs too, and at last just push apart what is left.
-            i, j = collisions.overlapping_pairs(pos, ci, cj, reach - OVERLAP_SLOP_M)
+            i, j = broadphase.overlapping_pairs(pos, ci, cj, reach - OVERLAP_SLOP_M)
         if not moved:
-            return
+            return np.empty(0, dtype=np.intp)
         self._collision_records = records
         self.collision_count += sum(len(r) for r in records)
-        # Only pucks that pairs moved can have been pushed into a wall (a row
-        # listed twice is just checked twice).
-        moved_rows = np.concatenate(moved)
-        collisions.resolve_walls(pos, vel, radius, self.size_m, self.cr_wall, self.wall_correction, only=moved_rows)
+        return np.concatenate(moved)
 
     def _spring_forces(self, dt: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """(rows of p1, rows of p2, force on p1) for every spring; p2 gets minus that."""
-        pairs = self.spring_pairs
-        a, b = pairs[:, 0], pairs[:, 1]
-        pos, vel, mass = self.pos_m, self.vel_mps, self.mass_kg
-        n, dist = collisions.unit_vectors(rows.take(pos, a) - rows.take(pos, b))
-        m_a, m_b = mass.take(a), mass.take(b)
-        mu = m_a * m_b / (m_a + m_b)
-        k = np.minimum(self.spring_k_Npm, STIFFNESS_LIMIT * mu / (dt * dt))
-        c = np.minimum(self.spring_damper_Nspm, STIFFNESS_LIMIT * mu / dt)
-        vn = collisions.dot_rows(rows.take(vel, a) - rows.take(vel, b), n)
-        return a, b, (k * (self.spring_length_m - dist) - c * vn)[:, None] * n
+        a, b = self._springs.view("i"), self._springs.view("j")
+        f1 = forces.spring_forces(
+            self.pos_m,
+            self.vel_mps,
+            self.mass_kg,
+            a,
+            b,
+            self.spring_length_m,
+            self.spring_k_Npm,
+            self.spring_damper_Nspm,
+            dt,
+        )
+        return a, b, f1
 
-    def _cursor_strings(self, dt: float) -> list[tuple[int, np.ndarray, float]]:
-        """(puck row, spring force k (cursor - x), drag c) for every client holding a puck."""
-        out = []
-        for client in self.clients:
-            puck = getattr(client, "held", None)
-            if puck is None or not puck.alive or client.button not in CURSOR_STRINGS:
-                continue
-            row = puck.index
-            k, c = CURSOR_STRINGS[client.button]
-            k = min(k, STIFFNESS_LIMIT * self.mass_kg[row] / (dt * dt))
-            out.append((row, k * (np.asarray(client.cursor_m) - self.pos_m[row]), c))
-        return out
-
-    def _add_spring_forces(self, force: np.ndarray, dt: float) -> None:
-        if self._springs.n:
-            a, b, f1 = self._spring_forces(dt)
-            rows.add_at(force, a, f1)
-            rows.add_at(force, b, -f1)
-
-    def _add_cursor_forces(self, force: np.ndarray, drag: np.ndarray | None, dt: float) -> None:
-        for row, f, c in self._cursor_strings(dt):
-            force[row] += f
-            drag[row] += c
-
-    def forces_on(self, puck: Puck, dt_s: float = 1 / 240) -> dict[str, np.ndarray]:
-        """The forces (N) the next step will apply to `puck`, by source.
+    def forces_on(self, puck: Puck, dt_s: float = 1 / 240, pulls: Sequence[Pull] = ()) -> dict[str, np.ndarray]:
+        """The forces (N) the next step will apply to `puck`, by source, if `pulls` act on it.
 
         Keys: "cursor strings", "springs", "gravity" (only the non-zero ones).
-        `dt_s` matters only for springs stiffer than the step can integrate.
+        `dt_s` matters only for springs and pulls stiffer than the step can integrate.
         """
         row = puck.index
         out: dict[str, np.ndarray] = {}
         v = self.vel_mps[row]
-        strings = [f - c * v for r, f, c in self._cursor_strings(dt_s) if r == row]
+        strings = [f - c * v for r, f, c in forces.pull_forces(pulls, self.pos_m, self.mass_kg, dt_s) if r == row]
         if strings:
             out["cursor strings"] = np.sum(strings, axis=0)
         if self._springs.n:

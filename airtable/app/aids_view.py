@@ -1,0 +1,75 @@
+"""Drawing the teaching aids of a frame: collision annotations, vectors, the energy chart, the inspector.
+
+The numbers come from aids.py and the table; the pixels from the window's
+AidsPainter. The app calls `draw_aids(app)` after the table is drawn.
+"""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from airtable.app import aids
+from airtable.app.client import cursor_pulls
+
+if TYPE_CHECKING:
+    from airtable.app.app import App
+
+DIM_FORCE = (200, 200, 200)
+COM_COLOR = (255, 255, 255)
+FORCE_COLORS = {"cursor strings": (255, 120, 80), "springs": (255, 215, 0), "gravity": (90, 160, 255)}
+
+
+def draw_aids(app: App) -> None:
+    t, paint = app.table, app.painter
+    if app.show_annotations:
+        for annotation in app.collision_log.live(app.clock_s):
+            paint.annotation(annotation, app.clock_s)
+    if app.vectors and len(t.pos_m):
+        _draw_vectors(app)
+    if app.show_chart:
+        note = app.chart.euler_wiggle_note(t)
+        paint.energy_chart(app.chart.series(), app.chart.latest(), note)
+    if app.inspecting:
+        puck = t.puck_at(app.env.to_world(app.mouse_px))
+        if puck is not None:
+            v = puck.vel_mps
+            speed = float(np.hypot(*v))
+            paint.inspector(
+                puck.pos_m,
+                [
+                    f"mass {puck.mass_kg:.4g} kg   radius {puck.radius_m:.4g} m",
+                    f"speed {speed:.4g} m/s",
+                    f"velocity ({v[0]:.3f}, {v[1]:.3f}) m/s",
+                    f"kinetic energy {0.5 * puck.mass_kg * speed**2:.4g} J",
+                ],
+            )
+
+
+def _draw_vectors(app: App) -> None:
+    t, paint = app.table, app.painter
+    if app.vectors == 1:
+        name, unit, values, color = "velocity", "m/s", t.vel_mps, (120, 220, 255)
+    else:
+        name, unit, values, color = "momentum", "N s", t.vel_mps * t.mass_kg[:, None], (230, 120, 230)
+    amount, m_per_unit = aids.nice_scale(float(np.hypot(values[:, 0], values[:, 1]).max()), target_m=1.0)
+    paint.arrows(t.pos_m, values * m_per_unit, color)
+    legend = [(f"{name}: an arrow 1 m long is {amount:g} {unit}", color)]
+    # The centre of mass moves in a straight line while no outside force acts.
+    com, com_v = t.center_of_mass_m(), t.center_of_mass_vel_mps()
+    _, m_per_mps = aids.nice_scale(float(np.hypot(t.vel_mps[:, 0], t.vel_mps[:, 1]).max()), target_m=1.0)
+    paint.arrow(com, com_v * m_per_mps, COM_COLOR, width=3)
+    paint.marker(com, COM_COLOR, f"centre of mass, {np.hypot(*com_v):.2f} m/s")
+    held = app.local.held
+    if held is not None and held.alive:
+        forces = t.forces_on(held, app.dt_s, cursor_pulls(app.clients))
+        if forces:
+            biggest = max(float(np.hypot(*f)) for f in forces.values())
+            newtons, m_per_n = aids.nice_scale(biggest, target_m=1.5)
+            for source, f in forces.items():
+                c = FORCE_COLORS[source]
+                paint.arrow(held.pos_m, f * m_per_n, c, width=3)
+                legend.append((f"force, {source}: {np.hypot(*f):.3g} N", c))
+            legend.append((f"forces: an arrow 1 m long is {newtons / 1.5:.3g} N", DIM_FORCE))
+    paint.legend(legend)

@@ -1,0 +1,138 @@
+"""The fixed-step game loop: how many physics steps a frame runs, the frame rate, the pacing.
+
+Physics runs at a fixed step `dt_s` with an accumulator, so its results do not
+depend on the frame rate; drawing runs once per frame. Three small pieces,
+used by the teacher's app and by the load tool's headless table:
+
+- `FixedStep`: turns each frame's (scaled) time into a whole number of steps,
+  with a cap so a stalled frame cannot make the physics run away.
+- `FpsCounter`: frames counted over the last second (the frame itself ticks it,
+  with its own clock, so a simulated run reports its simulated rate).
+- `FrameLoop`: calls `frame(dt_s)` until told to stop. In real time it sleeps
+  until the next frame is due (it never spins), at most `fps` frames a second;
+  with `fixed_dt_s` it runs simulated frames of that length back to back, so
+  tests and headless runs count frames, not wall-clock seconds.
+"""
+
+from __future__ import annotations
+
+import threading
+import time
+from collections import deque
+from collections.abc import Callable
+
+# A stalled frame (window dragged, laptop busy) runs at most this much
+# simulated time; the rest is dropped rather than exploding the physics.
+MAX_SIM_PER_FRAME_S = 0.1
+# A real frame longer than this (the process was stopped) counts as this long.
+MAX_FRAME_S = 0.25
+
+
+class FixedStep:
+    """Fixed physics steps of `dt_s` out of variable frame times."""
+
+    def __init__(self, dt_s: float, max_sim_per_frame_s: float = MAX_SIM_PER_FRAME_S) -> None:
+        self.dt_s = dt_s
+        self.max_sim_per_frame_s = max_sim_per_frame_s
+        self.accumulator_s = 0.0
+
+    def reset(self, dt_s: float | None = None) -> None:
+        if dt_s is not None:
+            self.dt_s = dt_s
+        self.accumulator_s = 0.0
+
+    def steps(self, frame_dt_s: float, speed: float = 1.0) -> int:
+        """How many steps to run for a frame of `frame_dt_s` at `speed` times real time."""
+        self.accumulator_s += frame_dt_s * speed
+        max_steps = max(1, int(self.max_sim_per_frame_s / self.dt_s))
+        # The small slack keeps 1/60 s frames of 1/240 s steps at exactly 4 despite round-off.
+        steps = min(int(self.accumulator_s / self.dt_s + 1e-9), max_steps)
+        self.accumulator_s -= steps * self.dt_s
+        if steps == max_steps:
+            self.accumulator_s = min(self.accumulator_s, self.dt_s)
+        return steps
+
+
+class FpsCounter:
+    """Frames counted over the last second: steadier than 1 / dt of one frame."""
+
+    def __init__(self) -> None:
+        self.fps = 0.0
+        self._times: deque[float] = deque()
+
+    def tick(self, now_s: float) -> float:
+        """Count a frame at time `now_s` (seconds, any origin); returns the frame rate."""
+        times = self._times
+        times.append(now_s)
+        while times[0] < now_s - 1.0:
+            times.popleft()
+        span = times[-1] - times[0]
+        if span > 0:
+            self.fps = (len(times) - 1) / span
+        return self.fps
+
+
+class FrameLoop:
+    """Calls `frame(dt_s)` once per frame until it returns False or a limit is reached.
+
+    Real time (`fixed_dt_s` None): `dt_s` is the measured frame time, and the
+    loop sleeps until the next frame is due, so it runs at most `fps` frames a
+    second and a still table leaves the processor idle. `stop` (a
+    threading.Event) ends the loop from another thread, waking it at once.
+
+    Simulated time (`fixed_dt_s` given): every frame is `fixed_dt_s` long and
+    nothing sleeps.
+    """
+
+    def __init__(
+        self,
+        fps: float = 60.0,
+        fixed_dt_s: float | None = None,
+        clock: Callable[[], float] = time.monotonic,
+        sleep: Callable[[float], object] | None = None,
+    ) -> None:
+        """`clock` and `sleep` (seconds) are time.monotonic and a wait on `stop`; tests pass fakes."""
+        if not fps > 0:
+            raise ValueError(f"fps must be above 0, not {fps!r}")
+        self.period_s = 1.0 / fps
+        self.fixed_dt_s = fixed_dt_s
+        self.clock = clock
+        self.stop = threading.Event()
+        self.sleep = sleep if sleep is not None else self.stop.wait
+
+    def run(
+        self,
+        frame: Callable[[float], bool | None],
+        max_frames: int | None = None,
+        max_time_s: float | None = None,
+    ) -> int:
+        """Run frames until `frame` returns False, `max_frames` frames or `max_time_s`
+        seconds (of simulated time when `fixed_dt_s` is set). Returns the frames run."""
+        ran, elapsed_s = 0, 0.0
+        start = last = next_due = self.clock()
+        while not self.stop.is_set():
+            if self.fixed_dt_s is not None:
+                dt_s = self.fixed_dt_s
+                elapsed_s += dt_s
+            else:
+                now = self.clock()
+                dt_s, last = min(now - last, MAX_FRAME_S), now
+                elapsed_s = now - start
+            ran += 1
+            if frame(dt_s) is False:
+                break
+            if max_frames is not None and ran >= max_frames:
+                break
+            if max_time_s is not None and elapsed_s >= max_time_s - 1e-9:  # 120 frames of 1/60 s are 2 s
+                break
+            if self.fixed_dt_s is None:
+                next_due = self._wait(next_due + self.period_s)
+        return ran
+
+    def _wait(self, due: float) -> float:
+        """Sleep until `due`; returns when the frame after it is due from."""
+        delay = due - self.clock()
+        if delay > 0:
+            self.sleep(delay)
+            return due
+        return self.clock()  # fell behind: start afresh rather than burst to catch up

@@ -1,0 +1,69 @@
+"""The demo menu: every demo in a list, picked with the arrow keys and Enter or by typing its key.
+
+Keys like "t1" have no key of their own on the keyboard; the menu reaches them.
+Typing narrows the choice: the first demo whose key starts with what was typed
+is selected, and a key that nothing else extends (say "t2" beside "t10")
+starts at once. No pygame here: the app passes key names ("up", "return",
+"backspace") and typed characters.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+VISIBLE_ROWS = 14  # rows shown around the selection in a long list
+
+
+class DemoMenu:
+    def __init__(self, items: Sequence[tuple[str, str]], current: str | None = None) -> None:
+        """`items`: (demo key, title) in the order shown; `current` is selected first."""
+        self.items = list(items)
+        keys = [k for k, _ in self.items]
+        self.selected = keys.index(current) if current in keys else 0
+        self.typed = ""
+
+    def press(self, name: str, text: str = "") -> str | None:
+        """A key press: `name` as pygame.key.name gives it, `text` the character typed.
+
+        Returns the demo key to start, or None while the choice goes on.
+        """
+        if not self.items:
+            return None
+        if name in ("up", "down", "page up", "page down"):
+            step = {"up": -1, "down": 1, "page up": -VISIBLE_ROWS, "page down": VISIBLE_ROWS}[name]
+            self.selected = min(max(self.selected + step, 0), len(self.items) - 1)
+            self.typed = ""
+            return None
+        if name in ("return", "enter"):
+            return self.items[self.selected][0]
+        if name == "backspace":
+            self.typed = self.typed[:-1]
+        elif text and text.isprintable() and not text.isspace():
+            self.typed += text
+        else:
+            return None
+        return self._match()
+
+    def _match(self) -> str | None:
+        keys = [k for k, _ in self.items]
+        starting = [i for i, k in enumerate(keys) if k.lower().startswith(self.typed.lower())]
+        if not self.typed or not starting:
+            return None
+        self.selected = starting[0]
+        if len(starting) == 1 and keys[starting[0]].lower() == self.typed.lower():
+            return keys[starting[0]]
+        return None
+
+    def rows(self) -> list[tuple[str, str]]:
+        """The rows to show: at most VISIBLE_ROWS around the selection, the selected one marked."""
+        first = min(max(self.selected - VISIBLE_ROWS // 2, 0), max(len(self.items) - VISIBLE_ROWS, 0))
+        shown = []
+        for i in range(first, min(first + VISIBLE_ROWS, len(self.items))):
+            key, title = self.items[i]
+            mark = "> " if i == self.selected else "   "
+            shown.append((f"{mark}{key}", title))
+        return shown
+
+    def footer(self) -> str:
+        typed = f'   typed: "{self.typed}"' if self.typed else ""
+        return f"{self.selected + 1} of {len(self.items)}: Up/Down and Enter, or type a key; Esc closes{typed}"

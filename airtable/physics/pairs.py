@@ -1,0 +1,348 @@
+"""Puck pairs: collide the overlapping pairs one pair at a time, then part them.
+
+Sequential resolution matters: each pair sees the velocities left by the pairs
+before it, which conserves momentum and (restitution 1) energy to round-off.
+To keep that and still vectorise, `disjoint_rounds` splits the pairs into
+rounds in which no puck appears twice (a colouring of the graph of pairs that
+keeps their order); pairs in one round cannot affect each other, so resolving
+a round at once gives exactly the result of resolving its pairs one by one.
+
+A round is resolved by the function of the table's correction mode, all three
+built from the same two pieces: `collide_along_normal` (the 1D collision with
+restitution along the line of centres; the tangential velocity is kept) and
+`separate` (move the pair apart along a normal, then push apart what still
+overlaps).
+
+* "off": velocities only; the pucks stay overlapping ("stickiness").
+* "two-step": back both pucks up along their normal velocities for the
+  penetration time t_p = overlap / |vn|, then forward t_p with the
+  restitution-1 normal velocities: the pair ends as far apart as it overlapped.
+* "perfect-kiss": back the pair up along its full relative motion to the
+  moment of first contact, take the normal there, collide, and go forward
+  again by the same time.
+
+reference.py does the same for one pair in plain Python floats, equation by
+equation; the tests check the two agree.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import numpy as np
+
+from airtable.physics import vectors
+
+CORRECTION_MODES = ("off", "two-step", "perfect-kiss")
+
+# A relative normal speed smaller than this (m/s) counts as "not moving": such
+# an overlap cannot be explained by the last step's motion.
+REST_SPEED_MPS = 1e-9
+
+
+@dataclass
+class Collisions:
+    """What the pair resolution of one step did, for diagnostics and drawing.
+
+    One row per collision (an approaching pair whose velocities were changed):
+    puck rows i and j, the contact normal (unit, from j to i), the contact
+    point, the overlap when detected, the pair's reach (sum of the radii) and
+    both pucks' positions and velocities before and after this collision.
+    """
+
+    i: np.ndarray
+    j: np.ndarray
+    normal: np.ndarray
+    contact_m: np.ndarray
+    overlap_m: np.ndarray
+    reach_m: np.ndarray
+    pos_i_before: np.ndarray
+    pos_j_before: np.ndarray
+    pos_i_after: np.ndarray
+    pos_j_after: np.ndarray
+    vel_i_before: np.ndarray
+    vel_j_before: np.ndarray
+    vel_i_after: np.ndarray
+    vel_j_after: np.ndarray
+
+    @property
+    def separation_m(self) -> np.ndarray:
+        """The gap the position correction left (m); negative: still overlapping."""
+        return vectors.lengths(self.pos_i_after - self.pos_j_after) - self.reach_m
+
+    @classmethod
+    def empty(cls) -> Collisions:
+        z = np.empty(0)
+        zi = np.empty(0, dtype=np.intp)
+        z2 = np.empty((0, 2))
+        return cls(zi, zi, z2, z2, z, z, *([z2] * 8))
+
+    def __len__(self) -> int:
+        return len(self.i)
+
+    @classmethod
+    def concatenate(cls, parts: list[Collisions]) -> Collisions:
+        if not parts:
+            return cls.empty()
+        if len(parts) == 1:
+            return parts[0]
+        return cls(*(np.concatenate([getattr(p, f) for p in parts]) for f in cls.__dataclass_fields__))
+
+    def take(self, k: np.ndarray) -> Collisions:
+        """Only the collisions k (indices into this record)."""
+        return Collisions(*(getattr(self, f).take(k, axis=0) for f in self.__dataclass_fields__))
+
+
+def disjoint_rounds(i: np.ndarray, j: np.ndarray, n: int) -> list[np.ndarray]:
+    """Split pairs into rounds in which no puck appears twice.
+
+    Keeps the pairs' order: a pair goes into the first round after every
+    earlier pair that shares a puck with it. Resolving the rounds in turn is
+    therefore the same as resolving the pairs one by one in the given order.
+    """
+    m = len(i)
+    if m == 0:
+        return []
+    uses = np.bincount(np.concatenate([i, j]), minlength=n)
+    if uses.max() == 1:
+        return [np.arange(m)]  # the common case: no puck in two pairs
+    # A pair whose pucks are in no other pair can go in any round: the first.
+    # For the others, level[k] = how many earlier pairs form a chain into
+    # pair k. One pass in Python over just those, a handful per step.
+    shared = np.flatnonzero((uses.take(i) > 1) | (uses.take(j) > 1))
+    busy_until: dict[int, int] = {}  # per puck: first level at which it is free again
+    levels = []
+    for a, b in zip(i.take(shared).tolist(), j.take(shared).tolist(), strict=True):
+        lvl = max(busy_until.get(a, 0), busy_until.get(b, 0))
+        levels.append(lvl)
+        busy_until[a] = busy_until[b] = lvl + 1
+    level = np.zeros(m, dtype=np.intp)
+    level[shared] = levels
+    order = np.argsort(level, kind="stable")
+    bounds = np.searchsorted(level.take(order), np.arange(max(levels) + 2))
+    return [order[bounds[r] : bounds[r + 1]] for r in range(len(bounds) - 1)]
+
+
+def resolve_pairs(
+    pos: np.ndarray,
+    vel: np.ndarray,
+    radius: np.ndarray,
+    mass: np.ndarray,
+    i: np.ndarray,
+    j: np.ndarray,
+    cr_puck: float,
+    mode: str,
+    dt_s: float,
+) -> list[Collisions]:
+    """Collide the overlapping pairs (i, j) in order, in place (see the module docstring).
+
+    Returns one record per round that collided anything; `Collisions.concatenate`
+    joins them, which is left to whoever reads them.
+    """
+    if mode not in CORRECTION_MODES:
+        raise ValueError(f"puck_correction must be one of {CORRECTION_MODES}, not {mode!r}")
+    records = []
+    for r in disjoint_rounds(i, j, len(pos)):
+        c = _resolve_round(pos, vel, radius, mass, i.take(r), j.take(r), cr_puck, mode, dt_s)
+        if c is not None:
+            records.append(c)
+    return records
+
+
+def push_apart(pos: np.ndarray, radius: np.ndarray, mass: np.ndarray, i: np.ndarray, j: np.ndarray) -> None:
+    """Move each overlapping pair (i, j) apart along its line of centres, in place.
+
+    Positions only: each puck moves its mass-weighted share of the overlap
+    (the lighter one more), so the centre of mass stays put. Pairs that share
+    a puck add their pushes. Used for the small overlaps a correction leaves
+    behind; velocities (and so energy and momentum) are untouched.
+    """
+    n, dist = vectors.unit_vectors(vectors.take(pos, i) - vectors.take(pos, j))
+    left = np.maximum(radius.take(i) + radius.take(j) - dist, 0.0)
+    m_i, m_j = mass.take(i), mass.take(j)
+    push = (left / (m_i + m_j))[:, None] * n
+    vectors.add_at(pos, i, push * m_j[:, None])
+    vectors.add_at(pos, j, -push * m_i[:, None])
+
+
+# ---------------------------------------------------------------- one round
+
+
+@dataclass
+class _Round:
+    """The overlapping pairs of one round, gathered: puck 1 is row a, puck 2 row b."""
+
+    a: np.ndarray
+    b: np.ndarray
+    x1: np.ndarray
+    x2: np.ndarray
+    v1: np.ndarray
+    v2: np.ndarray
+    r2: np.ndarray
+    reach: np.ndarray  # r1 + r2
+    n: np.ndarray  # unit normal from puck 2 to puck 1, along the line of centres
+    overlap: np.ndarray
+    vrel: np.ndarray  # v1 - v2
+    vn: np.ndarray  # relative normal speed, negative when approaching
+    share1: np.ndarray  # puck 1's part of a change in relative motion: m2 / (m1 + m2)
+    share2: np.ndarray  # m1 / (m1 + m2)
+
+
+@dataclass
+class _Outcome:
+    """What a correction mode did to a round."""
+
+    n: np.ndarray  # the normal the pair collided along
+    contact_from: np.ndarray  # centre of puck 2 when they touched
+    approach: np.ndarray  # which pairs collided
+    v1: np.ndarray
+    v2: np.ndarray
+    x1: np.ndarray
+    x2: np.ndarray
+
+
+def _gather(pos, vel, radius, mass, a, b) -> _Round | None:
+    """The pairs (a, b) that still overlap (an earlier round may have parted some); None if none do."""
+    x1, x2 = vectors.take(pos, a), vectors.take(pos, b)
+    r2 = radius.take(b)
+    reach = radius.take(a) + r2
+    n, dist = vectors.unit_vectors(x1 - x2)
+    overlap = reach - dist
+    if np.count_nonzero(overlap > 0.0) < len(overlap):
+        keep = np.flatnonzero(overlap > 0.0)
+        if len(keep) == 0:
+            return None
+        a, b, x1, x2, r2, reach, n, overlap = (v.take(keep, axis=0) for v in (a, b, x1, x2, r2, reach, n, overlap))
+    v1, v2 = vectors.take(vel, a), vectors.take(vel, b)
+    m1, m2 = mass.take(a), mass.take(b)
+    m_sum = m1 + m2
+    vrel = v1 - v2
+    vn = vectors.dot_rows(vrel, n)
+    return _Round(a, b, x1, x2, v1, v2, r2, reach, n, overlap, vrel, vn, m2 / m_sum, m1 / m_sum)
+
+
+def collide_along_normal(g: _Round, n: np.ndarray, vn: np.ndarray, approach: np.ndarray, cr: float):
+    """Velocities (v1, v2) after the 1D collision with restitution cr along n, for the approaching pairs.
+
+    The relative normal speed vn becomes -cr vn, shared so that momentum is
+    kept (the lighter puck takes more of the change); the tangential
+    velocities are untouched.
+    """
+    jn = -(1.0 + cr) * vn  # change of relative normal speed
+    if np.count_nonzero(approach) < len(approach):
+        jn = np.where(approach, jn, 0.0)
+    return g.v1 + (jn * g.share1)[:, None] * n, g.v2 - (jn * g.share2)[:, None] * n
+
+
+def separate(g: _Round, n: np.ndarray, move: np.ndarray, approach: np.ndarray):
+    """Positions (x1, x2) after moving each approaching pair `move` apart along n.
+
+    Each puck moves its mass share. Whatever still overlaps (separating,
+    resting, created on top of each other, or capped) is then pushed apart
+    along its line of centres, by the same shares.
+    """
+    if np.count_nonzero(approach) < len(approach):
+        move = np.where(approach, move, 0.0)
+    x1 = g.x1 + (move * g.share1)[:, None] * n
+    x2 = g.x2 - (move * g.share2)[:, None] * n
+    d = x1 - x2
+    if np.count_nonzero(vectors.squared_lengths(d) < g.reach * g.reach):
+        n_now, dist_now = vectors.unit_vectors(d)
+        left = np.maximum(g.reach - dist_now, 0.0)
+        x1 = x1 + (left * g.share1)[:, None] * n_now
+        x2 = x2 - (left * g.share2)[:, None] * n_now
+    return x1, x2
+
+
+def _round_off(g: _Round, cr: float, dt_s: float) -> _Outcome:
+    """Velocities only: the overlap stays, which is what this mode shows."""
+    approach = g.vn < -REST_SPEED_MPS
+    v1, v2 = collide_along_normal(g, g.n, g.vn, approach, cr)
+    return _Outcome(g.n, g.x2, approach, v1, v2, g.x1, g.x2)
+
+
+def _two_step_move(g: _Round, dt_s: float) -> np.ndarray:
+    """How far the two-step correction parts each pair along the normal.
+
+    Back up t_p = overlap / |vn|, then forward t_p with the restitution-1
+    normal velocities: the pair parts by 2 |vn| t_p = twice the overlap. An
+    overlap deeper than one step of approach can explain is capped there;
+    `separate` pushes the rest apart.
+    """
+    return 2.0 * np.minimum(g.overlap, -g.vn * dt_s)
+
+
+def _round_two_step(g: _Round, cr: float, dt_s: float) -> _Outcome:
+    approach = g.vn < -REST_SPEED_MPS
+    v1, v2 = collide_along_normal(g, g.n, g.vn, approach, cr)
+    x1, x2 = separate(g, g.n, _two_step_move(g, dt_s), approach)
+    return _Outcome(g.n, g.x2, approach, v1, v2, x1, x2)
+
+
+def _time_since_contact(g: _Round, dt_s: float) -> tuple[np.ndarray, np.ndarray]:
+    """(t, ok): how long ago each pair first touched, and whether this step's motion explains it.
+
+    Solves |d - vrel t| = reach for the larger root t, with d = x1 - x2.
+    """
+    d = g.x1 - g.x2
+    vv = vectors.squared_lengths(g.vrel)
+    dv = vectors.dot_rows(d, g.vrel)
+    disc = np.maximum(dv * dv - vv * (vectors.squared_lengths(d) - g.reach * g.reach), 0.0)
+    moving = vv > REST_SPEED_MPS**2
+    t_back = (dv + np.sqrt(disc)) / np.where(moving, vv, 1.0)
+    ok = moving & (t_back >= 0.0) & (t_back <= dt_s * (1.0 + 1e-9) + 1e-15)
+    return t_back, ok
+
+
+def _round_perfect_kiss(g: _Round, cr: float, dt_s: float) -> _Outcome:
+    """Collide at first contact; pairs whose overlap this step cannot explain get the two-step correction."""
+    t_back, kiss = _time_since_contact(g, dt_s)
+    if not kiss.any():
+        return _round_two_step(g, cr, dt_s)
+    t_b = np.where(kiss, t_back, 0.0)[:, None]
+    c2 = g.x2 - g.v2 * t_b  # both centres at first contact
+    n_kiss, _ = vectors.unit_vectors(g.x1 - g.v1 * t_b - c2)
+    vn_kiss = vectors.dot_rows(g.vrel, n_kiss)
+    kiss2 = kiss[:, None]
+    n = np.where(kiss2, n_kiss, g.n)
+    vn = np.where(kiss, vn_kiss, g.vn)
+    # Approaching is judged at the contact time: a fast pair is often caught
+    # after its closest approach. Going forward t_b with the new velocities
+    # parts the pair by (1 + cr) |vn| t_b.
+    approach = np.where(kiss, vn_kiss < 0.0, g.vn < -REST_SPEED_MPS)
+    move = np.where(kiss, -(1.0 + cr) * vn_kiss * t_b[:, 0], _two_step_move(g, dt_s))
+    v1, v2 = collide_along_normal(g, n, vn, approach, cr)
+    x1, x2 = separate(g, n, move, approach)
+    return _Outcome(n, np.where(kiss2, c2, g.x2), approach, v1, v2, x1, x2)
+
+
+_ROUND_BY_MODE: dict[str, Callable[[_Round, float, float], _Outcome]] = {
+    "off": _round_off,
+    "two-step": _round_two_step,
+    "perfect-kiss": _round_perfect_kiss,
+}
+
+
+def _resolve_round(pos, vel, radius, mass, a, b, cr, mode, dt_s) -> Collisions | None:
+    """Resolve pairs that share no puck, all at once, in place (see `disjoint_rounds`).
+
+    Returns the record of the pairs that collided, None if none did.
+    """
+    g = _gather(pos, vel, radius, mass, a, b)
+    if g is None:
+        return None
+    out = _ROUND_BY_MODE[mode](g, cr, dt_s)
+    vectors.put(vel, g.a, out.v1)
+    vectors.put(vel, g.b, out.v2)
+    if mode != "off":
+        vectors.put(pos, g.a, out.x1)
+        vectors.put(pos, g.b, out.x2)
+    contact = out.contact_from + out.n * g.r2[:, None]
+    record = Collisions(
+        g.a, g.b, out.n, contact, g.overlap, g.reach, g.x1, g.x2, out.x1, out.x2, g.v1, g.v2, out.v1, out.v2
+    )
+    if np.count_nonzero(out.approach) == len(out.approach):
+        return record
+    hit = np.flatnonzero(out.approach)
+    return record.take(hit) if len(hit) else None

@@ -1,0 +1,131 @@
+"""One puck pair, collided in plain Python floats: the course's equations, top to bottom.
+
+`collide_pair` does for one pair what pairs.py does for thousands at once
+with numpy. It is slower and simpler; read it first, then pairs.py. The tests
+check that the two agree to round-off on random scenes.
+
+Vectors are (x, y) tuples in metres and m/s. Puck 1 and puck 2 overlap when
+their centres are closer than r1 + r2. The normal n is the unit vector from
+puck 2 to puck 1 along the line of centres; the tangent is perpendicular.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import NamedTuple
+
+from airtable.physics.pairs import REST_SPEED_MPS
+
+Vec = tuple[float, float]
+
+
+class Disc(NamedTuple):
+    """One puck: position (m), velocity (m/s), radius (m), mass (kg)."""
+
+    pos: Vec
+    vel: Vec
+    r: float
+    m: float
+
+
+def _add(a: Vec, b: Vec) -> Vec:
+    return (a[0] + b[0], a[1] + b[1])
+
+
+def _sub(a: Vec, b: Vec) -> Vec:
+    return (a[0] - b[0], a[1] - b[1])
+
+
+def _scale(s: float, a: Vec) -> Vec:
+    return (s * a[0], s * a[1])
+
+
+def _dot(a: Vec, b: Vec) -> float:
+    return a[0] * b[0] + a[1] * b[1]
+
+
+def _unit(d: Vec) -> tuple[Vec, float]:
+    """d / |d| and |d|; two pucks exactly on top of each other get the normal (1, 0)."""
+    dist = math.sqrt(d[0] * d[0] + d[1] * d[1])
+    return ((d[0] / dist, d[1] / dist) if dist > 0.0 else (1.0, 0.0)), dist
+
+
+def collide_1d(u1: float, u2: float, m1: float, m2: float, cr: float) -> tuple[float, float]:
+    """Speeds after a 1D collision with restitution cr: momentum is kept, and
+    the relative speed reverses, times cr: v1 - v2 = -cr (u1 - u2)."""
+    p = m1 * u1 + m2 * u2
+    v1 = (p - m2 * cr * (u1 - u2)) / (m1 + m2)
+    v2 = (p + m1 * cr * (u1 - u2)) / (m1 + m2)
+    return v1, v2
+
+
+def collide_along(n: Vec, v1: Vec, v2: Vec, m1: float, m2: float, cr: float) -> tuple[Vec, Vec]:
+    """Velocities after the collision along the normal n: the normal parts
+    collide in 1D, the tangential parts are kept."""
+    u1, u2 = _dot(v1, n), _dot(v2, n)
+    w1, w2 = collide_1d(u1, u2, m1, m2, cr)
+    return _add(v1, _scale(w1 - u1, n)), _add(v2, _scale(w2 - u2, n))
+
+
+def _push_apart(x1: Vec, x2: Vec, p1: Disc, p2: Disc) -> tuple[Vec, Vec]:
+    """Part a pair that still overlaps along its line of centres; the lighter puck moves more."""
+    n, dist = _unit(_sub(x1, x2))
+    left = max(p1.r + p2.r - dist, 0.0)
+    m_sum = p1.m + p2.m
+    return _add(x1, _scale(left * p2.m / m_sum, n)), _sub(x2, _scale(left * p1.m / m_sum, n))
+
+
+def _time_since_contact(p1: Disc, p2: Disc, dt_s: float) -> float | None:
+    """How long ago the pair first touched, if this step's motion explains the overlap, else None.
+
+    With d = x1 - x2 and w = v1 - v2, the centres were r1 + r2 apart t ago:
+    |d - w t| = r1 + r2, a quadratic in t; the larger root is the first contact.
+    """
+    d, w = _sub(p1.pos, p2.pos), _sub(p1.vel, p2.vel)
+    reach = p1.r + p2.r
+    ww, dw = _dot(w, w), _dot(d, w)
+    if not ww > REST_SPEED_MPS**2:
+        return None  # not moving: nothing to back up along
+    disc = max(dw * dw - ww * (_dot(d, d) - reach * reach), 0.0)
+    t = (dw + math.sqrt(disc)) / ww
+    return t if 0.0 <= t <= dt_s * (1.0 + 1e-9) + 1e-15 else None
+
+
+def collide_pair(p1: Disc, p2: Disc, cr: float, mode: str, dt_s: float) -> tuple[Disc, Disc]:
+    """The two pucks after their collision, with the position correction `mode`.
+
+    mode is "off", "two-step" or "perfect-kiss"; dt_s is the step that
+    brought them into overlap. A pair that does not overlap is returned as is.
+    """
+    n, dist = _unit(_sub(p1.pos, p2.pos))
+    overlap = p1.r + p2.r - dist
+    if not overlap > 0.0:
+        return p1, p2
+    m1, m2 = p1.m, p2.m
+    x1, x2 = p1.pos, p2.pos
+    v1, v2 = p1.vel, p2.vel
+    vn = _dot(_sub(v1, v2), n)  # relative normal speed; negative: approaching
+    t_kiss = _time_since_contact(p1, p2, dt_s) if mode == "perfect-kiss" else None
+    if t_kiss is not None:
+        # Perfect kiss: back both pucks up t along their velocities to first
+        # contact, collide there along the normal at contact, and move forward
+        # t with the new velocities. Approaching is judged at contact.
+        c1, c2 = _sub(x1, _scale(t_kiss, v1)), _sub(x2, _scale(t_kiss, v2))
+        n, _ = _unit(_sub(c1, c2))
+        if _dot(_sub(v1, v2), n) < 0.0:
+            v1, v2 = collide_along(n, v1, v2, m1, m2, cr)
+            x1, x2 = _add(c1, _scale(t_kiss, v1)), _add(c2, _scale(t_kiss, v2))
+    elif vn < -REST_SPEED_MPS:
+        w1, w2 = collide_along(n, v1, v2, m1, m2, 1.0)  # restitution 1: for the correction only
+        v1, v2 = collide_along(n, v1, v2, m1, m2, cr)
+        if mode != "off":
+            # Two-step: back up the penetration time t_p = overlap / |vn| along
+            # the normal velocities, then go forward t_p with the restitution-1
+            # normal velocities, so the pair ends as far apart as it overlapped.
+            # An overlap deeper than this step's approach is capped at dt.
+            t_p = min(overlap / -vn, dt_s)
+            x1 = _add(x1, _scale(t_p * (_dot(w1, n) - _dot(p1.vel, n)), n))
+            x2 = _add(x2, _scale(t_p * (_dot(w2, n) - _dot(p2.vel, n)), n))
+    if mode != "off":
+        x1, x2 = _push_apart(x1, x2, p1, p2)  # whatever still overlaps
+    return Disc(x1, v1, p1.r, m1), Disc(x2, v2, p2.r, m2)

@@ -1,0 +1,70 @@
+"""Rows of 2D vectors: (N, 2) float arrays, one vector per puck, pair or spring.
+
+Lengths, unit vectors and dot products are written per column
+(`d[:, 0] * d[:, 0] + d[:, 1] * d[:, 1]`): numpy's axis reductions and
+`einsum` cost several times more on arrays this narrow.
+
+Gather and scatter: `pos[idx]`, `pos[idx] = v` and `np.add.at(pos, idx, v)`
+on a 2-D array go through numpy's general N-dimensional indexing, which costs
+about ten times more per row than the same operation on a 1-D array. The step
+does little else with its index arrays, so it uses `take`, `put` and `add_at`
+instead: `take` gathers with `ndarray.take`, and `put` and `add_at` see each
+row of two float64 numbers as one complex number, which turns the array into a
+1-D one without copying (so the target must be C-contiguous float64, as the
+table's columns are). The results are exactly those of plain indexing.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+# The direction given to a zero-length row (two pucks exactly on top of each other).
+FALLBACK_NORMAL = np.array([1.0, 0.0])
+
+
+def squared_lengths(d: np.ndarray) -> np.ndarray:
+    """Squared length of each row of d."""
+    dd = d * d
+    return dd[:, 0] + dd[:, 1]
+
+
+def lengths(d: np.ndarray) -> np.ndarray:
+    """Length of each row of d."""
+    return np.sqrt(squared_lengths(d))
+
+
+def unit_vectors(d: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Unit vectors along the rows of d and their lengths; zero rows get FALLBACK_NORMAL."""
+    dist = lengths(d)
+    # np.count_nonzero, here and in the step, costs a quarter of .all() or
+    # .any(), whose Python-level wrappers dominate on a few dozen pairs.
+    if np.count_nonzero(dist) == len(dist):
+        return d / dist[:, None], dist
+    safe = dist > 0.0
+    n = np.where(safe[:, None], d / np.where(safe, dist, 1.0)[:, None], FALLBACK_NORMAL)
+    return n, dist
+
+
+def dot_rows(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """The dot product of each row of a with the same row of b."""
+    return a[:, 0] * b[:, 0] + a[:, 1] * b[:, 1]
+
+
+def take(a: np.ndarray, idx: np.ndarray) -> np.ndarray:
+    """a[idx] (a new array of the rows idx)."""
+    return a.take(idx, axis=0)
+
+
+def _as_complex(a: np.ndarray) -> np.ndarray:
+    """The (N,) complex128 view of a C-contiguous (N, 2) float64 array."""
+    return a.view(np.complex128).reshape(-1)
+
+
+def put(a: np.ndarray, idx: np.ndarray, values: np.ndarray) -> None:
+    """a[idx] = values for an (N, 2) float64 array, in place (the last write wins where idx repeats)."""
+    _as_complex(a)[idx] = _as_complex(np.ascontiguousarray(values, dtype=np.float64))
+
+
+def add_at(a: np.ndarray, idx: np.ndarray, values: np.ndarray) -> None:
+    """np.add.at(a, idx, values) for an (N, 2) float64 array, in place: repeated rows add up."""
+    np.add.at(_as_complex(a), idx, _as_complex(np.ascontiguousarray(values, dtype=np.float64)))

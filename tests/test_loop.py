@@ -1,0 +1,102 @@
+"""The fixed-step loop: steps per frame, the frame rate, and pacing that sleeps rather than spins."""
+
+from __future__ import annotations
+
+import threading
+
+import pytest
+
+from airtable.app.loop import MAX_SIM_PER_FRAME_S, FixedStep, FpsCounter, FrameLoop
+
+
+class FakeClock:
+    """A clock that only moves when the loop sleeps or a frame takes time."""
+
+    def __init__(self) -> None:
+        self.now = 100.0
+        self.slept: list[float] = []
+
+    def __call__(self) -> float:
+        return self.now
+
+    def sleep(self, seconds: float) -> None:
+        self.slept.append(seconds)
+        self.now += seconds
+
+
+def test_fixed_step_turns_frames_into_whole_steps():
+    step = FixedStep(1 / 240)
+    assert [step.steps(1 / 60) for _ in range(100)] == [4] * 100  # no 3-5-3 jitter from round-off
+    assert sum(step.steps(1 / 144) for _ in range(144)) == 240
+    slow = FixedStep(1 / 240)
+    assert [slow.steps(1 / 60, speed=s) for s in (0.25, 0.25, 0.5, 1 / 16, 1 / 16, 1 / 16, 1 / 16)] == [
+        1,
+        1,
+        2,
+        0,
+        0,
+        0,
+        1,
+    ]
+
+
+def test_a_stalled_frame_runs_at_most_a_tenth_of_a_second():
+    step = FixedStep(1 / 240)
+    assert step.steps(5.0) == round(MAX_SIM_PER_FRAME_S * 240)
+    assert step.accumulator_s <= 1 / 240  # the rest is dropped, not carried
+    assert step.steps(1 / 60) in (4, 5)
+
+
+def test_fps_counts_the_frames_of_the_last_second():
+    counter = FpsCounter()
+    for i in range(90):
+        fps = counter.tick(i / 45)
+    assert fps == pytest.approx(45.0)
+
+
+def test_simulated_frames_never_sleep():
+    clock = FakeClock()
+    loop = FrameLoop(fps=60, fixed_dt_s=1 / 60, clock=clock, sleep=clock.sleep)
+    seen: list[float] = []
+    assert loop.run(seen.append, max_time_s=2.0) == 120
+    assert seen == [1 / 60] * 120
+    assert clock.slept == []
+
+
+def test_real_time_sleeps_until_each_frame_is_due():
+    clock = FakeClock()
+    loop = FrameLoop(fps=50, clock=clock, sleep=clock.sleep)
+
+    def frame(dt_s: float) -> None:
+        clock.now += 0.005  # the frame's own work: 5 ms
+
+    assert loop.run(frame, max_frames=10) == 10
+    # 20 ms a frame: 5 ms of work and 15 ms asleep, never a busy wait.
+    assert clock.slept == pytest.approx([0.015] * 9)
+    assert loop.run(frame, max_time_s=1.0) == 51
+
+
+def test_a_slow_frame_does_not_make_the_next_ones_burst():
+    clock = FakeClock()
+    loop = FrameLoop(fps=50, clock=clock, sleep=clock.sleep)
+    work = iter([0.1, 0.005, 0.005, 0.005])
+    dts: list[float] = []
+
+    def frame(dt_s: float) -> None:
+        dts.append(dt_s)
+        clock.now += next(work)
+
+    loop.run(frame, max_frames=4)
+    assert clock.slept == pytest.approx([0.015, 0.015])  # after the 100 ms frame, no sleep, then the pace again
+    assert dts[1] == pytest.approx(0.1)
+
+
+def test_frame_returning_false_or_stop_ends_the_loop():
+    loop = FrameLoop(fps=1000, fixed_dt_s=0.01)
+    assert loop.run(lambda dt: False) == 1
+    stopper = FrameLoop(fps=1000)
+    thread = threading.Thread(target=lambda: stopper.run(lambda dt: None))
+    thread.start()
+    stopper.stop.set()
+    thread.join(timeout=5.0)
+    assert not thread.is_alive()

@@ -1,0 +1,301 @@
+"""A teacher's workflow: demo files edited while the app runs, errors in the terminal, the demo
+menu, an Esc that never drops a class by accident, and the small things (keypad, screenshots)."""
+
+from __future__ import annotations
+
+import os
+import socket
+import subprocess
+import sys
+from pathlib import Path
+
+import pygame
+import pytest
+from conftest import FRAME_S, press, wait_until
+
+from airtable.app.app import App
+from airtable.app.demo_loader import BUILTIN_DIR, DemoShelf, key_order
+from airtable.cli import main
+from airtable.net import protocol as proto
+from airtable.net.server import GameServer
+
+ROOT = Path(__file__).resolve().parent.parent
+
+
+def demo_source(key: str, pucks: int = 1, build_line: str = "", title: str = "Mine") -> str:
+    return (
+        f"KEY = {key!r}\nTITLE = {title!r}\nNOTES = 'One. Two.'\n\n"
+        "def build(table, variation=0):\n"
+        f"    for i in range({pucks}):\n"
+        "        table.add_puck((1.0 + i, 1.0), 0.2)\n"
+        f"{build_line}"
+    )
+
+
+RAISES = "    raise RuntimeError('my mistake')\n"
+SYNTAX_ERROR = "KEY = '5'\nTITLE = 'Broken'\ndef build(table, variation=0)\n    pass\n"
+
+
+def make_app(*folders: Path, key: str = "1") -> App:
+    app = App(DemoShelf([BUILTIN_DIR, *folders]), demo_key=key, headless=True)
+    pygame.event.clear()
+    return app
+
+
+def run_cli(*args: str, env: dict | None = None, timeout: float = 60) -> subprocess.CompletedProcess:
+    return subprocess.run(
+        [sys.executable, "-m", "airtable", *args],
+        capture_output=True,
+        text=True,
+        timeout=timeout,
+        env={**os.environ, **(env or {})},
+        cwd=ROOT,
+    )
+
+
+# ---------------------------------------------------------------- demo files reload
+
+
+def test_pressing_a_demo_key_reads_its_file_again_after_an_edit(tmp_path, capsys):
+    mine = tmp_path / "mine.py"
+    mine.write_text(demo_source("5", pucks=2))
+    app = make_app(tmp_path, key="5")
+    assert len(app.table.pucks) == 2
+    mine.write_text(demo_source("5", pucks=3, title="Mine, edited"))
+    press(app, pygame.K_5)
+    assert len(app.table.pucks) == 3 and "Mine, edited" in app.window.caption
+
+    mine.write_text(SYNTAX_ERROR)
+    press(app, pygame.K_5)
+    assert app.panel() == "error" and app.build_error.stage == "load"
+    assert len(app.table.pucks) == 0  # not the built-in demo 5 in its place
+    assert f"{mine}:3: syntax error" in capsys.readouterr().err
+
+    mine.write_text(demo_source("5", pucks=4, build_line=RAISES))
+    press(app, pygame.K_5)
+    assert app.build_error is not None and app.build_error.stage == "build"
+    assert f"{mine}:8: RuntimeError: my mistake" in capsys.readouterr().err
+
+    mine.write_text(demo_source("5", pucks=4))  # fixed: the next press builds it
+    press(app, pygame.K_5)
+    assert app.build_error is None and app.panel() is None and len(app.table.pucks) == 4
+
+
+def test_a_file_that_failed_at_start_loads_once_fixed(tmp_path):
+    broken = tmp_path / "late.py"
+    broken.write_text("KEY = 't1'\nTITLE = 'x'\ndef build(table, variation=0)\n")
+    app = make_app(tmp_path)
+    assert app.panel() == "notice"
+    press(app, pygame.K_SPACE)  # any key goes on
+    assert app.panel() is None and "t1" not in app.demos
+    broken.write_text(demo_source("t1", pucks=2))
+    press(app, pygame.K_PAGEUP)  # from demo 1 back round to the last key, now t1
+    assert app.demo_key == "t1" and len(app.table.pucks) == 2
+
+
+def test_demo_keys_sort_naturally_everywhere(tmp_path, capsys):
+    for key in ("t10", "t2", "t1"):
+        (tmp_path / f"demo_{key}.py").write_text(demo_source(key))
+    keys = sorted(["t10", "1p", "t2", "0", "1", "t1"], key=key_order)
+    assert keys == ["1", "0", "1p", "t1", "t2", "t10"]
+    app = make_app(tmp_path)
+    assert list(app.demos)[-3:] == ["t1", "t2", "t10"]
+    assert main(["--list-demos", "--demos", str(tmp_path)]) == 0
+    listed = [line.split()[0] for line in capsys.readouterr().out.splitlines()]
+    assert listed[-3:] == ["t1", "t2", "t10"]
+
+
+def test_the_demo_menu_lists_every_demo_and_starts_the_one_picked(tmp_path):
+    for key in ("t1", "t2", "t10"):
+        (tmp_path / f"demo_{key}.py").write_text(demo_source(key, pucks=int(key[1:])))
+    app = make_app(tmp_path)
+    press(app, pygame.K_TAB)
+    assert app.panel() == "menu"
+    assert [key for key, _ in app.menu.items] == list(app.demos)
+    press(app, pygame.K_t, unicode="t")
+    press(app, pygame.K_2, unicode="2")  # "t2": no other key starts so, it starts at once
+    assert app.panel() is None and app.demo_key == "t2" and len(app.table.pucks) == 2
+    press(app, pygame.K_TAB)
+    press(app, pygame.K_t, unicode="t")
+    press(app, pygame.K_1, unicode="1")  # "t1" or "t10": wait for Enter
+    assert app.panel() == "menu" and app.demo_key == "t2"
+    press(app, pygame.K_RETURN)
+    assert app.demo_key == "t1"
+    press(app, pygame.K_TAB)
+    press(app, pygame.K_DOWN)
+    press(app, pygame.K_RETURN)
+    assert app.demo_key == "t2"
+    press(app, pygame.K_TAB)
+    press(app, pygame.K_ESCAPE)  # closes the menu, quits nothing
+    assert app.panel() is None and app.running and app.demo_key == "t2"
+
+
+# ---------------------------------------------------------------- errors reach the terminal
+
+
+def test_a_failing_timed_event_is_reported_and_titled_as_one(tmp_path, capsys):
+    late = tmp_path / "late.py"
+    late.write_text(demo_source("t7", build_line="    table.schedule(0.5, lambda t: t.no_such_thing())\n"))
+    app = make_app(tmp_path, key="t7")
+    app.run(seconds=1.0, frame_dt_s=FRAME_S)
+    assert app.paused and app.build_error.stage == "event"
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and err[0].startswith(f"{late}:8: AttributeError")
+    shown: list[str] = []
+    app.window.draw_panel = lambda title, *a, **k: shown.append(title)
+    app.draw()
+    assert shown == ["Demo t7: a timed event failed"]
+
+
+def test_headless_run_of_a_demo_that_cannot_be_built_exits_1_and_shows_its_error(tmp_path):
+    folder = tmp_path / "demos"
+    folder.mkdir()
+    (folder / "throws.py").write_text(demo_source("t9", build_line=RAISES))
+    (folder / "syntax.py").write_text("KEY = 't8'\nTITLE = 'x'\ndef build(table, variation=0)\n")
+    shot = tmp_path / "shot"
+    done = run_cli("--headless", "--no-server", "--seconds", "0.5", "--demos", str(folder), "--demo", "t9",
+                   "--screenshot", str(shot))  # fmt: skip
+    assert done.returncode == 1
+    lines = done.stderr.strip().splitlines()
+    assert f"{folder / 'syntax.py'}:3: syntax error: expected ':'" in lines
+    assert f"{folder / 'throws.py'}:8: RuntimeError: my mistake" in lines
+    assert "Traceback" not in done.stderr
+    assert (tmp_path / "shot.png").exists()  # .png added
+    # The screenshot shows this demo's error panel, not the list of files that failed to load.
+    app = make_app(folder, key="t9")
+    assert app.panel() == "error"
+
+
+# ---------------------------------------------------------------- Esc is safe
+
+
+@pytest.mark.parametrize("opener", [pygame.K_F1, pygame.K_l, pygame.K_TAB])
+def test_esc_closes_an_open_panel_first(demos, opener):
+    app = App(demos, headless=True)
+    press(app, opener)
+    assert app.panel() is not None
+    press(app, pygame.K_ESCAPE)
+    assert app.panel() is None and app.running
+    press(app, pygame.K_ESCAPE)
+    assert not app.running
+
+
+def test_esc_on_a_press_any_key_notice_goes_on_without_quitting(tmp_path):
+    (tmp_path / "bad.py").write_text("KEY = 't8'\n")
+    app = make_app(tmp_path)
+    assert app.panel() == "notice"
+    press(app, pygame.K_ESCAPE)
+    assert app.running and app.panel() is None
+
+
+def test_quitting_with_a_student_connected_takes_a_second_esc(demos):
+    with GameServer(host="127.0.0.1", port=0) as server:
+        app = App(demos, headless=True, server=server)
+        student = socket.create_connection(("127.0.0.1", server.port), timeout=5.0)
+        try:
+            student.sendall(proto.encode_hello("Ann"))
+
+            def joined() -> bool:
+                app.frame(FRAME_S)
+                return app.student_count() == 1
+
+            wait_until(joined, what="the student to join")
+            shown: list[tuple] = []
+            draw_panel = app.window.draw_panel
+            app.window.draw_panel = lambda title, rows, **k: (shown.append((title, rows)), draw_panel(title, rows, **k))
+            press(app, pygame.K_ESCAPE)
+            assert app.running and app.panel() == "quit"
+            assert shown[-1][0] == "Quit?" and "1 student will be dropped." in shown[-1][1]
+            press(app, pygame.K_SPACE)  # any other key: stay
+            assert app.running and app.panel() is None and not app.paused
+            press(app, pygame.K_ESCAPE)
+            app.run(seconds=5.0, frame_dt_s=FRAME_S)  # a second Esc long after the first only asks again
+            assert app.running and app.panel() is None
+            press(app, pygame.K_ESCAPE)
+            assert app.running and app.panel() == "quit"
+            press(app, pygame.K_ESCAPE)
+            assert not app.running
+        finally:
+            student.close()
+
+
+# ---------------------------------------------------------------- a quiet laptop
+
+
+def test_a_still_table_with_nobody_at_it_is_still(demos):
+    app = App(demos, demo_key="2", headless=True)  # demo 2 waits for the cue
+    app.run(seconds=0.5, frame_dt_s=FRAME_S)
+    assert not app.still()  # start-up counts as input for a second
+    app.run(seconds=1.0, frame_dt_s=FRAME_S)
+    assert app.still()
+    app.clients.append(type(app.local)(name="C1", color=(1, 2, 3)))  # a student arrives
+    assert not app.still()
+    app.run(seconds=1.5, frame_dt_s=FRAME_S)
+    assert app.still()  # whose cursor rests
+    app.clients[1].cursor_m = app.clients[1].cursor_m + 0.1
+    assert not app.still()
+    app.run(seconds=1.5, frame_dt_s=FRAME_S)
+    press(app, pygame.K_SPACE)
+    assert app.paused and not app.still()  # a key was just pressed
+    app.run(seconds=1.5, frame_dt_s=FRAME_S)
+    assert app.still()
+    app.table.vel_mps[0] = (1.0, 0.0)
+    press(app, pygame.K_SPACE)
+    app.run(seconds=1.5, frame_dt_s=FRAME_S)
+    assert not app.paused and not app.still()  # a puck moves
+
+
+# ---------------------------------------------------------------- small things
+
+
+def test_keypad_digits_act_like_the_number_row(demos):
+    app = App(demos, headless=True)
+    press(app, pygame.K_KP_3)
+    assert app.demo_key == "3"
+    press(app, pygame.K_KP_0)
+    assert app.demo_key == "0"
+    press(app, pygame.K_KP_2, mod=pygame.KMOD_LSHIFT)
+    assert app.demo_key == "2p"
+
+
+def test_f12_screenshots_never_overwrite_each_other(demos, tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    app = App(demos, headless=True)
+    for _ in range(3):  # within one second: the same time stamp
+        press(app, pygame.K_F12)
+    files = sorted((tmp_path / "screenshots").glob("*.png"))
+    assert len(files) == 3
+    assert str(files[-1].resolve()) in app.message or any(str(f.resolve()) in app.message for f in files)
+
+
+def test_the_status_line_puts_what_matters_first(demos):
+    app = App(demos, demo_key="1", headless=True)
+    press(app, pygame.K_SPACE)
+    press(app, pygame.K_s)
+    parts = app.status_parts()
+    assert parts[:3] == ["PAUSED", "slow motion x1/2", "t = 0.00 s"]
+    assert "5 pucks" in parts and "0 collisions" in parts
+    assert app.scene().status_parts == parts  # the window (and every student) can drop parts from the end
+
+
+@pytest.mark.parametrize(
+    "name, message",
+    [
+        ("no_folder/shot.png", "there is no folder"),
+        (".", "that is a folder"),
+    ],
+)
+def test_an_unwritable_screenshot_path_is_one_line_and_exit_1(name, message, tmp_path, capsys):
+    assert main(["--headless", "--no-server", "--seconds", "0.1", "--screenshot", str(tmp_path / name)]) == 1
+    err = capsys.readouterr().err
+    assert message in err and len(err.strip().splitlines()) == 1 and "Traceback" not in err
+
+
+def test_no_display_is_one_line_naming_headless_and_exit_1():
+    env = {k: v for k, v in os.environ.items() if k not in ("DISPLAY", "WAYLAND_DISPLAY", "SDL_VIDEODRIVER")}
+    done = subprocess.run(
+        [sys.executable, "-m", "airtable", "--no-server"], capture_output=True, text=True, timeout=30, env=env
+    )
+    assert done.returncode == 1
+    (line,) = done.stderr.strip().splitlines()
+    assert "--headless" in line and "display" in line
