@@ -125,7 +125,7 @@ def test_zoom_and_pan_survive_a_resize() -> None:
     centre_before = env.to_world((450, 394))  # the middle of the 900 x 788 window
     env.resize((1920, 1080))
     assert env.zoom == pytest.approx(3.0)
-    np.testing.assert_allclose(env.to_world((960, 540)), centre_before, atol=1e-9)  # same spot in the middle
+    np.testing.assert_allclose(env.to_world((960, 540)), centre_before, atol=1e-4)  # same spot in the middle
     assert env.px_per_m == pytest.approx(3.0 * 1080 / 8.7556)
     # Zooming about the cursor still keeps the point under it.
     under = env.to_world((100.0, 900.0))

@@ -15,6 +15,7 @@ from collections.abc import Sequence
 import numpy as np
 import pygame
 
+from airtable.app.aids import VectorScale
 from airtable.app.panel_view import DIM_TEXT, TEXT_COLOR
 from airtable.app.panel_view import wrap as _wrap
 
@@ -81,6 +82,15 @@ class AidsPainter:
         self.w = window
         self.chart_corner = 0  # index into CHART_CORNERS
         self.chart_small = False
+        self._vector_scales: dict[str, VectorScale] = {}
+
+    def new_demo(self) -> None:
+        """A demo (re)started: arrow scales start afresh."""
+        self._vector_scales.clear()
+
+    def vector_scale(self, quantity: str) -> VectorScale:
+        """The round arrow scale of `quantity` ("velocity", "momentum") for the current demo."""
+        return self._vector_scales.setdefault(quantity, VectorScale())
 
     # ------------------------------------------------------------ basics
 

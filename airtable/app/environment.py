@@ -65,8 +65,9 @@ class Environment:
         """A new window size: the table is fitted again; zoom and pan are kept."""
         w, h = _checked_size(size_px)
         self.size_px = (w, h)
-        # (A hair of tolerance, so a window of the table's own shape has no margin at all.)
-        if w / self.width_m <= h / self.height_m * (1 + 1e-9):  # the width fits: margins above and below
+        # A window within 0.01 % of the table's shape counts as that shape, so 900 x 788
+        # is 90 px per metre across the 10 x 8.7556 m table (8.7556 being 788 / 90 rounded).
+        if w / self.width_m <= h / self.height_m * (1 + 1e-4):  # the width fits: margins above and below
             self.fit_px_per_m = w / self.width_m
             self.offset_px = (0.0, 0.5 * max(0.0, h - self.height_m * self.fit_px_per_m))
         else:

@@ -7,7 +7,6 @@ nothing is ever cut, whatever the window size or the number of demos.
 
 from __future__ import annotations
 
-import re
 from collections.abc import Sequence
 from dataclasses import dataclass
 
@@ -17,14 +16,9 @@ ACCENT = (255, 220, 120)
 TEXT_COLOR = (230, 230, 230)
 DIM_TEXT = (150, 150, 150)
 PANEL_COLOR = (10, 10, 30, 242)
-COLUMN_EMS = 26  # a column is at least this many font sizes wide (about 50 characters)
+COLUMN_EMS = 20  # a column is at least this many font sizes wide (about 50 characters)
 
 Row = tuple[str, str] | str
-
-
-def natural_key(text: str) -> tuple:
-    """Sort key that orders the numbers inside text by value: t2 before t10."""
-    return tuple((0, int(part), "") if part.isdigit() else (1, 0, part.lower()) for part in re.split(r"(\d+)", text))
 
 
 def wrap(font: pygame.font.Font, text: str, width: int) -> list[str]:
@@ -60,14 +54,16 @@ def _blocks(font, sections: Sequence[tuple[str, Sequence[Row]]], col_w: int) -> 
         if heading:  # a blank line, then the heading (the blank is dropped at a column's top)
             blocks.append([(0, "", ACCENT), (0, heading, ACCENT)] if blocks else [(0, heading, ACCENT)])
         keys = [r[0] for r in rows if isinstance(r, tuple)]
-        key_w = min(max((font.size(k)[0] for k in keys), default=0) + font.get_height(), col_w * 2 // 5)
+        gap = font.get_height()
+        key_w = min(max((font.size(k)[0] for k in keys), default=0), col_w // 3) + gap
         for row in rows:
             if isinstance(row, tuple):
                 key, text = row
-                lines = wrap(font, text, col_w - key_w) or [""]
-                block = [(0, key, ACCENT), *((key_w, line, TEXT_COLOR) for line in lines)]
-                # The key shares the first line's y: mark it so the flow does not count it.
-                blocks.append([(-1, *block[0][1:]), *block[1:]])
+                lines = [(key_w, line, TEXT_COLOR) for line in wrap(font, text, col_w - key_w) or [""]]
+                if font.size(key)[0] + gap > key_w:  # a long key gets a line of its own
+                    blocks.append([(0, key, ACCENT), *lines])
+                else:  # the key shares the first line's y: marked so the flow does not count it
+                    blocks.append([(-1, key, ACCENT), *lines])
             else:
                 blocks.append([(0, line, TEXT_COLOR) for line in wrap(font, row, col_w) or [""]])
     return blocks
@@ -95,6 +91,8 @@ def layout(
             if col == n_cols:
                 pages.append([])
                 col = 0
+        if used == 0 and block[0][1] == "":  # no blank line at the top of a column
+            block = block[1:]
         x0 = col * (col_w + gap)
         y = used * line_h
         for x, text, color in block:
@@ -115,9 +113,8 @@ def body_rect(size_px: tuple[int, int], font, title_font, small_font) -> pygame.
     return pygame.Rect(pad, top, size_px[0] - 2 * pad, size_px[1] - top - small_font.get_linesize() - pad // 2)
 
 
-def draw_panel(
-    surface: pygame.Surface,
-    rect: pygame.Rect,
+def render_panel(
+    size_px: tuple[int, int],
     title: str,
     sections: Sequence[tuple[str, Sequence[Row]]],
     *,
@@ -125,20 +122,19 @@ def draw_panel(
     title_font: pygame.font.Font,
     small_font: pygame.font.Font,
     page: int = 0,
-) -> int:
-    """Draw a translucent panel in `rect` with `title` and the page `page` of its text; returns the page count."""
+) -> tuple[pygame.Surface, int]:
+    """A translucent panel of `size_px` with `title` and the page `page` of its text, and the page count."""
     pad = font.get_height()
-    panel = pygame.Surface(rect.size, pygame.SRCALPHA)
+    panel = pygame.Surface(size_px, pygame.SRCALPHA)
     panel.fill(PANEL_COLOR)
     pygame.draw.rect(panel, ACCENT, panel.get_rect(), max(1, pad // 10))
     panel.blit(title_font.render(title, True, ACCENT), (pad, pad // 2))
-    body = body_rect(rect.size, font, title_font, small_font)
+    body = body_rect(size_px, font, title_font, small_font)
     pages = layout(font, sections, body.size)
     page %= len(pages)
     for piece in pages[page]:
         panel.blit(font.render(piece.text, True, piece.color), (body.x + piece.x, body.y + piece.y))
     if len(pages) > 1:
         note = small_font.render(f"page {page + 1} of {len(pages)}: press F1 for the next", True, DIM_TEXT)
-        panel.blit(note, note.get_rect(bottomright=(rect.width - pad, rect.height - pad // 4)))
-    surface.blit(panel, rect)
-    return len(pages)
+        panel.blit(note, note.get_rect(bottomright=(size_px[0] - pad, size_px[1] - pad // 4)))
+    return panel, len(pages)

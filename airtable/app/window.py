@@ -97,9 +97,10 @@ class GameWindow:
         self.headless = headless
         self.fullscreen = False
         self.sprites = PuckSprites()
-        self._fonts: dict[tuple[str, int], pygame.font.Font] = {}
+        self._fonts: dict[int, pygame.font.Font] = {}
         self._trail_layer: pygame.Surface | None = None
         self._labels: dict[tuple, pygame.Surface] = {}
+        self._panels: dict[tuple, tuple[pygame.Surface, int]] = {}
         self._status_bar: pygame.Surface | None = None
         self.hud_bottom_px = 0  # below the title and HUD lines: panels start under it
         self.label_boxes: list[pygame.Rect] = []  # text drawn this frame; the aids place labels around it
@@ -164,16 +165,35 @@ class GameWindow:
         self._trail_layer = None
         self._status_bar = None
         self._labels.clear()
+        self._panels.clear()
+
+    def _size_px(self, role: str) -> int:
+        size, floor = FONT_SIZES[role]
+        return max(floor, round(size * self.unit))
 
     def _font(self, role: str) -> pygame.font.Font:
-        size, floor = FONT_SIZES[role]
-        px = max(floor, round(size * self.unit))
-        font = self._fonts.get((role, px))
+        return self._font_px(self._size_px(role))
+
+    def _font_px(self, px: int) -> pygame.font.Font:
+        font = self._fonts.get(px)
         if font is None:
             if len(self._fonts) > 32:  # many resizes: keep the cache small
                 self._fonts.clear()
-            font = self._fonts[(role, px)] = pygame.font.Font(None, px)
+            font = self._fonts[px] = pygame.font.Font(None, px)
         return font
+
+    def _panel_font(self, sections, rect: pygame.Rect) -> pygame.font.Font:
+        """The largest type, down to the smallest readable size, that fits the panel on one page."""
+        best = None
+        for px in range(self._size_px("text"), FONT_SIZES["label"][1] - 1, -2):
+            font = self._font_px(px)
+            pages = len(
+                panel_view.layout(font, sections, panel_view.body_rect(rect.size, font, self.big_font, font).size)
+            )
+            if pages == 1:
+                return font
+            best = best if best is not None and best[0] <= pages else (pages, font)
+        return best[1]
 
     def line_px(self, width_at_720: float = 2.0) -> int:
         """A line width that scales with the window: `width_at_720` px at 720 px tall, never under 2."""
@@ -434,16 +454,19 @@ class GameWindow:
         `side_rows`, if any, follow under their own `side_title`. Rows flow
         into columns and, if they still do not fit, onto pages: `page` picks one.
         """
-        sections = [("", rows)]
+        sections = [("", tuple(rows))]
         if side_rows:
-            sections.append((side_title, side_rows))
-        return panel_view.draw_panel(
-            self.surface,
-            self.panel_rect(),
-            title,
-            sections,
-            font=self.big_font if large else self.font,
-            title_font=self.big_font,
-            small_font=self.label_font,
-            page=page,
-        )
+            sections.append((side_title, tuple(side_rows)))
+        rect = self.panel_rect()
+        key = (title, tuple(sections), large, rect.size, page)
+        cached = self._panels.get(key)
+        if cached is None:  # laying out and rendering text is slow: once per content and size
+            font = self.big_font if large else self._panel_font(sections, rect)
+            cached = panel_view.render_panel(
+                rect.size, title, sections, font=font, title_font=self.big_font, small_font=self.label_font, page=page
+            )
+            if len(self._panels) >= 8:
+                self._panels.clear()
+            self._panels[key] = cached
+        self.surface.blit(cached[0], rect)
+        return cached[1]
