@@ -41,7 +41,7 @@ CHART_LABELS = {
     "momentum_Ns": "|momentum|",
 }
 CHART_CORNERS = ("top right", "bottom right", "bottom left", "top left")
-CHART_SIZE_PX = (440, 250)  # at 720 px tall; the small chart is 0.65 of it
+CHART_SIZE_PX = (520, 240)  # at 720 px tall; the small chart is 0.65 of it
 # Where a label may go around its anchor, in order of preference: (x side, y side).
 AROUND = ((1, 1), (1, -1), (-1, 1), (-1, -1), (0, 1), (0, -1))
 
@@ -278,9 +278,15 @@ class AidsPainter:
         pygame.draw.rect(surf, DIM_TEXT, box, 1)
         self._taken.append(box)
         line_h = font.get_linesize()
-        key_w = font.size("|momentum|  0.00000 J")[0]
-        notes = _wrap(font, note, box.width - 20)[:2] if note and not self.chart_small else []
         pad = self.w.line_px(4)
+        legend = [
+            (f"{CHART_LABELS[k]} {latest[k]:.3g} {'N s' if k == 'momentum_Ns' else 'J'}", c)
+            for k, c in CHART_COLORS.items()
+        ]
+        # Sized for the widest value the format gives, so the plot does not jitter.
+        widest = max(font.size(f"{CHART_LABELS[k]} -8.88e-88 N s")[0] for k in CHART_COLORS)
+        key_w = widest + 5 * pad
+        notes = _wrap(font, note, box.width - 20)[:2] if note and not self.chart_small else []
         plot = pygame.Rect(
             box.x + pad, box.y + pad, box.width - key_w - 3 * pad, box.height - 2 * pad - line_h * len(notes)
         )
@@ -292,16 +298,10 @@ class AidsPainter:
             self._text(f"{top_e:.3g} J", (plot.x + 2, plot.y + 2), DIM_TEXT)
             self._text(f"last {max(t[-1] - t[0], 0.0):.1f} s", (plot.x + 2, plot.bottom - line_h), DIM_TEXT)
         y = box.y + pad
-        for key, color in CHART_COLORS.items():
-            value = f"{latest[key]:.4f} N s" if key == "momentum_Ns" else f"{latest[key]:.5g} J"
-            pygame.draw.line(
-                surf,
-                color,
-                (plot.right + pad, y + line_h // 2),
-                (plot.right + 2 * pad, y + line_h // 2),
-                self.w.line_px(3),
-            )
-            self._text(f"{CHART_LABELS[key]} {value}", (plot.right + 2 * pad + 4, y), color)
+        for text, color in legend:
+            mid = y + line_h // 2
+            pygame.draw.line(surf, color, (plot.right + pad, mid), (plot.right + 3 * pad, mid), self.w.line_px(3))
+            self._text(text, (plot.right + 3 * pad + 4, y), color)
             y += line_h + (pad // 2 if not self.chart_small else 0)
         for k, line in enumerate(notes):
             self._text(line, (box.x + pad, plot.bottom + k * line_h), DIM_TEXT)
