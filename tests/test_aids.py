@@ -434,3 +434,16 @@ def test_demo_5_motion_matches_its_notes(demos):
         app.frame(FRAME_S)
     assert 0.03 < app.chart.total_wiggle(2.0) < 0.04
     assert "does not drift" in app.chart.euler_wiggle_note(app.table)
+
+
+@pytest.mark.parametrize("key", ["4", "7", "8"])
+def test_the_chart_opens_in_the_corner_with_fewest_pucks(demos, key):
+    app = make_app(demos, key)
+    press(app, pygame.K_c)
+    px = app.env.to_screen(app.table.pos_m)
+
+    def covered(rect):
+        return int(np.count_nonzero([rect.collidepoint(float(x), float(y)) for x, y in px]))
+
+    counts = [covered(app.painter.chart_rect(corner)) for corner in range(4)]
+    assert covered(app.painter.chart_rect()) == min(counts)

@@ -80,13 +80,14 @@ class AidsPainter:
 
     def __init__(self, window) -> None:  # a GameWindow
         self.w = window
-        self.chart_corner = 0  # index into CHART_CORNERS
+        self.chart_corner: int | None = None  # index into CHART_CORNERS; None: pick one clear of pucks
         self.chart_small = False
         self._vector_scales: dict[str, VectorScale] = {}
 
     def new_demo(self) -> None:
-        """A demo (re)started: arrow scales start afresh."""
+        """A demo (re)started: arrow scales start afresh, and the chart picks its corner again."""
         self._vector_scales.clear()
+        self.chart_corner = None
 
     def vector_scale(self, quantity: str) -> VectorScale:
         """The round arrow scale of `quantity` ("velocity", "momentum") for the current demo."""
@@ -241,22 +242,38 @@ class AidsPainter:
 
     def cycle_chart_corner(self) -> str:
         """Move the chart to the next corner; returns the corner's name."""
-        self.chart_corner = (self.chart_corner + 1) % len(CHART_CORNERS)
+        self.chart_corner = ((self.chart_corner or 0) + 1) % len(CHART_CORNERS)
         return CHART_CORNERS[self.chart_corner]
+
+    def choose_chart_corner(self, points_px: np.ndarray) -> None:
+        """Put the chart in the corner that covers the fewest of `points_px` (the pucks), once per demo."""
+        if self.chart_corner is not None:
+            return
+        covered = []
+        for corner in range(len(CHART_CORNERS)):
+            rect = self.chart_rect(corner)
+            inside = (
+                (points_px[:, 0] >= rect.left)
+                & (points_px[:, 0] < rect.right)
+                & (points_px[:, 1] >= rect.top)
+                & (points_px[:, 1] < rect.bottom)
+            )
+            covered.append(int(np.count_nonzero(inside)))
+        self.chart_corner = covered.index(min(covered))
 
     def toggle_chart_size(self) -> None:
         self.chart_small = not self.chart_small
 
-    def chart_rect(self) -> pygame.Rect:
-        """The chart's box: in its corner, under the HUD or above the status bar."""
+    def chart_rect(self, corner: int | None = None) -> pygame.Rect:
+        """The chart's box: in its corner, under the HUD or above the status bar, at most half the width."""
         w, h = self.w.surface.get_size()
         scale = self.w.unit * (0.65 if self.chart_small else 1.0)
         size = (
-            min(w - 8, int(CHART_SIZE_PX[0] * max(scale, 0.6))),
+            min(w // 2, int(CHART_SIZE_PX[0] * max(scale, 0.6))),
             min(h // 2, int(CHART_SIZE_PX[1] * max(scale, 0.6))),
         )
         pad = self.w.line_px(4)
-        name = CHART_CORNERS[self.chart_corner]
+        name = CHART_CORNERS[(self.chart_corner or 0) if corner is None else corner]
         rect = pygame.Rect((0, 0), size)
         if name.startswith("top"):
             rect.top = self.w.hud_bottom_px + pad

@@ -23,14 +23,15 @@ FORCE_COLORS = {"cursor strings": (255, 120, 80), "springs": (255, 215, 0), "gra
 
 def draw_aids(app: App) -> None:
     t, paint = app.table, app.painter
+    if app.show_chart:  # first: the labels below then find their places around it
+        paint.choose_chart_corner(app.env.to_screen(t.pos_m))
+        note = app.chart.euler_wiggle_note(t)
+        paint.energy_chart(app.chart.series(), app.chart.latest(), note)
     if app.show_annotations:
         for annotation in app.collision_log.live(app.clock_s):
             paint.annotation(annotation, app.clock_s)
     if app.vectors and len(t.pos_m):
         _draw_vectors(app)
-    if app.show_chart:
-        note = app.chart.euler_wiggle_note(t)
-        paint.energy_chart(app.chart.series(), app.chart.latest(), note)
     if app.inspecting:
         puck = t.puck_at(app.env.to_world(app.mouse_px))
         if puck is not None:
