@@ -80,7 +80,7 @@ def test_status_line_never_overflows_and_drops_the_least_important_parts() -> No
 def test_status_bar_fits_every_width_and_paused_is_large_and_centred(width) -> None:
     win = window((width, 720))
     status = ["PAUSED", "slow motion x1/4", "gravity off", "correction: two-step", "restitution: pucks 1, walls 1"]
-    win.draw(scene(status=status, title="Demo 1: a very long title " * 3))
+    win.draw(scene(status="   ".join(status), title="Demo 1: a very long title " * 3))
     img = pixels(win)
     yellow = np.argwhere(np.all(img == PAUSED_COLOR, axis=2))
     assert len(yellow) > 0

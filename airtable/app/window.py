@@ -22,7 +22,7 @@ from airtable.app import panel_view
 from airtable.app.aids_paint import AidsPainter  # noqa: F401  (imported from here by the app)
 from airtable.app.environment import Environment, fitting_size_px
 from airtable.app.pucks_view import COLORKEY, MIN_PUCK_RADIUS_PX, PuckSprites, draw_pucks
-from airtable.app.scene import Scene
+from airtable.app.scene import STATUS_SEPARATOR, Scene
 from airtable.assets import ASSETS_DIR
 
 BACKGROUND = (0, 0, 0)
@@ -38,7 +38,7 @@ REFERENCE_HEIGHT_PX = 720  # type sizes below are for a window this tall, and sc
 # Font sizes (pygame's default font) at the reference height, and their floor:
 # the smallest, 22, is 15 px tall, so no text is under 14 px at 720p.
 FONT_SIZES = {"label": (24, 22), "text": (28, 22), "big": (44, 30), "huge": (72, 40)}
-STATUS_SEPARATOR = "   "
+
 PAUSED = "PAUSED"
 
 
@@ -49,13 +49,6 @@ def background_for(scene: Scene) -> tuple[int, int, int]:
     if scene.gravity_on:
         return BACKGROUND_GRAVITY
     return BACKGROUND
-
-
-def status_parts(status: str | Sequence[str]) -> list[str]:
-    """The status line as parts, most important first (a string is split at its wide gaps)."""
-    if isinstance(status, str):
-        return [p.strip() for p in status.split(STATUS_SEPARATOR) if p.strip()]
-    return [str(p) for p in status if str(p)]
 
 
 def fit_parts(font: pygame.font.Font, parts: Sequence[str], width_px: int) -> str:
@@ -200,7 +193,10 @@ class GameWindow:
         return max(2, round(width_at_720 * self.unit))
 
     def follow_display(self) -> None:
-        """Catch up with a size the window manager gave the display without an event we saw."""
+        """Catch up with a size the window manager gave the display without an event we saw,
+        or with a new Environment handed to `self.env` (a player's, on reconnecting)."""
+        if self.env.size_px != self.surface.get_size():
+            self._sized()
         if not self.headless:
             display = pygame.display.get_surface()
             if display is not None and (display is not self.surface or display.get_size() != self.env.size_px):
@@ -241,9 +237,9 @@ class GameWindow:
         """Draw a whole frame of `scene` into `self.surface`.
 
         `hud` lines go under the title; `hud_color`, if given, colours the first
-        (a player's "You are C3" in the player's colour). `scene.status` is a
-        string or a list of parts, most important first: parts that do not fit
-        the width are dropped from the end, and a "PAUSED" part is shown large.
+        (a player's "You are C3" in the player's colour). Of the status line's
+        parts (most important first) those that do not fit the width are
+        dropped from the end, and a "PAUSED" part is shown large.
 
         With `trails` on, pucks are also stamped onto a layer that is never
         erased (the course's "erase off"), while springs, cursors and text stay
@@ -391,7 +387,7 @@ class GameWindow:
             self.label_boxes.append(self.surface.blit(text, (pad, y)))
             y += line_h
         self.hud_bottom_px = y
-        parts = status_parts(scene.status)
+        parts = [p.strip() for p in scene.status_parts]
         paused = PAUSED in parts
         parts = [p for p in parts if p != PAUSED]
         bar_h = line_h + pad
