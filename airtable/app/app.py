@@ -26,7 +26,7 @@ from airtable.app.loop import FixedStep, FpsCounter, FrameLoop
 from airtable.app.menu import DemoMenu
 from airtable.app.scene import STATUS_SEPARATOR, Scene
 from airtable.app.window import AidsPainter, GameWindow
-from airtable.physics.table import AirTable
+from airtable.physics.table import TABLE_HEIGHT_M, TABLE_WIDTH_M, AirTable
 
 MESSAGE_S = 4.0
 QUIT_CONFIRM_S = 4.0  # a second Esc within this time quits while students are connected
@@ -77,16 +77,18 @@ class App:
         headless: bool = False,
         server=None,
         demo_errors=(),
+        window_size_px: tuple[int, int] | None = None,
+        fullscreen: bool = False,
     ) -> None:
         self.shelf = demos if isinstance(demos, DemoShelf) else DemoShelf.from_demos(demos)
         if not self.shelf.demos:
             raise ValueError("no demos found")
-        self.env = Environment()
-        self.table = AirTable(self.env.size_px[0] / self.env.base_px_per_m, self.env.view_height_m)
+        self.table = AirTable(TABLE_WIDTH_M, TABLE_HEIGHT_M)
+        self.env = Environment(width_m=TABLE_WIDTH_M, height_m=TABLE_HEIGHT_M)
         self.local = Client(name="local", color=LOCAL_COLOR)
         # The loop owns the clients (index 0 is the local user); the server adds the students.
         self.clients: list[Client] = [self.local]
-        self.window = GameWindow(self.env, headless=headless)
+        self.window = GameWindow(self.env, headless=headless, size_px=window_size_px, fullscreen=fullscreen)
         self.painter = AidsPainter(self.window)
         if not headless:
             pygame.mouse.set_visible(False)  # the local client's arrow is the pointer
@@ -104,6 +106,7 @@ class App:
         self.trails = False
         self.speed = 1.0
         self.show_help = False
+        self.help_page, self.help_pages = 0, 1
         self.show_notes = False
         self.show_annotations = False
         self.show_chart = False
@@ -187,6 +190,7 @@ class App:
         self.window.clear_trails()
         self.collision_log.clear()
         self.chart.clear()
+        self.painter.new_demo()  # arrow scales are per demo
 
     def _demo_failed(self, exc: BaseException, stage: str) -> None:
         path = self.demo_path or Path(f"demo {self.demo_key}")
@@ -411,7 +415,9 @@ class App:
             w.draw_panel("Some demo files could not be loaded", [*self.notice, "Press any key to go on."])
         elif panel == "help":
             rows = [(key_label(k), d.title) for k, d in self.demos.items()]
-            w.draw_panel("Keys", [(b.label, b.help) for b in BINDINGS], side_title="Demos", side_rows=rows)
+            self.help_pages = w.draw_panel(
+                "Keys", [(b.label, b.help) for b in BINDINGS], side_title="Demos", side_rows=rows, page=self.help_page
+            )
         elif panel == "notes":
             w.draw_panel(self.demo.label(self.variation), [self.demo.notes or "(no notes)"], large=True)
 

@@ -131,7 +131,26 @@ def inspect(app: App) -> None:
 
 
 def toggle_help(app: App) -> None:
-    app.show_help = not app.show_help
+    """F1: help; again for its next page, if it has more than one; then closed."""
+    if not app.show_help:
+        app.show_help, app.help_page = True, 0
+    else:
+        app.help_page += 1
+        app.show_help = app.help_page < app.help_pages
+
+
+def toggle_fullscreen(app: App) -> None:
+    app.window.toggle_fullscreen()
+
+
+def move_chart(app: App) -> None:
+    app.show_chart = True
+    app.say(f"energy chart: {app.painter.cycle_chart_corner()}")
+
+
+def resize_chart(app: App) -> None:
+    app.show_chart = True
+    app.painter.toggle_chart_size()
 
 
 def open_menu(app: App) -> None:
@@ -189,9 +208,13 @@ BINDINGS: tuple[Binding, ...] = (
     Binding("a", "collision annotations: axes, overlap, separation, angle", {pygame.K_a: toggle_annotations}),
     Binding("v", "vectors: velocity / momentum arrows, forces, centre of mass", {pygame.K_v: next_vectors}),
     Binding("c", "energy and momentum chart", {pygame.K_c: toggle_chart}),
+    Binding(
+        "m / b", "chart: move to the next corner / big or small", {pygame.K_m: move_chart, pygame.K_b: resize_chart}
+    ),
     Binding("i (hold)", "inspect the puck under the cursor", {pygame.K_i: inspect}, held=True),
     Binding("l", "lecture notes for this demo", {pygame.K_l: toggle_notes}),
-    Binding("F1", "this help screen", {pygame.K_F1: toggle_help}),
+    Binding("F1", "this help screen (again: next page)", {pygame.K_F1: toggle_help}),
+    Binding("F11", "fullscreen on / off", {pygame.K_F11: toggle_fullscreen}),
     Binding("F12", "save a screenshot PNG", {pygame.K_F12: screenshot}),
     Binding("Esc", "close what is open; else quit (twice if students are connected)", {pygame.K_ESCAPE: escape}),
 )
@@ -269,3 +292,5 @@ def handle_event(app: App, event: pygame.event.Event) -> None:
         app.keys_down.discard(event.key)
     elif event.type in MOUSE_EVENTS:
         handle_mouse(app, event)
+    elif event.type in (pygame.VIDEORESIZE, pygame.WINDOWSIZECHANGED):
+        app.window.handle_event(event)  # the table and the type follow the new size
