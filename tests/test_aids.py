@@ -447,3 +447,19 @@ def test_the_chart_opens_in_the_corner_with_fewest_pucks(demos, key):
 
     counts = [covered(app.painter.chart_rect(corner)) for corner in range(4)]
     assert covered(app.painter.chart_rect()) == min(counts)
+
+
+def test_labels_never_overlap_in_a_crowd(demos):
+    app = make_app(demos, "4")
+    app.window.resize((739, 648))  # the default window on a 1280 x 720 projector
+    app.table.vel_mps[:] = np.random.default_rng(3).normal(0.0, 2.0, app.table.vel_mps.shape)
+    for key in (pygame.K_a, pygame.K_v, pygame.K_c):
+        press(app, key)
+    most = 0
+    for _ in range(240):
+        app.frame(FRAME_S)
+        boxes = app.window.label_boxes
+        most = max(most, len(boxes))
+        for k, a in enumerate(boxes):
+            assert a.collidelist(boxes[k + 1 :]) < 0, f"label {a} overlaps another"
+    assert most >= 12  # several annotations were labelled at once

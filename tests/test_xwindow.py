@@ -203,3 +203,33 @@ def test_f11_toggles_desktop_fullscreen_and_back(display, tmp_path):
     left = round((1024 - 900 * TABLE_ASPECT) / 2)
     xs = wall_columns(image, 450)
     assert abs(xs.min() - left) <= 2 and abs(xs.max() - (1023 - left)) <= 2
+
+
+def test_f11_in_the_app_fills_the_screen(display, tmp_path):
+    shot = tmp_path / "app_full.png"
+    env = {**os.environ, "DISPLAY": display, "SDL_VIDEODRIVER": "x11"}
+    app = subprocess.Popen(
+        [sys.executable, "-m", "airtable", "--no-server", "--demo", "2", "--seconds", "60", "--screenshot", str(shot)],
+        env=env,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+    )
+    try:
+        wid = wait_for(lambda: find_window(display), what="the window")
+        xdotool(display, "windowfocus", "--sync", wid)
+        xdotool(display, "key", "F11")
+        time.sleep(1.0)
+        wid = wait_for(lambda: find_window(display), what="the fullscreen window")
+        xdotool(display, "windowfocus", "--sync", wid)
+        xdotool(display, "key", "Escape")
+        assert app.wait(timeout=20) == 0, app.stderr.read().decode()
+    finally:
+        if app.poll() is None:
+            app.kill()
+            app.wait()
+    pygame.display.init()
+    image = pygame.surfarray.array3d(pygame.image.load(str(shot)))
+    assert image.shape[:2] == (1024, 900)
+    left = round((1024 - 900 * TABLE_ASPECT) / 2)
+    xs = wall_columns(image, 450)
+    assert abs(xs.min() - left) <= 2 and abs(xs.max() - (1023 - left)) <= 2

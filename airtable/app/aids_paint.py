@@ -44,6 +44,7 @@ CHART_CORNERS = ("top right", "bottom right", "bottom left", "top left")
 CHART_SIZE_PX = (520, 240)  # at 720 px tall; the small chart is 0.65 of it
 # Where a label may go around its anchor, in order of preference: (x side, y side).
 AROUND = ((1, 1), (1, -1), (-1, 1), (-1, -1), (0, 1), (0, -1))
+RINGS = 8  # how far out (in lines) a label may move from its anchor
 
 
 def _faded(color: Sequence[int], alpha: float) -> tuple[int, int, int]:
@@ -62,17 +63,18 @@ def box_at(anchor: tuple[float, float], size: tuple[int, int], side: tuple[int, 
 
 def place_box(
     size: tuple[int, int], anchor, gap: float, taken: Sequence[pygame.Rect], screen: pygame.Rect, step: int
-) -> pygame.Rect:
+) -> pygame.Rect | None:
     """The first box around `anchor` that stays on `screen` and overlaps none of `taken`.
 
     Tries the spots of AROUND, then the same spots pushed further out by `step`
-    px at a time; if all are taken, the first spot, kept on screen."""
-    for ring in range(12):
+    px at a time, up to RINGS times; None if all are taken (a crowded frame:
+    the label is left out rather than drawn over another)."""
+    for ring in range(RINGS):
         for side in AROUND:
             rect = box_at(anchor, size, side, gap + ring * step)
             if screen.contains(rect) and rect.collidelist(taken) < 0:
                 return rect
-    return box_at(anchor, size, AROUND[0], gap).clamp(screen)
+    return None
 
 
 class AidsPainter:
@@ -112,13 +114,29 @@ class AidsPainter:
         self.w.surface.blit(label, rect)
         return rect
 
-    def label(self, lines: Sequence[tuple[str, Sequence[int]]], anchor_px, gap: float = 0.0, font=None) -> pygame.Rect:
-        """A block of coloured lines placed beside `anchor_px` where no other label is."""
+    def label(
+        self,
+        lines: Sequence[tuple[str, Sequence[int]]],
+        anchor_px,
+        gap: float = 0.0,
+        font=None,
+        *,
+        always: bool = False,
+    ) -> pygame.Rect | None:
+        """A block of coloured lines placed beside `anchor_px` where no other label is.
+
+        Where there is no such place it is left out (None), unless `always`
+        (the inspector, asked for by a held key): then it goes beside its anchor."""
         font = font or self.w.label_font
         line_h = font.get_linesize()
         size = (max(font.size(t)[0] for t, _ in lines) + 6, line_h * len(lines) + 2)
         pad = self.w.line_px(2)
-        rect = place_box(size, anchor_px, gap + pad, self._taken, self.w.surface.get_rect(), line_h)
+        screen = self.w.surface.get_rect()
+        rect = place_box(size, anchor_px, gap + pad, self._taken, screen, line_h)
+        if rect is None:
+            if not always:
+                return None
+            rect = box_at(anchor_px, size, AROUND[0], gap + pad).clamp(screen)
         self._taken.append(rect)
         pygame.draw.rect(self.w.surface, (0, 0, 0), rect)
         for k, (text, color) in enumerate(lines):
@@ -153,12 +171,20 @@ class AidsPainter:
         self.label([(label, color)], (x, y), gap=1.5 * r)
 
     def legend(self, lines: Sequence[tuple[str, Sequence[int]]]) -> None:
-        """Coloured lines of text in the top-left corner, under the HUD."""
-        pad = self.w.line_px(4)
-        y = self.w.hud_bottom_px + pad
-        for text, color in lines:
-            self._taken.append(self._text(text, (pad * 2, y), color, font=self.w.font))
-            y += self.w.font.get_linesize()
+        """Coloured lines of text at the left, under the HUD (and under the chart, if that is there)."""
+        font, pad = self.w.font, self.w.line_px(4)
+        line_h = font.get_linesize()
+        block = pygame.Rect(
+            pad * 2 - 2, self.w.hud_bottom_px + pad, max(font.size(t)[0] for t, _ in lines) + 4, line_h * len(lines)
+        )
+        for _ in range(len(self._taken)):  # slide down past whatever is in the way
+            hit = block.collidelist(self._taken)
+            if hit < 0:
+                break
+            block.top = self._taken[hit].bottom + pad
+        for k, (text, color) in enumerate(lines):
+            self._text(text, (pad * 2, block.top + k * line_h), color, font=font)
+        self._taken.append(block)
 
     def _dashed(self, color, a_px, b_px, width: int) -> None:
         length = math.hypot(b_px[0] - a_px[0], b_px[1] - a_px[1])
@@ -342,4 +368,6 @@ class AidsPainter:
 
     def inspector(self, point_m, lines: Sequence[str]) -> None:
         x, y = self._px(point_m)
-        self.label([(line, TEXT_COLOR) for line in lines], (x, y), gap=self.w.font.get_height(), font=self.w.font)
+        self.label(
+            [(line, TEXT_COLOR) for line in lines], (x, y), gap=self.w.font.get_height(), font=self.w.font, always=True
+        )

@@ -27,11 +27,11 @@ def draw_aids(app: App) -> None:
         paint.choose_chart_corner(app.env.to_screen(t.pos_m))
         note = app.chart.euler_wiggle_note(t)
         paint.energy_chart(app.chart.series(), app.chart.latest(), note)
+    if app.vectors and len(t.pos_m):  # before the annotations: its legend has a fixed place
+        _draw_vectors(app)
     if app.show_annotations:
         for annotation in app.collision_log.live(app.clock_s):
             paint.annotation(annotation, app.clock_s)
-    if app.vectors and len(t.pos_m):
-        _draw_vectors(app)
     if app.inspecting:
         puck = t.puck_at(app.env.to_world(app.mouse_px))
         if puck is not None:
@@ -65,11 +65,11 @@ def _draw_vectors(app: App) -> None:
     _, m_per_mps = paint.vector_scale("velocity").update(t.vel_mps[moving])
     if np.hypot(*com_v) >= aids.MIN_ARROW_SPEED_MPS:
         paint.arrow(com, com_v * m_per_mps, COM_COLOR, width=paint.w.line_px(3))
-    paint.marker(com, COM_COLOR, f"centre of mass, {np.hypot(*com_v):.2f} m/s")
     held = app.local.held
     if held is not None and held.alive:
         legend.extend(_draw_forces(app, held))
-    paint.legend(legend)
+    paint.legend(legend)  # before the marker's label: the legend's place is fixed
+    paint.marker(com, COM_COLOR, f"centre of mass, {np.hypot(*com_v):.2f} m/s")
 
 
 def _draw_forces(app: App, held) -> list[tuple[str, tuple[int, int, int]]]:

@@ -21,6 +21,15 @@ COLUMN_EMS = 20  # a column is at least this many font sizes wide (about 50 char
 Row = tuple[str, str] | str
 
 
+def shorten(font: pygame.font.Font, text: str, width: int) -> str:
+    """`text`, cut and ended with "..." if it is wider than `width` pixels."""
+    if font.size(text)[0] <= width:
+        return text
+    while text and font.size(text + "...")[0] > width:
+        text = text[:-1]
+    return text + "..." if text else ""
+
+
 def wrap(font: pygame.font.Font, text: str, width: int) -> list[str]:
     """Split text into lines that fit `width` pixels (a word longer than that is cut at the edge)."""
     lines: list[str] = []
@@ -128,7 +137,9 @@ def render_panel(
     panel = pygame.Surface(size_px, pygame.SRCALPHA)
     panel.fill(PANEL_COLOR)
     pygame.draw.rect(panel, ACCENT, panel.get_rect(), max(1, pad // 10))
-    panel.blit(title_font.render(title, True, ACCENT), (pad, pad // 2))
+    if title_font.size(title)[0] > size_px[0] - 2 * pad:  # a long title in the body's type
+        title_font = font
+    panel.blit(title_font.render(shorten(title_font, title, size_px[0] - 2 * pad), True, ACCENT), (pad, pad // 2))
     body = body_rect(size_px, font, title_font, small_font)
     pages = layout(font, sections, body.size)
     page %= len(pages)

@@ -59,10 +59,7 @@ def fit_parts(font: pygame.font.Font, parts: Sequence[str], width_px: int) -> st
         text = STATUS_SEPARATOR.join(parts[:n])
         if font.size(text)[0] <= width_px:
             return text
-    text = parts[0] if parts else ""
-    while text and font.size(text + "...")[0] > width_px:
-        text = text[:-1]
-    return text + "..." if text else ""
+    return panel_view.shorten(font, parts[0], width_px) if parts else ""
 
 
 class GameWindow:
