@@ -16,6 +16,7 @@ from collections.abc import Sequence
 from pathlib import Path
 
 from airtable.app.demo_loader import BUILTIN_DIR, Demo, DemoError, DemoShelf
+from airtable.app.recorder import check_record_path
 from airtable.assets import ASSETS_DIR
 from airtable.memory import keep_freed_memory
 
@@ -51,6 +52,13 @@ def build_parser() -> argparse.ArgumentParser:
         default=None,
         metavar="FILE.png",
         help="save the last frame to FILE.png at exit (.png is added if the name lacks it)",
+    )
+    p.add_argument(
+        "--record",
+        default=None,
+        metavar="FILE.csv",
+        help="at exit, write every puck's state at every step to FILE.csv and the energies and momentum to"
+        " FILE_energy.csv (as far back as memory keeps: minutes for a few pucks)",
     )
     p.add_argument(
         "--demos",
@@ -212,6 +220,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     shot = None
     try:
         shot = screenshot_path(args.screenshot) if args.screenshot else None
+        args.record = check_record_path(args.record) if args.record else None
     except ValueError as exc:
         print(f"airtable: {exc}", file=sys.stderr)
         return 1
@@ -220,6 +229,20 @@ def main(argv: Sequence[str] | None = None) -> int:
         print(f"airtable: {problem}", file=sys.stderr)
         return 1
     return run_app(args, shelf, shot)
+
+
+def write_outputs(app, args: argparse.Namespace) -> int:
+    """At the end of a run: the --record files; 1 if one could not be written (said on stderr), else 0."""
+    status = 0
+    if args.record is not None:
+        try:
+            pucks, energy = app.lessons.recorder.write(args.record)
+        except OSError as exc:
+            print(f"airtable: could not write the recording {args.record}: {exc}", file=sys.stderr)
+            status = 1
+        else:
+            print(f"recorded {app.lessons.recorder.summary()} to {pucks} and {energy}")
+    return status
 
 
 def run_app(args: argparse.Namespace, shelf: DemoShelf, shot: Path | None) -> int:
@@ -244,6 +267,7 @@ def run_app(args: argparse.Namespace, shelf: DemoShelf, shot: Path | None) -> in
             except (OSError, pygame.error) as exc:
                 print(f"airtable: could not save the screenshot {shot}: {exc}", file=sys.stderr)
                 status = 1
+        status = max(status, write_outputs(app, args))
         if args.headless and any(e.stage != "load" for e in app.errors):
             status = 1
     except KeyboardInterrupt:

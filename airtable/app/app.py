@@ -22,6 +22,7 @@ from airtable.app.aids_view import draw_aids
 from airtable.app.client import LOCAL_COLOR, Client, cursor_pulls
 from airtable.app.demo_loader import Demo, DemoError, DemoShelf, error_from_exception, key_label
 from airtable.app.environment import Environment
+from airtable.app.lessons import Lessons
 from airtable.app.loop import FixedStep, FpsCounter, FrameLoop
 from airtable.app.menu import DemoMenu
 from airtable.app.scene import STATUS_SEPARATOR, Scene
@@ -116,6 +117,7 @@ class App:
         self.quit_armed_until = -1.0  # clock_s until which a second Esc quits
         self.collision_log = aids.CollisionLog()
         self.chart = aids.EnergyChart()
+        self.lessons = Lessons()  # recording, momenta, saving the moment (lessons.py)
         self.keys_down: set[int] = set()
         self.mouse_px = (self.env.size_px[0] / 2, self.env.size_px[1] / 2)
         self.mouse_button = 0
@@ -180,6 +182,7 @@ class App:
         self.stepper.reset(demo.dt_s if demo else self.stepper.dt_s)
         self.trails = demo.trails if demo else False
         self.chart.sample(self.table)
+        self.lessons.start(self.table)
         self.window.set_caption(f"Air Table - {self.caption()}")
 
     def _clear_table(self) -> None:
@@ -320,6 +323,7 @@ class App:
             self.paused = True
             return False
         self.chart.sample(self.table)
+        self.lessons.after_step(self.table)
         if self.show_annotations:
             self.collision_log.add(self.table, self.clock_s)
         return True

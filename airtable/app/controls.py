@@ -17,7 +17,7 @@ from typing import TYPE_CHECKING
 
 import pygame
 
-from airtable.app import aids
+from airtable.app import aids, lessons
 
 if TYPE_CHECKING:
     from airtable.app.app import App
@@ -213,6 +213,11 @@ BINDINGS: tuple[Binding, ...] = (
     ),
     Binding("i (hold)", "inspect the puck under the cursor", {pygame.K_i: inspect}, held=True),
     Binding("l", "lecture notes for this demo", {pygame.K_l: toggle_notes}),
+    Binding(
+        "x",
+        "export the recording (every step, as far back as memory keeps) to two CSV files",
+        {pygame.K_x: lessons.export_recording},
+    ),
     Binding("F1", "this help screen (again: next page)", {pygame.K_F1: toggle_help}),
     Binding("F11", "fullscreen on / off", {pygame.K_F11: toggle_fullscreen}),
     Binding("F12", "save a screenshot PNG", {pygame.K_F12: screenshot}),
