@@ -17,6 +17,8 @@ from pathlib import Path
 
 from airtable.app.demo_loader import BUILTIN_DIR, Demo, DemoError, DemoShelf
 from airtable.app.recorder import check_record_path
+from airtable.app.saved_demo import DEFAULT_FOLDER as SAVED_DEMOS_DIR
+from airtable.app.saved_demo import check_save_demo_path
 from airtable.assets import ASSETS_DIR
 from airtable.memory import keep_freed_memory
 
@@ -61,11 +63,18 @@ def build_parser() -> argparse.ArgumentParser:
         " FILE_energy.csv (as far back as memory keeps: minutes for a few pucks)",
     )
     p.add_argument(
+        "--save-demo",
+        default=None,
+        metavar="FILE.py",
+        help="at exit, write the table as it is then as a new demo file FILE.py (load it with --demos FOLDER)",
+    )
+    p.add_argument(
         "--demos",
         action="append",
         default=[],
         metavar="DIR",
-        help="also load every demo file in DIR (a key already taken is replaced); may be repeated",
+        help="also load every demo file in DIR (a key already taken is replaced); may be repeated; Ctrl+S saves"
+        " demos in the last DIR (without --demos: in ./my_demos, loaded when it exists)",
     )
     p.add_argument(
         "--new-demo", default=None, metavar="FILE.py", help="write a commented starter demo to FILE.py and exit"
@@ -187,7 +196,10 @@ def load_demos(parser: argparse.ArgumentParser, args: argparse.Namespace) -> Dem
     for directory in args.demos:
         if not Path(directory).is_dir():
             parser.error(f"--demos {directory}: no such folder")
-    shelf = DemoShelf([BUILTIN_DIR, *map(Path, args.demos)])
+    folders = [Path(d) for d in args.demos]
+    if not folders and SAVED_DEMOS_DIR.is_dir():  # the demos Ctrl+S saved here before
+        folders.append(SAVED_DEMOS_DIR)
+    shelf = DemoShelf([BUILTIN_DIR, *folders])
     if args.list_demos:
         return shelf
     if args.demo not in shelf.demos:
@@ -221,6 +233,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     try:
         shot = screenshot_path(args.screenshot) if args.screenshot else None
         args.record = check_record_path(args.record) if args.record else None
+        args.save_demo = check_save_demo_path(args.save_demo) if args.save_demo else None
     except ValueError as exc:
         print(f"airtable: {exc}", file=sys.stderr)
         return 1
@@ -232,8 +245,17 @@ def main(argv: Sequence[str] | None = None) -> int:
 
 
 def write_outputs(app, args: argparse.Namespace) -> int:
-    """At the end of a run: the --record files; 1 if one could not be written (said on stderr), else 0."""
+    """At the end of a run: the --record files and the --save-demo file; 1 if one could not be written
+    (said on stderr), else 0."""
+    from airtable.app.lessons import save_moment
+
     status = 0
+    if args.save_demo is not None:
+        if save_moment(app, args.save_demo) is None:
+            print(f"airtable: {app.message}", file=sys.stderr)
+            status = 1
+        else:
+            print(app.message)
     if args.record is not None:
         try:
             pucks, energy = app.lessons.recorder.write(args.record)

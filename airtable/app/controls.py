@@ -34,7 +34,8 @@ class Binding:
 
     label: str
     help: str
-    actions: Mapping[int, Action] = field(default_factory=dict)
+    # A key is a pygame key, or (modifier mask, key) for a key pressed with Ctrl or Shift.
+    actions: Mapping[int | tuple[int, int], Action] = field(default_factory=dict)
     held: bool = False  # acts every frame while held, not on the press
 
     @property
@@ -214,6 +215,11 @@ BINDINGS: tuple[Binding, ...] = (
     Binding("i (hold)", "inspect the puck under the cursor", {pygame.K_i: inspect}, held=True),
     Binding("l", "lecture notes for this demo", {pygame.K_l: toggle_notes}),
     Binding(
+        "Ctrl+S",
+        "save the table as it is now as a new demo (key s1, s2, ...; Tab and its key start it)",
+        {(pygame.KMOD_CTRL, pygame.K_s): lessons.save_moment},
+    ),
+    Binding(
         "x",
         "export the recording (every step, as far back as memory keeps) to two CSV files",
         {pygame.K_x: lessons.export_recording},
@@ -224,7 +230,12 @@ BINDINGS: tuple[Binding, ...] = (
     Binding("Esc", "close what is open; else quit (twice if students are connected)", {pygame.K_ESCAPE: escape}),
 )
 
-PRESS_ACTIONS: dict[int, Action] = {k: a for b in BINDINGS if not b.held for k, a in b.actions.items()}
+PRESS_ACTIONS: dict[int, Action] = {
+    k: a for b in BINDINGS if not b.held for k, a in b.actions.items() if isinstance(k, int)
+}
+MODIFIED_ACTIONS: dict[tuple[int, int], Action] = {
+    k: a for b in BINDINGS for k, a in b.actions.items() if isinstance(k, tuple)
+}
 HELD_ACTIONS: dict[int, Action] = {k: a for b in BINDINGS if b.held for k, a in b.actions.items()}
 
 
@@ -240,12 +251,21 @@ def demo_key_for(event: pygame.event.Event) -> str | None:
 # ---------------------------------------------------------------- events
 
 
+def modified_action(event: pygame.event.Event) -> Action | None:
+    """The action of a key pressed with Ctrl or Shift (Ctrl+S), if the key table has one."""
+    mod = getattr(event, "mod", 0)
+    for (mask, key), action in MODIFIED_ACTIONS.items():
+        if key == event.key and mod & mask:
+            return action
+    return None
+
+
 def handle_key(app: App, event: pygame.event.Event) -> None:
     """A KEYDOWN: an open panel takes it first, then the key table, then the demo keys."""
     app.keys_down.add(event.key)
     if app.take_key_for_overlay(event):
         return
-    action = PRESS_ACTIONS.get(event.key)
+    action = modified_action(event) or PRESS_ACTIONS.get(event.key)
     if action is not None:
         action(app)
         return

@@ -12,7 +12,9 @@ import time
 from pathlib import Path
 from typing import TYPE_CHECKING
 
+from airtable.app.demo_loader import BUILTIN_DIR
 from airtable.app.recorder import DEFAULT_BUDGET_BYTES, Recorder, free_csv_pair
+from airtable.app.saved_demo import demo_source, free_key, save_folder, write_demo
 from airtable.physics.table import AirTable
 
 if TYPE_CHECKING:
@@ -46,3 +48,30 @@ def export_recording(app: App) -> None:
         app.say(f"could not write the recording: {exc}")
         return
     app.say(f"recorded {app.lessons.recorder.summary()} to {pucks.resolve()} and {energy.name}")
+
+
+def save_moment(app: App, path: Path | None = None) -> Path | None:
+    """Write the table as it is now as a new demo file, under a new key; say where (None if it could not).
+
+    Without `path` it goes to the teacher's demo folder (save_folder), which the
+    app then loads from, so the new key works at once and `--list-demos` lists it.
+    """
+    shelf = app.shelf
+    folder = save_folder(shelf.directories, BUILTIN_DIR) if path is None else Path(path).parent
+    key = free_key(app.demos, folder)
+    target = Path(path) if path is not None else folder / f"{key}.py"
+    title = f"{app.demo.title}, saved at t = {app.table.time_s:.2f} s"
+    source = demo_source(app.table, key=key, title=title, dt_s=app.dt_s, origin=f"from {app.caption()}")
+    try:
+        write_demo(target, source)
+    except OSError as exc:
+        app.say(f"could not save the demo: {exc}")
+        return None
+    if path is None:
+        if all(Path(d).resolve() != folder.resolve() for d in shelf.directories):
+            shelf.directories.append(folder)
+        for error in shelf.refresh():
+            app.report(error)
+    how = f"Tab, then {key}, starts it" if path is None else f"load it with --demos {target.parent}"
+    app.say(f"saved as demo {key} in {target.resolve()} ({how})")
+    return target
