@@ -23,6 +23,7 @@ from airtable.app.client import LOCAL_COLOR, Client, cursor_pulls
 from airtable.app.demo_loader import Demo, DemoError, DemoShelf, error_from_exception, key_label
 from airtable.app.environment import Environment
 from airtable.app.lessons import Lessons
+from airtable.app.lessons_view import draw_lessons
 from airtable.app.loop import FixedStep, FpsCounter, FrameLoop
 from airtable.app.menu import DemoMenu
 from airtable.app.scene import STATUS_SEPARATOR, Scene
@@ -394,6 +395,7 @@ class App:
     def draw(self, scene: Scene | None = None) -> None:
         """Draw `scene` (by default the table as it is now), the aids and the panel on top."""
         self.window.draw(scene or self.scene(), trails=self.trails, hud=self.hud_lines())
+        draw_lessons(self)  # first: the aids' labels then place themselves around its panels
         draw_aids(self)
         self._draw_panel()
         self.window.present()

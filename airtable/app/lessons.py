@@ -13,6 +13,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from airtable.app.demo_loader import BUILTIN_DIR
+from airtable.app.momenta import MomentaLog
 from airtable.app.recorder import DEFAULT_BUDGET_BYTES, Recorder, free_csv_pair
 from airtable.app.saved_demo import demo_source, free_key, save_folder, write_demo
 from airtable.physics.table import AirTable
@@ -24,18 +25,35 @@ RECORDINGS_DIR = Path("recordings")  # where the export key writes, created on d
 
 
 class Lessons:
-    """The state of the lesson tools: the recording, and which of their panels show."""
+    """The state of the lesson tools: the recording, the latest collision's momenta, which panels show."""
 
     def __init__(self, budget_bytes: int = DEFAULT_BUDGET_BYTES) -> None:
         self.recorder = Recorder(budget_bytes)
+        self.momenta = MomentaLog()
+        self.show_momenta = False  # the momenta diagram (d)
+        self.show_values = False  # the values panel (t)
+        self.painter = None  # the LessonsPainter, made on the first draw (lessons_view.py)
 
     def start(self, table: AirTable) -> None:
-        """A demo (re)started: a new recording from its first moment."""
+        """A demo (re)started: a new recording from its first moment, no collision seen yet."""
         self.recorder.clear()
         self.recorder.sample(table)
+        self.momenta.clear()
+        if self.painter is not None:
+            self.painter.new_demo()
 
     def after_step(self, table: AirTable) -> None:
         self.recorder.sample(table)
+        if self.show_momenta:  # only then: most steps nobody asks what the collisions did
+            self.momenta.observe(table)
+
+
+def toggle_momenta(app: App) -> None:
+    app.lessons.show_momenta = not app.lessons.show_momenta
+
+
+def toggle_values(app: App) -> None:
+    app.lessons.show_values = not app.lessons.show_values
 
 
 def export_recording(app: App) -> None:
