@@ -17,7 +17,7 @@ from pathlib import Path
 import numpy as np
 import pygame
 
-from airtable.app import aids, controls
+from airtable.app import aids, controls, world
 from airtable.app.aids_view import draw_aids
 from airtable.app.client import LOCAL_COLOR, Client, cursor_pulls
 from airtable.app.demo_loader import Demo, DemoError, DemoShelf, error_from_exception, key_label
@@ -370,7 +370,7 @@ class App:
             parts.append(f"slow motion x1/{round(1 / self.speed)}")
         parts.append(f"t = {t.time_s:.2f} s")
         parts.append("F1: help")
-        parts.append("gravity on" if t.gravity_on else "gravity off")
+        parts.append(world.gravity_label(t))
         parts.append(f"correction: {t.puck_correction}")
         n, hits = len(t.pos_m), t.collision_count
         parts.append(f"{n} puck{'' if n == 1 else 's'}")

@@ -17,7 +17,7 @@ from typing import TYPE_CHECKING
 
 import pygame
 
-from airtable.app import aids, lessons
+from airtable.app import aids, lessons, world
 
 if TYPE_CHECKING:
     from airtable.app.app import App
@@ -214,6 +214,34 @@ BINDINGS: tuple[Binding, ...] = (
     ),
     Binding("i (hold)", "inspect the puck under the cursor", {pygame.K_i: inspect}, held=True),
     Binding("l", "lecture notes for this demo", {pygame.K_l: toggle_notes}),
+    Binding(
+        "u / w",
+        "restitution of pucks / walls down a tenth (with Shift: up)",
+        {
+            pygame.K_u: world.puck_restitution_down,
+            (pygame.KMOD_SHIFT, pygame.K_u): world.puck_restitution_up,
+            pygame.K_w: world.wall_restitution_down,
+            (pygame.KMOD_SHIFT, pygame.K_w): world.wall_restitution_up,
+        },
+    ),
+    Binding(
+        "Shift+g",
+        "gravity: off, Moon 1.62, Mars 3.71, Earth 9.8 m/s²",
+        {(pygame.KMOD_SHIFT, pygame.K_g): world.cycle_gravity},
+    ),
+    Binding(
+        "- / =, [ / ]",
+        "mass, radius of the puck under the cursor: down / up",
+        {
+            pygame.K_MINUS: world.mass_down,
+            pygame.K_KP_MINUS: world.mass_down,
+            pygame.K_EQUALS: world.mass_up,
+            pygame.K_PLUS: world.mass_up,
+            pygame.K_KP_PLUS: world.mass_up,
+            pygame.K_LEFTBRACKET: world.radius_down,
+            pygame.K_RIGHTBRACKET: world.radius_up,
+        },
+    ),
     Binding(
         "d / t",
         "momenta before / after the latest collision; values of each puck",
