@@ -45,11 +45,13 @@ class Sample:
         return self.pucks.nbytes + SAMPLE_OVERHEAD_BYTES
 
 
-def sample_of(table: AirTable) -> Sample:
-    """Copy what a recording keeps out of `table`."""
+def sample_of(table: AirTable, out: np.ndarray | None = None) -> Sample:
+    """Copy what a recording keeps out of `table` (into `out`, an old sample's (N, 6) array, if given)."""
     ke, se, ge = table.kinetic_energy_J(), table.spring_energy_J(), table.gravity_energy_J()
     p = table.momentum_Ns()
-    pucks = np.column_stack((table.mass_kg, table.radius_m, table.pos_m, table.vel_mps))
+    n = len(table.pos_m)
+    pucks = out if out is not None and out.shape == (n, 6) else np.empty((n, 6))
+    pucks[:, 0], pucks[:, 1], pucks[:, 2:4], pucks[:, 4:6] = table.mass_kg, table.radius_m, table.pos_m, table.vel_mps
     return Sample(float(table.time_s), pucks, (ke, se, ge, ke + se + ge, float(p[0]), float(p[1])))
 
 
@@ -71,13 +73,20 @@ class Recorder:
         return len(self.samples)
 
     def sample(self, table: AirTable) -> None:
-        """Keep the table as it is now; drop the oldest samples past the budget (the newest always stays)."""
-        s = sample_of(table)
+        """Keep the table as it is now, dropping the oldest samples to stay in budget (the newest always stays).
+
+        A dropped sample's array is reused for the new one: a full recording allocates nothing."""
+        n = len(table.pos_m)
+        size = n * 6 * 8 + SAMPLE_OVERHEAD_BYTES
+        spare = None
+        while self.samples and self.nbytes + size > self.budget_bytes:
+            old = self.samples.popleft()
+            self.nbytes -= old.nbytes
+            self.dropped += 1
+            spare = old.pucks if len(old.pucks) == n else spare
+        s = sample_of(table, spare)
         self.samples.append(s)
         self.nbytes += s.nbytes
-        while self.nbytes > self.budget_bytes and len(self.samples) > 1:
-            self.nbytes -= self.samples.popleft().nbytes
-            self.dropped += 1
 
     @property
     def span_s(self) -> float:
