@@ -128,3 +128,14 @@ def test_t_shows_the_values_panel(app):
     assert app.lessons.show_values and pixels_of(app, ACCENT) > 20
     press(app, pygame.K_t)
     assert pixels_of(app, ACCENT) == 0
+
+
+def test_the_panels_and_the_chart_take_different_corners(app):
+    press(app, pygame.K_1)
+    press(app, pygame.K_d)
+    press(app, pygame.K_t)  # both panels choose while the chart is closed
+    first = dict(app.lessons.painter.corners)
+    assert first["momenta"] != first["values"]
+    press(app, pygame.K_c)  # the chart takes the corner over the fewest pucks; a panel there moves
+    corners = app.lessons.painter.corners
+    assert len({corners["momenta"], corners["values"], app.painter.chart_corner}) == 3

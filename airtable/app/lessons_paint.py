@@ -37,8 +37,8 @@ class LessonsPainter:
     # ------------------------------------------------------------ corners
 
     def choose_corner(self, panel: str, points_px: np.ndarray, avoid: Sequence[int]) -> int:
-        """The corner of `panel`: kept once chosen; else the corner not in `avoid` over the fewest points."""
-        if panel not in self.corners:
+        """The corner of `panel`: kept once chosen, unless in `avoid`; else the free corner over the fewest points."""
+        if self.corners.get(panel) is None or self.corners[panel] in avoid:
             free = [k for k in range(len(CHART_CORNERS)) if k not in avoid] or [0]
             w, h = self.w.surface.get_size()
             mid = np.array([w / 2, h / 2])
@@ -175,6 +175,8 @@ class LessonsPainter:
                 r = swatch // 3
                 pygame.draw.circle(self.w.surface, tuple(int(v) for v in puck_color), (x + r, y + line_h // 2), r)
             for c, text in enumerate(cells):
+                if x + widths[c] - 2 * pad > rect.right:
+                    break  # a narrow window: the columns that fit
                 shift = swatch if c == 0 else 0
                 self._text(text, (x + shift, y), color, font)
                 x += widths[c]

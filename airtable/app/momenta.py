@@ -130,7 +130,7 @@ class PuckValues:
         return (self.name, f"{self.mass_kg:.3g}", speed, f"{self.momentum_Ns:.3g}", f"{self.kinetic_J:.3g}")
 
 
-VALUE_HEADINGS = ("puck", "mass kg", "speed m/s", "momentum N s", "kinetic J")
+VALUE_HEADINGS = ("puck", "m kg", "|v| m/s", "|p| N s", "KE J")  # mass, speed, momentum, kinetic energy
 
 
 def puck_values(table: AirTable, rows) -> list[PuckValues]:
