@@ -64,7 +64,7 @@ def test_memory_is_bounded_by_bytes_and_the_newest_samples_stay():
     table = AirTable()
     for k in range(10):
         table.add_puck((1.0 + 0.8 * k, 4.0), radius_m=0.3, vel_mps=(0.1 * k, 0.2))
-    per_sample = 10 * 6 * 8 + SAMPLE_OVERHEAD_BYTES  # 730 bytes
+    per_sample = 10 * 6 * 8 + SAMPLE_OVERHEAD_BYTES  # 880 bytes
     rec = Recorder(budget_bytes=100 * per_sample)
     for _ in range(1000):
         table.step(0.01)
@@ -78,6 +78,27 @@ def test_memory_is_bounded_by_bytes_and_the_newest_samples_stay():
     tiny.sample(table)
     tiny.sample(table)
     assert len(tiny) == 1
+
+
+@pytest.mark.parametrize("n_pucks, samples", [(10, 6000), (1000, 120)])
+def test_the_memory_really_used_stays_within_the_budget(n_pucks, samples):
+    import tracemalloc
+
+    table = AirTable()
+    for k in range(n_pucks):
+        table.add_puck((0.5 + (k % 90) * 0.1, 0.5 + (k // 90) * 0.5), radius_m=0.04, vel_mps=(0.1, 0.2))
+    budget = 2 * 2**20
+    rec = Recorder(budget_bytes=budget)
+    tracemalloc.start()
+    try:
+        for _ in range(samples):  # well past the budget: 6000 x 880 B, 120 x 48.4 kB
+            table.time_s += 0.01
+            rec.sample(table)
+        used, _ = tracemalloc.get_traced_memory()
+    finally:
+        tracemalloc.stop()
+    assert rec.dropped > 0 and rec.nbytes <= budget
+    assert used <= 1.05 * budget, f"{used} bytes for a budget of {budget}"
 
 
 def test_csv_pair_names():

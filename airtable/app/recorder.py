@@ -27,12 +27,14 @@ from airtable.physics.table import AirTable
 
 PUCK_COLUMNS = ("t_s", "puck", "mass_kg", "radius_m", "x_m", "y_m", "vx_mps", "vy_mps")
 ENERGY_COLUMNS = ("t_s", "kinetic_J", "spring_J", "gravity_J", "total_J", "px_Ns", "py_Ns")
-DEFAULT_BUDGET_BYTES = 32 * 2**20  # 32 MB: about 4 minutes of five pucks at 240 steps a second
-SAMPLE_OVERHEAD_BYTES = 250  # a sample's Python objects beside its array, counted against the budget
+DEFAULT_BUDGET_BYTES = 32 * 2**20  # 32 MB: 3.6 minutes of five pucks at 240 steps a second
+# A sample's Python objects beside its array's data (the Sample, its tuple of six floats, the
+# array's header), as tracemalloc measures them: counted against the budget too.
+SAMPLE_OVERHEAD_BYTES = 400
 ENERGY_SUFFIX = "_energy"
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, slots=True)
 class Sample:
     """The table at one moment: `pucks` is (N, 6) of mass, radius, x, y, vx, vy; `energy` follows ENERGY_COLUMNS[1:]."""
 
