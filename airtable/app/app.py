@@ -17,11 +17,13 @@ from pathlib import Path
 import numpy as np
 import pygame
 
-from airtable.app import aids, controls
+from airtable.app import aids, controls, world
 from airtable.app.aids_view import draw_aids
 from airtable.app.client import LOCAL_COLOR, Client, cursor_pulls
 from airtable.app.demo_loader import Demo, DemoError, DemoShelf, error_from_exception, key_label
 from airtable.app.environment import Environment
+from airtable.app.lessons import Lessons
+from airtable.app.lessons_view import draw_lessons
 from airtable.app.loop import FixedStep, FpsCounter, FrameLoop
 from airtable.app.menu import DemoMenu
 from airtable.app.scene import STATUS_SEPARATOR, Scene
@@ -116,6 +118,7 @@ class App:
         self.quit_armed_until = -1.0  # clock_s until which a second Esc quits
         self.collision_log = aids.CollisionLog()
         self.chart = aids.EnergyChart()
+        self.lessons = Lessons()  # recording, momenta, saving the moment (lessons.py)
         self.keys_down: set[int] = set()
         self.mouse_px = (self.env.size_px[0] / 2, self.env.size_px[1] / 2)
         self.mouse_button = 0
@@ -180,6 +183,7 @@ class App:
         self.stepper.reset(demo.dt_s if demo else self.stepper.dt_s)
         self.trails = demo.trails if demo else False
         self.chart.sample(self.table)
+        self.lessons.start(self.table)
         self.window.set_caption(f"Air Table - {self.caption()}")
 
     def _clear_table(self) -> None:
@@ -320,6 +324,7 @@ class App:
             self.paused = True
             return False
         self.chart.sample(self.table)
+        self.lessons.after_step(self.table)
         if self.show_annotations:
             self.collision_log.add(self.table, self.clock_s)
         return True
@@ -365,7 +370,7 @@ class App:
             parts.append(f"slow motion x1/{round(1 / self.speed)}")
         parts.append(f"t = {t.time_s:.2f} s")
         parts.append("F1: help")
-        parts.append("gravity on" if t.gravity_on else "gravity off")
+        parts.append(world.gravity_label(t))
         parts.append(f"correction: {t.puck_correction}")
         n, hits = len(t.pos_m), t.collision_count
         parts.append(f"{n} puck{'' if n == 1 else 's'}")
@@ -390,6 +395,7 @@ class App:
     def draw(self, scene: Scene | None = None) -> None:
         """Draw `scene` (by default the table as it is now), the aids and the panel on top."""
         self.window.draw(scene or self.scene(), trails=self.trails, hud=self.hud_lines())
+        draw_lessons(self)  # first: the aids' labels then place themselves around its panels
         draw_aids(self)
         self._draw_panel()
         self.window.present()

@@ -17,7 +17,7 @@ from typing import TYPE_CHECKING
 
 import pygame
 
-from airtable.app import aids
+from airtable.app import aids, lessons, world
 
 if TYPE_CHECKING:
     from airtable.app.app import App
@@ -34,7 +34,8 @@ class Binding:
 
     label: str
     help: str
-    actions: Mapping[int, Action] = field(default_factory=dict)
+    # A key is a pygame key, or (modifier mask, key) for a key pressed with Ctrl or Shift.
+    actions: Mapping[int | tuple[int, int], Action] = field(default_factory=dict)
     held: bool = False  # acts every frame while held, not on the press
 
     @property
@@ -213,13 +214,56 @@ BINDINGS: tuple[Binding, ...] = (
     ),
     Binding("i (hold)", "inspect the puck under the cursor", {pygame.K_i: inspect}, held=True),
     Binding("l", "lecture notes for this demo", {pygame.K_l: toggle_notes}),
+    Binding(
+        "u / w",
+        "restitution of pucks / walls down a tenth (with Shift: up)",
+        {
+            pygame.K_u: world.puck_restitution_down,
+            (pygame.KMOD_SHIFT, pygame.K_u): world.puck_restitution_up,
+            pygame.K_w: world.wall_restitution_down,
+            (pygame.KMOD_SHIFT, pygame.K_w): world.wall_restitution_up,
+        },
+    ),
+    Binding(
+        "Shift+g",
+        "gravity: off, Moon 1.62, Mars 3.71, Earth 9.8 m/s²",
+        {(pygame.KMOD_SHIFT, pygame.K_g): world.cycle_gravity},
+    ),
+    Binding(
+        "- / =, [ / ]",
+        "mass, radius of the puck under the cursor: down / up",
+        {
+            pygame.K_MINUS: world.mass_down,
+            pygame.K_KP_MINUS: world.mass_down,
+            pygame.K_EQUALS: world.mass_up,
+            pygame.K_PLUS: world.mass_up,
+            pygame.K_KP_PLUS: world.mass_up,
+            pygame.K_LEFTBRACKET: world.radius_down,
+            pygame.K_RIGHTBRACKET: world.radius_up,
+        },
+    ),
+    Binding(
+        "d / t",
+        "momenta before / after the latest collision; values of each puck",
+        {pygame.K_d: lessons.toggle_momenta, pygame.K_t: lessons.toggle_values},
+    ),
+    Binding(
+        "x / Ctrl+S",
+        "export the recording as CSV; save the moment as a new demo (s1, s2, ...)",
+        {pygame.K_x: lessons.export_recording, (pygame.KMOD_CTRL, pygame.K_s): lessons.save_moment},
+    ),
     Binding("F1", "this help screen (again: next page)", {pygame.K_F1: toggle_help}),
     Binding("F11", "fullscreen on / off", {pygame.K_F11: toggle_fullscreen}),
     Binding("F12", "save a screenshot PNG", {pygame.K_F12: screenshot}),
     Binding("Esc", "close what is open; else quit (twice if students are connected)", {pygame.K_ESCAPE: escape}),
 )
 
-PRESS_ACTIONS: dict[int, Action] = {k: a for b in BINDINGS if not b.held for k, a in b.actions.items()}
+PRESS_ACTIONS: dict[int, Action] = {
+    k: a for b in BINDINGS if not b.held for k, a in b.actions.items() if isinstance(k, int)
+}
+MODIFIED_ACTIONS: dict[tuple[int, int], Action] = {
+    k: a for b in BINDINGS for k, a in b.actions.items() if isinstance(k, tuple)
+}
 HELD_ACTIONS: dict[int, Action] = {k: a for b in BINDINGS if b.held for k, a in b.actions.items()}
 
 
@@ -235,12 +279,21 @@ def demo_key_for(event: pygame.event.Event) -> str | None:
 # ---------------------------------------------------------------- events
 
 
+def modified_action(event: pygame.event.Event) -> Action | None:
+    """The action of a key pressed with Ctrl or Shift (Ctrl+S), if the key table has one."""
+    mod = getattr(event, "mod", 0)
+    for (mask, key), action in MODIFIED_ACTIONS.items():
+        if key == event.key and mod & mask:
+            return action
+    return None
+
+
 def handle_key(app: App, event: pygame.event.Event) -> None:
     """A KEYDOWN: an open panel takes it first, then the key table, then the demo keys."""
     app.keys_down.add(event.key)
     if app.take_key_for_overlay(event):
         return
-    action = PRESS_ACTIONS.get(event.key)
+    action = modified_action(event) or PRESS_ACTIONS.get(event.key)
     if action is not None:
         action(app)
         return
