@@ -158,6 +158,7 @@ def test_a_spring_beyond_what_a_step_can_compute_is_softened_and_says_so_once() 
     assert f"{k_eff:.3g}" in softened[0]
     assert not any("Spring 0 " in s for s in table.notices)
     assert len(table.notices) == 2  # and one that some springs are solved implicitly
+    assert table.springs_on(a) == table.springs_on(b) == (soft, hard)
 
 
 def test_soft_springs_raise_no_notice_and_stay_explicit() -> None:

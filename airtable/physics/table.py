@@ -7,9 +7,11 @@ and Spring objects are handles onto those rows (see bodies.py).
 `step(dt_s, pulls)` is the course's game loop; each stage is a method below,
 and the numpy work of each is in a module of its own:
 0. timed events (a demo's throw) that are due;
-1. forces: pulls (cursor strings) and springs (forces.py);
-2. integrate, semi-implicit Euler: v += (F/m + g) dt, the pulls' drag taken
-   implicitly, then x += v dt;
+1. forces: pulls (cursor strings) and springs (forces.py); what a puck's
+   springs have beyond what an explicit step can hold is marked implicit;
+2. integrate, semi-implicit Euler: v += (F/m + g) dt, then x += v dt; the
+   pulls' drag and the stiff springs' implicit parts are solved for
+   (implicit.py), so springs hold at any stiffness;
 3. walls: push pucks back inside and bounce them (walls.py);
 4. puck pairs: the candidates from a neighbour list (broadphase.py), then
    collision + position correction one pair at a time (pairs.py), then a
@@ -342,6 +344,10 @@ class AirTable:
         d = self.pos_m - p
         inside = np.flatnonzero(vectors.squared_lengths(d) <= self.radius_m**2)
         return self._puck_handles[int(inside[-1])] if len(inside) else None
+
+    def springs_on(self, puck: Puck) -> tuple[Spring, ...]:
+        """The springs attached to `puck`, in creation order."""
+        return tuple(s for s in self._spring_handles if s.p1 is puck or s.p2 is puck)
 
     def kinetic_energy_J(self) -> float:
         return kinetic_energy_J(self.mass_kg, self.vel_mps)
