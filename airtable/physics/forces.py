@@ -58,7 +58,7 @@ class Pull:
 class Implicit:
     """What one step takes implicitly (see implicit.py), gathered by the force stage.
 
-    `diag` (N,): each puck's isotropic terms dt c + dt^2 k (pulls' drag and stiff pulls);
+    `diag` (N, 2): each puck's terms dt c + dt^2 k on each axis (pulls' drag and stiff pulls);
     `lag` (N, 2): the matching -dt k v forces; for springs with an implicit part,
     rows `a`, `b`, unit vectors `n` (from b to a), and the 2 x 2 block weights
     along n, `w_n` = dt c_i + dt^2 k_i, and across it, `w_t` = dt^2 k_i (1 - L/d) when stretched.
@@ -74,7 +74,7 @@ class Implicit:
 
     @classmethod
     def empty(cls, count: int) -> Implicit:
-        return cls(np.zeros(count), np.zeros((count, 2)))
+        return cls(np.zeros((count, 2)), np.zeros((count, 2)))
 
     @property
     def any(self) -> bool:

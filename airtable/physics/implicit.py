@@ -3,7 +3,8 @@
     (M + D + sum over springs of B_s) dv = dt F,
 
 a backward-Euler step linearised along each spring's current line. M holds
-the masses, D the pulls' isotropic terms dt c + dt^2 k, and B_s the 2 x 2
+the masses, D the pulls' terms dt c + dt^2 k (and walls bracing a body, see
+AirTable._brace_walls) on each axis, and B_s the 2 x 2
 block of spring s, w_n n n^T + w_t (I - n n^T), added on its two pucks'
 diagonal and subtracted off it (forces.Implicit gathers them). F is the
 step's whole force, gravity included, with the lag terms -dt K v.
@@ -34,21 +35,24 @@ CG_MAX_ITERATIONS = 200
 
 def velocity_change(mass: np.ndarray, implicit: Implicit, rhs: np.ndarray) -> np.ndarray:
     """(N, 2) dv solving the step's implicit system; `rhs` is dt F."""
-    dv = rhs / (mass + implicit.diag)[:, None]
+    m = mass[:, None] + implicit.diag
+    dv = rhs / m
     if implicit.a is None or len(implicit.a) == 0:
         return dv
-    rows = np.unique(np.concatenate([implicit.a, implicit.b]))
+    rows = coupled_rows(implicit)
     local = np.full(len(mass), -1, dtype=np.intp)
     local[rows] = np.arange(len(rows))
-    system = _System(
-        (mass + implicit.diag)[rows],
-        local[implicit.a],
-        local[implicit.b],
-        _blocks(implicit.n, implicit.w_n, implicit.w_t),
-    )
+    system = _System(m[rows], local[implicit.a], local[implicit.b], _blocks(implicit.n, implicit.w_n, implicit.w_t))
     solve = system.solve_dense if len(rows) <= DENSE_LIMIT else system.solve_cg
     dv[rows] = solve(rhs[rows])
     return dv
+
+
+def coupled_rows(implicit: Implicit) -> np.ndarray:
+    """The rows of the pucks on implicit springs (sorted)."""
+    if implicit.a is None:
+        return np.empty(0, dtype=np.intp)
+    return np.unique(np.concatenate([implicit.a, implicit.b]))
 
 
 def _blocks(n: np.ndarray, w_n: np.ndarray, w_t: np.ndarray) -> np.ndarray:
@@ -59,7 +63,7 @@ def _blocks(n: np.ndarray, w_n: np.ndarray, w_t: np.ndarray) -> np.ndarray:
 
 
 class _System:
-    """The coupled pucks' matrix diag(m) + sum of spring blocks, in local rows 0..P-1."""
+    """The coupled pucks' matrix diag(m) + sum of spring blocks, in local rows 0..P-1 (m is (P, 2): per axis)."""
 
     def __init__(self, m: np.ndarray, a: np.ndarray, b: np.ndarray, blocks: np.ndarray) -> None:
         self.m, self.a, self.b, self.blocks = m, a, b, blocks
@@ -74,11 +78,11 @@ class _System:
         weights = signs * self.blocks[:, None, :, :]
         flat = np.broadcast_to(rows * size + cols, weights.shape)
         matrix = np.bincount(flat.ravel(), weights.ravel(), size * size).reshape(size, size)
-        matrix[np.arange(size), np.arange(size)] += np.repeat(self.m, 2)
+        matrix[np.arange(size), np.arange(size)] += self.m.reshape(-1)
         return np.linalg.solve(matrix, rhs.reshape(-1)).reshape(-1, 2)
 
     def apply(self, x: np.ndarray) -> np.ndarray:
-        y = self.m[:, None] * x
+        y = self.m * x
         d = vectors.take(x, self.a) - vectors.take(x, self.b)
         f = np.einsum("sij,sj->si", self.blocks, d)
         vectors.add_at(y, self.a, f)
@@ -88,7 +92,7 @@ class _System:
     def _preconditioner(self) -> np.ndarray:
         """(P, 2, 2) inverses of each puck's own diagonal block."""
         diag = np.zeros((len(self.m), 2, 2))
-        diag[:, 0, 0] = diag[:, 1, 1] = self.m
+        diag[:, 0, 0], diag[:, 1, 1] = self.m[:, 0], self.m[:, 1]
         np.add.at(diag, self.a, self.blocks)
         np.add.at(diag, self.b, self.blocks)
         return np.linalg.inv(diag)

@@ -43,6 +43,8 @@ TABLE_HEIGHT_M = 8.7556
 EXTRA_PASSES = 2
 # Overlaps smaller than this (m) are left to the next step: round-off only.
 OVERLAP_SLOP_M = 1e-9
+# Passes that add walls to the implicit solve (see _brace_walls).
+BRACE_PASSES = 4
 # A last guard against runaway values: nothing real on a table moves this fast.
 MAX_SPEED_MPS = 1e8
 
@@ -436,7 +438,13 @@ class AirTable:
             rhs = dt * (force + implicit.lag)
             if self.gravity_on:
                 rhs[:, 1] -= GRAVITY_MPS2 * dt * mass
-            vel += implicit_solve.velocity_change(mass, implicit, rhs)
+            dv = implicit_solve.velocity_change(mass, implicit, rhs)
+            braced = np.zeros(dv.shape, dtype=bool)
+            for _ in range(BRACE_PASSES):  # bracing one puck can push another of its body into a wall
+                if not self._brace_walls(implicit, rhs, dv, braced, dt):
+                    break
+                dv = implicit_solve.velocity_change(mass, implicit, rhs)
+            vel += dv
         else:
             if np.count_nonzero(force):  # usually nothing pushes: skip the (N, 2) update
                 vel += force * (dt / mass)[:, None]
@@ -448,6 +456,41 @@ class AirTable:
             speed = np.hypot(vel[:, 0], vel[:, 1])  # not lengths(): v^2 may overflow here
             vel *= np.minimum(1.0, MAX_SPEED_MPS / np.maximum(speed, 1e-300))[:, None]
         pos += vel * dt
+
+    def _brace_walls(
+        self, implicit: forces.Implicit, rhs: np.ndarray, dv: np.ndarray, braced: np.ndarray, dt: float
+    ) -> bool:
+        """Make the walls part of the implicit solve for pucks on implicit springs that would cross one.
+
+        The wall stage bounces one puck at a time, after the step; a puck on
+        stiff springs would then be jerked against its neighbours, whose
+        springs store the jerk as energy they never had (a stiff jelly landing
+        gained 100 times its energy). Instead such a puck's velocity into the
+        wall is set in the solve itself, to -cr_wall times its approach (or to
+        just reach the wall, at restitution 0), so the whole body takes the
+        impact in the same step. `braced` (N, 2) marks the walls already in;
+        returns whether any was added (then solve again).
+        """
+        rows = implicit_solve.coupled_rows(implicit)
+        if len(rows) == 0:
+            return False
+        x, r = self.pos_m[rows], self.radius_m[rows][:, None]
+        v1 = self.vel_mps[rows] + dv[rows]
+        ends = x + v1 * dt
+        lo, hi = r, self.size_m - r
+        fresh = ~braced[rows]
+        below, above = (ends < lo) & (v1 < 0.0) & fresh, (ends > hi) & (v1 > 0.0) & fresh
+        if not (below.any() or above.any()):
+            return False
+        bounce = -self.cr_wall * v1
+        target = np.where(below, np.maximum(bounce, (lo - x) / dt), np.minimum(bounce, (hi - x) / dt))
+        hit = below | above
+        # A weight a million times the puck's own: the solve meets the target to 1e-6.
+        weight = np.where(hit, 1e6 * (self.mass_kg[rows][:, None] + implicit.diag[rows]), 0.0)
+        rhs[rows] += weight * (target - self.vel_mps[rows])
+        implicit.diag[rows] += weight
+        braced[rows] |= hit
+        return True
 
     def _resolve_walls(self, only: np.ndarray | None = None) -> None:
         """Push pucks back inside the walls and bounce them (only the rows `only`, if given)."""
