@@ -60,8 +60,8 @@ class Implicit:
 
     `diag` (N, 2): each puck's terms dt c + dt^2 k on each axis (pulls' drag and stiff pulls);
     `lag` (N, 2): the matching -dt k v forces; for springs with an implicit part,
-    rows `a`, `b`, unit vectors `n` (from b to a), and the 2 x 2 block weights
-    along n, `w_n` = dt c_i + dt^2 k_i, and across it, `w_t` = dt^2 k_i (1 - L/d) when stretched.
+    rows `a`, `b`, unit vectors `n` (from b to a), and the weight along n,
+    `w` = dt c_i + dt^2 k_i.
     """
 
     diag: np.ndarray
@@ -69,8 +69,7 @@ class Implicit:
     a: np.ndarray | None = None
     b: np.ndarray | None = None
     n: np.ndarray | None = None
-    w_n: np.ndarray | None = None
-    w_t: np.ndarray | None = None
+    w: np.ndarray | None = None
 
     @classmethod
     def empty(cls, count: int) -> Implicit:
@@ -145,38 +144,38 @@ def spring_forces(
     length_m: np.ndarray,
     k: np.ndarray,
     c: np.ndarray,
-) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """(unit vectors n, distances d, forces on puck a[s]) of each spring s; puck b[s] gets minus the force."""
+) -> tuple[np.ndarray, np.ndarray]:
+    """(unit vectors n, forces on puck a[s]) of each spring s; puck b[s] gets minus the force."""
     n, dist = vectors.unit_vectors(vectors.take(pos, a) - vectors.take(pos, b))
     vn = vectors.dot_rows(vectors.take(vel, a) - vectors.take(vel, b), n)
-    return n, dist, (k * (length_m - dist) - c * vn)[:, None] * n
+    return n, (k * (length_m - dist) - c * vn)[:, None] * n
 
 
 def implicit_springs(
     implicit: Implicit,
     vel: np.ndarray,
-    springs: tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray],
+    springs: tuple[np.ndarray, np.ndarray, np.ndarray],
     k_i: np.ndarray,
     c_i: np.ndarray,
     dt_s: float,
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Record the springs' implicit parts k_i, c_i in `implicit`; return (a, b, lag force -dt K_i (v_a - v_b) on a).
+    """Record the springs' implicit parts k_i, c_i in `implicit`; return (a, b, lag force on a).
 
-    `springs` is (a, b, n, stretch factor max(0, 1 - L/d)) of each spring. The
-    across-the-line stiffness k (1 - L/d) of a stretched spring is taken too, so
-    a fast swing on a stiff spring stays stable; a compressed spring's is left
-    out (it would make the solve's matrix indefinite).
+    The lag force is -dt k_i ((v_a - v_b) . n) n; b gets minus that.
+
+    `springs` is (a, b, n) of each spring. Only the stiffness along the line
+    is taken implicitly: the impulses then stay along the lines of centres at
+    the start of the step, as in semi-implicit Euler, so angular momentum is
+    kept exactly (taking the across-the-line stiffness too made a spinning
+    stiff jelly stop within seconds).
     """
-    a, b, n, across = springs
+    a, b, n = springs
     keep = (k_i > 0.0) | (c_i > 0.0)
-    a, b, n, across, k_i, c_i = a[keep], b[keep], n[keep], across[keep], k_i[keep], c_i[keep]
+    a, b, n, k_i, c_i = a[keep], b[keep], n[keep], k_i[keep], c_i[keep]
     implicit.a, implicit.b, implicit.n = a, b, n
-    implicit.w_n = dt_s * c_i + dt_s * dt_s * k_i
-    implicit.w_t = dt_s * dt_s * k_i * across
-    dv = vectors.take(vel, a) - vectors.take(vel, b)
-    along = vectors.dot_rows(dv, n)
-    lag = -(dt_s * k_i)[:, None] * (along[:, None] * n + across[:, None] * (dv - along[:, None] * n))
-    return a, b, lag
+    implicit.w = dt_s * c_i + dt_s * dt_s * k_i
+    along = vectors.dot_rows(vectors.take(vel, a) - vectors.take(vel, b), n)
+    return a, b, -(dt_s * k_i * along)[:, None] * n
 
 
 def add_spring_forces(force: np.ndarray, a: np.ndarray, b: np.ndarray, f1: np.ndarray) -> None:

@@ -5,7 +5,7 @@
 a backward-Euler step linearised along each spring's current line. M holds
 the masses, D the pulls' terms dt c + dt^2 k (and walls bracing a body, see
 AirTable._brace_walls) on each axis, and B_s the 2 x 2
-block of spring s, w_n n n^T + w_t (I - n n^T), added on its two pucks'
+block of spring s, w n n^T, added on its two pucks'
 diagonal and subtracted off it (forces.Implicit gathers them). F is the
 step's whole force, gravity included, with the lag terms -dt K v.
 
@@ -42,7 +42,7 @@ def velocity_change(mass: np.ndarray, implicit: Implicit, rhs: np.ndarray) -> np
     rows = coupled_rows(implicit)
     local = np.full(len(mass), -1, dtype=np.intp)
     local[rows] = np.arange(len(rows))
-    system = _System(m[rows], local[implicit.a], local[implicit.b], _blocks(implicit.n, implicit.w_n, implicit.w_t))
+    system = _System(m[rows], local[implicit.a], local[implicit.b], _blocks(implicit.n, implicit.w))
     solve = system.solve_dense if len(rows) <= DENSE_LIMIT else system.solve_cg
     dv[rows] = solve(rhs[rows])
     return dv
@@ -55,11 +55,9 @@ def coupled_rows(implicit: Implicit) -> np.ndarray:
     return np.unique(np.concatenate([implicit.a, implicit.b]))
 
 
-def _blocks(n: np.ndarray, w_n: np.ndarray, w_t: np.ndarray) -> np.ndarray:
-    """(S, 2, 2) blocks w_n n n^T + w_t (I - n n^T)."""
-    outer = n[:, :, None] * n[:, None, :]
-    eye = np.eye(2)[None, :, :]
-    return w_n[:, None, None] * outer + w_t[:, None, None] * (eye - outer)
+def _blocks(n: np.ndarray, w: np.ndarray) -> np.ndarray:
+    """(S, 2, 2) blocks w n n^T."""
+    return w[:, None, None] * n[:, :, None] * n[:, None, :]
 
 
 class _System:

@@ -536,13 +536,12 @@ class AirTable:
         mass, length = self.mass_kg, self.spring_length_m
         mu = forces.reduced_masses(mass, a, b)
         k, c = forces.effective_spring(self.spring_k_Npm, self.spring_damper_Nspm, mu, dt)
-        n, dist, f1 = forces.spring_forces(self.pos_m, self.vel_mps, a, b, length, k, c)
+        n, f1 = forces.spring_forces(self.pos_m, self.vel_mps, a, b, length, k, c)
         if implicit is not None:
             self._spring_dt_s = dt
             frac_k, frac_c = forces.explicit_fractions(mass, a, b, k, c, dt)
-            across = np.maximum(0.0, 1.0 - length / np.maximum(dist, 1e-300))
             k_i, c_i = (1.0 - frac_k) * k, (1.0 - frac_c) * c
-            ia, ib, lag = forces.implicit_springs(implicit, self.vel_mps, (a, b, n, across), k_i, c_i, dt)
+            ia, ib, lag = forces.implicit_springs(implicit, self.vel_mps, (a, b, n), k_i, c_i, dt)
             forces.add_spring_forces(implicit.lag, ia, ib, lag)
             self._notice_springs(k, k_i)
         return a, b, f1
