@@ -60,8 +60,8 @@ class Implicit:
 
     `diag` (N, 2): each puck's terms dt c + dt^2 k on each axis (pulls' drag and stiff pulls);
     `lag` (N, 2): the matching -dt k v forces; for springs with an implicit part,
-    rows `a`, `b`, unit vectors `n` (from b to a), and the weight along n,
-    `w` = dt c_i + dt^2 k_i.
+    rows `a`, `b`, unit vectors `n` (from b to a), the weight along n,
+    `w` = dt c_i + dt^2 k_i, and `k` = k_i.
     """
 
     diag: np.ndarray
@@ -70,6 +70,9 @@ class Implicit:
     b: np.ndarray | None = None
     n: np.ndarray | None = None
     w: np.ndarray | None = None
+    k: np.ndarray | None = None  # the implicit part k_i of each of those springs
+    fixed: np.ndarray | None = None  # (N, 2) velocity components a wall sets (AirTable._brace_walls) ...
+    fixed_dv: np.ndarray | None = None  # ... and their velocity changes
 
     @classmethod
     def empty(cls, count: int) -> Implicit:
@@ -174,6 +177,7 @@ def implicit_springs(
     a, b, n, k_i, c_i = a[keep], b[keep], n[keep], k_i[keep], c_i[keep]
     implicit.a, implicit.b, implicit.n = a, b, n
     implicit.w = dt_s * c_i + dt_s * dt_s * k_i
+    implicit.k = k_i
     along = vectors.dot_rows(vectors.take(vel, a) - vectors.take(vel, b), n)
     return a, b, -(dt_s * k_i * along)[:, None] * n
 

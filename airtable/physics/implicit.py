@@ -31,21 +31,75 @@ DENSE_LIMIT = 50
 # this many iterations.
 CG_TOLERANCE = 1e-8
 CG_MAX_ITERATIONS = 200
+# Solve again for the springs' turning (correct_for_turning) when the stretch
+# it misses holds more than this share of the coupled pucks' kinetic energy.
+TURNING_SHARE = 1e-4
 
 
 def velocity_change(mass: np.ndarray, implicit: Implicit, rhs: np.ndarray) -> np.ndarray:
-    """(N, 2) dv solving the step's implicit system; `rhs` is dt F."""
-    m = mass[:, None] + implicit.diag
-    dv = rhs / m
+    """(N, 2) dv solving the step's implicit system; `rhs` is dt F. Components in `implicit.fixed` are given."""
+    dv = rhs / (mass[:, None] + implicit.diag)
+    fixed = implicit.fixed
+    if fixed is not None:
+        dv[fixed] = implicit.fixed_dv[fixed]
     if implicit.a is None or len(implicit.a) == 0:
         return dv
     rows = coupled_rows(implicit)
     local = np.full(len(mass), -1, dtype=np.intp)
     local[rows] = np.arange(len(rows))
-    system = _System(m[rows], local[implicit.a], local[implicit.b], _blocks(implicit.n, implicit.w))
+    system = _System(
+        mass[rows, None] + implicit.diag[rows],
+        local[implicit.a],
+        local[implicit.b],
+        _blocks(implicit.n, implicit.w),
+        np.zeros((len(rows), 2), dtype=bool) if fixed is None else fixed[rows],
+    )
     solve = system.solve_dense if len(rows) <= DENSE_LIMIT else system.solve_cg
-    dv[rows] = solve(rhs[rows])
+    dv[rows] = solve(rhs[rows], dv[rows])
     return dv
+
+
+def wall_impulses(mass: np.ndarray, implicit: Implicit, rhs: np.ndarray, dv: np.ndarray) -> np.ndarray:
+    """(N, 2) the impulse (N s) that held each fixed component at its value: (M + D + B) dv - rhs there, else 0."""
+    out = np.zeros_like(dv)
+    if implicit.fixed is None or not implicit.fixed.any():
+        return out
+    rows = coupled_rows(implicit)
+    local = np.full(len(mass), -1, dtype=np.intp)
+    local[rows] = np.arange(len(rows))
+    m = mass[rows, None] + implicit.diag[rows]
+    system = _System(m, local[implicit.a], local[implicit.b], _blocks(implicit.n, implicit.w), implicit.fixed[rows])
+    out[rows] = (system.apply(dv[rows]) - rhs[rows]) * implicit.fixed[rows]
+    return out
+
+
+def correct_for_turning(
+    pos: np.ndarray, vel: np.ndarray, mass: np.ndarray, implicit: Implicit, rhs: np.ndarray, dt: float
+) -> bool:
+    """Add to `rhs` the stretch the solve's first-order lengths miss; return whether it matters (then solve again).
+
+    The solve takes each spring's length at the end of the step as
+    d + dt (v_a - v_b) . n, but a spring that turns by an angle t also
+    lengthens by about d t^2 / 2. On a spring of 1e7 N/m that unseen stretch
+    held as much energy as a whole jelly had, at the moment it hit a wall.
+    So with the new velocities `vel`, each implicit spring pulls as well by
+    k_i times that stretch, still along n (so angular momentum stays exact).
+    """
+    a, b, n, k = implicit.a, implicit.b, implicit.n, implicit.k
+    if a is None or len(a) == 0:
+        return False
+    d = vectors.take(pos, a) - vectors.take(pos, b)
+    end = d + dt * (vectors.take(vel, a) - vectors.take(vel, b))
+    missed = vectors.lengths(end) - vectors.dot_rows(end, n)
+    # Worth a second solve only where it is a visible share of the pucks' kinetic energy.
+    rows = coupled_rows(implicit)
+    kinetic = 0.5 * float(np.dot(mass[rows], vectors.squared_lengths(vel[rows])))
+    if 0.5 * float(np.dot(k, missed * missed)) <= TURNING_SHARE * kinetic:
+        return False
+    pull = (dt * k * missed)[:, None] * n
+    vectors.add_at(rhs, a, -pull)
+    vectors.add_at(rhs, b, pull)
+    return True
 
 
 def coupled_rows(implicit: Implicit) -> np.ndarray:
@@ -61,12 +115,16 @@ def _blocks(n: np.ndarray, w: np.ndarray) -> np.ndarray:
 
 
 class _System:
-    """The coupled pucks' matrix diag(m) + sum of spring blocks, in local rows 0..P-1 (m is (P, 2): per axis)."""
+    """The coupled pucks' matrix diag(m) + sum of spring blocks, in local rows 0..P-1 (m is (P, 2): per axis).
 
-    def __init__(self, m: np.ndarray, a: np.ndarray, b: np.ndarray, blocks: np.ndarray) -> None:
-        self.m, self.a, self.b, self.blocks = m, a, b, blocks
+    Components marked `fixed` (P, 2) are known (a wall sets them): the
+    solves keep them at their given values and solve for the others.
+    """
 
-    def solve_dense(self, rhs: np.ndarray) -> np.ndarray:
+    def __init__(self, m: np.ndarray, a: np.ndarray, b: np.ndarray, blocks: np.ndarray, fixed: np.ndarray) -> None:
+        self.m, self.a, self.b, self.blocks, self.fixed = m, a, b, blocks, fixed
+
+    def solve_dense(self, rhs: np.ndarray, given: np.ndarray) -> np.ndarray:
         size = 2 * len(self.m)
         c = np.arange(2)
         # Flat indices of entry (2 p + r, 2 q + s) for the four (p, q) of each spring.
@@ -77,7 +135,16 @@ class _System:
         flat = np.broadcast_to(rows * size + cols, weights.shape)
         matrix = np.bincount(flat.ravel(), weights.ravel(), size * size).reshape(size, size)
         matrix[np.arange(size), np.arange(size)] += self.m.reshape(-1)
-        return np.linalg.solve(matrix, rhs.reshape(-1)).reshape(-1, 2)
+        b = rhs.reshape(-1).copy()
+        known = np.flatnonzero(self.fixed.reshape(-1))
+        if len(known):
+            values = given.reshape(-1)[known]
+            b -= matrix[:, known] @ values
+            matrix[known, :] = 0.0
+            matrix[:, known] = 0.0
+            matrix[known, known] = 1.0
+            b[known] = values
+        return np.linalg.solve(matrix, b).reshape(-1, 2)
 
     def apply(self, x: np.ndarray) -> np.ndarray:
         y = self.m * x
@@ -95,21 +162,22 @@ class _System:
         np.add.at(diag, self.b, self.blocks)
         return np.linalg.inv(diag)
 
-    def solve_cg(self, rhs: np.ndarray) -> np.ndarray:
-        inv = self._preconditioner()
-        x = np.einsum("pij,pj->pi", inv, rhs)
-        r = rhs - self.apply(x)
-        z = np.einsum("pij,pj->pi", inv, r)
+    def solve_cg(self, rhs: np.ndarray, given: np.ndarray) -> np.ndarray:
+        """Conjugate gradients on the free components (the fixed ones start at their values and stay)."""
+        inv, free = self._preconditioner(), ~self.fixed
+        x = np.where(self.fixed, given, np.einsum("pij,pj->pi", inv, rhs))
+        r = (rhs - self.apply(x)) * free
+        z = np.einsum("pij,pj->pi", inv, r) * free
         p, rz = z.copy(), float(np.vdot(r, z))
-        stop = CG_TOLERANCE**2 * max(float(np.vdot(rhs, rhs)), 1e-300)
+        stop = CG_TOLERANCE**2 * max(float(np.vdot(rhs * free, rhs * free)), 1e-300)
         for _ in range(CG_MAX_ITERATIONS):
-            if float(np.vdot(r, r)) <= stop:
+            if float(np.vdot(r, r)) <= stop or rz <= 0.0:
                 break
-            ap = self.apply(p)
+            ap = self.apply(p) * free
             alpha = rz / float(np.vdot(p, ap))
             x += alpha * p
             r -= alpha * ap
-            z = np.einsum("pij,pj->pi", inv, r)
+            z = np.einsum("pij,pj->pi", inv, r) * free
             rz, rz_old = float(np.vdot(r, z)), rz
             p = z + (rz / rz_old) * p
         return x

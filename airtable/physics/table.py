@@ -438,13 +438,7 @@ class AirTable:
             rhs = dt * (force + implicit.lag)
             if self.gravity_on:
                 rhs[:, 1] -= GRAVITY_MPS2 * dt * mass
-            dv = implicit_solve.velocity_change(mass, implicit, rhs)
-            braced = np.zeros(dv.shape, dtype=bool)
-            for _ in range(BRACE_PASSES):  # bracing one puck can push another of its body into a wall
-                if not self._brace_walls(implicit, rhs, dv, braced, dt):
-                    break
-                dv = implicit_solve.velocity_change(mass, implicit, rhs)
-            vel += dv
+            vel += self._implicit_velocity_change(implicit, rhs, dt)
         else:
             if np.count_nonzero(force):  # usually nothing pushes: skip the (N, 2) update
                 vel += force * (dt / mass)[:, None]
@@ -457,9 +451,30 @@ class AirTable:
             vel *= np.minimum(1.0, MAX_SPEED_MPS / np.maximum(speed, 1e-300))[:, None]
         pos += vel * dt
 
-    def _brace_walls(
-        self, implicit: forces.Implicit, rhs: np.ndarray, dv: np.ndarray, braced: np.ndarray, dt: float
-    ) -> bool:
+    def _implicit_velocity_change(self, implicit: forces.Implicit, rhs: np.ndarray, dt: float) -> np.ndarray:
+        """dv from the implicit solve (implicit.py), with walls braced and the springs' turning taken in."""
+        mass = self.mass_kg
+        dv = implicit_solve.velocity_change(mass, implicit, rhs)
+        released = np.zeros(dv.shape, dtype=bool)
+        for _ in range(BRACE_PASSES):  # bracing one puck can push another of its body into a wall
+            if not self._brace_walls(implicit, dv, released, dt):
+                break
+            dv = implicit_solve.velocity_change(mass, implicit, rhs)
+            # A wall only pushes: let go where it had to pull the puck to keep it bouncing.
+            pulled = implicit_solve.wall_impulses(mass, implicit, rhs, dv) * self._wall_sides(implicit.fixed) < 0.0
+            if pulled.any():
+                implicit.fixed &= ~pulled
+                released |= pulled
+                dv = implicit_solve.velocity_change(mass, implicit, rhs)
+        if implicit_solve.correct_for_turning(self.pos_m, self.vel_mps + dv, mass, implicit, rhs, dt):
+            dv = implicit_solve.velocity_change(mass, implicit, rhs)
+        return dv
+
+    def _wall_sides(self, fixed: np.ndarray) -> np.ndarray:
+        """(N, 2) +1 where a fixed component is held by the low wall (x = 0 or y = 0), -1 by the high one."""
+        return np.where(self.pos_m < 0.5 * self.size_m, 1.0, -1.0) * fixed
+
+    def _brace_walls(self, implicit: forces.Implicit, dv: np.ndarray, released: np.ndarray, dt: float) -> bool:
         """Make the walls part of the implicit solve for pucks on implicit springs that would cross one.
 
         The wall stage bounces one puck at a time, after the step; a puck on
@@ -468,8 +483,7 @@ class AirTable:
         gained 100 times its energy). Instead such a puck's velocity into the
         wall is set in the solve itself, to -cr_wall times its approach (or to
         just reach the wall, at restitution 0), so the whole body takes the
-        impact in the same step. `braced` (N, 2) marks the walls already in;
-        returns whether any was added (then solve again).
+        impact in the same step. Returns whether any wall was added (then solve again).
         """
         rows = implicit_solve.coupled_rows(implicit)
         if len(rows) == 0:
@@ -478,18 +492,17 @@ class AirTable:
         v1 = self.vel_mps[rows] + dv[rows]
         ends = x + v1 * dt
         lo, hi = r, self.size_m - r
-        fresh = ~braced[rows]
+        if implicit.fixed is None:
+            implicit.fixed, implicit.fixed_dv = np.zeros(dv.shape, dtype=bool), np.zeros(dv.shape)
+        fresh = ~(implicit.fixed[rows] | released[rows])
         below, above = (ends < lo) & (v1 < 0.0) & fresh, (ends > hi) & (v1 > 0.0) & fresh
         if not (below.any() or above.any()):
             return False
         bounce = -self.cr_wall * v1
         target = np.where(below, np.maximum(bounce, (lo - x) / dt), np.minimum(bounce, (hi - x) / dt))
         hit = below | above
-        # A weight a million times the puck's own: the solve meets the target to 1e-6.
-        weight = np.where(hit, 1e6 * (self.mass_kg[rows][:, None] + implicit.diag[rows]), 0.0)
-        rhs[rows] += weight * (target - self.vel_mps[rows])
-        implicit.diag[rows] += weight
-        braced[rows] |= hit
+        implicit.fixed_dv[rows] = np.where(hit, target - self.vel_mps[rows], implicit.fixed_dv[rows])
+        implicit.fixed[rows] |= hit
         return True
 
     def _resolve_walls(self, only: np.ndarray | None = None) -> None:
