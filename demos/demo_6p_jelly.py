@@ -7,9 +7,9 @@ TITLE = "Jelly"
 NOTES = """
 Twenty-five pucks joined by springs along every edge and diagonal act like a block of
 jelly: it falls, lands, wobbles and settles, and you can grab a puck and throw it at a wall.
-The diagonals stop the squares from folding flat. These springs are too stiff for a plain
-step, so the step solves them implicitly: the block keeps its shape and sags just as k
-says, but its fastest wobble is damped away. Left and Right change the stiffness.
+The diagonals stop the squares from folding flat. The stiffer jellies vibrate faster than a
+step can follow, so the step solves their springs implicitly: the block keeps its shape and
+sags just as k says, but its fastest wobble is damped away. Left and Right change the stiffness.
 """
 
 VARIATIONS = ("k 300 N/m", "soft: k 60 N/m", "stiff: k 1500 N/m")

@@ -37,7 +37,7 @@ GRAVITY_MPS2 = 9.8
 # Per puck, the springs' sum of k dt^2 / m and of c dt / m taken explicitly
 # (Gershgorin: the fastest mode then has omega dt <= 1, well inside the
 # limit of 2); the rest is taken implicitly. A pull gets a budget of its own.
-EXPLICIT_STIFFNESS = 0.25
+EXPLICIT_STIFFNESS = 0.5
 EXPLICIT_DAMPING = 0.25
 # Beyond k dt^2 / mu (and c dt / mu) this large a spring is softened: the
 # implicit solve's matrix would hold numbers 1e16 apart and lose the masses.
