@@ -43,6 +43,11 @@ TABLE_HEIGHT_M = 8.7556
 EXTRA_PASSES = 2
 # Overlaps smaller than this (m) are left to the next step: round-off only.
 OVERLAP_SLOP_M = 1e-9
+# Said once (in `notices`) when springs are first solved implicitly.
+IMPLICIT_NOTICE = (
+    "Some springs vibrate faster than a step can follow: the step solves them implicitly,"
+    " so they hold and sag as their k says, but their fastest wobble is damped away."
+)
 # Passes that add walls to the implicit solve (see _brace_walls).
 BRACE_PASSES = 4
 # A last guard against runaway values: nothing real on a table moves this fast.
@@ -553,10 +558,14 @@ class AirTable:
         if implicit is not None:
             self._spring_dt_s = dt
             frac_k, frac_c = forces.explicit_fractions(mass, a, b, k, c, dt)
-            k_i, c_i = (1.0 - frac_k) * k, (1.0 - frac_c) * c
-            ia, ib, lag = forces.implicit_springs(implicit, self.vel_mps, (a, b, n), k_i, c_i, dt)
-            forces.add_spring_forces(implicit.lag, ia, ib, lag)
-            self._notice_springs(k, k_i)
+            if frac_k.min() < 1.0 or frac_c.min() < 1.0:  # else all explicit, as soft springs usually are
+                k_i, c_i = (1.0 - frac_k) * k, (1.0 - frac_c) * c
+                ia, ib, lag = forces.implicit_springs(implicit, self.vel_mps, (a, b, n), k_i, c_i, dt)
+                forces.add_spring_forces(implicit.lag, ia, ib, lag)
+                if frac_k.min() < 1.0:
+                    self._notice("implicit", IMPLICIT_NOTICE)
+            if (k < self.spring_k_Npm).any():
+                self._notice_softened(k)
         return a, b, f1
 
     @property
@@ -578,20 +587,18 @@ class AirTable:
         mu = forces.reduced_masses(self.mass_kg, a, b)
         return forces.effective_spring(self.spring_k_Npm, self.spring_damper_Nspm, mu, self._spring_dt_s)[1]
 
-    def _notice_springs(self, k: np.ndarray, k_implicit: np.ndarray) -> None:
-        """Add a sentence to `notices` the first time a spring is softened or too fast for an explicit step."""
+    def _notice(self, key, sentence: str) -> None:
+        """Add `sentence` to `notices`, once for each `key` (until clear())."""
+        if key not in self._noticed:
+            self._noticed.add(key)
+            self.notices.append(sentence)
+
+    def _notice_softened(self, k: np.ndarray) -> None:
         for s in np.flatnonzero(k < self.spring_k_Npm):
-            if ("softened", int(s)) not in self._noticed:
-                self._noticed.add(("softened", int(s)))
-                self.notices.append(
-                    f"Spring {s} asks for k = {self.spring_k_Npm[s]:.3g} N/m, more than a step can compute;"
-                    f" it acts with k = {k[s]:.3g} N/m (its k_effective_Npm)."
-                )
-        if "implicit" not in self._noticed and np.any(k_implicit > 0.0):
-            self._noticed.add("implicit")
-            self.notices.append(
-                "Some springs vibrate faster than a step can follow: the step solves them implicitly,"
-                " so they hold and sag as their k says, but their fastest wobble is damped away."
+            self._notice(
+                ("softened", int(s)),
+                f"Spring {s} asks for k = {self.spring_k_Npm[s]:.3g} N/m, more than a step can compute;"
+                f" it acts with k = {k[s]:.3g} N/m (its k_effective_Npm).",
             )
 
     def forces_on(self, puck: Puck, dt_s: float = 1 / 240, pulls: Sequence[Pull] = ()) -> dict[str, np.ndarray]:
