@@ -71,8 +71,9 @@ class Implicit:
     n: np.ndarray | None = None
     w: np.ndarray | None = None
     k: np.ndarray | None = None  # the implicit part k_i of each of those springs
-    fixed: np.ndarray | None = None  # (N, 2) velocity components a wall sets (AirTable._brace_walls) ...
-    fixed_dv: np.ndarray | None = None  # ... and their velocity changes
+    fixed: np.ndarray | None = None  # (N, 2) velocity components a wall sets (implicit.brace_walls) ...
+    fixed_dv: np.ndarray | None = None  # ... their velocity changes ...
+    fixed_side: np.ndarray | None = None  # ... and +1 where the wall pushes towards +x or +y, -1 the other way
 
     @classmethod
     def empty(cls, count: int) -> Implicit:

@@ -3,11 +3,11 @@
     (M + D + sum over springs of B_s) dv = dt F,
 
 a backward-Euler step linearised along each spring's current line. M holds
-the masses, D the pulls' terms dt c + dt^2 k (and walls bracing a body, see
-AirTable._brace_walls) on each axis, and B_s the 2 x 2
-block of spring s, w n n^T, added on its two pucks'
-diagonal and subtracted off it (forces.Implicit gathers them). F is the
-step's whole force, gravity included, with the lag terms -dt K v.
+the masses, D the pulls' terms dt c + dt^2 k on each axis, and B_s the 2 x 2
+block w n n^T of spring s, added on its two pucks' diagonal and subtracted
+off it (forces.Implicit gathers them). F is the
+step's whole force, gravity included, with the lag terms -dt K v. Velocity
+components that a wall sets (brace_walls) are known, and solved around.
 
 The matrix is symmetric positive definite, so the step is stable for any k:
 a spring far too stiff for the step just holds its pucks at its length. A puck
@@ -57,6 +57,55 @@ def velocity_change(mass: np.ndarray, implicit: Implicit, rhs: np.ndarray) -> np
     solve = system.solve_dense if len(rows) <= DENSE_LIMIT else system.solve_cg
     dv[rows] = solve(rhs[rows], dv[rows])
     return dv
+
+
+def brace_walls(
+    pos: np.ndarray,
+    vel: np.ndarray,
+    dv: np.ndarray,
+    radius: np.ndarray,
+    walls: tuple[np.ndarray, float],
+    implicit: Implicit,
+    released: np.ndarray,
+    dt: float,
+) -> bool:
+    """Make the walls part of the solve for pucks on implicit springs that would cross one; return whether any.
+
+    The wall stage bounces one puck at a time, after the step; a puck on
+    stiff springs would then be jerked against its neighbours, whose springs
+    store the jerk as energy they never had (a stiff jelly landing gained 100
+    times its energy). Instead such a puck's velocity into the wall is fixed
+    in the solve itself, to -cr_wall times its approach (or to just reach the
+    wall, at restitution 0), so the whole body takes the impact in the same
+    step. `vel` is the velocity at the start of the step and `dv` the last
+    solve's change; `walls` is (table size, cr_wall); components in
+    `released` (walls that would have had to pull) stay out. Solve again after a True.
+    """
+    rows = coupled_rows(implicit)
+    if len(rows) == 0:
+        return False
+    if implicit.fixed is None:
+        implicit.fixed, implicit.fixed_dv, implicit.fixed_side = (
+            np.zeros(vel.shape, dtype=bool),
+            np.zeros(vel.shape),
+            np.zeros(vel.shape),
+        )
+    size_m, cr_wall = walls
+    x, r, v0 = pos[rows], radius[rows][:, None], vel[rows]
+    v1 = v0 + dv[rows]
+    ends = x + v1 * dt
+    lo, hi = r, size_m - r
+    fresh = ~(implicit.fixed[rows] | released[rows])
+    below, above = (ends < lo) & (v1 < 0.0) & fresh, (ends > hi) & (v1 > 0.0) & fresh
+    if not (below.any() or above.any()):
+        return False
+    bounce = -cr_wall * v1
+    target = np.where(below, np.maximum(bounce, (lo - x) / dt), np.minimum(bounce, (hi - x) / dt))
+    hit = below | above
+    implicit.fixed[rows] |= hit
+    implicit.fixed_dv[rows] = np.where(hit, target - v0, implicit.fixed_dv[rows])
+    implicit.fixed_side[rows] = np.where(below, 1.0, np.where(above, -1.0, implicit.fixed_side[rows]))
+    return True
 
 
 def wall_impulses(mass: np.ndarray, implicit: Implicit, rhs: np.ndarray, dv: np.ndarray) -> np.ndarray:

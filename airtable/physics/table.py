@@ -325,7 +325,7 @@ class AirTable:
         self._pucks.clear()
         self._springs.clear()
         self._events = []
-        self.notices: list[str] = []  # sentences for the user, appended once each (see _notice_springs)
+        self.notices: list[str] = []  # sentences for the user, appended once each (see _notice)
         self._noticed: set = set()
         self._spring_dt_s = 1 / 240  # the dt the springs' effective stiffness was last worked out for
         self.time_s = 0.0
@@ -466,7 +466,7 @@ class AirTable:
                 break
             dv = implicit_solve.velocity_change(mass, implicit, rhs)
             # A wall only pushes: let go where it had to pull the puck to keep it bouncing.
-            pulled = implicit_solve.wall_impulses(mass, implicit, rhs, dv) * self._wall_sides(implicit.fixed) < 0.0
+            pulled = implicit_solve.wall_impulses(mass, implicit, rhs, dv) * implicit.fixed_side < 0.0
             if pulled.any():
                 implicit.fixed &= ~pulled
                 released |= pulled
@@ -475,40 +475,10 @@ class AirTable:
             dv = implicit_solve.velocity_change(mass, implicit, rhs)
         return dv
 
-    def _wall_sides(self, fixed: np.ndarray) -> np.ndarray:
-        """(N, 2) +1 where a fixed component is held by the low wall (x = 0 or y = 0), -1 by the high one."""
-        return np.where(self.pos_m < 0.5 * self.size_m, 1.0, -1.0) * fixed
-
     def _brace_walls(self, implicit: forces.Implicit, dv: np.ndarray, released: np.ndarray, dt: float) -> bool:
-        """Make the walls part of the implicit solve for pucks on implicit springs that would cross one.
-
-        The wall stage bounces one puck at a time, after the step; a puck on
-        stiff springs would then be jerked against its neighbours, whose
-        springs store the jerk as energy they never had (a stiff jelly landing
-        gained 100 times its energy). Instead such a puck's velocity into the
-        wall is set in the solve itself, to -cr_wall times its approach (or to
-        just reach the wall, at restitution 0), so the whole body takes the
-        impact in the same step. Returns whether any wall was added (then solve again).
-        """
-        rows = implicit_solve.coupled_rows(implicit)
-        if len(rows) == 0:
-            return False
-        x, r = self.pos_m[rows], self.radius_m[rows][:, None]
-        v1 = self.vel_mps[rows] + dv[rows]
-        ends = x + v1 * dt
-        lo, hi = r, self.size_m - r
-        if implicit.fixed is None:
-            implicit.fixed, implicit.fixed_dv = np.zeros(dv.shape, dtype=bool), np.zeros(dv.shape)
-        fresh = ~(implicit.fixed[rows] | released[rows])
-        below, above = (ends < lo) & (v1 < 0.0) & fresh, (ends > hi) & (v1 > 0.0) & fresh
-        if not (below.any() or above.any()):
-            return False
-        bounce = -self.cr_wall * v1
-        target = np.where(below, np.maximum(bounce, (lo - x) / dt), np.minimum(bounce, (hi - x) / dt))
-        hit = below | above
-        implicit.fixed_dv[rows] = np.where(hit, target - self.vel_mps[rows], implicit.fixed_dv[rows])
-        implicit.fixed[rows] |= hit
-        return True
+        """Put the walls that pucks on implicit springs would cross into the solve (implicit.brace_walls)."""
+        walls = (self.size_m, self.cr_wall)
+        return implicit_solve.brace_walls(self.pos_m, self.vel_mps, dv, self.radius_m, walls, implicit, released, dt)
 
     def _resolve_walls(self, only: np.ndarray | None = None) -> None:
         """Push pucks back inside the walls and bounce them (only the rows `only`, if given)."""
