@@ -64,3 +64,18 @@ def test_a_few_pucks_look_as_before_overlaps_included() -> None:
     assert tuple(image[310, 205]) == core_color(ORANGE)  # on top of the white one
     assert tuple(image[600, 50]) == WHITE
     assert tuple(image[2, 300]) == core_color((0, 200, 255))
+
+
+def test_stamped_pucks_overlap_in_their_own_order_as_blitted_ones_do() -> None:
+    # 3000 pucks of radius 6 piled on a 200 x 150 px patch: the later puck is on top, as with blits.
+    rng = np.random.default_rng(2)
+    centers = rng.uniform((40.0, 30.0), (240.0, 180.0), (3000, 2))
+    r_px = np.full(3000, 6)
+    colors = np.tile(np.array(WHITE, dtype=np.uint8), (3000, 1))
+    sprites = PuckSprites()
+    stamped = []
+    original = sprites.stamp
+    sprites.stamp = lambda r, color, target: stamped.append(r) or original(r, color, target)
+    image = drawn((320, 240), centers, r_px, colors, sprites)
+    assert stamped == [6]
+    assert np.array_equal(image, blitted_one_by_one((320, 240), centers, r_px, colors))
