@@ -75,8 +75,11 @@ def _child_app(how: str) -> None:
     """`python -m airtable.bench_cpu still|paused|server`: the app with its server on, until killed."""
     from airtable.app.app import App
     from airtable.app.demo_loader import BUILTIN_DIR, DemoShelf
+    from airtable.app.window import prefer_plain_framebuffer
     from airtable.net.server import GameServer
 
+    if how != "server":
+        prefer_plain_framebuffer()  # as the app's own entry point does (cli.main)
     server = GameServer(host="127.0.0.1", port=0)
     server.start()
     app = App(DemoShelf([BUILTIN_DIR]), demo_key="2", headless=how == "server", server=server)
