@@ -152,7 +152,7 @@ def draw_pucks(target: pygame.Surface, sprites: PuckSprites, centers: np.ndarray
     inverse = inverse.ravel()
     sprite_of = [(k >> 24, ((k >> 16) & 255, (k >> 8) & 255, k & 255)) for k in uniq.tolist()]
     corner = np.rint(centers).astype(np.int64) - r_px[:, None]
-    if target.get_bytesize() == 4 and target.get_parent() is None and counts.max() >= STAMP_MIN_PUCKS:
+    if _stampable(target) and counts.max() >= STAMP_MIN_PUCKS:
         left = _stamp_groups(target, sprites, sprite_of, inverse, counts, corner)
         if not left.all():
             corner, inverse = corner[left], inverse[left]
@@ -162,13 +162,18 @@ def draw_pucks(target: pygame.Surface, sprites: PuckSprites, centers: np.ndarray
         target.fblits(list(zip(sources, zip(corner[:, 0].tolist(), corner[:, 1].tolist()))))
 
 
+def _stampable(target: pygame.Surface) -> bool:
+    """Pixels written straight into `target` look as blitted: 32 bits, no alpha, not a view of another surface."""
+    return target.get_bytesize() == 4 and not target.get_flags() & pygame.SRCALPHA and target.get_parent() is None
+
+
 def _stamp_groups(
     target: pygame.Surface, sprites: PuckSprites, sprite_of, inverse: np.ndarray, counts, corner: np.ndarray
 ) -> np.ndarray:
     """Stamp every group big enough for it, of a sprite small enough; returns which pucks are left to blit."""
     left = np.ones(len(corner), dtype=bool)
     for i, ((r, color), count) in enumerate(zip(sprite_of, counts.tolist())):
-        if count < STAMP_MIN_PUCKS or (r + 1) ** 2 > STAMP_MAX_PIXELS:  # a sprite has more pixels than (r + 1)^2
+        if count < STAMP_MIN_PUCKS or (r + 1) ** 2 > STAMP_MAX_PIXELS:  # too big, as a disc has more pixels
             continue
         stamp = sprites.stamp(r, color, target)
         if len(stamp[0]) <= STAMP_MAX_PIXELS:
