@@ -427,7 +427,7 @@ class GameServer:
                 case PlayerInput(cid, record):
                     client = self._clients.get(cid)
                     if client is not None:
-                        client.set_input(table, record.cursor_m, record.button, record.keys)
+                        client.set_input(table, record.cursor_m, record.button)  # INPUT's keys are not used
                         client.active = True
 
     def apply_inputs(self, clients: list[Client], table) -> None:
