@@ -57,6 +57,7 @@ class Gate:
         self.handshakes: Counter[str] = Counter()
         self.players: Counter[str] = Counter()
         self._guesses: dict[str, _Guesses] = {}
+        self._open = 0
 
     def _limited(self, host: str) -> bool:
         return self.limit_loopback or not is_loopback(host)
@@ -79,12 +80,19 @@ class Gate:
             )
         return None
 
+    @property
+    def handshakes_open(self) -> int:
+        """Handshakes under way, from every address."""
+        return self._open
+
     def handshake_started(self, host: str) -> None:
         self.handshakes[host] += 1
+        self._open += 1
 
     def handshake_ended(self, host: str, seated: bool) -> None:
         """A handshake finished: welcomed into a seat (`seated`) or dropped."""
         _down(self.handshakes, host)
+        self._open -= 1
         if seated:
             self.players[host] += 1
 

@@ -547,7 +547,7 @@ class GameServer:
         refusal = self._gate.handshake_refusal(host)
         if len(self._numbers) >= self.max_clients:
             refusal = self._full_sentence()
-        elif sum(c.state == State.HELLO for c in self._conns.values()) >= self.max_handshakes:
+        elif self._gate.handshakes_open >= self.max_handshakes:
             refusal = (
                 f"the table is busy: {self.max_handshakes} computers are joining at once; "
                 "your client tries again by itself in a few seconds"
