@@ -6,12 +6,14 @@ BIN := $(VENV)/bin
 STAMP := $(VENV)/.installed
 ARGS ?=
 
-.PHONY: run test bench lint format clean
+.PHONY: run test bench lint format wheel clean
 
 $(STAMP): pyproject.toml
+	@echo "First run: making $(VENV) and installing airtable with pygame-ce, numpy and the test tools (a minute or so)..."
 	$(PYTHON) -m venv $(VENV)
-	$(BIN)/python -m pip install --quiet --disable-pip-version-check -e '.[test,bench]'
+	$(BIN)/python -m pip install --disable-pip-version-check --progress-bar on -e '.[test,bench]'
 	touch $(STAMP)
+	@echo "Done. To type the commands of README.md as written, activate it: . $(VENV)/bin/activate"
 
 run: $(STAMP)
 	$(BIN)/python -m airtable $(ARGS)
@@ -30,5 +32,9 @@ format: $(STAMP)
 	$(BIN)/ruff format .
 	$(BIN)/ruff check --fix .
 
+# dist/airtable-*.whl: what a student installs with pip to get airtable-client.
+wheel: $(STAMP)
+	$(BIN)/python -m pip wheel --no-deps --wheel-dir dist .
+
 clean:
-	rm -rf $(VENV) build *.egg-info .pytest_cache .ruff_cache
+	rm -rf $(VENV) build dist *.egg-info .pytest_cache .ruff_cache

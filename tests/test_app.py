@@ -258,3 +258,16 @@ def test_frame_rate_counts_the_frames_of_the_last_second(app):
         app.frame(1 / 45)
     assert app.fps == pytest.approx(45.0, rel=1e-6)
     assert app.scene().fps == app.fps
+
+
+def test_importing_the_package_and_the_app_changes_no_environment_variable():
+    import subprocess
+    import sys
+
+    code = (
+        "import os; before = dict(os.environ); import airtable, airtable.cli, airtable.app.app;"
+        " print(sorted(set(os.environ.items()) ^ set(before.items())))"
+    )
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=60)
+    assert done.returncode == 0, done.stderr
+    assert done.stdout.strip().splitlines()[-1] == "[]"

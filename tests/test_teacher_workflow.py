@@ -15,11 +15,10 @@ from conftest import FRAME_S, press, wait_until
 
 from airtable.app.app import App
 from airtable.app.demo_loader import BUILTIN_DIR, DemoShelf, key_order
+from airtable.app.window import GameWindow
 from airtable.cli import main
 from airtable.net import protocol as proto
 from airtable.net.server import GameServer
-
-ROOT = Path(__file__).resolve().parent.parent
 
 
 def demo_source(key: str, pucks: int = 1, build_line: str = "", title: str = "Mine") -> str:
@@ -42,17 +41,6 @@ def make_app(*folders: Path, key: str = "1") -> App:
     return app
 
 
-def run_cli(*args: str, env: dict | None = None, timeout: float = 60) -> subprocess.CompletedProcess:
-    return subprocess.run(
-        [sys.executable, "-m", "airtable", *args],
-        capture_output=True,
-        text=True,
-        timeout=timeout,
-        env={**os.environ, **(env or {})},
-        cwd=ROOT,
-    )
-
-
 # ---------------------------------------------------------------- demo files reload
 
 
@@ -71,6 +59,9 @@ def test_pressing_a_demo_key_reads_its_file_again_after_an_edit(tmp_path, capsys
     assert len(app.table.pucks) == 0  # not the built-in demo 5 in its place
     assert f"{mine}:3: syntax error" in capsys.readouterr().err
 
+    press(app, pygame.K_6)
+    press(app, pygame.K_5)  # from another demo, too: the error, not the built-in 5
+    assert app.panel() == "error" and len(app.table.pucks) == 0
     mine.write_text(demo_source("5", pucks=4, build_line=RAISES))
     press(app, pygame.K_5)
     assert app.build_error is not None and app.build_error.stage == "build"
@@ -128,6 +119,9 @@ def test_the_demo_menu_lists_every_demo_and_starts_the_one_picked(tmp_path):
     press(app, pygame.K_TAB)
     press(app, pygame.K_ESCAPE)  # closes the menu, quits nothing
     assert app.panel() is None and app.running and app.demo_key == "t2"
+    press(app, pygame.K_TAB)
+    press(app, pygame.K_TAB)  # Tab again closes it too
+    assert app.panel() is None
 
 
 # ---------------------------------------------------------------- errors reach the terminal
@@ -147,23 +141,30 @@ def test_a_failing_timed_event_is_reported_and_titled_as_one(tmp_path, capsys):
     assert shown == ["Demo t7: a timed event failed"]
 
 
-def test_headless_run_of_a_demo_that_cannot_be_built_exits_1_and_shows_its_error(tmp_path):
+def test_headless_run_of_a_demo_that_cannot_be_built_exits_1_and_shows_its_error(tmp_path, capsys, monkeypatch):
     folder = tmp_path / "demos"
     folder.mkdir()
     (folder / "throws.py").write_text(demo_source("t9", build_line=RAISES))
     (folder / "syntax.py").write_text("KEY = 't8'\nTITLE = 'x'\ndef build(table, variation=0)\n")
+    panels: list[str] = []
+    monkeypatch.setattr(GameWindow, "draw_panel", lambda self, title, *a, **k: panels.append(title))
     shot = tmp_path / "shot"
-    done = run_cli("--headless", "--no-server", "--seconds", "0.5", "--demos", str(folder), "--demo", "t9",
-                   "--screenshot", str(shot))  # fmt: skip
-    assert done.returncode == 1
-    lines = done.stderr.strip().splitlines()
-    assert f"{folder / 'syntax.py'}:3: syntax error: expected ':'" in lines
-    assert f"{folder / 'throws.py'}:8: RuntimeError: my mistake" in lines
-    assert "Traceback" not in done.stderr
+    argv = ["--headless", "--no-server", "--seconds", "0.5", "--demos", str(folder), "--demo", "t9"]
+    assert main([*argv, "--screenshot", str(shot)]) == 1
+    lines = capsys.readouterr().err.strip().splitlines()
+    assert lines == [
+        f"{folder / 'syntax.py'}:3: syntax error: expected ':'",
+        f"{folder / 'throws.py'}:8: RuntimeError: my mistake",
+    ]
     assert (tmp_path / "shot.png").exists()  # .png added
-    # The screenshot shows this demo's error panel, not the list of files that failed to load.
-    app = make_app(folder, key="t9")
-    assert app.panel() == "error"
+    # Every frame, the last one (the screenshot) included, shows this demo's error,
+    # not the list of files that failed to load.
+    assert set(panels) == {"Demo t9 could not be built"}
+
+
+def test_a_headless_run_that_works_exits_0_in_simulated_time(capsys):
+    assert main(["--headless", "--no-server", "--seconds", "10", "--demo", "7"]) == 0  # 10 s of demo, at once
+    assert capsys.readouterr().err == ""
 
 
 # ---------------------------------------------------------------- Esc is safe

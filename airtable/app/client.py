@@ -1,7 +1,7 @@
 """Client: one user at the table (the local mouse or a network player).
 
 A client holds its latest input: cursor position in world metres, which mouse
-button is down (0 none, 1-3 the three cursor strings) and the keys held. When a
+button is down (0 none, 1-3 the three cursor strings). When a
 button goes down over a puck the client grabs it; until the button is released,
 `cursor_pulls` turns it into a Pull (the string's spring and drag) that the game
 loop hands to every `AirTable.step`. No pygame and no sockets here.
@@ -35,18 +35,16 @@ class Client:
     color: tuple[int, int, int] = LOCAL_COLOR
     cursor_m: np.ndarray = field(default_factory=lambda: np.zeros(2))
     button: int = 0
-    keys: frozenset[str] = frozenset()
     held: object = None  # airtable.physics.bodies.Puck or None
     active: bool = True
 
-    def set_input(self, table, cursor_m, button: int, keys=frozenset()) -> None:
+    def set_input(self, table, cursor_m, button: int) -> None:
         """Take new input; grab the puck under the cursor when a button goes down."""
         self.cursor_m = np.asarray(cursor_m, dtype=float).reshape(2).copy()
         if button not in (0, *CURSOR_STRINGS):
             raise ValueError(f"mouse button must be 0-3, not {button!r}")
         pressed = button != 0 and self.button == 0
         self.button = button
-        self.keys = frozenset(keys)
         if button == 0:
             self.held = None
         elif pressed:

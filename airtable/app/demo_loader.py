@@ -190,6 +190,7 @@ class DemoShelf:
         self._extra: list[Path] = []  # files given one by one (from_demos)
         self._fixed: dict[str, Demo] = {}  # demos with no file
         self._loaded: dict[Path, tuple[tuple[int, int] | None, Demo | DemoError]] = {}
+        self._last_key: dict[Path, str] = {}  # the key each file had when it last loaded
         self.demos: dict[str, Demo] = {}
         self.errors: list[DemoError] = []
         self.refresh()
@@ -223,16 +224,19 @@ class DemoShelf:
                 self._loaded[path] = known
             if isinstance(known[1], Demo):
                 demos[known[1].key] = known[1]
+                self._last_key[path] = known[1].key
             else:
                 errors.append(known[1])
         self.demos = {k: demos[k] for k in sorted(demos, key=key_order)}
         self.errors = errors
         return fresh
 
-    def error_for(self, path: Path | None) -> DemoError | None:
-        """The load error of the file at `path` as it is now, if it has one."""
-        known = self._loaded.get(Path(path)) if path is not None else None
-        return known[1] if known is not None and isinstance(known[1], DemoError) else None
+    def broken(self, key: str) -> DemoError | None:
+        """The load error of the file that last gave demo `key`, if that file now fails."""
+        for path, (_, item) in self._loaded.items():
+            if isinstance(item, DemoError) and self._last_key.get(path) == key:
+                return item
+        return None
 
 
 def discover(directories: Iterable[Path]) -> tuple[dict[str, Demo], list[DemoError]]:

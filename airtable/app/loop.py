@@ -11,7 +11,24 @@ used by the teacher's app and by the load tool's headless table:
 - `FrameLoop`: calls `frame(dt_s)` until told to stop. In real time it sleeps
   until the next frame is due (it never spins), at most `fps` frames a second;
   with `fixed_dt_s` it runs simulated frames of that length back to back, so
-  tests and headless runs count frames, not wall-clock seconds.
+  tests and headless runs count frames, not wall-clock seconds. `period_s`
+  may change between frames (the app slows down while the table is still).
+
+A headless table in a thread, as the load tool runs one:
+
+    stepper, counter, loop = FixedStep(1 / 240), FpsCounter(), FrameLoop(fps=60)
+
+    def frame(dt_s):
+        for _ in range(stepper.steps(dt_s)):
+            table.step(stepper.dt_s, pulls)
+        fps = counter.tick(time.monotonic())
+        ...
+
+    thread = threading.Thread(target=loop.run, args=(frame,), daemon=True)
+    thread.start()
+    ...
+    loop.stop.set()   # wakes the loop at once; it returns after the current frame
+    thread.join()
 """
 
 from __future__ import annotations

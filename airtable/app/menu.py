@@ -65,5 +65,5 @@ class DemoMenu:
         return shown
 
     def footer(self) -> str:
-        typed = f'   typed: "{self.typed}"' if self.typed else ""
-        return f"{self.selected + 1} of {len(self.items)}: Up/Down and Enter, or type a key; Esc closes{typed}"
+        typed = f"; typed so far: {self.typed}" if self.typed else ""
+        return f"{self.selected + 1} of {len(self.items)}. Up / Down and Enter, or type a key; Esc or Tab closes{typed}"
