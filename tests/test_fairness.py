@@ -6,20 +6,16 @@ reason elsewhere. Takes about ten seconds.
 
 from __future__ import annotations
 
-import inspect
 import statistics
 
 import pytest
 
 from airtable.net import fairness
-from airtable.net.server import GameServer
 
 WHY_NOT = fairness.available()
-SPEAKS_FORMAT_2 = "snapshot_format" in inspect.signature(GameServer).parameters
 
 
 @pytest.mark.skipif(WHY_NOT is not None, reason=f"no network namespace here: {WHY_NOT}")
-@pytest.mark.skipif(not SPEAKS_FORMAT_2, reason="the server does not send snapshot format 2 yet")
 def test_thirty_students_on_ten_mbit_each_get_25_snapshots_a_second():
     result = fairness.measure_rates(10, clients=30, seconds=4)
     rates = result.rates

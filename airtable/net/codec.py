@@ -36,18 +36,27 @@ from dataclasses import dataclass
 import numpy as np
 
 from airtable.app.scene import CursorView, Scene
-from airtable.net.protocol import SNAPSHOT, ProtocolError, printable
+from airtable.net.protocol import (
+    LAYOUT,
+    MAX_DRAWN_CURSORS,
+    MAX_DRAWN_PUCKS,
+    MAX_DRAWN_SPRINGS,
+    MAX_DRAWN_TEXT_CHARS,
+    MAX_VIEW_ZOOM,
+    MIN_VIEW_ZOOM,
+    SNAPSHOT,
+    ProtocolError,
+    cursor_limits,
+    encode_frame,
+    printable,
+    table_size_problem,
+)
 
 FORMAT_VERSION = 2
-LAYOUT = 7  # frame type: the layout part of a snapshot (server -> client)
 UNITS_PER_M = 4000  # positions travel as whole quarter millimetres
 MAX_Q = 1 << 30  # |position| <= 268 km in those units, so residuals fit 32 bits
-MAX_PUCKS = 1_000_000
-MAX_SPRINGS = 1_000_000
-MAX_CURSORS = 1024
 MAX_TEXT_BYTES = 1024  # title, correction mode, names
 MAX_STATUS_BYTES = 2048
-MAX_TABLE_M = 1e6
 MAX_TIME_US = 1 << 60
 MAX_GAP = 255  # ticks between a delta and its base; further back gets a keyframe
 MAX_PREDICT_SPAN_US = 10_000_000  # prediction only over gaps up to 10 s (keeps int64 products small)
@@ -58,7 +67,6 @@ HAS_STATUS = 4
 DEFLATED = 8
 GRAVITY = 1
 
-_ENVELOPE = struct.Struct(">IB")
 # magic, format, flags, seq, gap1, gap2, layout version, epoch, time_us, server clock ms, centi-fps, residual width
 _TICK = struct.Struct("<4sBBIBBHHqIHB")
 _VIEW = struct.Struct("<3d")
@@ -67,11 +75,6 @@ _TEXT_DELTA = struct.Struct("<HHH")
 _LAYOUT = struct.Struct("<4sBBHIII2d")
 TICK_MAGIC = b"ATSN"
 LAYOUT_MAGIC = b"ATLY"
-
-
-def frame(frame_type: int, payload: bytes) -> bytes:
-    """The protocol's frame envelope around a payload."""
-    return _ENVELOPE.pack(len(payload) + 1, frame_type) + payload
 
 
 def _bad(what: str) -> ProtocolError:
@@ -247,17 +250,14 @@ def decode_layout(payload: bytes) -> Layout:
         raise ProtocolError(f"the layout is only {len(payload)} bytes, less than its {_LAYOUT.size} byte header")
     magic, version, flags, layout_version, n, s, c, width_m, height_m = _LAYOUT.unpack_from(payload)
     _check_magic(magic, version, LAYOUT_MAGIC)
-    if n > MAX_PUCKS or s > MAX_SPRINGS or c > MAX_CURSORS:
+    if n > MAX_DRAWN_PUCKS or s > MAX_DRAWN_SPRINGS or c > MAX_DRAWN_CURSORS:
         raise _bad(
-            f"a layout of {n} pucks, {s} springs and {c} cursors (limits {MAX_PUCKS}, {MAX_SPRINGS}, {MAX_CURSORS})"
+            f"{n} pucks, {s} springs and {c} cursors, more than this client draws "
+            f"({MAX_DRAWN_PUCKS}, {MAX_DRAWN_SPRINGS} and {MAX_DRAWN_CURSORS})"
         )
-    if not (
-        math.isfinite(width_m)
-        and math.isfinite(height_m)
-        and 0 < width_m <= MAX_TABLE_M
-        and 0 < height_m <= MAX_TABLE_M
-    ):
-        raise _bad(f"a bad table size ({width_m!r} x {height_m!r} m)")
+    problem = table_size_problem(width_m, height_m)
+    if problem:
+        raise _bad(problem)
     fixed = n * 11 + s * 27 + c * 3
     body = _inflate_texts(payload[_LAYOUT.size :], fixed, c)
     r = _Reader(body, "layout")
@@ -272,19 +272,14 @@ def decode_layout(payload: bytes) -> Layout:
     correction = r.text(MAX_TEXT_BYTES, "puck correction mode")
     names = tuple(r.text(MAX_TEXT_BYTES, "cursor name") for _ in range(c))
     r.done()
-    if not (np.isfinite(radius).all() and (radius > 0).all() and (radius <= MAX_TABLE_M).all()):
-        raise _bad("a puck radius that is not a positive number")
-    if not (np.isfinite(spring_length).all() and np.isfinite(spring_width).all()):
-        raise _bad("a spring size that is not finite")
-    if s and int(pairs.max()) >= n:
-        raise _bad("a spring joined to a puck that is not there")
+    _check_bodies(max(width_m, height_m), radius, pairs, spring_length, spring_width, n)
     return Layout(
         layout_version,
         width_m,
         height_m,
         bool(flags & GRAVITY),
         correction,
-        title,
+        title[:MAX_DRAWN_TEXT_CHARS],
         radius,
         color,
         pairs,
@@ -294,6 +289,21 @@ def decode_layout(payload: bytes) -> Layout:
         names,
         cursor_colors,
     )
+
+
+def _check_bodies(size: float, radius, pairs, spring_length, spring_width, n: int) -> None:
+    """The same bounds as the drawing code assumes: sizes against the table's size."""
+    if not (np.isfinite(radius).all() and ((radius > 0) & (radius <= size)).all()):
+        raise _bad("a puck radius that is not between 0 and the table's size")
+    if not (np.isfinite(spring_length).all() and np.isfinite(spring_width).all()):
+        raise _bad("a spring size that is not finite")
+    if not (
+        ((spring_length >= 0) & (spring_length <= 100 * size)).all()
+        and ((spring_width >= 0) & (spring_width <= size)).all()
+    ):
+        raise _bad("a spring longer or wider than the table allows")
+    if len(pairs) and int(pairs.max()) >= n:
+        raise _bad("a spring joined to a puck that is not there")
 
 
 def _inflate_texts(data: bytes, fixed: int, cursors: int) -> bytes:
@@ -559,11 +569,18 @@ class SnapshotEncoder:
         )
         with self._lock:
             if layout is not old:
-                self._layout_frame = frame(LAYOUT, encode_layout(layout))
+                self._layout_frame = encode_frame(LAYOUT, encode_layout(layout))
             self._layout = layout
             self._newest = tick
             self._cache = {}
         return tick
+
+    def forget(self) -> None:
+        """Drop the newest tick (nobody is watching): a player who joins later waits
+        for the next one instead of being greeted with a picture from long ago."""
+        with self._lock:
+            self._newest = None
+            self._cache = {}
 
     def frames_for(self, viewer: Viewer) -> bytes:
         """The bytes that bring `viewer` to the newest tick (b"" if it has it); updates `viewer`."""
@@ -583,7 +600,7 @@ class SnapshotEncoder:
         cached = cache.get(key)
         if cached is None:
             payload, keyframe = encode_tick(tick, b1, b2)
-            cached = cache[key] = (frame(SNAPSHOT, payload), keyframe)
+            cached = cache[key] = (encode_frame(SNAPSHOT, payload), keyframe)
             self.encodings += 1
         data, keyframe = cached
         viewer.layout_version = tick.layout.version
@@ -653,7 +670,7 @@ class SnapshotDecoder:
             if len(b1.values) != count:
                 raise _bad("a delta on a tick with another number of pucks or cursors")
             values = predict(time_us, 2 * n + 2 * c, b1, b2) + residuals
-        _check_values(values, n, c)
+        _check_values(values, layout)
         tick = Tick(seq, layout, epoch, time_us, clock_ms, centi_fps, view, status, values)
         if self.last is not None:  # unwrap the 32-bit millisecond clock
             self._clock_s += ((clock_ms - self.last.clock_ms) & 0xFFFFFFFF) / 1e3
@@ -704,7 +721,7 @@ class SnapshotDecoder:
             spring_color_rgb=layout.spring_color_rgb,
             cursors=cursors,
             title=layout.title,
-            status=tick.status,
+            status=tick.status[:MAX_DRAWN_TEXT_CHARS],
             gravity_on=layout.gravity_on,
             puck_correction=layout.puck_correction,
             time_s=tick.time_us / 1e6,
@@ -716,14 +733,22 @@ class SnapshotDecoder:
 
 def _check_view(view: tuple[float, float, float], layout: Layout) -> None:
     zoom, ox, oy = view
-    if not all(math.isfinite(x) for x in view) or not 0 < zoom <= 1e6 or max(abs(ox), abs(oy)) > MAX_TABLE_M:
-        raise _bad(f"a bad view (zoom {zoom!r}, origin {ox!r}, {oy!r})")
+    if not all(math.isfinite(x) for x in view) or not MIN_VIEW_ZOOM <= zoom <= MAX_VIEW_ZOOM:
+        raise _bad(f"a zoom of {zoom:g}, outside {MIN_VIEW_ZOOM:g} to {MAX_VIEW_ZOOM:g}")
+    x0, y0, x1, y1 = cursor_limits(layout.width_m, layout.height_m)
+    if not (x0 <= ox <= x1 and y0 <= oy <= y1):
+        raise _bad(f"a view origin ({ox:g}, {oy:g}) far off the table")
 
 
-def _check_values(values: np.ndarray, n: int, c: int) -> None:
+def _check_values(values: np.ndarray, layout: Layout) -> None:
+    """Positions near the table (as cursors may be), buttons 0-3, held rows of real pucks."""
+    n, _, c = layout.sizes
     moving = 2 * n + 2 * c
-    if len(values) and np.abs(values[:moving]).max(initial=0) > MAX_Q:
-        raise _bad("a position out of range")
+    x0, y0, x1, y1 = (round(v * UNITS_PER_M) for v in cursor_limits(layout.width_m, layout.height_m))
+    xs = np.concatenate([values[:n], values[2 * n : 2 * n + c]])
+    ys = np.concatenate([values[n : 2 * n], values[2 * n + c : moving]])
+    if len(xs) and (xs.min() < x0 or xs.max() > x1 or ys.min() < y0 or ys.max() > y1):
+        raise _bad("a position that is far off the table")
     buttons = values[moving : moving + c]
     held = values[moving + c :]
     if c and (buttons.min() < 0 or buttons.max() > 3 or held.min() < 0 or held.max() > n):

@@ -20,7 +20,6 @@ The two halves that run inside the namespace are subcommands of this module:
 from __future__ import annotations
 
 import argparse
-import inspect
 import json
 import os
 import selectors
@@ -135,25 +134,12 @@ def _wait_ready(proc: subprocess.Popen, timeout_s: float) -> None:
     raise RuntimeError("the table server in the namespace did not start")
 
 
-def measure_rates(
-    mbit: float, clients: int = 30, seconds: float = 5.0, demo: str = "4", snapshot_format: int = 2
-) -> Rates:
+def measure_rates(mbit: float, clients: int = 30, seconds: float = 5.0, demo: str = "4") -> Rates:
     """Run a demo table and `clients` players in a namespace held to `mbit` Mbit/s."""
     py = sys.executable
     with Namespace(mbit) as ns:
         server = subprocess.Popen(
-            ns.command(
-                py,
-                "-m",
-                "airtable.net.fairness",
-                "serve",
-                "--demo",
-                demo,
-                "--seconds",
-                str(seconds + 60),
-                "--format",
-                str(snapshot_format),
-            ),  # fmt: skip
+            ns.command(py, "-m", "airtable.net.fairness", "serve", "--demo", demo, "--seconds", str(seconds + 60)),
             stdout=subprocess.PIPE,
             stderr=subprocess.DEVNULL,
             text=True,
@@ -177,23 +163,15 @@ def measure_rates(
 # ---------------------------------------------------------------- the halves inside the namespace
 
 
-def serve(demo_key: str, seconds: float, snapshot_format: int = 2) -> int:
+def serve(demo_key: str, seconds: float) -> int:
     """A headless demo table with a server on 127.0.0.1:PORT, for `seconds` at most."""
-    from airtable.app.demo_loader import BUILTIN_DIR, discover
-    from airtable.net.loadtest import TableLoop
+    from airtable.net.loadtest import TableLoop, table_for
     from airtable.net.server import GameServer
-    from airtable.physics.table import AirTable
 
-    demos, _ = discover([BUILTIN_DIR])
-    demo = demos[demo_key]
-    table = AirTable()
-    demo.build(table, 0)
-    options = {}
-    if "snapshot_format" in inspect.signature(GameServer).parameters:  # until format 2 is the only one
-        options["snapshot_format"] = snapshot_format
-    server = GameServer(host="127.0.0.1", port=PORT, max_clients=200, **options)
+    table, dt_s, title = table_for(demo_key)
+    server = GameServer(host="127.0.0.1", port=PORT, max_clients=200)
     server.start()
-    loop = TableLoop(server, table, fps=60, dt_s=demo.dt_s, title=demo.label()).start()
+    loop = TableLoop(server, table, fps=60, dt_s=dt_s, title=title).start()
     print(READY, flush=True)
     try:
         time.sleep(seconds)
@@ -246,7 +224,6 @@ def main(argv: Sequence[str] | None = None) -> int:
     s = sub.add_parser("serve")
     s.add_argument("--demo", default="4")
     s.add_argument("--seconds", type=float, default=60.0)
-    s.add_argument("--format", type=int, choices=(1, 2), default=2, help="snapshot format")
     m = sub.add_parser("measure")
     m.add_argument("--clients", type=int, default=30)
     m.add_argument("--seconds", type=float, default=5.0)
@@ -255,7 +232,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     parser.add_argument("--seconds", type=float, default=5.0)
     args = parser.parse_args(argv)
     if args.command == "serve":
-        return serve(args.demo, min(args.seconds, 3600.0), args.format)
+        return serve(args.demo, min(args.seconds, 3600.0))
     if args.command == "measure":
         return measure(args.clients, args.seconds)
     bench(args.mbit, args.clients, args.seconds)

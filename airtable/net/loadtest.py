@@ -222,8 +222,9 @@ class TableLoop:
         """One frame of `frame_dt_s` seconds."""
         with self.lock:
             self.server.apply_inputs(self.clients, self.table)
+            pulls = cursor_pulls(self.clients)  # inputs change between frames, not between steps
             for _ in range(self._stepper.steps(frame_dt_s)):
-                self.table.step(self.dt_s, cursor_pulls(self.clients))
+                self.table.step(self.dt_s, pulls)
             self.fps = self._fps.tick(time.monotonic())
             t = self.table
             status = f"{len(t.pos_m)} pucks   {len(self.server.player_names())} players   t = {t.time_s:.2f} s"
@@ -244,8 +245,31 @@ class TableLoop:
             self._thread = None
 
 
-def serve(host: str, port: int, fps: float, seconds: float | None, password: str | None, max_clients: int) -> int:
-    """`--serve`: a bare headless table for load tests; prints its frame rate every 5 s."""
+def table_for(demo: str | None = None, gas: int | None = None) -> tuple[AirTable, float, str]:
+    """(table, physics step, title) to serve: a built-in demo by key, a gas of `gas`
+    pucks (the benchmark's: 30 % cover, 1 m/s), or the plain grid."""
+    if gas is not None:
+        from airtable.bench import DT_S, gas_scene
+
+        return gas_scene(gas), DT_S, f"gas of {gas} pucks"
+    if demo is not None:
+        from airtable.app.demo_loader import BUILTIN_DIR, discover
+
+        demos, _ = discover([BUILTIN_DIR])
+        if demo not in demos:
+            raise ValueError(f"there is no demo {demo!r}; the demos are {', '.join(demos)}")
+        table = AirTable()
+        demos[demo].build(table, 0)
+        return table, demos[demo].dt_s, demos[demo].label()
+    return grid_table(), 1 / 240, "headless table"
+
+
+def serve(
+    host: str, port: int, fps: float, seconds: float | None, password: str | None, max_clients: int, table=None
+) -> int:
+    """`--serve`: a headless table (`table_for`'s triple, default the grid) for load
+    tests; prints its frame rate every 5 s."""
+    table, dt_s, title = table or table_for()
     server = GameServer(host=host, port=port, password=password, max_clients=max_clients)
     try:
         server.start()
@@ -254,7 +278,7 @@ def serve(host: str, port: int, fps: float, seconds: float | None, password: str
         return 1
     for line in server.join_lines():
         print(line, flush=True)
-    loop = TableLoop(server, fps=fps).start()
+    loop = TableLoop(server, table, fps=fps, dt_s=dt_s, title=title).start()
     start = time.monotonic()
     try:
         while seconds is None or time.monotonic() - start < seconds:
@@ -306,27 +330,34 @@ def _start_workers(specs: list[WorkerSpec]) -> list[tuple]:
 
 
 def _expect(pipe, what: str, timeout_s: float):
-    """The next message from a worker, or a ValueError-free None after `timeout_s`."""
-    if not pipe.poll(timeout_s):
-        return None
+    """The next message from a worker, or None after `timeout_s` or when it has died."""
     try:
+        if not pipe.poll(timeout_s):
+            return None
         message = pipe.recv()
-    except EOFError:
+    except (EOFError, OSError):
         return None
     return message if message[0] == what else None
+
+
+def _tell(workers: list[tuple], message: tuple) -> None:
+    """Send `message` to every worker still listening (a dead one just misses it)."""
+    for _, pipe in workers:
+        try:
+            pipe.send(message)
+        except OSError:
+            pass
 
 
 def _run_workers(workers: list[tuple], seconds: float, timeout_s: float) -> list[WorkerReport]:
     """Step the workers through: first player (baseline), the rest join, play, report."""
     for _, pipe in workers:
         _expect(pipe, "joined-first", WORKER_START_S + timeout_s + BASELINE_S)
-    for _, pipe in workers:
-        pipe.send(("connect",))
+    _tell(workers, ("connect",))
     for _, pipe in workers:
         _expect(pipe, "ready", WORKER_START_S + 4 * timeout_s)
     start = time.monotonic() + 0.2  # CLOCK_MONOTONIC is shared by the processes of one machine
-    for _, pipe in workers:
-        pipe.send(("start", start, start + seconds))
+    _tell(workers, ("start", start, start + seconds))
     reports = []
     for _, pipe in workers:
         message = _expect(pipe, "done", seconds + 2 * timeout_s + 5)
@@ -414,11 +445,17 @@ def main(argv: Sequence[str] | None = None) -> int:
     serving.add_argument("--port", type=int, default=proto.DEFAULT_PORT, help="port (default 8888)")
     serving.add_argument("--fps", type=float, default=60.0, help="frames a second (default 60)")
     serving.add_argument("--max-clients", type=int, default=MAX_CLIENTS, help=f"default {MAX_CLIENTS}")
+    serving.add_argument("--demo", help="serve this built-in demo (e.g. 4) instead of a grid")
+    serving.add_argument("--gas", type=int, help="serve a gas of this many pucks instead of a grid")
     args = parser.parse_args(argv)
     if args.serve:
         if not (math.isfinite(args.fps) and 1 <= args.fps <= 1000):
             parser.error("--fps must be 1-1000")
-        return serve(args.host, args.port, args.fps, args.seconds, args.password, args.max_clients)
+        try:
+            table = table_for(args.demo, args.gas)
+        except ValueError as e:
+            parser.error(str(e))
+        return serve(args.host, args.port, args.fps, args.seconds, args.password, args.max_clients, table)
     if args.server is None:
         parser.error("give the table's address HOST[:PORT], or --serve to run one")
     try:

@@ -28,6 +28,7 @@ import numpy as np
 
 from airtable.app.scene import CursorView, Scene
 from airtable.net import protocol as proto
+from airtable.net.playout import SnapshotFeed
 
 CONNECT_TIMEOUT_S = 5.0
 SILENCE_S = 10.0  # no snapshot for this long: the server is gone (snapshots come 30 times a second)
@@ -148,6 +149,7 @@ class NetPlayer:
         self.reconnects = 0
         self.snapshots = 0
         self._scene: Scene | None = None
+        self._feed = SnapshotFeed()
         self._sock: socket.socket | None = None
         self._send_lock = threading.Lock()
         self._closed = threading.Event()
@@ -286,6 +288,7 @@ class NetPlayer:
         with self._send_lock:
             self._sock = sock
             self.welcome = welcome
+            self._feed = SnapshotFeed()  # a new connection starts from a keyframe
             self._throttle.reset()
             self.state = PlayerState.CONNECTED
             self.waiting_because = None
@@ -350,11 +353,13 @@ class NetPlayer:
 
     def _take(self, frames: list, now: float) -> None:
         for frame_type, payload in frames:
-            if frame_type == proto.SNAPSHOT:
+            if frame_type in (proto.SNAPSHOT, proto.LAYOUT):
                 try:
-                    scene = proto.decode_snapshot(payload)
+                    scene = self._feed.feed(frame_type, payload, now)
                 except proto.ProtocolError as e:
                     raise _ConnectionEndedError(str(e)) from None
+                if scene is None:
+                    continue  # a LAYOUT: what the next snapshots need
                 self._scene = scene  # one reference swap: readers see the old or the new scene
                 self.snapshots += 1
                 if self.on_snapshot is not None:
@@ -392,6 +397,11 @@ class NetPlayer:
     def latest(self) -> Scene | None:
         """The newest scene received (None before the first snapshot)."""
         return self._scene
+
+    def smooth(self, now_s: float | None = None) -> Scene | None:
+        """The scene to draw at `now_s` (default: now): interpolated between snapshots a
+        small adaptive delay ago, so motion stays even when snapshots arrive unevenly."""
+        return self._feed.scene(time.monotonic() if now_s is None else now_s)
 
     def send_input(self, cursor_m: Sequence[float], button: int = 0, keys: Iterable[str] = ()) -> bool:
         """Send one INPUT now (no throttle); False when not connected. Never raises."""
@@ -526,7 +536,7 @@ class PlayerApp:
         return self.env
 
     def _caption(self) -> str:
-        return f"Air Table - {self._welcome.client}" if self._welcome else "Air Table - waiting for a place"
+        return f"Air Table - {self._welcome.label}" if self._welcome else "Air Table - waiting for a place"
 
     def _handle_events(self, events) -> bool:
         """Mouse buttons and keys; False when the user quits (window closed or Esc)."""
@@ -564,7 +574,7 @@ class PlayerApp:
 
         net, env = self.net, self.env
         self._follow_welcome()
-        scene = net.latest() or _empty_scene(*self._table_size())
+        scene = net.smooth() or _empty_scene(*self._table_size())
         # The teacher's view: the student sees what the projector shows.
         env.zoom = min(max(scene.zoom, MIN_ZOOM), MAX_ZOOM)
         env.origin_m = np.array(scene.origin_m, dtype=float)
@@ -581,7 +591,7 @@ class PlayerApp:
 
     def _draw(self, scene: Scene, cursor_m: np.ndarray, focused: bool) -> None:
         net, win, welcome = self.net, self.window, self._welcome
-        me = welcome.client if welcome else ""
+        me = welcome.label if welcome else ""
         color = welcome.color if welcome else (200, 200, 200)
         cursors, extra = own_cursor_live(scene.cursors, me, cursor_m, self.button, focused)
         win.draw(
@@ -728,7 +738,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     if welcome is None:
         print(f"airtable-client: {net.waiting_because}; waiting for a place (Esc quits)")
     else:
-        print(f"airtable-client: connected to {net.address}; you are {welcome.client}")
+        print(f"airtable-client: connected to {net.address}; you are {welcome.label}")
     if not args.headless:
         from airtable.app.window import prefer_plain_framebuffer
 

@@ -1,8 +1,9 @@
-"""The airtable wire protocol, version 1 (no pygame, no sockets).
+"""The airtable wire protocol, version 2 (no pygame, no sockets).
 
 Every message is a frame: ``[u32 big-endian length L][u8 type][L-1 payload bytes]``.
-HELLO, WELCOME, ERROR and INPUT carry a JSON object; SNAPSHOT carries a binary
-Scene (layout in `encode_snapshot`); BYE is empty. See DESIGN.md section 5.
+HELLO, WELCOME, ERROR and INPUT carry a JSON object; SNAPSHOT and LAYOUT carry
+snapshot format 2 (codec.py: what moves, coded against what each player holds,
+and what rarely changes); BYE is empty. README documents every byte.
 
 Everything that comes off the network is checked here and turned into small
 immutable values (`Hello`, `InputRecord`, `Welcome`, a `Scene`); a bad message
@@ -26,7 +27,7 @@ import numpy as np
 from airtable.app.scene import CursorView, Scene
 from airtable.physics.table import TABLE_HEIGHT_M, TABLE_WIDTH_M
 
-PROTOCOL_VERSION = 1
+PROTOCOL_VERSION = 2
 DEFAULT_PORT = 8888
 DEFAULT_TABLE_SIZE_M = (TABLE_WIDTH_M, TABLE_HEIGHT_M)  # until the game loop (or a WELCOME) says otherwise
 
@@ -36,7 +37,16 @@ ERROR = 3
 INPUT = 4
 SNAPSHOT = 5
 BYE = 6
-FRAME_NAMES = {HELLO: "HELLO", WELCOME: "WELCOME", ERROR: "ERROR", INPUT: "INPUT", SNAPSHOT: "SNAPSHOT", BYE: "BYE"}
+LAYOUT = 7  # what rarely changes in a snapshot (codec.py), sent when it changes
+FRAME_NAMES = {
+    HELLO: "HELLO",
+    WELCOME: "WELCOME",
+    ERROR: "ERROR",
+    INPUT: "INPUT",
+    SNAPSHOT: "SNAPSHOT",
+    BYE: "BYE",
+    LAYOUT: "LAYOUT",
+}
 CLIENT_FRAMES = frozenset({HELLO, INPUT, BYE})
 
 # Bytes of L (type + payload) a client may send. A real INPUT is under 400
@@ -314,7 +324,7 @@ class Hello:
     password: str | None = None
 
 
-HELLO_EXAMPLE = '{"protocol": 1, "name": "Ann"}'
+HELLO_EXAMPLE = f'{{"protocol": {PROTOCOL_VERSION}, "name": "Ann"}}'
 
 
 def encode_hello(name: str | None = None, password: str | None = None, protocol: int = PROTOCOL_VERSION) -> bytes:
@@ -470,41 +480,52 @@ def parse_input(payload: bytes, table_size_m: Sequence[float] = DEFAULT_TABLE_SI
 
 @dataclass(frozen=True)
 class Welcome:
-    """A validated WELCOME: the player's name and colour and the table size (m)."""
+    """A validated WELCOME: the player's id ("C3") and name, colour and the table size (m)."""
 
     client: str
     color: tuple[int, int, int]
     width_m: float
     height_m: float
     protocol: int = PROTOCOL_VERSION
+    name: str | None = None
+
+    @property
+    def label(self) -> str:
+        """How the table labels this player's cursor: "C3 Ann", or "C3" without a name."""
+        return f"{self.client} {self.name}" if self.name else self.client
 
 
-def encode_welcome(client: str, color: Sequence[int], width_m: float, height_m: float) -> bytes:
-    """A WELCOME frame."""
-    return encode_json(
-        WELCOME,
-        {
-            "protocol": PROTOCOL_VERSION,
-            "client": client,
-            "color": [int(c) for c in color],
-            "table": {"width_m": float(width_m), "height_m": float(height_m)},
-        },
-    )
+def encode_welcome(
+    client: str, color: Sequence[int], width_m: float, height_m: float, name: str | None = None
+) -> bytes:
+    """A WELCOME frame; `client` is the id alone ("C3"), `name` the name the player gave."""
+    message = {
+        "protocol": PROTOCOL_VERSION,
+        "client": client,
+        "color": [int(c) for c in color],
+        "table": {"width_m": float(width_m), "height_m": float(height_m)},
+    }
+    if name:
+        message["name"] = name
+    return encode_json(WELCOME, message)
 
 
 def parse_welcome(payload: bytes) -> Welcome:
     """Check a WELCOME from the server (the player trusts no bytes either)."""
-    message = parse_json(payload, "the server's WELCOME", '{"protocol": 1, ...}')
+    message = parse_json(payload, "the server's WELCOME", f'{{"protocol": {PROTOCOL_VERSION}, ...}}')
     protocol = message.get("protocol")
     if protocol != PROTOCOL_VERSION or isinstance(protocol, bool):
         raise ProtocolError(
             f"the server speaks airtable protocol {_short(protocol)} but this client speaks protocol "
             f"{PROTOCOL_VERSION}; install the same airtable version as the teacher's"
         )
-    _check_fields(message, "the server's WELCOME", ("protocol", "client", "color", "table"))
+    _check_fields(message, "the server's WELCOME", ("protocol", "client", "color", "table"), ("name",))
     client = message["client"]
-    if not (isinstance(client, str) and 1 <= len(client) <= 2 * MAX_NAME_CHARS and client.isprintable()):
-        raise ProtocolError(f"the server's WELCOME has a bad client name {_short(client)}")
+    if not (isinstance(client, str) and re.fullmatch(r"C[1-9][0-9]{0,5}", client)):
+        raise ProtocolError(f"the server's WELCOME has a bad client id {_short(client)} (it should be like C3)")
+    name = message.get("name")
+    if name is not None:
+        name = check_name(name)
     color = _color(message["color"], "the server's WELCOME colour")
     table = message["table"]
     if not isinstance(table, dict):
@@ -515,7 +536,7 @@ def parse_welcome(payload: bytes) -> Welcome:
     problem = table_size_problem(w, h)
     if problem:
         raise ProtocolError(f"the server's WELCOME has {problem}")
-    return Welcome(client, color, w, h, protocol)
+    return Welcome(client, color, w, h, protocol, name)
 
 
 def encode_error(sentence: str, retry: bool = False) -> bytes:

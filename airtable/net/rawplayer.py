@@ -22,7 +22,7 @@ from dataclasses import dataclass, field
 
 from airtable.app.scene import Scene
 from airtable.net import protocol as proto
-from airtable.net.codec import LAYOUT, SnapshotDecoder
+from airtable.net.codec import SnapshotDecoder
 
 CIRCLE_RADIUS_M = 0.5
 CIRCLE_RAD_PER_S = 2.0
@@ -36,21 +36,6 @@ class LoadError(Exception):
 
 def _key(cursor_m) -> tuple[int, int]:
     return (round(cursor_m[0] / QUANTUM_M), round(cursor_m[1] / QUANTUM_M))
-
-
-class SnapshotReader:
-    """Decodes SNAPSHOT payloads of format 1 or 2 (LAYOUT frames feed format 2)."""
-
-    def __init__(self) -> None:
-        self.format2 = SnapshotDecoder()
-
-    def layout(self, payload: bytes) -> None:
-        self.format2.feed_layout(payload)
-
-    def scene(self, payload: bytes) -> Scene:
-        if payload[4:5] == b"\x01":
-            return proto.decode_snapshot(payload)
-        return self.format2.feed_tick(payload).scene
 
 
 @dataclass
@@ -81,8 +66,8 @@ class RawPlayer:
         except OSError as e:
             raise LoadError(f"cannot connect to {self.host}:{self.port} ({e})") from None
         sock.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
-        self._reader = proto.FrameReader(proto.MAX_SERVER_FRAME, {*proto.FRAME_NAMES, LAYOUT}, "the server")
-        self._snapshots = SnapshotReader()
+        self._reader = proto.FrameReader(proto.MAX_SERVER_FRAME, proto.FRAME_NAMES, "the server")
+        self._snapshots = SnapshotDecoder()
         deadline = time.monotonic() + timeout_s
         try:
             sock.sendall(proto.encode_hello(self.name, self.password))
@@ -107,12 +92,12 @@ class RawPlayer:
                 self.snapshot_times.append(now)
                 self.snapshot_sizes.append(5 + len(payload))
                 if self.decode:
-                    self._look(self._snapshots.scene(payload), now)
+                    self._look(self._snapshots.feed_tick(payload).scene, now)
                 continue
             self.other_bytes += 5 + len(payload)
-            if kind == LAYOUT:
+            if kind == proto.LAYOUT:
                 if self.decode:
-                    self._snapshots.layout(payload)
+                    self._snapshots.feed_layout(payload)
             elif kind == proto.WELCOME:
                 self.welcome = proto.parse_welcome(payload)
             elif kind == proto.ERROR:
@@ -123,7 +108,7 @@ class RawPlayer:
     def _look(self, scene: Scene, now: float) -> None:
         self.scene = scene
         self.fps.append((now, scene.fps))
-        me = self.welcome.client if self.welcome else None
+        me = self.welcome.label if self.welcome else None
         for cursor in scene.cursors:
             if cursor.name == me:
                 sent = self.sent.pop(_key(cursor.cursor_m), None)
