@@ -61,8 +61,9 @@ def test_a_calm_run_holds_the_class_and_counts_the_bandwidth():
 def test_a_busy_tool_says_it_was_the_bottleneck():
     busy = _result(tool_cpu=[0.95, 0.4], snapshot_rates=[10.0] + [30.0] * 29)
     assert "the load tool itself was the bottleneck (a worker used 95 % of a core)" in busy.verdict()
-    late = _result(tool_lag_s=[0.05])
-    assert "loop ran 50 ms late" in late.verdict()
+    assert "bottleneck" not in _result(tool_lag_s=[0.03]).verdict()  # a frame or two late is normal
+    late = _result(tool_lag_s=[0.2])
+    assert "loop ran 200 ms late" in late.verdict()
 
 
 def test_about_fifty_players_per_process():

@@ -58,6 +58,9 @@ MAX_SECONDS = 600.0
 BASELINE_S = 1.0  # frame rate measured with one quiet player before the others join
 WORKER_START_S = 20.0  # a spawned worker imports numpy and airtable first
 TOOL_CPU_LIMIT = 0.85  # a worker busier than this (share of one core) may be what limits the numbers
+# A worker whose loop runs later than this (95th percentile) sends its inputs late and reads late.
+TOOL_LATE_PERIODS = 3
+TOOL_LATE_S = 0.05
 
 
 @dataclass
@@ -101,7 +104,7 @@ class LoadResult:
     def tool_bottleneck(self) -> str | None:
         """Why this tool's own numbers cannot be trusted, or None."""
         busy = [c for c in self.tool_cpu if c > TOOL_CPU_LIMIT]
-        late = [lag for lag in self.tool_lag_s if lag > self.input_period_s]
+        late = [lag for lag in self.tool_lag_s if lag > max(TOOL_LATE_PERIODS * self.input_period_s, TOOL_LATE_S)]
         if not busy and not late:
             return None
         why = []

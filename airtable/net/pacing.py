@@ -41,7 +41,7 @@ except (ImportError, AttributeError):  # Windows, or a platform without the requ
 SLACK_SNAPSHOTS = 1  # snapshots in flight besides the new one, while the link is not queueing
 # The link is queueing when the smoothed round trip exceeds the lowest seen by this much.
 QUEUEING_FACTOR = 2.0
-QUEUEING_EXTRA_S = 0.005
+QUEUEING_EXTRA_S = 0.03
 RECHECK_S = 0.002  # how often a held-back student is looked at again
 
 T = TypeVar("T")
