@@ -16,6 +16,9 @@ from collections.abc import Sequence
 from pathlib import Path
 
 from airtable.app.demo_loader import BUILTIN_DIR, Demo, DemoError, DemoShelf
+from airtable.app.recorder import check_record_path
+from airtable.app.saved_demo import DEFAULT_FOLDER as SAVED_DEMOS_DIR
+from airtable.app.saved_demo import check_save_demo_path
 from airtable.assets import ASSETS_DIR
 from airtable.memory import keep_freed_memory
 
@@ -53,11 +56,25 @@ def build_parser() -> argparse.ArgumentParser:
         help="save the last frame to FILE.png at exit (.png is added if the name lacks it)",
     )
     p.add_argument(
+        "--record",
+        default=None,
+        metavar="FILE.csv",
+        help="at exit, write every puck's state at every step to FILE.csv and the energies and momentum to"
+        " FILE_energy.csv (as far back as memory keeps: minutes for a few pucks)",
+    )
+    p.add_argument(
+        "--save-demo",
+        default=None,
+        metavar="FILE.py",
+        help="at exit, write the table as it is then as a new demo file FILE.py (load it with --demos FOLDER)",
+    )
+    p.add_argument(
         "--demos",
         action="append",
         default=[],
         metavar="DIR",
-        help="also load every demo file in DIR (a key already taken is replaced); may be repeated",
+        help="also load every demo file in DIR (a key already taken is replaced); may be repeated; Ctrl+S saves"
+        " demos in the last DIR (without --demos: in ./my_demos, loaded when it exists)",
     )
     p.add_argument(
         "--new-demo", default=None, metavar="FILE.py", help="write a commented starter demo to FILE.py and exit"
@@ -179,7 +196,10 @@ def load_demos(parser: argparse.ArgumentParser, args: argparse.Namespace) -> Dem
     for directory in args.demos:
         if not Path(directory).is_dir():
             parser.error(f"--demos {directory}: no such folder")
-    shelf = DemoShelf([BUILTIN_DIR, *map(Path, args.demos)])
+    folders = [Path(d) for d in args.demos]
+    if not folders and SAVED_DEMOS_DIR.is_dir():  # the demos Ctrl+S saved here before
+        folders.append(SAVED_DEMOS_DIR)
+    shelf = DemoShelf([BUILTIN_DIR, *folders])
     if args.list_demos:
         return shelf
     if args.demo not in shelf.demos:
@@ -212,6 +232,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     shot = None
     try:
         shot = screenshot_path(args.screenshot) if args.screenshot else None
+        args.record = check_record_path(args.record) if args.record else None
+        args.save_demo = check_save_demo_path(args.save_demo) if args.save_demo else None
     except ValueError as exc:
         print(f"airtable: {exc}", file=sys.stderr)
         return 1
@@ -220,6 +242,29 @@ def main(argv: Sequence[str] | None = None) -> int:
         print(f"airtable: {problem}", file=sys.stderr)
         return 1
     return run_app(args, shelf, shot)
+
+
+def write_outputs(app, args: argparse.Namespace) -> int:
+    """At the end of a run: the --record files and the --save-demo file; 1 if one could not be written
+    (said on stderr), else 0."""
+    from airtable.app.lessons import save_moment
+
+    status = 0
+    if args.save_demo is not None:
+        if save_moment(app, args.save_demo) is None:
+            print(f"airtable: {app.message}", file=sys.stderr)
+            status = 1
+        else:
+            print(app.message)
+    if args.record is not None:
+        try:
+            pucks, energy = app.lessons.recorder.write(args.record)
+        except OSError as exc:
+            print(f"airtable: could not write the recording {args.record}: {exc}", file=sys.stderr)
+            status = 1
+        else:
+            print(f"recorded {app.lessons.recorder.summary()} to {pucks} and {energy}")
+    return status
 
 
 def run_app(args: argparse.Namespace, shelf: DemoShelf, shot: Path | None) -> int:
@@ -244,6 +289,7 @@ def run_app(args: argparse.Namespace, shelf: DemoShelf, shot: Path | None) -> in
             except (OSError, pygame.error) as exc:
                 print(f"airtable: could not save the screenshot {shot}: {exc}", file=sys.stderr)
                 status = 1
+        status = max(status, write_outputs(app, args))
         if args.headless and any(e.stage != "load" for e in app.errors):
             status = 1
     except KeyboardInterrupt:

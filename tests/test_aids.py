@@ -305,3 +305,161 @@ def test_a_failing_timed_event_shows_its_error_and_pauses(demos, tmp_path):
     press(app, pygame.K_2)
     assert app.build_error is None and len(app.table.pucks) == 8
     assert not app.paused
+
+
+# ---------------------------------------------------------------- aids that teach
+
+SHIFT_DEMOS = [("1p", 29.36, 14.48), ("2p", 29.36, 14.48), ("3p", 14.48, 14.48)]
+
+
+@pytest.mark.parametrize("key, actual, ideal", SHIFT_DEMOS)
+def test_the_target_leaves_at_its_angle_against_the_ideal(demos, key, actual, ideal):
+    # By hand: the cue's path misses the target's centre by b = r / 2, so at first
+    # contact the centres are 2 r apart and the normal is asin(b / 2r) = asin(1/4)
+    # = 14.48 deg off the path. At the coarse step the hit is found 0.4 m along x,
+    # where the centres' line is atan(0.225 / 0.4) = 29.36 deg off it.
+    app = make_app(demos, key)
+    press(app, pygame.K_a)
+    shown: list[str] = []
+    original = app.painter._text
+    app.painter._text = lambda text, *a, **k: (shown.append(text), original(text, *a, **k))
+    for _ in range(600):
+        app.physics_step()
+        if len(app.table.last_collisions):
+            break
+    app.draw()
+    push = app.collision_log.items[-1].target
+    assert push.ideal_deg == pytest.approx(math.degrees(math.asin(0.25)), abs=1e-9)
+    assert push.actual_deg == pytest.approx(actual, abs=0.01)
+    assert push.ideal_deg == pytest.approx(ideal, abs=0.01)
+    assert f"target {actual:.1f} deg vs ideal {ideal:.1f} deg" in shown
+    # Every label of the frame, the HUD's included, has a box of its own.
+    boxes = app.window.label_boxes
+    assert len(boxes) >= 6
+    for k, a in enumerate(boxes):
+        assert a.collidelist(boxes[k + 1 :]) < 0, f"label {a} overlaps another"
+
+
+def test_labels_placed_around_one_spot_never_overlap():
+    from airtable.app.aids_paint import place_box
+
+    screen = pygame.Rect(0, 0, 1280, 720)
+    taken: list[pygame.Rect] = []
+    for k in range(30):
+        taken.append(place_box((120 + 7 * k, 22), (640, 360), 10, taken, screen, 22))
+    for k, a in enumerate(taken):
+        assert screen.contains(a)
+        assert a.collidelist(taken[k + 1 :]) < 0
+
+
+def test_annotation_lines_are_at_least_2_px_at_720p(demos):
+    app = make_app(demos, "1p")
+    app.window.resize((1280, 720))
+    assert app.window.line_px(2) >= 2
+    app.window.resize((3840, 2160))
+    assert app.window.line_px(2) == 6  # and thicker on a 4K screen
+
+
+def test_vector_scale_is_round_fixed_for_the_demo_and_ignores_resting_pucks():
+    scale = aids.VectorScale(target_m=1.0)
+    assert scale.update(np.array([[2e-8, 0.0]])) == (1.0, 1.0)  # at rest: the default, not "2e-08 m/s"
+    assert scale.update(np.array([[1.7, 0.0], [0.0, -0.2]])) == (2.0, 0.5)
+    assert scale.update(np.array([[0.3, 0.0]])) == (2.0, 0.5)  # slower later: the same scale
+    assert scale.update(np.array([[0.0, 4.2]])) == (5.0, 0.2)  # faster: the next round number
+    for largest, unit in ((0.0013, 0.002), (0.04, 0.05), (9.9, 10.0), (10.0, 10.0), (120.0, 200.0)):
+        assert aids.nice_scale(largest)[0] == pytest.approx(unit)
+    scale.reset()
+    assert scale.update(np.zeros((3, 2))) == (1.0, 1.0)
+
+
+def _simulate(rgb, matrix):
+    """Colour seen with a colour-vision deficiency (in linear RGB), back to sRGB 0-255."""
+    c = np.asarray(rgb, float) / 255
+    lin = np.where(c <= 0.04045, c / 12.92, ((c + 0.055) / 1.055) ** 2.4)
+    out = np.clip(np.asarray(matrix) @ lin, 0, 1)
+    return 255 * np.where(out <= 0.0031308, 12.92 * out, 1.055 * out ** (1 / 2.4) - 0.055)
+
+
+DEFICIENCIES = {  # Viénot et al. 1999 (protan, deutan); Machado et al. 2009 (tritan, severity 1)
+    "normal": np.eye(3),
+    "protanopia": [[0.11238, 0.88762, 0.0], [0.11238, 0.88762, 0.0], [0.00401, -0.00401, 1.0]],
+    "deuteranopia": [[0.29275, 0.70725, 0.0], [0.29275, 0.70725, 0.0], [-0.02234, 0.02234, 1.0]],
+    "tritanopia": [[1.255528, -0.076749, -0.178779], [-0.078411, 0.930809, 0.147602], [0.004733, 0.691367, 0.3039]],
+}
+
+
+@pytest.mark.parametrize("kind", DEFICIENCIES)
+def test_chart_colours_stay_distinct_for_colour_blind_viewers(kind):
+    from airtable.app.aids_paint import CHART_COLORS
+
+    energies = [CHART_COLORS[k] for k in ("kinetic_J", "spring_J", "gravity_J", "total_J")]
+    seen = [_simulate(c, DEFICIENCIES[kind]) for c in energies]
+    for a in range(len(seen)):
+        for b in range(a + 1, len(seen)):
+            assert np.linalg.norm(seen[a] - seen[b]) > 60, f"{kind}: colours {a} and {b} look alike"
+
+
+def test_the_chart_moves_between_corners_and_shrinks(demos):
+    app = make_app(demos, "5")
+    press(app, pygame.K_c)
+    w, h = app.window.surface.get_size()
+    corners = []
+    for _ in range(4):
+        rect = app.painter.chart_rect()
+        corners.append((rect.centerx > w / 2, rect.centery > h / 2))
+        app.painter.cycle_chart_corner()
+    assert sorted(corners) == [(False, False), (False, True), (True, False), (True, True)]
+    big = app.painter.chart_rect()
+    app.painter.toggle_chart_size()
+    small = app.painter.chart_rect()
+    assert small.width < big.width and small.height < big.height
+    app.frame(FRAME_S)  # draws in its small size without trouble
+
+
+def test_demo_5_motion_matches_its_notes(demos):
+    # Damper: the bouncing dies within a couple of seconds, the pair drifts on at 0.22 m/s.
+    app = make_app(demos, "5")
+    start = app.table.center_of_mass_m().copy()
+    for _ in range(3 * 60):
+        app.frame(FRAME_S)
+    (a, b) = app.table.pucks
+    assert np.hypot(*(a.pos_m - b.pos_m)) == pytest.approx(1.5, abs=0.02)  # relaxed: no more bouncing
+    moved = app.table.center_of_mass_m() - start
+    np.testing.assert_allclose(moved / app.table.time_s, (0.2, 0.1), atol=1e-6)  # still drifting
+    assert app.chart.euler_wiggle_note(app.table) is None  # no "swings without drifting" claim here
+    # No damper (Right): the bouncing goes on and the total swings by about 3 % (omega dt / 2).
+    press(app, pygame.K_RIGHT)
+    assert "no damper" in app.window.caption
+    for _ in range(3 * 60):
+        app.frame(FRAME_S)
+    assert 0.03 < app.chart.total_wiggle(2.0) < 0.04
+    assert "does not drift" in app.chart.euler_wiggle_note(app.table)
+
+
+@pytest.mark.parametrize("key", ["4", "7", "8"])
+def test_the_chart_opens_in_the_corner_with_fewest_pucks(demos, key):
+    app = make_app(demos, key)
+    press(app, pygame.K_c)
+    px = app.env.to_screen(app.table.pos_m)
+
+    def covered(rect):
+        return int(np.count_nonzero([rect.collidepoint(float(x), float(y)) for x, y in px]))
+
+    counts = [covered(app.painter.chart_rect(corner)) for corner in range(4)]
+    assert covered(app.painter.chart_rect()) == min(counts)
+
+
+def test_labels_never_overlap_in_a_crowd(demos):
+    app = make_app(demos, "4")
+    app.window.resize((739, 648))  # the default window on a 1280 x 720 projector
+    app.table.vel_mps[:] = np.random.default_rng(3).normal(0.0, 2.0, app.table.vel_mps.shape)
+    for key in (pygame.K_a, pygame.K_v, pygame.K_c):
+        press(app, key)
+    most = 0
+    for _ in range(240):
+        app.frame(FRAME_S)
+        boxes = app.window.label_boxes
+        most = max(most, len(boxes))
+        for k, a in enumerate(boxes):
+            assert a.collidelist(boxes[k + 1 :]) < 0, f"label {a} overlaps another"
+    assert most >= 12  # several annotations were labelled at once

@@ -8,6 +8,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from airtable import Environment
+from airtable.app.environment import fitting_size_px, parse_size
 
 coords_m = st.floats(-1e3, 1e3)
 coords_px = st.floats(-1e4, 1e4)
@@ -87,3 +88,72 @@ def test_reset_restores_the_default_view() -> None:
 def test_bad_window_size_raises() -> None:
     with pytest.raises(ValueError, match="positive"):
         Environment(size_px=(0, 788))
+
+
+# ---------------------------------------------------------------- a window of any size
+
+sizes_px = st.tuples(st.integers(200, 4000), st.integers(150, 2200))
+
+
+@settings(max_examples=200, deadline=None, derandomize=True)
+@given(views(), sizes_px, st.lists(st.tuples(coords_m, coords_m), min_size=1, max_size=20))
+def test_round_trip_after_a_resize(env: Environment, size: tuple[int, int], points) -> None:
+    env.resize(size)
+    world = np.array(points)
+    np.testing.assert_allclose(env.to_world(env.to_screen(world)), world, rtol=1e-9, atol=1e-9)
+    screen = np.array([[0.0, 0.0], [size[0], size[1]], [size[0] / 3, size[1] / 7]])
+    np.testing.assert_allclose(env.to_screen(env.to_world(screen)), screen, rtol=1e-9, atol=1e-6)
+
+
+@settings(max_examples=100, deadline=None, derandomize=True)
+@given(sizes_px)
+def test_the_table_fits_any_window_centred_with_its_aspect_kept(size: tuple[int, int]) -> None:
+    env = Environment(width_m=10.0, height_m=8.7556)
+    env.resize(size)
+    w, h = size
+    (x0, y0), (x1, y1) = env.to_screen([(0.0, 8.7556), (10.0, 0.0)])  # top-left, bottom-right corners
+    assert -1e-6 <= x0 and x1 <= w + 1e-6 and -1e-6 <= y0 and y1 <= h + 1e-6  # all of it shows
+    assert (x1 - x0) / (y1 - y0) == pytest.approx(10.0 / 8.7556)  # not stretched
+    assert min(x0, y0) == pytest.approx(0.0, abs=1e-6)  # it fills one direction
+    assert x0 == pytest.approx(w - x1) and y0 == pytest.approx(h - y1)  # centred
+
+
+def test_zoom_and_pan_survive_a_resize() -> None:
+    env = Environment(width_m=10.0, height_m=8.7556)
+    env.zoom_about((300, 200), 3.0)
+    env.pan((40, -25))
+    centre_before = env.to_world((450, 394))  # the middle of the 900 x 788 window
+    env.resize((1920, 1080))
+    assert env.zoom == pytest.approx(3.0)
+    np.testing.assert_allclose(env.to_world((960, 540)), centre_before, atol=1e-4)  # same spot in the middle
+    assert env.px_per_m == pytest.approx(3.0 * 1080 / 8.7556)
+    # Zooming about the cursor still keeps the point under it.
+    under = env.to_world((100.0, 900.0))
+    env.zoom_about((100.0, 900.0), 1.7)
+    np.testing.assert_allclose(env.to_world((100.0, 900.0)), under, atol=1e-9)
+
+
+def test_a_zoom_from_anywhere_is_clamped() -> None:
+    env = Environment()
+    env.zoom = 1e9  # e.g. a snapshot's zoom
+    assert env.zoom == 200.0
+    env.zoom = 0.0
+    assert env.zoom == 0.05
+    env.zoom = float("nan")
+    assert env.zoom == 1.0
+
+
+@pytest.mark.parametrize(
+    ("desktop", "expected"),
+    [((1280, 720), (739, 648)), ((1920, 1080), (1110, 972)), ((3840, 2160), (2220, 1944)), ((1000, 2000), (900, 788))],
+)
+def test_default_window_is_the_tables_shape_in_90_percent_of_the_desktop(desktop, expected) -> None:
+    assert fitting_size_px(desktop, 10.0 / 8.7556) == pytest.approx(expected, abs=1)
+
+
+def test_window_size_from_the_command_line() -> None:
+    assert parse_size("1280x720") == (1280, 720)
+    assert parse_size("1920X1080") == (1920, 1080)
+    for bad in ("big", "1280", "10x10", "1280x720x3"):
+        with pytest.raises(ValueError, match="1280x720|at least"):
+            parse_size(bad)

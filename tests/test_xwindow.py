@@ -15,8 +15,8 @@ import pytest
 pytestmark = [
     pytest.mark.xvfb,
     pytest.mark.skipif(
-        not (shutil.which("Xvfb") and shutil.which("xdotool") and sys.platform.startswith("linux")),
-        reason="needs Xvfb and xdotool (apt-get install xvfb xdotool)",
+        not (all(map(shutil.which, ("Xvfb", "xdotool", "xwininfo"))) and sys.platform.startswith("linux")),
+        reason="needs Xvfb, xdotool and xwininfo (apt-get install xvfb xdotool x11-utils)",
     ),
 ]
 ORANGE = (255, 165, 0)
@@ -55,11 +55,14 @@ def xdotool(display: str, *args: str) -> str:
     return out.stdout.strip()
 
 
-def find_window(display: str) -> str | None:
-    # `search --name` misses SDL's windows on some xdotool builds; list them all and match the title.
-    for wid in xdotool(display, "search", "--class", "").split():
-        if "Air Table" in xdotool(display, "getwindowname", wid):
-            return wid
+def find_window(display: str, title: str = "Air Table") -> str | None:
+    # `xdotool search --name` misses SDL's windows on some builds; xwininfo lists them all.
+    tree = subprocess.run(
+        ["xwininfo", "-root", "-tree"], env={**os.environ, "DISPLAY": display}, capture_output=True, text=True
+    ).stdout
+    for line in tree.splitlines():
+        if f'"{title}' in line:
+            return str(int(line.split()[0], 16))
     return None
 
 
@@ -101,3 +104,132 @@ def test_demo_key_and_mouse_drag_in_a_real_window(display, tmp_path):
     centre = orange.mean(axis=0)
     # It was pulled toward the cursor: down and to the right of where it started.
     assert centre[0] > 405 + 50 and centre[1] > 383 + 50
+
+
+WALL = (255, 69, 0)
+TABLE_ASPECT = 10.0 / 8.7556
+
+
+def wall_columns(image: np.ndarray, row: int) -> np.ndarray:
+    """The x of every wall-coloured pixel on one row of a screenshot."""
+    return np.flatnonzero(np.all(image[:, row] == WALL, axis=1))
+
+
+def test_the_table_follows_a_resize_of_the_window(display, tmp_path):
+    shot = tmp_path / "resized.png"
+    env = {**os.environ, "DISPLAY": display, "SDL_VIDEODRIVER": "x11"}
+    app = subprocess.Popen(
+        [sys.executable, "-m", "airtable", "--no-server", "--demo", "2", "--seconds", "60", "--screenshot", str(shot)],
+        env=env,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+    )
+    try:
+        wid = wait_for(lambda: find_window(display), what="the window")
+        xdotool(display, "windowsize", "--sync", wid, "1000", "500")
+        time.sleep(1.0)  # a few frames at the new size
+        xdotool(display, "windowfocus", "--sync", wid)
+        xdotool(display, "key", "Escape")
+        assert app.wait(timeout=20) == 0, app.stderr.read().decode()
+    finally:
+        if app.poll() is None:
+            app.kill()
+            app.wait()
+    pygame.display.init()
+    image = pygame.surfarray.array3d(pygame.image.load(str(shot)))
+    assert image.shape[:2] == (1000, 500)
+    # The 500 px tall table is 571 px wide and centred: walls near x = 214 and 785, not at the old edges.
+    left = round((1000 - 500 * TABLE_ASPECT) / 2)
+    xs = wall_columns(image, 250)
+    assert abs(xs.min() - left) <= 2 and abs(xs.max() - (999 - left)) <= 2
+    ys = np.flatnonzero(np.all(image[500] == WALL, axis=1))
+    assert ys.min() <= 2 and ys.max() >= 497  # top and bottom walls at the window's edges
+
+
+FULLSCREEN_DRIVER = """
+import sys, numpy as np, pygame
+from airtable.app.environment import Environment
+from airtable.app.scene import Scene
+from airtable.app.window import GameWindow
+env = Environment(width_m=10.0, height_m=8.7556)
+win = GameWindow(env, caption="Air Table - fullscreen test", size_px=(640, 480))
+scene = Scene(10.0, 8.7556, np.array([[5.0, 4.4]]), np.array([0.5]), np.array([[255, 165, 0]], np.uint8))
+clock = pygame.time.Clock()
+for frame in range(1200):
+    for event in pygame.event.get():
+        if event.type == pygame.KEYDOWN and event.key == pygame.K_F12:
+            win.save_screenshot(sys.argv[1])
+        elif event.type == pygame.KEYDOWN and event.key == pygame.K_ESCAPE:
+            print("size", *win.surface.get_size(), int(win.fullscreen), flush=True)
+            sys.exit(0)
+        win.handle_event(event)
+    win.draw(scene)
+    win.present()
+    clock.tick(60)
+sys.exit(3)
+"""
+
+
+def test_f11_toggles_desktop_fullscreen_and_back(display, tmp_path):
+    shot = tmp_path / "full.png"
+    env = {**os.environ, "DISPLAY": display, "SDL_VIDEODRIVER": "x11"}
+    proc = subprocess.Popen(
+        [sys.executable, "-c", FULLSCREEN_DRIVER, str(shot)], env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE
+    )
+    try:
+        wid = wait_for(lambda: find_window(display), what="the window")
+        xdotool(display, "windowfocus", "--sync", wid)
+        xdotool(display, "key", "F11")
+        wid = wait_for(lambda: find_window(display), what="the fullscreen window")  # SDL may make a new one
+        time.sleep(1.0)
+        xdotool(display, "windowfocus", "--sync", wid)
+        xdotool(display, "key", "F12")  # a screenshot while fullscreen
+        wait_for(shot.exists, what="the screenshot")
+        xdotool(display, "key", "F11")  # and back to the window
+        wid = wait_for(lambda: find_window(display), what="the window again")
+        time.sleep(1.0)
+        xdotool(display, "windowfocus", "--sync", wid)
+        xdotool(display, "key", "Escape")
+        assert proc.wait(timeout=20) == 0, proc.stderr.read().decode()
+        assert proc.stdout.read().decode().split() == ["size", "640", "480", "0"]
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+            proc.wait()
+    pygame.display.init()
+    image = pygame.surfarray.array3d(pygame.image.load(str(shot)))
+    assert image.shape[:2] == (1024, 900)  # the whole Xvfb screen
+    # The table fills the height of the 1024 x 900 screen, centred: side walls at x = 30 and 993.
+    left = round((1024 - 900 * TABLE_ASPECT) / 2)
+    xs = wall_columns(image, 450)
+    assert abs(xs.min() - left) <= 2 and abs(xs.max() - (1023 - left)) <= 2
+
+
+def test_f11_in_the_app_fills_the_screen(display, tmp_path):
+    shot = tmp_path / "app_full.png"
+    env = {**os.environ, "DISPLAY": display, "SDL_VIDEODRIVER": "x11"}
+    app = subprocess.Popen(
+        [sys.executable, "-m", "airtable", "--no-server", "--demo", "2", "--seconds", "60", "--screenshot", str(shot)],
+        env=env,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+    )
+    try:
+        wid = wait_for(lambda: find_window(display), what="the window")
+        xdotool(display, "windowfocus", "--sync", wid)
+        xdotool(display, "key", "F11")
+        time.sleep(1.0)
+        wid = wait_for(lambda: find_window(display), what="the fullscreen window")
+        xdotool(display, "windowfocus", "--sync", wid)
+        xdotool(display, "key", "Escape")
+        assert app.wait(timeout=20) == 0, app.stderr.read().decode()
+    finally:
+        if app.poll() is None:
+            app.kill()
+            app.wait()
+    pygame.display.init()
+    image = pygame.surfarray.array3d(pygame.image.load(str(shot)))
+    assert image.shape[:2] == (1024, 900)
+    left = round((1024 - 900 * TABLE_ASPECT) / 2)
+    xs = wall_columns(image, 450)
+    assert abs(xs.min() - left) <= 2 and abs(xs.max() - (1023 - left)) <= 2

@@ -23,14 +23,15 @@ FORCE_COLORS = {"cursor strings": (255, 120, 80), "springs": (255, 215, 0), "gra
 
 def draw_aids(app: App) -> None:
     t, paint = app.table, app.painter
+    if app.show_chart:  # first: the labels below then find their places around it
+        paint.choose_chart_corner(app.env.to_screen(t.pos_m))
+        note = app.chart.euler_wiggle_note(t)
+        paint.energy_chart(app.chart.series(), app.chart.latest(), note)
+    if app.vectors and len(t.pos_m):  # before the annotations: its legend has a fixed place
+        _draw_vectors(app)
     if app.show_annotations:
         for annotation in app.collision_log.live(app.clock_s):
             paint.annotation(annotation, app.clock_s)
-    if app.vectors and len(t.pos_m):
-        _draw_vectors(app)
-    if app.show_chart:
-        note = app.chart.euler_wiggle_note(t)
-        paint.energy_chart(app.chart.series(), app.chart.latest(), note)
     if app.inspecting:
         puck = t.puck_at(app.env.to_world(app.mouse_px))
         if puck is not None:
@@ -48,28 +49,41 @@ def draw_aids(app: App) -> None:
 
 
 def _draw_vectors(app: App) -> None:
+    """Arrows on the moving pucks at the demo's fixed round scale, the centre of mass, the forces on a held puck."""
     t, paint = app.table, app.painter
+    speed = np.hypot(t.vel_mps[:, 0], t.vel_mps[:, 1])
+    moving = speed >= aids.MIN_ARROW_SPEED_MPS  # a resting puck gets no arrow
     if app.vectors == 1:
         name, unit, values, color = "velocity", "m/s", t.vel_mps, (120, 220, 255)
     else:
         name, unit, values, color = "momentum", "N s", t.vel_mps * t.mass_kg[:, None], (230, 120, 230)
-    amount, m_per_unit = aids.nice_scale(float(np.hypot(values[:, 0], values[:, 1]).max()), target_m=1.0)
-    paint.arrows(t.pos_m, values * m_per_unit, color)
+    amount, m_per_unit = paint.vector_scale(name).update(values[moving])
+    paint.arrows(t.pos_m[moving], values[moving] * m_per_unit, color)
     legend = [(f"{name}: an arrow 1 m long is {amount:g} {unit}", color)]
     # The centre of mass moves in a straight line while no outside force acts.
     com, com_v = t.center_of_mass_m(), t.center_of_mass_vel_mps()
-    _, m_per_mps = aids.nice_scale(float(np.hypot(t.vel_mps[:, 0], t.vel_mps[:, 1]).max()), target_m=1.0)
-    paint.arrow(com, com_v * m_per_mps, COM_COLOR, width=3)
-    paint.marker(com, COM_COLOR, f"centre of mass, {np.hypot(*com_v):.2f} m/s")
+    _, m_per_mps = paint.vector_scale("velocity").update(t.vel_mps[moving])
+    if np.hypot(*com_v) >= aids.MIN_ARROW_SPEED_MPS:
+        paint.arrow(com, com_v * m_per_mps, COM_COLOR, width=paint.w.line_px(3))
     held = app.local.held
     if held is not None and held.alive:
-        forces = t.forces_on(held, app.dt_s, cursor_pulls(app.clients))
-        if forces:
-            biggest = max(float(np.hypot(*f)) for f in forces.values())
-            newtons, m_per_n = aids.nice_scale(biggest, target_m=1.5)
-            for source, f in forces.items():
-                c = FORCE_COLORS[source]
-                paint.arrow(held.pos_m, f * m_per_n, c, width=3)
-                legend.append((f"force, {source}: {np.hypot(*f):.3g} N", c))
-            legend.append((f"forces: an arrow 1 m long is {newtons / 1.5:.3g} N", DIM_FORCE))
-    paint.legend(legend)
+        legend.extend(_draw_forces(app, held))
+    paint.legend(legend)  # before the marker's label: the legend's place is fixed
+    paint.marker(com, COM_COLOR, f"centre of mass, {np.hypot(*com_v):.2f} m/s")
+
+
+def _draw_forces(app: App, held) -> list[tuple[str, tuple[int, int, int]]]:
+    """Arrows of the forces on the held puck, scaled to round newtons; their legend lines."""
+    paint = app.painter
+    forces = app.table.forces_on(held, app.dt_s, cursor_pulls(app.clients))
+    if not forces:
+        return []
+    biggest = max(float(np.hypot(*f)) for f in forces.values())
+    newtons, m_per_n = aids.nice_scale(biggest, target_m=1.0)
+    legend = []
+    for source, f in forces.items():
+        c = FORCE_COLORS[source]
+        paint.arrow(held.pos_m, f * m_per_n, c, width=paint.w.line_px(3))
+        legend.append((f"force, {source}: {np.hypot(*f):.3g} N", c))
+    legend.append((f"forces: an arrow 1 m long is {newtons:g} N", DIM_FORCE))
+    return legend

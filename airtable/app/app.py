@@ -17,16 +17,18 @@ from pathlib import Path
 import numpy as np
 import pygame
 
-from airtable.app import aids, controls
+from airtable.app import aids, controls, world
 from airtable.app.aids_view import draw_aids
 from airtable.app.client import LOCAL_COLOR, Client, cursor_pulls
 from airtable.app.demo_loader import Demo, DemoError, DemoShelf, error_from_exception, key_label
 from airtable.app.environment import Environment
+from airtable.app.lessons import Lessons
+from airtable.app.lessons_view import draw_lessons
 from airtable.app.loop import FixedStep, FpsCounter, FrameLoop
 from airtable.app.menu import DemoMenu
 from airtable.app.scene import STATUS_SEPARATOR, Scene
 from airtable.app.window import AidsPainter, GameWindow
-from airtable.physics.table import AirTable
+from airtable.physics.table import TABLE_HEIGHT_M, TABLE_WIDTH_M, AirTable
 
 MESSAGE_S = 4.0
 QUIT_CONFIRM_S = 4.0  # a second Esc within this time quits while students are connected
@@ -77,16 +79,18 @@ class App:
         headless: bool = False,
         server=None,
         demo_errors=(),
+        window_size_px: tuple[int, int] | None = None,
+        fullscreen: bool = False,
     ) -> None:
         self.shelf = demos if isinstance(demos, DemoShelf) else DemoShelf.from_demos(demos)
         if not self.shelf.demos:
             raise ValueError("no demos found")
-        self.env = Environment()
-        self.table = AirTable(self.env.size_px[0] / self.env.base_px_per_m, self.env.view_height_m)
+        self.table = AirTable(TABLE_WIDTH_M, TABLE_HEIGHT_M)
+        self.env = Environment(width_m=TABLE_WIDTH_M, height_m=TABLE_HEIGHT_M)
         self.local = Client(name="local", color=LOCAL_COLOR)
         # The loop owns the clients (index 0 is the local user); the server adds the students.
         self.clients: list[Client] = [self.local]
-        self.window = GameWindow(self.env, headless=headless)
+        self.window = GameWindow(self.env, headless=headless, size_px=window_size_px, fullscreen=fullscreen)
         self.painter = AidsPainter(self.window)
         if not headless:
             pygame.mouse.set_visible(False)  # the local client's arrow is the pointer
@@ -104,6 +108,7 @@ class App:
         self.trails = False
         self.speed = 1.0
         self.show_help = False
+        self.help_page, self.help_pages = 0, 1
         self.show_notes = False
         self.show_annotations = False
         self.show_chart = False
@@ -113,6 +118,7 @@ class App:
         self.quit_armed_until = -1.0  # clock_s until which a second Esc quits
         self.collision_log = aids.CollisionLog()
         self.chart = aids.EnergyChart()
+        self.lessons = Lessons()  # recording, momenta, saving the moment (lessons.py)
         self.keys_down: set[int] = set()
         self.mouse_px = (self.env.size_px[0] / 2, self.env.size_px[1] / 2)
         self.mouse_button = 0
@@ -177,6 +183,7 @@ class App:
         self.stepper.reset(demo.dt_s if demo else self.stepper.dt_s)
         self.trails = demo.trails if demo else False
         self.chart.sample(self.table)
+        self.lessons.start(self.table)
         self.window.set_caption(f"Air Table - {self.caption()}")
 
     def _clear_table(self) -> None:
@@ -187,6 +194,7 @@ class App:
         self.window.clear_trails()
         self.collision_log.clear()
         self.chart.clear()
+        self.painter.new_demo()  # arrow scales are per demo
 
     def _demo_failed(self, exc: BaseException, stage: str) -> None:
         path = self.demo_path or Path(f"demo {self.demo_key}")
@@ -316,6 +324,7 @@ class App:
             self.paused = True
             return False
         self.chart.sample(self.table)
+        self.lessons.after_step(self.table)
         if self.show_annotations:
             self.collision_log.add(self.table, self.clock_s)
         return True
@@ -361,7 +370,7 @@ class App:
             parts.append(f"slow motion x1/{round(1 / self.speed)}")
         parts.append(f"t = {t.time_s:.2f} s")
         parts.append("F1: help")
-        parts.append("gravity on" if t.gravity_on else "gravity off")
+        parts.append(world.gravity_label(t))
         parts.append(f"correction: {t.puck_correction}")
         n, hits = len(t.pos_m), t.collision_count
         parts.append(f"{n} puck{'' if n == 1 else 's'}")
@@ -386,6 +395,7 @@ class App:
     def draw(self, scene: Scene | None = None) -> None:
         """Draw `scene` (by default the table as it is now), the aids and the panel on top."""
         self.window.draw(scene or self.scene(), trails=self.trails, hud=self.hud_lines())
+        draw_lessons(self)  # first: the aids' labels then place themselves around its panels
         draw_aids(self)
         self._draw_panel()
         self.window.present()
@@ -411,7 +421,9 @@ class App:
             w.draw_panel("Some demo files could not be loaded", [*self.notice, "Press any key to go on."])
         elif panel == "help":
             rows = [(key_label(k), d.title) for k, d in self.demos.items()]
-            w.draw_panel("Keys", [(b.label, b.help) for b in BINDINGS], side_title="Demos", side_rows=rows)
+            self.help_pages = w.draw_panel(
+                "Keys", [(b.label, b.help) for b in BINDINGS], side_title="Demos", side_rows=rows, page=self.help_page
+            )
         elif panel == "notes":
             w.draw_panel(self.demo.label(self.variation), [self.demo.notes or "(no notes)"], large=True)
 

@@ -17,7 +17,7 @@ from typing import TYPE_CHECKING
 
 import pygame
 
-from airtable.app import aids
+from airtable.app import aids, lessons, world
 
 if TYPE_CHECKING:
     from airtable.app.app import App
@@ -34,7 +34,8 @@ class Binding:
 
     label: str
     help: str
-    actions: Mapping[int, Action] = field(default_factory=dict)
+    # A key is a pygame key, or (modifier mask, key) for a key pressed with Ctrl or Shift.
+    actions: Mapping[int | tuple[int, int], Action] = field(default_factory=dict)
     held: bool = False  # acts every frame while held, not on the press
 
     @property
@@ -131,7 +132,26 @@ def inspect(app: App) -> None:
 
 
 def toggle_help(app: App) -> None:
-    app.show_help = not app.show_help
+    """F1: help; again for its next page, if it has more than one; then closed."""
+    if not app.show_help:
+        app.show_help, app.help_page = True, 0
+    else:
+        app.help_page += 1
+        app.show_help = app.help_page < app.help_pages
+
+
+def toggle_fullscreen(app: App) -> None:
+    app.window.toggle_fullscreen()
+
+
+def move_chart(app: App) -> None:
+    app.show_chart = True
+    app.say(f"energy chart: {app.painter.cycle_chart_corner()}")
+
+
+def resize_chart(app: App) -> None:
+    app.show_chart = True
+    app.painter.toggle_chart_size()
 
 
 def open_menu(app: App) -> None:
@@ -189,14 +209,61 @@ BINDINGS: tuple[Binding, ...] = (
     Binding("a", "collision annotations: axes, overlap, separation, angle", {pygame.K_a: toggle_annotations}),
     Binding("v", "vectors: velocity / momentum arrows, forces, centre of mass", {pygame.K_v: next_vectors}),
     Binding("c", "energy and momentum chart", {pygame.K_c: toggle_chart}),
+    Binding(
+        "m / b", "chart: move to the next corner / big or small", {pygame.K_m: move_chart, pygame.K_b: resize_chart}
+    ),
     Binding("i (hold)", "inspect the puck under the cursor", {pygame.K_i: inspect}, held=True),
     Binding("l", "lecture notes for this demo", {pygame.K_l: toggle_notes}),
-    Binding("F1", "this help screen", {pygame.K_F1: toggle_help}),
+    Binding(
+        "u / w",
+        "restitution of pucks / walls down a tenth (with Shift: up)",
+        {
+            pygame.K_u: world.puck_restitution_down,
+            (pygame.KMOD_SHIFT, pygame.K_u): world.puck_restitution_up,
+            pygame.K_w: world.wall_restitution_down,
+            (pygame.KMOD_SHIFT, pygame.K_w): world.wall_restitution_up,
+        },
+    ),
+    Binding(
+        "Shift+g",
+        "gravity: off, Moon 1.62, Mars 3.71, Earth 9.8 m/s²",
+        {(pygame.KMOD_SHIFT, pygame.K_g): world.cycle_gravity},
+    ),
+    Binding(
+        "- / =, [ / ]",
+        "mass, radius of the puck under the cursor: down / up",
+        {
+            pygame.K_MINUS: world.mass_down,
+            pygame.K_KP_MINUS: world.mass_down,
+            pygame.K_EQUALS: world.mass_up,
+            pygame.K_PLUS: world.mass_up,
+            pygame.K_KP_PLUS: world.mass_up,
+            pygame.K_LEFTBRACKET: world.radius_down,
+            pygame.K_RIGHTBRACKET: world.radius_up,
+        },
+    ),
+    Binding(
+        "d / t",
+        "momenta before / after the latest collision; values of each puck",
+        {pygame.K_d: lessons.toggle_momenta, pygame.K_t: lessons.toggle_values},
+    ),
+    Binding(
+        "x / Ctrl+S",
+        "export the recording as CSV; save the moment as a new demo (s1, s2, ...)",
+        {pygame.K_x: lessons.export_recording, (pygame.KMOD_CTRL, pygame.K_s): lessons.save_moment},
+    ),
+    Binding("F1", "this help screen (again: next page)", {pygame.K_F1: toggle_help}),
+    Binding("F11", "fullscreen on / off", {pygame.K_F11: toggle_fullscreen}),
     Binding("F12", "save a screenshot PNG", {pygame.K_F12: screenshot}),
     Binding("Esc", "close what is open; else quit (twice if students are connected)", {pygame.K_ESCAPE: escape}),
 )
 
-PRESS_ACTIONS: dict[int, Action] = {k: a for b in BINDINGS if not b.held for k, a in b.actions.items()}
+PRESS_ACTIONS: dict[int, Action] = {
+    k: a for b in BINDINGS if not b.held for k, a in b.actions.items() if isinstance(k, int)
+}
+MODIFIED_ACTIONS: dict[tuple[int, int], Action] = {
+    k: a for b in BINDINGS for k, a in b.actions.items() if isinstance(k, tuple)
+}
 HELD_ACTIONS: dict[int, Action] = {k: a for b in BINDINGS if b.held for k, a in b.actions.items()}
 
 
@@ -212,12 +279,21 @@ def demo_key_for(event: pygame.event.Event) -> str | None:
 # ---------------------------------------------------------------- events
 
 
+def modified_action(event: pygame.event.Event) -> Action | None:
+    """The action of a key pressed with Ctrl or Shift (Ctrl+S), if the key table has one."""
+    mod = getattr(event, "mod", 0)
+    for (mask, key), action in MODIFIED_ACTIONS.items():
+        if key == event.key and mod & mask:
+            return action
+    return None
+
+
 def handle_key(app: App, event: pygame.event.Event) -> None:
     """A KEYDOWN: an open panel takes it first, then the key table, then the demo keys."""
     app.keys_down.add(event.key)
     if app.take_key_for_overlay(event):
         return
-    action = PRESS_ACTIONS.get(event.key)
+    action = modified_action(event) or PRESS_ACTIONS.get(event.key)
     if action is not None:
         action(app)
         return
@@ -269,3 +345,5 @@ def handle_event(app: App, event: pygame.event.Event) -> None:
         app.keys_down.discard(event.key)
     elif event.type in MOUSE_EVENTS:
         handle_mouse(app, event)
+    elif event.type in (pygame.VIDEORESIZE, pygame.WINDOWSIZECHANGED):
+        app.window.handle_event(event)  # the table and the type follow the new size

@@ -1,14 +1,16 @@
 """GameWindow: the only place that draws.
 
 It draws a `Scene` (see scene.py) through an `Environment` transform, so the
-teacher's window and every student's window share this code. Pucks are blitted
-from cached sprites (one per size and colour) with `Surface.fblits`, which
-keeps thousands of pucks at full frame rate.
+teacher's window and every student's window share this code. The window is
+resizable and can go fullscreen (F11); the table is fitted to it with its
+aspect kept, and text and lines scale with the window's height, so a
+projector at 1280x720 and a 4K screen both show all of it, readably.
+Pucks are drawn by pucks_view.py, text panels by panel_view.py and the
+teaching aids by aids_paint.py.
 """
 
 from __future__ import annotations
 
-import math
 import os
 from collections.abc import Sequence
 from pathlib import Path
@@ -16,20 +18,29 @@ from pathlib import Path
 import numpy as np
 import pygame
 
-from airtable.app.environment import Environment
-from airtable.app.scene import Scene
+from airtable.app import panel_view
+from airtable.app.aids_paint import AidsPainter  # noqa: F401  (imported from here by the app)
+from airtable.app.environment import Environment, fitting_size_px
+from airtable.app.lessons_paint import LessonsPainter  # noqa: F401  (imported from here by lessons_view)
+from airtable.app.pucks_view import COLORKEY, MIN_PUCK_RADIUS_PX, PuckSprites, draw_pucks
+from airtable.app.scene import STATUS_SEPARATOR, Scene
 from airtable.assets import ASSETS_DIR
 
 BACKGROUND = (0, 0, 0)
 BACKGROUND_GRAVITY = (20, 20, 70)
 BACKGROUND_NO_CORRECTION = (40, 40, 40)
+MARGIN_COLOR = (12, 12, 12)  # outside the table, where the window is wider than it
 WALL_COLOR = (255, 69, 0)  # orange-red
-TEXT_COLOR = (230, 230, 230)
-DIM_TEXT = (150, 150, 150)
-PANEL_COLOR = (10, 10, 30, 225)
-MIN_PUCK_RADIUS_PX = 2
-_COLORKEY = (1, 2, 3)  # sprite background; no puck uses this colour
-_SPRITE_CACHE_LIMIT = 4096
+TEXT_COLOR = panel_view.TEXT_COLOR
+DIM_TEXT = panel_view.DIM_TEXT
+ACCENT = panel_view.ACCENT
+PAUSED_COLOR = (255, 210, 60)
+REFERENCE_HEIGHT_PX = 720  # type sizes below are for a window this tall, and scale with it
+# Font sizes (pygame's default font) at the reference height, and their floor:
+# the smallest, 22, is 15 px tall, so no text is under 14 px at 720p.
+FONT_SIZES = {"label": (24, 22), "text": (28, 22), "big": (44, 30), "huge": (72, 40)}
+
+PAUSED = "PAUSED"
 
 
 def background_for(scene: Scene) -> tuple[int, int, int]:
@@ -41,29 +52,169 @@ def background_for(scene: Scene) -> tuple[int, int, int]:
     return BACKGROUND
 
 
-class GameWindow:
-    """Owns the display surface (or an off-screen one when headless) and draws scenes."""
+def fit_parts(font: pygame.font.Font, parts: Sequence[str], width_px: int) -> str:
+    """As many of `parts` as fit `width_px`, dropping the least important (last) first.
 
-    def __init__(self, env: Environment, caption: str = "Air Table", headless: bool = False) -> None:
-        if headless:  # no screen needed, so none is asked for
+    The first part alone is shortened with an ellipsis if even it does not fit."""
+    for n in range(len(parts), 0, -1):
+        text = STATUS_SEPARATOR.join(parts[:n])
+        if font.size(text)[0] <= width_px:
+            return text
+    return panel_view.shorten(font, parts[0], width_px) if parts else ""
+
+
+class GameWindow:
+    """Owns the display surface (or an off-screen one when headless) and draws scenes.
+
+    `size_px` is the window's size (default: the table's shape in 90 % of the
+    desktop; headless: the Environment's size); `fullscreen` starts on the whole
+    desktop. Pass every event to `handle_event`: it follows resizes and F11.
+    """
+
+    def __init__(
+        self,
+        env: Environment,
+        caption: str = "Air Table",
+        headless: bool = False,
+        *,
+        size_px: Sequence[int] | None = None,
+        fullscreen: bool = False,
+    ) -> None:
+        if headless:  # no screen needed, so none is asked for (pygame's events still need a driver)
             os.environ.setdefault("SDL_VIDEODRIVER", "dummy")
         pygame.display.init()
         pygame.font.init()
         self.env = env
         self.headless = headless
-        if headless:
-            self.surface = pygame.Surface(env.size_px)
-        else:
-            self.surface = pygame.display.set_mode(env.size_px)
-            pygame.display.set_icon(pygame.image.load(str(ASSETS_DIR / "icon.png")))
-        self.set_caption(caption)
-        self.font = pygame.font.Font(None, 22)
-        self.big_font = pygame.font.Font(None, 40)
-        self.label_font = pygame.font.Font(None, 18)
-        self._sprites: dict[tuple[int, int, int, int], pygame.Surface] = {}
+        self.fullscreen = False
+        self.sprites = PuckSprites()
+        self._fonts: dict[int, pygame.font.Font] = {}
         self._trail_layer: pygame.Surface | None = None
         self._labels: dict[tuple, pygame.Surface] = {}
+        self._panels: dict[tuple, tuple[pygame.Surface, int]] = {}
         self._status_bar: pygame.Surface | None = None
+        self.hud_bottom_px = 0  # below the title and HUD lines: panels start under it
+        self.label_boxes: list[pygame.Rect] = []  # text drawn this frame; the aids place labels around it
+        self.status_top_px = 0
+        if headless:
+            self.windowed_size_px = tuple(int(v) for v in (size_px or env.size_px))
+            self.surface = pygame.Surface(self.windowed_size_px)
+        else:
+            self.windowed_size_px = tuple(int(v) for v in (size_px or self.default_size_px()))
+            self._open(fullscreen)
+            icon = ASSETS_DIR / "icon.png"
+            if icon.is_file():
+                pygame.display.set_icon(pygame.image.load(str(icon)))
+        self._sized()
+        self.set_caption(caption)
+
+    # ------------------------------------------------------------ the window itself
+
+    def default_size_px(self) -> tuple[int, int]:
+        """The table's shape in at most 90 % of the (first) desktop."""
+        try:
+            desktop = pygame.display.get_desktop_sizes()[0]
+        except (pygame.error, IndexError):
+            desktop = (1280, 720)
+        return fitting_size_px(desktop, self.env.width_m / self.env.height_m)
+
+    def _open(self, fullscreen: bool) -> None:
+        if fullscreen:
+            # Size (0, 0) with FULLSCREEN: the desktop's own mode, no mode switch.
+            self.surface = pygame.display.set_mode((0, 0), pygame.FULLSCREEN)
+        else:
+            self.surface = pygame.display.set_mode(self.windowed_size_px, pygame.RESIZABLE)
+        self.fullscreen = fullscreen
+
+    def toggle_fullscreen(self) -> None:
+        """Desktop fullscreen on or off (F11); the windowed size comes back after."""
+        if self.headless:
+            return
+        if not self.fullscreen:
+            self.windowed_size_px = self.surface.get_size()
+        self._open(not self.fullscreen)
+        self._sized()
+
+    def resize(self, size_px: Sequence[int]) -> None:
+        """Make the window (headless: the off-screen surface) `size_px` big; leaves fullscreen."""
+        size = (max(1, int(size_px[0])), max(1, int(size_px[1])))
+        if self.headless:
+            self.surface = pygame.Surface(size)
+        else:
+            self.windowed_size_px = size
+            self._open(False)
+        self._sized()
+
+    def _sized(self) -> None:
+        """After any change of size: the transform, the type and the layers follow."""
+        self.env.resize(self.surface.get_size())
+        self.unit = self.surface.get_height() / REFERENCE_HEIGHT_PX
+        self.label_font = self._font("label")
+        self.font = self._font("text")
+        self.big_font = self._font("big")
+        self.huge_font = self._font("huge")
+        self._trail_layer = None
+        self._status_bar = None
+        self._labels.clear()
+        self._panels.clear()
+
+    def _size_px(self, role: str) -> int:
+        size, floor = FONT_SIZES[role]
+        return max(floor, round(size * self.unit))
+
+    def _font(self, role: str) -> pygame.font.Font:
+        return self._font_px(self._size_px(role))
+
+    def _font_px(self, px: int) -> pygame.font.Font:
+        font = self._fonts.get(px)
+        if font is None:
+            if len(self._fonts) > 32:  # many resizes: keep the cache small
+                self._fonts.clear()
+            font = self._fonts[px] = pygame.font.Font(None, px)
+        return font
+
+    def _panel_font(self, sections, rect: pygame.Rect) -> pygame.font.Font:
+        """The largest type, down to the smallest readable size, that fits the panel on one page."""
+        best = None
+        for px in range(self._size_px("text"), FONT_SIZES["label"][1] - 1, -2):
+            font = self._font_px(px)
+            pages = len(
+                panel_view.layout(font, sections, panel_view.body_rect(rect.size, font, self.big_font, font).size)
+            )
+            if pages == 1:
+                return font
+            best = best if best is not None and best[0] <= pages else (pages, font)
+        return best[1]
+
+    def line_px(self, width_at_720: float = 2.0) -> int:
+        """A line width that scales with the window: `width_at_720` px at 720 px tall, never under 2."""
+        return max(2, round(width_at_720 * self.unit))
+
+    def follow_display(self) -> None:
+        """Catch up with a size the window manager gave the display without an event we saw,
+        or with a new Environment handed to `self.env` (a player's, on reconnecting)."""
+        if self.env.size_px != self.surface.get_size():
+            self._sized()
+        if not self.headless:
+            display = pygame.display.get_surface()
+            if display is not None and (display is not self.surface or display.get_size() != self.env.size_px):
+                self.surface = display
+                if not self.fullscreen:
+                    self.windowed_size_px = display.get_size()
+                self._sized()
+
+    def handle_event(self, event: pygame.event.Event) -> bool:
+        """Resizes and F11 (fullscreen); True when the event was one of those."""
+        if event.type in (pygame.VIDEORESIZE, pygame.WINDOWSIZECHANGED):
+            if self.headless:  # posted by a test: there is no display to follow
+                self.resize(event.size if event.type == pygame.VIDEORESIZE else (event.x, event.y))
+            else:  # the display surface already has the new size
+                self.follow_display()
+            return True
+        if event.type == pygame.KEYDOWN and event.key == pygame.K_F11:
+            self.toggle_fullscreen()
+            return True
+        return False
 
     def set_caption(self, caption: str) -> None:
         self.caption = caption
@@ -84,19 +235,24 @@ class GameWindow:
         """Draw a whole frame of `scene` into `self.surface`.
 
         `hud` lines go under the title; `hud_color`, if given, colours the first
-        (a player's "You are C3" in the player's colour).
+        (a player's "You are C3" in the player's colour). Of the status line's
+        parts (most important first) those that do not fit the width are
+        dropped from the end, and a "PAUSED" part is shown large.
 
         With `trails` on, pucks are also stamped onto a layer that is never
         erased (the course's "erase off"), while springs, cursors and text stay
         crisp on top.
         """
+        self.follow_display()
+        self.label_boxes = []
         surf = self.surface
-        surf.fill(background_for(scene))
+        surf.fill(MARGIN_COLOR)
+        surf.fill(background_for(scene), self._table_rect(scene))
         if trails:
             if self._trail_layer is None:
                 self._trail_layer = pygame.Surface(surf.get_size())
-                self._trail_layer.fill(_COLORKEY)
-                self._trail_layer.set_colorkey(_COLORKEY)
+                self._trail_layer.fill(COLORKEY)
+                self._trail_layer.set_colorkey(COLORKEY)
             self._draw_pucks(self._trail_layer, scene)
             surf.blit(self._trail_layer, (0, 0))
         else:
@@ -125,61 +281,39 @@ class GameWindow:
 
     # ------------------------------------------------------------ parts
 
+    def _table_rect(self, scene: Scene) -> pygame.Rect:
+        """The table on screen, clipped to the window (no huge rectangles when zoomed in)."""
+        (x0, y0), (x1, y1) = self.env.to_screen(np.array([[0.0, scene.height_m], [scene.width_m, 0.0]]))
+        w, h = self.surface.get_size()
+        left, top = int(round(np.clip(x0, -2, w + 2))), int(round(np.clip(y0, -2, h + 2)))
+        right, bottom = int(round(np.clip(x1, -2, w + 2))), int(round(np.clip(y1, -2, h + 2)))
+        return pygame.Rect(left, top, max(0, right - left), max(0, bottom - top))
+
     def _draw_walls(self, scene: Scene) -> None:
         # The wall line sits just inside the table's edge, so it shows even
         # when the table exactly fills the window.
+        width = max(self.line_px(2), int(round(self.env.length_to_px(0.03))))
+        width = min(width, 4 * self.line_px(2))
         (x0, y0), (x1, y1) = self.env.to_screen(np.array([[0.0, scene.height_m], [scene.width_m, 0.0]]))
-        width = max(2, int(round(self.env.length_to_px(0.03))))
-        rect = pygame.Rect(int(round(x0)), int(round(y0)), int(round(x1 - x0)), int(round(y1 - y0)))
-        pygame.draw.rect(self.surface, WALL_COLOR, rect, width)
-
-    def _puck_sprite(self, r_px: int, color: tuple[int, int, int]) -> pygame.Surface:
-        key = (r_px, *color)
-        sprite = self._sprites.get(key)
-        if sprite is None:
-            if len(self._sprites) > _SPRITE_CACHE_LIMIT:
-                self._sprites.clear()
-            size = 2 * r_px + 1
-            sprite = pygame.Surface((size, size))
-            sprite.fill(_COLORKEY)
-            sprite.set_colorkey(_COLORKEY)
-            center = (r_px, r_px)
-            if r_px <= 3:
-                pygame.draw.circle(sprite, color, center, r_px)
-            else:
-                # An outlined puck: a ring in its colour around a dark core.
-                core = tuple(max(4, c * 3 // 10) for c in color)
-                pygame.draw.circle(sprite, core, center, r_px)
-                pygame.draw.circle(sprite, color, center, r_px, max(2, r_px // 6))
-            self._sprites[key] = sprite
-        return sprite
+        w, h = self.surface.get_size()
+        if x0 < w and x1 > 0 and y0 < h and y1 > 0:  # each edge drawn alone, clipped to the window
+            top, bottom = max(y0, -width), min(y1, h + width)
+            left, right = max(x0, -width), min(x1, w + width)
+            for rect in (
+                (left, y0, right - left, width),
+                (left, y1 - width, right - left, width),
+                (x0, top, width, bottom - top),
+                (x1 - width, top, width, bottom - top),
+            ):
+                self.surface.fill(WALL_COLOR, pygame.Rect(*(int(round(v)) for v in rect)))
 
     def _draw_pucks(self, target: pygame.Surface, scene: Scene) -> None:
-        n = len(scene.pos_m)
-        if n == 0:
+        if len(scene.pos_m) == 0:
             return
         centers = self.env.to_screen(scene.pos_m)
-        r_px = np.maximum(np.rint(self.env.length_to_px(scene.radius_m)), MIN_PUCK_RADIUS_PX).astype(np.int64)
-        w, h = target.get_size()
-        visible = (
-            (centers[:, 0] + r_px >= 0)
-            & (centers[:, 0] - r_px <= w)
-            & (centers[:, 1] + r_px >= 0)
-            & (centers[:, 1] - r_px <= h)
-        )
-        if not visible.all():
-            centers, r_px, colors = centers[visible], r_px[visible], scene.color_rgb[visible]
-        else:
-            colors = scene.color_rgb
-        # One sprite per distinct (radius, colour); usually a handful.
-        c = colors.astype(np.int64)
-        keys = (r_px << 24) | (c[:, 0] << 16) | (c[:, 1] << 8) | c[:, 2]
-        uniq, inverse = np.unique(keys, return_inverse=True)
-        sprites = [self._puck_sprite(int(k >> 24), (int(k >> 16) & 255, int(k >> 8) & 255, int(k) & 255)) for k in uniq]
-        corner = np.rint(centers).astype(np.int64) - r_px[:, None]
-        target.fblits(
-            [(sprites[k], (x, y)) for k, x, y in zip(inverse.tolist(), corner[:, 0].tolist(), corner[:, 1].tolist())]
-        )
+        # Clipped before the cast, so a zoom of any size stays a sane integer.
+        r_px = np.clip(np.rint(self.env.length_to_px(scene.radius_m)), MIN_PUCK_RADIUS_PX, 1 << 20).astype(np.int64)
+        draw_pucks(target, self.sprites, centers, r_px, scene.color_rgb)
 
     def _draw_springs(self, scene: Scene) -> None:
         if len(scene.spring_pairs) == 0:
@@ -198,10 +332,11 @@ class GameWindow:
         qa, qb = self.env.to_screen(a + half), self.env.to_screen(b + half)
         ra, rb = self.env.to_screen(a - half), self.env.to_screen(b - half)
         width_px = self.env.length_to_px(width_m)
+        thin = self.line_px(1)
         for s in range(len(scene.spring_pairs)):
             color = tuple(int(v) for v in scene.spring_color_rgb[s])
-            if width_px[s] < 2.0 or dist[s] == 0.0:
-                pygame.draw.line(self.surface, color, pa[s], pb[s], 1)
+            if width_px[s] < 2.0 * thin or dist[s] == 0.0:
+                pygame.draw.line(self.surface, color, pa[s], pb[s], thin)
             else:
                 pygame.draw.polygon(self.surface, color, [qa[s], qb[s], rb[s], ra[s]])
 
@@ -210,13 +345,14 @@ class GameWindow:
             if 0 <= cur.held < len(scene.pos_m):
                 start = self.env.to_screen(np.asarray(cur.cursor_m))
                 end = self.env.to_screen(scene.pos_m[cur.held])
-                pygame.draw.line(self.surface, cur.color, start, end, 2)
+                pygame.draw.line(self.surface, cur.color, start, end, self.line_px(2))
             self.draw_cursor(cur.name, cur.color, cur.cursor_m)
 
     def draw_cursor(self, name: str, color: Sequence[int], cursor_m: Sequence[float]) -> None:
         """A coloured arrow with the client's name, its tip at the cursor."""
         x, y = self.env.to_screen(np.asarray(cursor_m, dtype=float))
-        arrow = [(x, y), (x + 4, y + 15), (x + 7, y + 10), (x + 13, y + 12)]
+        u = max(1.0, self.unit)
+        arrow = [(x, y), (x + 4 * u, y + 15 * u), (x + 7 * u, y + 10 * u), (x + 13 * u, y + 12 * u)]
         pygame.draw.polygon(self.surface, color, arrow)
         pygame.draw.polygon(self.surface, (0, 0, 0), arrow, 1)
         key = (name, tuple(color))
@@ -225,272 +361,106 @@ class GameWindow:
             if len(self._labels) > 256:
                 self._labels.clear()
             label = self._labels[key] = self.label_font.render(name, True, color)
-        self.surface.blit(label, (x + 12, y + 14))
+        self.surface.blit(label, (x + 12 * u, y + 14 * u))
 
     def _draw_hud(self, scene: Scene, hud: Sequence[str], hud_color: Sequence[int] | None = None) -> None:
         w, h = self.surface.get_size()
+        pad = self.font.get_height() // 2
         # Frame-rate box, top right.
         fps = self.font.render(f"{scene.fps:5.1f} fps", True, TEXT_COLOR)
-        box = fps.get_rect(topright=(w - 8, 8)).inflate(10, 6)
+        box = fps.get_rect(topright=(w - pad, pad)).inflate(pad, pad // 2)
         pygame.draw.rect(self.surface, (0, 0, 0), box)
         pygame.draw.rect(self.surface, DIM_TEXT, box, 1)
         self.surface.blit(fps, fps.get_rect(center=box.center))
-        y = 8
+        self.label_boxes.append(box)
+        y = pad
+        line_h = self.font.get_linesize()
         if scene.title:
-            self.surface.blit(self.font.render(scene.title, True, TEXT_COLOR), (10, y))
-            y += 22
+            title = fit_parts(self.font, [scene.title], box.left - 2 * pad)
+            self.label_boxes.append(self.surface.blit(self.font.render(title, True, TEXT_COLOR), (pad, y)))
+            y += line_h
         for k, line in enumerate(hud):
             color = tuple(hud_color) if (k == 0 and hud_color is not None) else DIM_TEXT
-            self.surface.blit(self.font.render(line, True, color), (10, y))
-            y += 20
-        if scene.status:
-            status = self.font.render(scene.status, True, TEXT_COLOR)
+            text = self.font.render(fit_parts(self.font, [line], w - 2 * pad), True, color)
+            self.label_boxes.append(self.surface.blit(text, (pad, y)))
+            y += line_h
+        self.hud_bottom_px = y
+        parts = [p.strip() for p in scene.status_parts]
+        paused = PAUSED in parts
+        parts = [p for p in parts if p != PAUSED]
+        bar_h = line_h + pad
+        self.status_top_px = h - bar_h if parts else h
+        if parts:
             # See-through, so pucks resting on the bottom wall stay visible.
-            if self._status_bar is None or self._status_bar.get_width() != w:
-                self._status_bar = pygame.Surface((w, 26), pygame.SRCALPHA)
+            if self._status_bar is None or self._status_bar.get_size() != (w, bar_h):
+                self._status_bar = pygame.Surface((w, bar_h), pygame.SRCALPHA)
                 self._status_bar.fill((0, 0, 0, 150))
-            self.surface.blit(self._status_bar, (0, h - 26))
-            self.surface.blit(status, (10, h - 21))
+            self.label_boxes.append(self.surface.blit(self._status_bar, (0, h - bar_h)))
+            text = fit_parts(self.font, parts, w - 2 * pad)
+            self.surface.blit(self.font.render(text, True, TEXT_COLOR), (pad, h - bar_h + pad // 2))
+        if paused:
+            self._draw_paused()
+
+    def _draw_paused(self) -> None:
+        """PAUSED, large and centred near the top: unmistakable from the back of a room."""
+        w, _ = self.surface.get_size()
+        label = self.huge_font.render(PAUSED, True, PAUSED_COLOR)
+        pad = self.font.get_height() // 2
+        box = label.get_rect(midtop=(w // 2, self.hud_bottom_px + pad)).inflate(3 * pad, pad)
+        pygame.draw.rect(self.surface, (0, 0, 0), box)
+        pygame.draw.rect(self.surface, PAUSED_COLOR, box, self.line_px(3))
+        self.surface.blit(label, label.get_rect(center=box.center))
+        self.label_boxes.append(box)
 
     def draw_banner(self, text: str) -> None:
         """A big message across the middle of the window."""
         w, h = self.surface.get_size()
-        label = self.big_font.render(text, True, (255, 220, 120))
-        box = label.get_rect(center=(w // 2, h // 2)).inflate(30, 20)
+        label = self.big_font.render(fit_parts(self.big_font, [text], w - 40), True, ACCENT)
+        pad = self.font.get_height()
+        box = label.get_rect(center=(w // 2, h // 2)).inflate(pad, pad // 2)
         pygame.draw.rect(self.surface, (0, 0, 0), box)
-        pygame.draw.rect(self.surface, (255, 220, 120), box, 2)
+        pygame.draw.rect(self.surface, ACCENT, box, self.line_px(2))
         self.surface.blit(label, label.get_rect(center=box.center))
+
+    def panel_rect(self) -> pygame.Rect:
+        """Where panels go: under the title and HUD lines (the join line stays visible), above the status bar."""
+        w, h = self.surface.get_size()
+        pad = self.font.get_height() // 2
+        top = max(pad, self.hud_bottom_px + pad // 2)
+        bottom = min(h - pad, self.status_top_px - pad // 2)
+        side = max(pad, w // 40)
+        return pygame.Rect(side, top, w - 2 * side, max(4 * self.font.get_linesize(), bottom - top))
 
     def draw_panel(
         self,
         title: str,
-        rows: Sequence[tuple[str, str] | str],
+        rows: Sequence[panel_view.Row],
         *,
         large: bool = False,
         side_title: str = "",
-        side_rows: Sequence[tuple[str, str] | str] = (),
-    ) -> None:
-        """A translucent panel over the table: a title, then rows of text.
+        side_rows: Sequence[panel_view.Row] = (),
+        page: int = 0,
+    ) -> int:
+        """A translucent panel over the table: a title, then rows of text; returns its number of pages.
 
-        A row is either a line of text (wrapped to the panel) or a
-        (key, description) pair shown in two columns, as on the help screen.
-        `side_rows`, if any, fill a narrower column on the right.
+        A row is either a line of text (wrapped to the panel) or a (key,
+        description) pair shown in two columns, as on the help screen.
+        `side_rows`, if any, follow under their own `side_title`. Rows flow
+        into columns and, if they still do not fit, onto pages: `page` picks one.
         """
-        w, h = self.surface.get_size()
-        font = self.big_font if large else self.font
-        panel = pygame.Surface((w - 80, h - 80), pygame.SRCALPHA)
-        panel.fill(PANEL_COLOR)
-        top = 26 + self.big_font.get_linesize()
-        panel.blit(self.big_font.render(title, True, (255, 220, 120)), (20, 16))
-        width = panel.get_width() - 40
+        sections = [("", tuple(rows))]
         if side_rows:
-            side_w = int(width * 0.34)
-            width -= side_w + 20
-            x_side = 20 + width + 20
-            panel.blit(self.font.render(side_title, True, (255, 220, 120)), (x_side, top - 24))
-            self._panel_rows(panel, self.font, side_rows, x_side, top, side_w)
-        self._panel_rows(panel, font, rows, 20, top, width)
-        self.surface.blit(panel, (40, 40))
-
-    def _panel_rows(self, panel, font, rows, x: int, y: int, width: int) -> None:
-        line_h = font.get_linesize() + 2
-        key_w = max((font.size(r[0])[0] for r in rows if isinstance(r, tuple)), default=0) + 16
-        for row in rows:
-            if isinstance(row, tuple):
-                key, text = row
-                panel.blit(font.render(key, True, (255, 220, 120)), (x, y))
-                for line in _wrap(font, text, width - key_w) or [""]:
-                    panel.blit(font.render(line, True, TEXT_COLOR), (x + key_w, y))
-                    y += line_h
-            else:
-                for line in _wrap(font, row, width) or [""]:
-                    panel.blit(font.render(line, True, TEXT_COLOR), (x, y))
-                    y += line_h
-
-
-def _wrap(font: pygame.font.Font, text: str, width: int) -> list[str]:
-    """Split text into lines that fit `width` pixels."""
-    lines: list[str] = []
-    current = ""
-    for word in text.split():
-        trial = f"{current} {word}".strip()
-        if current and font.size(trial)[0] > width:
-            lines.append(current)
-            current = word
-        else:
-            current = trial
-    if current:
-        lines.append(current)
-    return lines
-
-
-# ---------------------------------------------------------------- teaching aids
-
-ANNOTATION_NORMAL = (255, 230, 90)
-ANNOTATION_TANGENT = (90, 200, 255)
-OVERLAP_COLOR = (255, 80, 80)
-SEPARATION_COLOR = (90, 255, 120)
-CHART_COLORS = {
-    "kinetic_J": (255, 165, 0),
-    "spring_J": (255, 215, 0),
-    "gravity_J": (90, 160, 255),
-    "total_J": (255, 255, 255),
-    "momentum_Ns": (230, 100, 230),
-}
-CHART_LABELS = {
-    "kinetic_J": "kinetic",
-    "spring_J": "spring",
-    "gravity_J": "gravity",
-    "total_J": "total",
-    "momentum_Ns": "|momentum|",
-}
-
-
-def _faded(color: Sequence[int], alpha: float) -> tuple[int, int, int]:
-    return tuple(int(c * alpha) for c in color[:3])
-
-
-class AidsPainter:
-    """Draws the teaching aids onto a GameWindow (kept apart from the core frame)."""
-
-    def __init__(self, window: GameWindow) -> None:
-        self.w = window
-
-    def _px(self, point_m) -> tuple[float, float]:
-        x, y = self.w.env.to_screen(np.asarray(point_m, dtype=float))
-        return (float(x), float(y))
-
-    def _text(self, text: str, pos_px, color, *, center: bool = False, font=None) -> None:
-        font = font or self.w.label_font
-        label = font.render(text, True, color)
-        rect = label.get_rect(center=pos_px) if center else label.get_rect(topleft=pos_px)
-        back = rect.inflate(4, 2)
-        pygame.draw.rect(self.w.surface, (0, 0, 0), back)
-        self.w.surface.blit(label, rect)
-
-    def arrow(self, start_m, vector_m, color, width: int = 2) -> None:
-        """An arrow from start_m along vector_m (both in metres)."""
-        start = np.asarray(start_m, dtype=float)
-        a, b = self._px(start), self._px(start + np.asarray(vector_m, dtype=float))
-        length = math.hypot(b[0] - a[0], b[1] - a[1])
-        if length < 1.0:
-            return
-        pygame.draw.line(self.w.surface, color, a, b, width)
-        ux, uy = (b[0] - a[0]) / length, (b[1] - a[1]) / length
-        head = min(10.0, 0.4 * length)
-        left = (b[0] - head * (ux - 0.5 * uy), b[1] - head * (uy + 0.5 * ux))
-        right = (b[0] - head * (ux + 0.5 * uy), b[1] - head * (uy - 0.5 * ux))
-        pygame.draw.polygon(self.w.surface, color, [b, left, right])
-
-    def arrows(self, starts_m: np.ndarray, vectors_m: np.ndarray, color) -> None:
-        for s, v in zip(starts_m, vectors_m):
-            self.arrow(s, v, color)
-
-    def marker(self, point_m, color, label: str) -> None:
-        x, y = self._px(point_m)
-        pygame.draw.circle(self.w.surface, color, (x, y), 7, 2)
-        pygame.draw.line(self.w.surface, color, (x - 11, y), (x + 11, y), 2)
-        pygame.draw.line(self.w.surface, color, (x, y - 11), (x, y + 11), 2)
-        self._text(label, (x + 12, y + 6), color)
-
-    def legend(self, lines: Sequence[tuple[str, Sequence[int]]]) -> None:
-        """Coloured lines of text in the top-left corner, under the HUD."""
-        y = 100
-        for text, color in lines:
-            self._text(text, (10, y), color, font=self.w.font)
-            y += 22
-
-    def annotation(self, a, now_s: float) -> None:
-        """Normal and tangent axes at the contact, overlap and separation with lengths and ratio."""
-        alpha = a.alpha(now_s)
-        n = np.asarray(a.normal)
-        t = np.array([-n[1], n[0]])
-        c = np.asarray(a.contact_m)
-        reach = 0.8 * (a.radius_i_m + a.radius_j_m)
-        for axis, color, name in ((n, ANNOTATION_NORMAL, "normal"), (t, ANNOTATION_TANGENT, "tangent")):
-            p0, p1 = self._px(c - reach * axis), self._px(c + reach * axis)
-            pygame.draw.line(self.w.surface, _faded(color, alpha), p0, p1, 2)
-            self._text(name, p1, _faded(color, alpha))
-        # Where the pucks were when the overlap was found, and after the correction.
-        for pos, r, color in (
-            (a.pos_i_before, a.radius_i_m, OVERLAP_COLOR),
-            (a.pos_j_before, a.radius_j_m, OVERLAP_COLOR),
-            (a.pos_i_after, a.radius_i_m, SEPARATION_COLOR),
-            (a.pos_j_after, a.radius_j_m, SEPARATION_COLOR),
-        ):
-            r_px = max(2, int(round(float(self.w.env.length_to_px(r)))))
-            pygame.draw.circle(self.w.surface, _faded(color, alpha), self._px(pos), r_px, 1)
-        # The overlap along the normal at detection, the gap after correction.
-        pi, pj = np.asarray(a.pos_i_before), np.asarray(a.pos_j_before)
-        pygame.draw.line(
-            self.w.surface,
-            _faded(OVERLAP_COLOR, alpha),
-            self._px(pj + n * a.radius_j_m),
-            self._px(pi - n * a.radius_i_m),
-            4,
-        )
-        qi, qj = np.asarray(a.pos_i_after), np.asarray(a.pos_j_after)
-        gap_n = (qi - qj) / max(float(np.hypot(*(qi - qj))), 1e-12)
-        pygame.draw.line(
-            self.w.surface,
-            _faded(SEPARATION_COLOR, alpha),
-            self._px(qj + gap_n * a.radius_j_m),
-            self._px(qi - gap_n * a.radius_i_m),
-            4,
-        )
-        x, y = self._px(c)
-        lines = [
-            (f"overlap {a.overlap_m * 1000:.1f} mm", OVERLAP_COLOR),
-            (f"separation {a.separation_m * 1000:.1f} mm", SEPARATION_COLOR),
-        ]
-        if a.ratio is not None:
-            lines.append((f"ratio {a.ratio:.4f}", TEXT_COLOR))
-        if a.angle_deg is not None:
-            lines.append((f"paths {a.angle_deg:.2f} deg apart", ANNOTATION_NORMAL))
-        for k, (text, color) in enumerate(lines):
-            self._text(text, (x + 24, y + 24 + 20 * k), _faded(color, alpha), font=self.w.font)
-
-    def energy_chart(self, series: dict[str, np.ndarray], latest: dict[str, float], note: str | None) -> None:
-        """Strip chart of energies (left scale) and |momentum| (right scale), bottom right."""
-        w, h = self.w.surface.get_size()
-        box = pygame.Rect(w - 430, h - 266, 420, 231)
-        panel = pygame.Surface(box.size, pygame.SRCALPHA)
-        panel.fill((0, 0, 0, 200))
-        self.w.surface.blit(panel, box)
-        pygame.draw.rect(self.w.surface, DIM_TEXT, box, 1)
-        plot = pygame.Rect(box.x + 10, box.y + 10, box.width - 150, box.height - 66)
-        pygame.draw.rect(self.w.surface, (60, 60, 60), plot, 1)
-        t = series["time_s"]
-        if len(t) >= 2:
-            span = max(t[-1] - t[0], 1e-9)
-            xs = plot.x + (t - t[0]) / span * plot.width
-            top_e = max(float(np.max(series["total_J"])), 1e-12) * 1.1
-            top_p = max(float(np.max(series["momentum_Ns"])), 1e-12) * 1.1
-            # Decimate to about one point per pixel column.
-            pick = np.unique(np.linspace(0, len(t) - 1, min(len(t), plot.width)).astype(int))
-            for key, color in CHART_COLORS.items():
-                top = top_p if key == "momentum_Ns" else top_e
-                ys = plot.bottom - np.clip(series[key] / top, 0.0, 1.0) * plot.height
-                pts = np.stack([xs[pick], ys[pick]], axis=1)
-                pygame.draw.lines(self.w.surface, color, False, pts.tolist(), 2 if key == "total_J" else 1)
-            self._text(f"{top_e:.3g} J", (plot.x + 2, plot.y + 2), DIM_TEXT)
-            self._text(f"last {span:.1f} s", (plot.x + 2, plot.bottom - 16), DIM_TEXT)
-        y = box.y + 10
-        for key, color in CHART_COLORS.items():
-            value = f"{latest[key]:.4f} N s" if key == "momentum_Ns" else f"{latest[key]:.5g} J"
-            self._text(f"{CHART_LABELS[key]}", (plot.right + 10, y), color)
-            self._text(value, (plot.right + 10, y + 14), color)
-            y += 34
-        if note:
-            for k, line in enumerate(_wrap(self.w.label_font, note, box.width - 20)[:3]):
-                self._text(line, (box.x + 10, plot.bottom + 6 + 16 * k), DIM_TEXT)
-
-    def inspector(self, point_m, lines: Sequence[str]) -> None:
-        x, y = self._px(point_m)
-        width = max(self.w.font.size(line)[0] for line in lines) + 16
-        box = pygame.Rect(int(x) + 20, int(y) - 10, width, 22 * len(lines) + 10)
-        box.clamp_ip(self.w.surface.get_rect())
-        pygame.draw.rect(self.w.surface, (0, 0, 0), box)
-        pygame.draw.rect(self.w.surface, (255, 220, 120), box, 1)
-        for k, line in enumerate(lines):
-            self.w.surface.blit(self.w.font.render(line, True, TEXT_COLOR), (box.x + 8, box.y + 6 + 22 * k))
+            sections.append((side_title, tuple(side_rows)))
+        rect = self.panel_rect()
+        key = (title, tuple(sections), large, rect.size, page)
+        cached = self._panels.get(key)
+        if cached is None:  # laying out and rendering text is slow: once per content and size
+            font = self.big_font if large else self._panel_font(sections, rect)
+            cached = panel_view.render_panel(
+                rect.size, title, sections, font=font, title_font=self.big_font, small_font=self.label_font, page=page
+            )
+            if len(self._panels) >= 8:
+                self._panels.clear()
+            self._panels[key] = cached
+        self.surface.blit(cached[0], rect)
+        return cached[1]

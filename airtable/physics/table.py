@@ -147,6 +147,7 @@ class AirTable:
     def reset_settings(self) -> None:
         """Back to the defaults every demo starts from."""
         self.gravity_on = False
+        self.gravity_mps2 = GRAVITY_MPS2  # the strength of gravity while it is on (Earth's unless changed)
         self.cr_puck = 1.0
         self.cr_wall = 1.0
         self.wall_correction = True
@@ -354,7 +355,7 @@ class AirTable:
         """m g y summed over pucks (floor at y = 0); 0 while gravity is off."""
         if not self.gravity_on:
             return 0.0
-        return float(GRAVITY_MPS2 * np.dot(self.mass_kg, self.pos_m[:, 1]))
+        return float(self.gravity_mps2 * np.dot(self.mass_kg, self.pos_m[:, 1]))
 
     def momentum_Ns(self) -> np.ndarray:
         return self.mass_kg @ self.vel_mps if self._pucks.n else np.zeros(2)
@@ -426,7 +427,7 @@ class AirTable:
         if np.count_nonzero(force):  # usually nothing pushes: skip the (N, 2) update
             vel += force * (dt / mass)[:, None]
         if self.gravity_on:
-            vel[:, 1] -= GRAVITY_MPS2 * dt
+            vel[:, 1] -= self.gravity_mps2 * dt
         if drag is not None and drag.any():
             # The drag -c v is taken at the end of the step (backward Euler):
             # v_new = v - c v_new dt / m, stable for any c and mass.
@@ -504,5 +505,5 @@ class AirTable:
             if (a == row).any() or (b == row).any():
                 out["springs"] = total
         if self.gravity_on:
-            out["gravity"] = np.array([0.0, -self.mass_kg[row] * GRAVITY_MPS2])
+            out["gravity"] = np.array([0.0, -self.mass_kg[row] * self.gravity_mps2])
         return out

@@ -1,0 +1,373 @@
+"""The teaching aids drawn over the table: collision annotations, arrows, the energy chart.
+
+The numbers come from aids.py (no pygame); this module only draws them, onto
+a GameWindow's surface, with its fonts and line widths (which scale with the
+window). Every label goes through one greedy placer: it tries a few spots
+around its anchor and takes the first whose box overlaps no label drawn
+before it in this frame, so labels never cover one another.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+
+import numpy as np
+import pygame
+
+from airtable.app.aids import VectorScale
+from airtable.app.panel_view import DIM_TEXT, TEXT_COLOR
+from airtable.app.panel_view import wrap as _wrap
+
+ANNOTATION_NORMAL = (255, 230, 90)
+ANNOTATION_TANGENT = (90, 200, 255)
+IDEAL_COLOR = (0, 200, 140)  # the push a perfect contact normal would give
+OVERLAP_COLOR = (255, 80, 80)
+SEPARATION_COLOR = (90, 255, 120)
+# Okabe and Ito's palette, which stays distinct with every common colour-vision
+# deficiency; white (drawn thicker) for the total.
+CHART_COLORS = {
+    "kinetic_J": (230, 159, 0),  # orange
+    "spring_J": (0, 158, 115),  # bluish green
+    "gravity_J": (86, 180, 233),  # sky blue
+    "total_J": (255, 255, 255),
+    "momentum_Ns": (204, 121, 167),  # reddish purple
+}
+CHART_LABELS = {
+    "kinetic_J": "kinetic",
+    "spring_J": "spring",
+    "gravity_J": "gravity",
+    "total_J": "total",
+    "momentum_Ns": "|momentum|",
+}
+CHART_CORNERS = ("top right", "bottom right", "bottom left", "top left")
+CHART_SIZE_PX = (520, 240)  # at 720 px tall; the small chart is 0.65 of it
+# Where a label may go around its anchor, in order of preference: (x side, y side).
+AROUND = ((1, 1), (1, -1), (-1, 1), (-1, -1), (0, 1), (0, -1))
+RINGS = 8  # how far out (in lines) a label may move from its anchor
+
+
+def _faded(color: Sequence[int], alpha: float) -> tuple[int, int, int]:
+    return tuple(int(c * alpha) for c in color[:3])
+
+
+def box_at(anchor: tuple[float, float], size: tuple[int, int], side: tuple[int, int], gap: float) -> pygame.Rect:
+    """A box of `size` beside `anchor`: side x/y of -1, 0 (centred) or 1, `gap` px away."""
+    w, h = size
+    ax, ay = anchor
+    sx, sy = side
+    left = ax + gap if sx > 0 else (ax - gap - w if sx < 0 else ax - w / 2)
+    top = ay + gap if sy > 0 else ay - gap - h
+    return pygame.Rect(int(round(left)), int(round(top)), w, h)
+
+
+def place_box(
+    size: tuple[int, int], anchor, gap: float, taken: Sequence[pygame.Rect], screen: pygame.Rect, step: int
+) -> pygame.Rect | None:
+    """The first box around `anchor` that stays on `screen` and overlaps none of `taken`.
+
+    Tries the spots of AROUND, then the same spots pushed further out by `step`
+    px at a time, up to RINGS times; None if all are taken (a crowded frame:
+    the label is left out rather than drawn over another)."""
+    for ring in range(RINGS):
+        for side in AROUND:
+            rect = box_at(anchor, size, side, gap + ring * step)
+            if screen.contains(rect) and rect.collidelist(taken) < 0:
+                return rect
+    return None
+
+
+class AidsPainter:
+    """Draws the teaching aids onto a GameWindow (kept apart from the core frame)."""
+
+    def __init__(self, window) -> None:  # a GameWindow
+        self.w = window
+        self.chart_corner: int | None = None  # index into CHART_CORNERS; None: pick one clear of pucks
+        self.chart_small = False
+        self._vector_scales: dict[str, VectorScale] = {}
+
+    def new_demo(self) -> None:
+        """A demo (re)started: arrow scales start afresh, and the chart picks its corner again."""
+        self._vector_scales.clear()
+        self.chart_corner = None
+
+    def vector_scale(self, quantity: str) -> VectorScale:
+        """The round arrow scale of `quantity` ("velocity", "momentum") for the current demo."""
+        return self._vector_scales.setdefault(quantity, VectorScale())
+
+    # ------------------------------------------------------------ basics
+
+    @property
+    def _taken(self) -> list[pygame.Rect]:
+        return self.w.label_boxes
+
+    def _px(self, point_m) -> tuple[float, float]:
+        x, y = self.w.env.to_screen(np.asarray(point_m, dtype=float))
+        return (float(x), float(y))
+
+    def _text(self, text: str, pos_px, color, *, center: bool = False, font=None) -> pygame.Rect:
+        """One line on a black box, at a given spot (placement is the caller's)."""
+        font = font or self.w.label_font
+        label = font.render(text, True, color)
+        rect = label.get_rect(center=pos_px) if center else label.get_rect(topleft=pos_px)
+        pygame.draw.rect(self.w.surface, (0, 0, 0), rect.inflate(4, 2))
+        self.w.surface.blit(label, rect)
+        return rect
+
+    def label(
+        self,
+        lines: Sequence[tuple[str, Sequence[int]]],
+        anchor_px,
+        gap: float = 0.0,
+        font=None,
+        *,
+        always: bool = False,
+    ) -> pygame.Rect | None:
+        """A block of coloured lines placed beside `anchor_px` where no other label is.
+
+        Where there is no such place it is left out (None), unless `always`
+        (the inspector, asked for by a held key): then it goes beside its anchor."""
+        font = font or self.w.label_font
+        line_h = font.get_linesize()
+        size = (max(font.size(t)[0] for t, _ in lines) + 6, line_h * len(lines) + 2)
+        pad = self.w.line_px(2)
+        screen = self.w.surface.get_rect()
+        rect = place_box(size, anchor_px, gap + pad, self._taken, screen, line_h)
+        if rect is None:
+            if not always:
+                return None
+            rect = box_at(anchor_px, size, AROUND[0], gap + pad).clamp(screen)
+        self._taken.append(rect)
+        pygame.draw.rect(self.w.surface, (0, 0, 0), rect)
+        for k, (text, color) in enumerate(lines):
+            self._text(text, (rect.x + 3, rect.y + 1 + k * line_h), color, font=font)
+        return rect
+
+    def arrow(self, start_m, vector_m, color, width: int | None = None) -> None:
+        """An arrow from start_m along vector_m (both in metres)."""
+        start = np.asarray(start_m, dtype=float)
+        a, b = self._px(start), self._px(start + np.asarray(vector_m, dtype=float))
+        length = math.hypot(b[0] - a[0], b[1] - a[1])
+        if length < 1.0 or not math.isfinite(length):
+            return
+        width = width or self.w.line_px(2)
+        pygame.draw.line(self.w.surface, color, a, b, width)
+        ux, uy = (b[0] - a[0]) / length, (b[1] - a[1]) / length
+        head = min(5.0 * width, 0.4 * length)
+        left = (b[0] - head * (ux - 0.5 * uy), b[1] - head * (uy + 0.5 * ux))
+        right = (b[0] - head * (ux + 0.5 * uy), b[1] - head * (uy - 0.5 * ux))
+        pygame.draw.polygon(self.w.surface, color, [b, left, right])
+
+    def arrows(self, starts_m: np.ndarray, vectors_m: np.ndarray, color) -> None:
+        for s, v in zip(starts_m, vectors_m):
+            self.arrow(s, v, color)
+
+    def marker(self, point_m, color, label: str) -> None:
+        x, y = self._px(point_m)
+        lw, r = self.w.line_px(2), 4 * self.w.line_px(2)
+        pygame.draw.circle(self.w.surface, color, (x, y), r, lw)
+        pygame.draw.line(self.w.surface, color, (x - 1.5 * r, y), (x + 1.5 * r, y), lw)
+        pygame.draw.line(self.w.surface, color, (x, y - 1.5 * r), (x, y + 1.5 * r), lw)
+        self.label([(label, color)], (x, y), gap=1.5 * r)
+
+    def legend(self, lines: Sequence[tuple[str, Sequence[int]]]) -> None:
+        """Coloured lines of text at the left, under the HUD (and under the chart, if that is there)."""
+        font, pad = self.w.font, self.w.line_px(4)
+        line_h = font.get_linesize()
+        block = pygame.Rect(
+            pad * 2 - 2, self.w.hud_bottom_px + pad, max(font.size(t)[0] for t, _ in lines) + 4, line_h * len(lines)
+        )
+        for _ in range(len(self._taken)):  # slide down past whatever is in the way
+            hit = block.collidelist(self._taken)
+            if hit < 0:
+                break
+            block.top = self._taken[hit].bottom + pad
+        for k, (text, color) in enumerate(lines):
+            self._text(text, (pad * 2, block.top + k * line_h), color, font=font)
+        self._taken.append(block)
+
+    def _dashed(self, color, a_px, b_px, width: int) -> None:
+        length = math.hypot(b_px[0] - a_px[0], b_px[1] - a_px[1])
+        dash = 4 * width
+        for k in range(int(length // (2 * dash)) + 1):
+            t0, t1 = min(1.0, 2 * k * dash / length), min(1.0, (2 * k + 1) * dash / length)
+            p = [(a_px[0] + (b_px[0] - a_px[0]) * t, a_px[1] + (b_px[1] - a_px[1]) * t) for t in (t0, t1)]
+            pygame.draw.line(self.w.surface, color, p[0], p[1], width)
+
+    # ------------------------------------------------------------ collisions
+
+    def annotation(self, a, now_s: float) -> None:
+        """Normal and tangent at the contact, overlap and separation, and the target's push against the ideal."""
+        alpha = a.alpha(now_s)
+        surf, lw = self.w.surface, self.w.line_px(2)
+        n = np.asarray(a.normal)
+        c = np.asarray(a.contact_m)
+        reach = 0.8 * (a.radius_i_m + a.radius_j_m)
+        ends = {}
+        for axis, color, name in (
+            (n, ANNOTATION_NORMAL, "normal"),
+            (np.array([-n[1], n[0]]), ANNOTATION_TANGENT, "tangent"),
+        ):
+            p0, ends[name] = self._px(c - reach * axis), self._px(c + reach * axis)
+            pygame.draw.line(surf, _faded(color, alpha), p0, ends[name], lw)
+        # Where the pucks were when the overlap was found, and after the correction.
+        for pos, r, color in (
+            (a.pos_i_before, a.radius_i_m, OVERLAP_COLOR),
+            (a.pos_j_before, a.radius_j_m, OVERLAP_COLOR),
+            (a.pos_i_after, a.radius_i_m, SEPARATION_COLOR),
+            (a.pos_j_after, a.radius_j_m, SEPARATION_COLOR),
+        ):
+            r_px = max(lw + 1, int(round(float(self.w.env.length_to_px(r)))))
+            pygame.draw.circle(surf, _faded(color, alpha), self._px(pos), r_px, lw)
+        self._gap_bars(a, n, alpha)
+        if a.target is not None:
+            self._target_rays(a, alpha, reach)
+        # Labels, most important first: each takes the first free spot.
+        reach_px = float(self.w.env.length_to_px(a.radius_i_m + a.radius_j_m))
+        self.label(self._annotation_lines(a, alpha), self._px(c), gap=min(reach_px, 200.0), font=self.w.font)
+        for name, color in (("normal", ANNOTATION_NORMAL), ("tangent", ANNOTATION_TANGENT)):
+            self.label([(name, _faded(color, alpha))], ends[name])
+        if a.target is not None:
+            tip = np.asarray(a.target.pos_m) + 1.6 * reach * np.asarray(a.target.ideal_dir)
+            self.label([("ideal", _faded(IDEAL_COLOR, alpha))], self._px(tip))
+
+    def _gap_bars(self, a, n: np.ndarray, alpha: float) -> None:
+        """The overlap along the normal at detection, the gap after correction."""
+        wide = self.w.line_px(4)
+        pi, pj = np.asarray(a.pos_i_before), np.asarray(a.pos_j_before)
+        ends = (self._px(pj + n * a.radius_j_m), self._px(pi - n * a.radius_i_m))
+        pygame.draw.line(self.w.surface, _faded(OVERLAP_COLOR, alpha), *ends, wide)
+        qi, qj = np.asarray(a.pos_i_after), np.asarray(a.pos_j_after)
+        gap_n = (qi - qj) / max(float(np.hypot(*(qi - qj))), 1e-12)
+        ends = (self._px(qj + gap_n * a.radius_j_m), self._px(qi - gap_n * a.radius_i_m))
+        pygame.draw.line(self.w.surface, _faded(SEPARATION_COLOR, alpha), *ends, wide)
+
+    def _target_rays(self, a, alpha: float, reach: float) -> None:
+        """From the target: the way it was pushed (solid) and the way a first-contact normal pushes (dashed)."""
+        start = np.asarray(a.target.pos_m)
+        lw = self.w.line_px(2)
+        self.arrow(start, 1.6 * reach * np.asarray(a.target.push_dir), _faded(ANNOTATION_NORMAL, alpha), lw)
+        tip = self._px(start + 1.6 * reach * np.asarray(a.target.ideal_dir))
+        self._dashed(_faded(IDEAL_COLOR, alpha), self._px(start), tip, lw)
+
+    @staticmethod
+    def _annotation_lines(a, alpha: float) -> list[tuple[str, tuple[int, int, int]]]:
+        lines = [
+            (f"overlap {a.overlap_m * 1000:.1f} mm", OVERLAP_COLOR),
+            (f"separation {a.separation_m * 1000:.1f} mm", SEPARATION_COLOR),
+        ]
+        if a.ratio is not None:
+            lines.append((f"ratio {a.ratio:.4f}", TEXT_COLOR))
+        if a.target is not None:
+            lines.append((f"target {a.target.actual_deg:.1f} deg vs ideal {a.target.ideal_deg:.1f} deg", IDEAL_COLOR))
+        if a.angle_deg is not None:
+            lines.append((f"paths {a.angle_deg:.2f} deg apart", ANNOTATION_NORMAL))
+        return [(text, _faded(color, alpha)) for text, color in lines]
+
+    # ------------------------------------------------------------ energy chart
+
+    def cycle_chart_corner(self) -> str:
+        """Move the chart to the next corner; returns the corner's name."""
+        self.chart_corner = ((self.chart_corner or 0) + 1) % len(CHART_CORNERS)
+        return CHART_CORNERS[self.chart_corner]
+
+    def choose_chart_corner(self, points_px: np.ndarray) -> None:
+        """Put the chart in the corner that covers the fewest of `points_px` (the pucks), once per demo."""
+        if self.chart_corner is not None:
+            return
+        covered = []
+        for corner in range(len(CHART_CORNERS)):
+            rect = self.chart_rect(corner)
+            inside = (
+                (points_px[:, 0] >= rect.left)
+                & (points_px[:, 0] < rect.right)
+                & (points_px[:, 1] >= rect.top)
+                & (points_px[:, 1] < rect.bottom)
+            )
+            covered.append(int(np.count_nonzero(inside)))
+        self.chart_corner = covered.index(min(covered))
+
+    def toggle_chart_size(self) -> None:
+        self.chart_small = not self.chart_small
+
+    def chart_rect(self, corner: int | None = None) -> pygame.Rect:
+        """The chart's box: in its corner, under the HUD or above the status bar, at most half the width."""
+        w, h = self.w.surface.get_size()
+        scale = self.w.unit * (0.65 if self.chart_small else 1.0)
+        size = (
+            min(w // 2, int(CHART_SIZE_PX[0] * max(scale, 0.6))),
+            min(h // 2, int(CHART_SIZE_PX[1] * max(scale, 0.6))),
+        )
+        pad = self.w.line_px(4)
+        name = CHART_CORNERS[(self.chart_corner or 0) if corner is None else corner]
+        rect = pygame.Rect((0, 0), size)
+        if name.startswith("top"):
+            rect.top = self.w.hud_bottom_px + pad
+        else:
+            rect.bottom = self.w.status_top_px - pad
+        if name.endswith("right"):
+            rect.right = w - pad
+        else:
+            rect.left = pad
+        return rect
+
+    def energy_chart(self, series: dict[str, np.ndarray], latest: dict[str, float], note: str | None) -> None:
+        """Strip chart of energies (left scale) and |momentum| (right scale) in a corner panel."""
+        box = self.chart_rect()
+        surf, font = self.w.surface, self.w.label_font
+        panel = pygame.Surface(box.size, pygame.SRCALPHA)
+        panel.fill((0, 0, 0, 215))
+        surf.blit(panel, box)
+        pygame.draw.rect(surf, DIM_TEXT, box, 1)
+        self._taken.append(box)
+        line_h = font.get_linesize()
+        pad = self.w.line_px(4)
+        legend = [
+            (f"{CHART_LABELS[k]} {latest[k]:.3g} {'N s' if k == 'momentum_Ns' else 'J'}", c)
+            for k, c in CHART_COLORS.items()
+        ]
+        # Sized for the widest value the format gives, so the plot does not jitter.
+        widest = max(font.size(f"{CHART_LABELS[k]} -8.88e-88 N s")[0] for k in CHART_COLORS)
+        key_w = widest + 5 * pad
+        notes = _wrap(font, note, box.width - 20)[:2] if note and not self.chart_small else []
+        plot = pygame.Rect(
+            box.x + pad, box.y + pad, box.width - key_w - 3 * pad, box.height - 2 * pad - line_h * len(notes)
+        )
+        pygame.draw.rect(surf, (60, 60, 60), plot, 1)
+        t = series["time_s"]
+        if len(t) >= 2 and plot.width > 10 and plot.height > 10:
+            self._chart_lines(series, plot)
+            top_e = max(float(np.max(series["total_J"])), 1e-12) * 1.1
+            self._text(f"{top_e:.3g} J", (plot.x + 2, plot.y + 2), DIM_TEXT)
+            self._text(f"last {max(t[-1] - t[0], 0.0):.1f} s", (plot.x + 2, plot.bottom - line_h), DIM_TEXT)
+        y = box.y + pad
+        for text, color in legend:
+            mid = y + line_h // 2
+            pygame.draw.line(surf, color, (plot.right + pad, mid), (plot.right + 3 * pad, mid), self.w.line_px(3))
+            self._text(text, (plot.right + 3 * pad + 4, y), color)
+            y += line_h + (pad // 2 if not self.chart_small else 0)
+        for k, line in enumerate(notes):
+            self._text(line, (box.x + pad, plot.bottom + k * line_h), DIM_TEXT)
+
+    def _chart_lines(self, series: dict[str, np.ndarray], plot: pygame.Rect) -> None:
+        t = series["time_s"]
+        span = max(t[-1] - t[0], 1e-9)
+        xs = plot.x + (t - t[0]) / span * plot.width
+        top_e = max(float(np.max(series["total_J"])), 1e-12) * 1.1
+        top_p = max(float(np.max(series["momentum_Ns"])), 1e-12) * 1.1
+        # Decimate to about one point per pixel column.
+        pick = np.unique(np.linspace(0, len(t) - 1, min(len(t), plot.width)).astype(int))
+        thin, thick = self.w.line_px(1.5), self.w.line_px(3)
+        for key, color in CHART_COLORS.items():
+            top = top_p if key == "momentum_Ns" else top_e
+            ys = plot.bottom - np.clip(series[key] / top, 0.0, 1.0) * plot.height
+            pts = np.stack([xs[pick], ys[pick]], axis=1)
+            pygame.draw.lines(self.w.surface, color, False, pts.tolist(), thick if key == "total_J" else thin)
+
+    # ------------------------------------------------------------ inspector
+
+    def inspector(self, point_m, lines: Sequence[str]) -> None:
+        x, y = self._px(point_m)
+        self.label(
+            [(line, TEXT_COLOR) for line in lines], (x, y), gap=self.w.font.get_height(), font=self.w.font, always=True
+        )

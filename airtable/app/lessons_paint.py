@@ -1,0 +1,183 @@
+"""Drawing the lesson panels: the momenta diagram and the values panel, each in a corner of the window.
+
+The numbers come from momenta.py (no pygame); this module only draws them
+onto a GameWindow's surface with its fonts and line widths, which scale with
+the window. Each panel takes a corner once per demo: not the energy chart's,
+and of the others the one over the fewest pucks. Their boxes join the
+window's label boxes, so the labels drawn after them stay clear of them.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+
+import numpy as np
+import pygame
+
+from airtable.app.aids_paint import CHART_COLORS, CHART_CORNERS
+from airtable.app.momenta import VALUE_HEADINGS, MomentaAround, PuckValues, fit_chains, tip_to_tail
+from airtable.app.panel_view import ACCENT, DIM_TEXT, TEXT_COLOR
+
+TOTAL_COLOR = CHART_COLORS["momentum_Ns"]  # the chart's |momentum| colour
+PANEL_FILL = (0, 0, 0, 215)
+MOMENTA_SIZE_PX = (480, 250)  # at 720 px tall, like the chart
+
+
+class LessonsPainter:
+    """Draws the momenta diagram and the values panel onto a GameWindow."""
+
+    def __init__(self, window) -> None:  # a GameWindow
+        self.w = window
+        self.corners: dict[str, int] = {}  # panel name -> index into CHART_CORNERS, chosen once per demo
+
+    def new_demo(self) -> None:
+        self.corners.clear()
+
+    # ------------------------------------------------------------ corners
+
+    def choose_corner(self, panel: str, points_px: np.ndarray, avoid: Sequence[int]) -> int:
+        """The corner of `panel`: kept once chosen, unless in `avoid`; else the free corner over the fewest points."""
+        if self.corners.get(panel) is None or self.corners[panel] in avoid:
+            free = [k for k in range(len(CHART_CORNERS)) if k not in avoid] or [0]
+            w, h = self.w.surface.get_size()
+            mid = np.array([w / 2, h / 2])
+            pts = np.asarray(points_px, dtype=float).reshape(-1, 2)
+            counts = []
+            for k in free:
+                name = CHART_CORNERS[k]
+                dx = pts[:, 0] > mid[0] if name.endswith("right") else pts[:, 0] <= mid[0]
+                dy = pts[:, 1] <= mid[1] if name.startswith("top") else pts[:, 1] > mid[1]
+                counts.append(int(np.count_nonzero(dx & dy)))
+            self.corners[panel] = free[counts.index(min(counts))]
+        return self.corners[panel]
+
+    def corner_rect(self, size: tuple[int, int], corner: int) -> pygame.Rect:
+        """A box of `size` in `corner`: under the HUD or above the status bar, at most half the window."""
+        w, h = self.w.surface.get_size()
+        pad = self.w.line_px(4)
+        rect = pygame.Rect(0, 0, min(size[0], w // 2 - 2 * pad), min(size[1], h // 2 - 2 * pad))
+        name = CHART_CORNERS[corner]
+        if name.startswith("top"):
+            rect.top = self.w.hud_bottom_px + pad
+        else:
+            rect.bottom = self.w.status_top_px - pad
+        if name.endswith("right"):
+            rect.right = w - pad
+        else:
+            rect.left = pad
+        return rect
+
+    def _panel(self, rect: pygame.Rect) -> None:
+        back = pygame.Surface(rect.size, pygame.SRCALPHA)
+        back.fill(PANEL_FILL)
+        self.w.surface.blit(back, rect)
+        pygame.draw.rect(self.w.surface, DIM_TEXT, rect, 1)
+        self.w.label_boxes.append(rect)
+
+    def _text(self, text: str, pos, color, font=None) -> pygame.Rect:
+        font = font or self.w.label_font
+        return self.w.surface.blit(font.render(text, True, color), pos)
+
+    def _arrow_px(self, a, b, color, width: int) -> None:
+        length = math.hypot(b[0] - a[0], b[1] - a[1])
+        if length < 1.0:
+            return
+        pygame.draw.line(self.w.surface, color, a, b, width)
+        ux, uy = (b[0] - a[0]) / length, (b[1] - a[1]) / length
+        head = min(4.0 * width, 0.4 * length)
+        left = (b[0] - head * (ux - 0.5 * uy), b[1] - head * (uy + 0.5 * ux))
+        right = (b[0] - head * (ux + 0.5 * uy), b[1] - head * (uy - 0.5 * ux))
+        pygame.draw.polygon(self.w.surface, color, [b, left, right])
+
+    # ------------------------------------------------------------ momenta diagram
+
+    def momenta_size(self) -> tuple[int, int]:
+        u = max(self.w.unit, 0.6)
+        return (int(MOMENTA_SIZE_PX[0] * u), int(MOMENTA_SIZE_PX[1] * u))
+
+    def momenta_diagram(self, m: MomentaAround | None, corner: int) -> pygame.Rect:
+        """Before and after the latest collision: each puck's momentum tip to tail (its colour), and the total."""
+        font, pad = self.w.label_font, self.w.line_px(4)
+        line_h = font.get_linesize()
+        if m is None:
+            text = "momenta: no collision yet"
+            rect = self.corner_rect((font.size(text)[0] + 2 * pad, line_h + 2 * pad), corner)
+            self._panel(rect)
+            self._text(text, (rect.x + pad, rect.y + pad), TEXT_COLOR)
+            return rect
+        rect = self.corner_rect(self.momenta_size(), corner)
+        self._panel(rect)
+        self._text(f"momenta, collision at t = {m.t_s:.2f} s", (rect.x + pad, rect.y + pad), TEXT_COLOR)
+        half = pygame.Rect(0, 0, (rect.width - 3 * pad) // 2, rect.height - 2 * pad - 3 * line_h)
+        rows = m.shown()
+        chains = []
+        for momenta in (m.before_Ns, m.after_Ns):
+            tails, tips = tip_to_tail(momenta[rows])
+            total = momenta.sum(axis=0)
+            chains.append((tails, tips, total))
+        fit = fit_chains([np.vstack([t, p, tot[None]]) for t, p, tot in chains], half.size)
+        for side, (name, (tails, tips, total)) in enumerate(zip(("before", "after"), chains)):
+            box = half.move(rect.x + pad + side * (half.width + pad), rect.y + pad + line_h)
+            pygame.draw.rect(self.w.surface, (60, 60, 60), box, 1)
+            self._text(name, (box.x + pad, box.y + pad // 2), DIM_TEXT)
+            self._chain(fit, side, box, tails, tips, total, m.colors[rows])
+            self._text(f"total ({total[0]:.3g}, {total[1]:.3g}) N s", (box.x, box.bottom + pad // 2), TOTAL_COLOR)
+            self._text(f"|total| {math.hypot(*total):.4g} N s", (box.x, box.bottom + pad // 2 + line_h), TOTAL_COLOR)
+        return rect
+
+    def _chain(self, fit, side: int, box: pygame.Rect, tails, tips, total, colors) -> None:
+        size = box.size
+        a, b = fit.to_px(side, tails, size), fit.to_px(side, tips, size)
+        width = self.w.line_px(2)
+        origin = np.array([box.x, box.y])
+        for k in range(len(tails)):
+            self._arrow_px(origin + a[k], origin + b[k], tuple(int(c) for c in colors[k]), width)
+        ends = fit.to_px(side, np.array([[0.0, 0.0], total]), size) + origin
+        # Beside the chain, not on it: when every arrow lies on one line the total would hide them.
+        d = ends[1] - ends[0]
+        n = np.array([-d[1], d[0]]) / max(float(np.hypot(*d)), 1e-9)
+        shift = n * 3 * self.w.line_px(2)
+        self._arrow_px(ends[0] + shift, ends[1] + shift, TOTAL_COLOR, self.w.line_px(3))
+
+    # ------------------------------------------------------------ values panel
+
+    def values_size(self, rows: Sequence[PuckValues], hint: str) -> tuple[tuple[int, ...], tuple[int, int]]:
+        """Column widths and the panel's size for `rows` (or the one-line `hint` if there are none)."""
+        font, pad = self.w.label_font, self.w.line_px(4)
+        if not rows:
+            return (), (font.size(hint)[0] + 2 * pad, font.get_linesize() + 2 * pad)
+        swatch = font.get_height()
+        table = [VALUE_HEADINGS, *(r.cells() for r in rows)]
+        widths = tuple(max(font.size(row[c])[0] for row in table) + 2 * pad for c in range(len(VALUE_HEADINGS)))
+        widths = (widths[0] + swatch, *widths[1:])
+        return widths, (sum(widths) + 2 * pad, font.get_linesize() * len(table) + 2 * pad)
+
+    def values_panel(self, rows: Sequence[PuckValues], colors: Sequence, hint: str, corner: int) -> pygame.Rect:
+        """A small table: each puck's mass, speed, momentum and kinetic energy; its colour beside its number."""
+        widths, size = self.values_size(rows, hint)
+        rect = self.corner_rect(size, corner)
+        self._panel(rect)
+        font, pad = self.w.label_font, self.w.line_px(4)
+        line_h = font.get_linesize()
+        if not rows:
+            self._text(hint, (rect.x + pad, rect.y + pad), DIM_TEXT)
+            return rect
+        swatch = font.get_height()
+        table = [(VALUE_HEADINGS, DIM_TEXT, None)]
+        table += [(r.cells(), ACCENT if r.speed_mps is None else TEXT_COLOR, c) for r, c in zip(rows, colors)]
+        for k, (cells, color, puck_color) in enumerate(table):
+            y = rect.y + pad + k * line_h
+            if y + line_h > rect.bottom:
+                break  # a window too small for the whole table: cut, never spill
+            x = rect.x + pad
+            if puck_color is not None:
+                r = swatch // 3
+                pygame.draw.circle(self.w.surface, tuple(int(v) for v in puck_color), (x + r, y + line_h // 2), r)
+            for c, text in enumerate(cells):
+                if x + widths[c] - 2 * pad > rect.right:
+                    break  # a narrow window: the columns that fit
+                shift = swatch if c == 0 else 0
+                self._text(text, (x + shift, y), color, font)
+                x += widths[c]
+        return rect

@@ -1,0 +1,157 @@
+"""The numbers behind the momenta diagram and the values panel (no pygame).
+
+The momenta diagram, as PhET's Collision Lab draws it: every puck's momentum
+m v as an arrow, tip to tail, so the arrow from the first tail to the last
+tip is the total; once just before the latest collision and once just after
+it, at one shared scale, so a student sees the total come out the same.
+"Before" is each puck's velocity as the step's first collision involving it
+found it (after that step's forces); "after" is the velocity at the end of
+the step. The pucks that did not collide have the same arrow in both.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from airtable.physics.table import AirTable
+
+FEW_PUCKS = 6  # the values panel lists every puck up to this many, else the puck under the cursor
+MAX_DIAGRAM_PUCKS = 40  # more than this: the diagram draws the pucks that collided, and the total of all
+
+
+@dataclass(frozen=True)
+class MomentaAround:
+    """Every puck's momentum (N, 2, in N s) just before and just after the collisions of one step."""
+
+    t_s: float
+    before_Ns: np.ndarray
+    after_Ns: np.ndarray
+    collided: np.ndarray  # (N,) bool: the pucks whose momentum the collisions changed
+    colors: np.ndarray  # (N, 3) uint8
+
+    @property
+    def total_before_Ns(self) -> np.ndarray:
+        return self.before_Ns.sum(axis=0)
+
+    @property
+    def total_after_Ns(self) -> np.ndarray:
+        return self.after_Ns.sum(axis=0)
+
+    def shown(self) -> np.ndarray:
+        """The rows the diagram draws: all of them, or only those that collided when there are many."""
+        n = len(self.before_Ns)
+        return np.arange(n) if n <= MAX_DIAGRAM_PUCKS else np.flatnonzero(self.collided)
+
+
+def momenta_around_collisions(table: AirTable) -> MomentaAround | None:
+    """The momenta around the collisions of the table's last step; None if it had none."""
+    c = table.last_collisions
+    if len(c) == 0:
+        return None
+    vel_after = table.vel_mps.copy()
+    vel_before = vel_after.copy()
+    # Each puck's velocity when its first collision of the step found it.
+    rows = np.stack([c.i, c.j], axis=1).ravel()
+    vels = np.stack([c.vel_i_before, c.vel_j_before], axis=1).reshape(-1, 2)
+    _, first = np.unique(rows, return_index=True)
+    vel_before[rows[first]] = vels[first]
+    collided = np.zeros(len(vel_after), dtype=bool)
+    collided[rows] = True
+    mass = table.mass_kg[:, None]
+    return MomentaAround(float(table.time_s), mass * vel_before, mass * vel_after, collided, table.color_rgb.copy())
+
+
+class MomentaLog:
+    """The momenta around the latest collision seen (kept until the next one, or a new demo)."""
+
+    def __init__(self) -> None:
+        self.latest: MomentaAround | None = None
+
+    def clear(self) -> None:
+        self.latest = None
+
+    def observe(self, table: AirTable) -> None:
+        found = momenta_around_collisions(table)
+        if found is not None:
+            self.latest = found
+
+
+def tip_to_tail(momenta_Ns: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(tails, tips), each (N, 2): arrow k starts where arrow k - 1 ends; the first starts at 0."""
+    tips = np.cumsum(momenta_Ns, axis=0)
+    return tips - momenta_Ns, tips
+
+
+@dataclass(frozen=True)
+class ChainFit:
+    """How to draw several tip-to-tail chains in boxes of one size, at one shared scale."""
+
+    px_per_Ns: float
+    centers_Ns: tuple[tuple[float, float], ...]  # the point of each chain drawn at its box's centre
+
+    def to_px(self, chain: int, points_Ns: np.ndarray, size_px: tuple[int, int]) -> np.ndarray:
+        """Points of chain `chain` in pixels from its box's top-left corner (y down on screen)."""
+        c = np.asarray(self.centers_Ns[chain])
+        d = (np.asarray(points_Ns, dtype=float) - c) * self.px_per_Ns
+        return np.column_stack((size_px[0] / 2 + d[..., 0], size_px[1] / 2 - d[..., 1]))
+
+
+def fit_chains(chains: list[np.ndarray], size_px: tuple[int, int], margin: float = 0.1) -> ChainFit:
+    """One scale for every chain (the points of its arrows, in N s) so each fits a box of `size_px`
+    with `margin` of the box left on each side; each chain is centred on its own box."""
+    usable = np.asarray(size_px, dtype=float) * (1.0 - 2.0 * margin)
+    scale, centers = math.inf, []
+    for pts in chains:
+        pts = np.vstack([np.zeros((1, 2)), np.asarray(pts, dtype=float).reshape(-1, 2)])
+        lo, hi = pts.min(axis=0), pts.max(axis=0)
+        centers.append((float((lo[0] + hi[0]) / 2), float((lo[1] + hi[1]) / 2)))
+        span = hi - lo
+        for k in (0, 1):
+            if span[k] > 0:
+                scale = min(scale, usable[k] / span[k])
+    return ChainFit(scale if math.isfinite(scale) else 1.0, tuple(centers))
+
+
+@dataclass(frozen=True)
+class PuckValues:
+    """What the values panel shows of one puck (or the total of all)."""
+
+    name: str
+    mass_kg: float
+    speed_mps: float | None  # None for the total: a sum of speeds means nothing
+    momentum_Ns: float
+    kinetic_J: float
+
+    def cells(self) -> tuple[str, str, str, str, str]:
+        speed = "" if self.speed_mps is None else f"{self.speed_mps:.3g}"
+        return (self.name, f"{self.mass_kg:.3g}", speed, f"{self.momentum_Ns:.3g}", f"{self.kinetic_J:.3g}")
+
+
+VALUE_HEADINGS = ("puck", "m kg", "|v| m/s", "|p| N s", "KE J")  # mass, speed, momentum, kinetic energy
+
+
+def puck_values(table: AirTable, rows) -> list[PuckValues]:
+    """Mass, speed, |momentum| and kinetic energy of the pucks in `rows` (named by row, as in the CSV)."""
+    out = []
+    for k in rows:
+        m = float(table.mass_kg[k])
+        v = table.vel_mps[k]
+        speed = math.hypot(float(v[0]), float(v[1]))
+        out.append(PuckValues(str(int(k)), m, speed, m * speed, 0.5 * m * speed * speed))
+    return out
+
+
+def values_for(table: AirTable, cursor_row: int | None) -> list[PuckValues]:
+    """Every puck and their total when there are few; else the puck under the cursor (none: empty)."""
+    n = len(table.pos_m)
+    if n <= FEW_PUCKS:
+        rows = puck_values(table, range(n))
+        if n > 1:
+            p = table.momentum_Ns()
+            total = PuckValues("total", float(table.mass_kg.sum()), None, math.hypot(*p), table.kinetic_energy_J())
+            rows.append(total)
+        return rows
+    return [] if cursor_row is None else puck_values(table, [cursor_row])

@@ -1,0 +1,151 @@
+"""Text panels over the table (help, notes, errors), laid out to fit the window.
+
+Rows flow top to bottom into as many columns as the panel's width holds at a
+readable line length; what does not fit on one page goes on the next, so
+nothing is ever cut, whatever the window size or the number of demos.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import pygame
+
+ACCENT = (255, 220, 120)
+TEXT_COLOR = (230, 230, 230)
+DIM_TEXT = (150, 150, 150)
+PANEL_COLOR = (10, 10, 30, 242)
+COLUMN_EMS = 20  # a column is at least this many font sizes wide (about 50 characters)
+
+Row = tuple[str, str] | str
+
+
+def shorten(font: pygame.font.Font, text: str, width: int) -> str:
+    """`text`, cut and ended with "..." if it is wider than `width` pixels."""
+    if font.size(text)[0] <= width:
+        return text
+    while text and font.size(text + "...")[0] > width:
+        text = text[:-1]
+    return text + "..." if text else ""
+
+
+def wrap(font: pygame.font.Font, text: str, width: int) -> list[str]:
+    """Split text into lines that fit `width` pixels (a word longer than that is cut at the edge)."""
+    lines: list[str] = []
+    current = ""
+    for word in text.split():
+        trial = f"{current} {word}".strip()
+        if current and font.size(trial)[0] > width:
+            lines.append(current)
+            current = word
+        else:
+            current = trial
+    if current:
+        lines.append(current)
+    return lines
+
+
+@dataclass(frozen=True)
+class Piece:
+    """One line of text placed in the panel: its top-left corner and colour."""
+
+    x: int
+    y: int
+    text: str
+    color: tuple[int, int, int]
+
+
+def _blocks(font, sections: Sequence[tuple[str, Sequence[Row]]], col_w: int) -> list[list[tuple[int, str, tuple]]]:
+    """Each row as a block of (x offset, text, colour) lines that must stay together."""
+    blocks = []
+    for heading, rows in sections:
+        if heading:  # a blank line, then the heading (the blank is dropped at a column's top)
+            blocks.append([(0, "", ACCENT), (0, heading, ACCENT)] if blocks else [(0, heading, ACCENT)])
+        keys = [r[0] for r in rows if isinstance(r, tuple)]
+        gap = font.get_height()
+        key_w = min(max((font.size(k)[0] for k in keys), default=0), col_w // 3) + gap
+        for row in rows:
+            if isinstance(row, tuple):
+                key, text = row
+                lines = [(key_w, line, TEXT_COLOR) for line in wrap(font, text, col_w - key_w) or [""]]
+                if font.size(key)[0] + gap > key_w:  # a long key gets a line of its own
+                    blocks.append([(0, key, ACCENT), *lines])
+                else:  # the key shares the first line's y: marked so the flow does not count it
+                    blocks.append([(-1, key, ACCENT), *lines])
+            else:
+                blocks.append([(0, line, TEXT_COLOR) for line in wrap(font, row, col_w) or [""]])
+    return blocks
+
+
+def layout(
+    font: pygame.font.Font,
+    sections: Sequence[tuple[str, Sequence[Row]]],
+    size_px: tuple[int, int],
+) -> list[list[Piece]]:
+    """Pages of placed lines filling a body of `size_px`: columns first, then pages."""
+    width, height = size_px
+    gap = font.get_height()
+    n_cols = max(1, min(3, (width + gap) // (COLUMN_EMS * font.get_height() + gap)))
+    col_w = (width - gap * (n_cols - 1)) // n_cols
+    line_h = font.get_linesize()
+    rows_per_col = max(1, height // line_h)
+    blocks = _blocks(font, sections, col_w)
+    pages: list[list[Piece]] = [[]]
+    col, used = 0, 0
+    for block in blocks:
+        lines = sum(1 for x, _, _ in block if x >= 0)
+        if used and used + lines > rows_per_col:  # the block goes whole to the next column
+            col, used = col + 1, 0
+            if col == n_cols:
+                pages.append([])
+                col = 0
+        if used == 0 and block[0][1] == "":  # no blank line at the top of a column
+            block = block[1:]
+        x0 = col * (col_w + gap)
+        y = used * line_h
+        for x, text, color in block:
+            if x < 0:  # a key beside the first line of its description
+                pages[-1].append(Piece(x0, y, text, color))
+                continue
+            if used >= rows_per_col:  # one block taller than a column: cut only then
+                break
+            pages[-1].append(Piece(x0 + x, used * line_h, text, color))
+            used += 1
+    return pages
+
+
+def body_rect(size_px: tuple[int, int], font, title_font, small_font) -> pygame.Rect:
+    """Where the text goes inside a panel of `size_px`: under the title, above the page note."""
+    pad = font.get_height()
+    top = pad // 2 + title_font.get_linesize() + pad // 3
+    return pygame.Rect(pad, top, size_px[0] - 2 * pad, size_px[1] - top - small_font.get_linesize() - pad // 2)
+
+
+def render_panel(
+    size_px: tuple[int, int],
+    title: str,
+    sections: Sequence[tuple[str, Sequence[Row]]],
+    *,
+    font: pygame.font.Font,
+    title_font: pygame.font.Font,
+    small_font: pygame.font.Font,
+    page: int = 0,
+) -> tuple[pygame.Surface, int]:
+    """A translucent panel of `size_px` with `title` and the page `page` of its text, and the page count."""
+    pad = font.get_height()
+    panel = pygame.Surface(size_px, pygame.SRCALPHA)
+    panel.fill(PANEL_COLOR)
+    pygame.draw.rect(panel, ACCENT, panel.get_rect(), max(1, pad // 10))
+    if title_font.size(title)[0] > size_px[0] - 2 * pad:  # a long title in the body's type
+        title_font = font
+    panel.blit(title_font.render(shorten(title_font, title, size_px[0] - 2 * pad), True, ACCENT), (pad, pad // 2))
+    body = body_rect(size_px, font, title_font, small_font)
+    pages = layout(font, sections, body.size)
+    page %= len(pages)
+    for piece in pages[page]:
+        panel.blit(font.render(piece.text, True, piece.color), (body.x + piece.x, body.y + piece.y))
+    if len(pages) > 1:
+        note = small_font.render(f"page {page + 1} of {len(pages)}: press F1 for the next", True, DIM_TEXT)
+        panel.blit(note, note.get_rect(bottomright=(size_px[0] - pad, size_px[1] - pad // 4)))
+    return panel, len(pages)

@@ -1,0 +1,141 @@
+"""The momenta diagram and the values panel: their numbers by hand, and the keys that show them."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pygame
+import pytest
+from conftest import FRAME_S, press
+
+from airtable.app.app import App
+from airtable.app.lessons_paint import TOTAL_COLOR
+from airtable.app.momenta import (
+    MomentaLog,
+    fit_chains,
+    momenta_around_collisions,
+    tip_to_tail,
+    values_for,
+)
+from airtable.app.panel_view import ACCENT
+from airtable.physics.table import AirTable
+
+
+def test_tip_to_tail():
+    tails, tips = tip_to_tail(np.array([[1.0, 0.0], [0.0, 2.0], [-3.0, 1.0]]))
+    assert tails.tolist() == [[0.0, 0.0], [1.0, 0.0], [1.0, 2.0]]
+    assert tips.tolist() == [[1.0, 0.0], [1.0, 2.0], [-2.0, 3.0]]  # the last tip is the total
+
+
+def head_on_table() -> AirTable:
+    """1 kg at 2 m/s onto a still 3 kg puck, head on; a third puck far away drifts up."""
+    t = AirTable()
+    t.add_puck((2.0, 4.0), radius_m=0.3, vel_mps=(2.0, 0.0))
+    t.add_puck((3.0, 4.0), radius_m=0.3)
+    t.add_puck((8.0, 1.0), radius_m=0.3, vel_mps=(0.0, 0.5))
+    t.mass_kg[:] = (1.0, 3.0, 0.5)
+    return t
+
+
+def test_momenta_before_and_after_an_elastic_head_on_hit():
+    t, log = head_on_table(), MomentaLog()
+    for _ in range(200):
+        t.step(1 / 240)
+        log.observe(t)
+        if log.latest is not None:
+            break
+    m = log.latest
+    assert m is not None and m.collided.tolist() == [True, True, False]
+    # Elastic, 1 kg at 2 m/s on 3 kg at rest: v1 = (1 - 3) / 4 * 2 = -1 m/s, v2 = 2 * 1 / 4 * 2 = 1 m/s.
+    assert m.before_Ns[:2].tolist() == [[2.0, 0.0], [0.0, 0.0]]
+    assert m.after_Ns[0] == pytest.approx([-1.0, 0.0]) and m.after_Ns[1] == pytest.approx([3.0, 0.0])
+    assert m.before_Ns[2].tolist() == m.after_Ns[2].tolist() == [0.0, 0.25]
+    assert m.total_before_Ns == pytest.approx([2.0, 0.25]) and m.total_after_Ns == pytest.approx([2.0, 0.25])
+    assert m.t_s == t.time_s
+    t.step(1 / 240)
+    assert momenta_around_collisions(t) is None  # no collision this step: the log keeps the last one
+    log.observe(t)
+    assert log.latest is m
+
+
+def test_one_scale_fits_both_chains():
+    fit = fit_chains([np.array([[0.0, 0.0], [2.0, 0.0]]), np.array([[1.0, 1.0]])], (100, 100), margin=0.1)
+    assert fit.px_per_Ns == 40.0  # 80 px for the 2 N s of the first; the second would take 80
+    assert fit.centers_Ns == ((1.0, 0.0), (0.5, 0.5))
+    assert fit.to_px(0, np.array([[0.0, 0.0], [2.0, 0.0]]), (100, 100)).tolist() == [[10.0, 50.0], [90.0, 50.0]]
+    assert fit.to_px(1, np.array([[1.0, 1.0]]), (100, 100)).tolist() == [[70.0, 30.0]]  # y up is up the screen
+
+
+def test_values_of_few_pucks_and_of_the_puck_under_the_cursor():
+    t = AirTable()
+    t.add_puck((2.0, 2.0), vel_mps=(3.0, 4.0))
+    t.add_puck((5.0, 2.0), vel_mps=(0.0, -1.0))
+    t.mass_kg[:] = (1.0, 2.0)
+    rows = values_for(t, None)
+    assert [(r.name, r.mass_kg, r.speed_mps, r.momentum_Ns, r.kinetic_J) for r in rows[:2]] == [
+        ("0", 1.0, 5.0, 5.0, 12.5),
+        ("1", 2.0, 1.0, 2.0, 1.0),
+    ]
+    total = rows[2]
+    assert (total.name, total.mass_kg, total.speed_mps, total.kinetic_J) == ("total", 3.0, None, 13.5)
+    assert total.momentum_Ns == pytest.approx(math.hypot(3.0, 2.0))
+    assert total.cells() == ("total", "3", "", "3.61", "13.5")
+    for k in range(5):
+        t.add_puck((1.0 + k, 6.0))
+    assert values_for(t, None) == []  # seven pucks: only the one under the cursor
+    assert [r.name for r in values_for(t, 1)] == ["1"]
+
+
+def pixels_of(app: App, color) -> int:
+    image = pygame.surfarray.pixels3d(app.window.surface)
+    count = int(np.count_nonzero(np.all(image == np.array(color, dtype=np.uint8), axis=2)))
+    del image
+    return count
+
+
+@pytest.fixture
+def app(demos):
+    a = App(demos, demo_key="8", headless=True, window_size_px=(1280, 720))  # the pool line
+    pygame.event.clear()
+    yield a
+    pygame.event.clear()
+
+
+def test_d_shows_the_momenta_of_the_latest_collision(app):
+    assert pixels_of(app, TOTAL_COLOR) == 0
+    press(app, pygame.K_d)
+    assert app.lessons.show_momenta
+    for _ in range(240):
+        app.frame(FRAME_S)
+        if app.lessons.momenta.latest is not None:
+            break
+    m = app.lessons.momenta.latest
+    assert m is not None and np.count_nonzero(m.collided) >= 2
+    assert m.total_after_Ns == pytest.approx(m.total_before_Ns, abs=1e-12)
+    app.draw()
+    assert pixels_of(app, TOTAL_COLOR) > 100  # the two totals' arrows and their lines of text
+    press(app, pygame.K_d)
+    assert not app.lessons.show_momenta and pixels_of(app, TOTAL_COLOR) == 0
+    press(app, pygame.K_8)  # a new demo: no collision seen yet
+    assert app.lessons.momenta.latest is None
+
+
+def test_t_shows_the_values_panel(app):
+    press(app, pygame.K_1)  # five pucks: each one, and the total in the accent colour
+    assert pixels_of(app, ACCENT) == 0
+    press(app, pygame.K_t)
+    assert app.lessons.show_values and pixels_of(app, ACCENT) > 20
+    press(app, pygame.K_t)
+    assert pixels_of(app, ACCENT) == 0
+
+
+def test_the_panels_and_the_chart_take_different_corners(app):
+    press(app, pygame.K_1)
+    press(app, pygame.K_d)
+    press(app, pygame.K_t)  # both panels choose while the chart is closed
+    first = dict(app.lessons.painter.corners)
+    assert first["momenta"] != first["values"]
+    press(app, pygame.K_c)  # the chart takes the corner over the fewest pucks; a panel there moves
+    corners = app.lessons.painter.corners
+    assert len({corners["momenta"], corners["values"], app.painter.chart_corner}) == 3

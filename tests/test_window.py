@@ -1,0 +1,148 @@
+"""GameWindow off screen: sizes, type, the status line, panels and the bounded sprite cache."""
+
+from __future__ import annotations
+
+import numpy as np
+import pygame
+import pytest
+
+from airtable.app import panel_view
+from airtable.app.demo_loader import key_order
+from airtable.app.environment import Environment
+from airtable.app.pucks_view import SPRITE_CACHE_BYTES, core_color
+from airtable.app.scene import Scene
+from airtable.app.window import PAUSED_COLOR, GameWindow, fit_parts
+
+TABLE = (10.0, 8.7556)
+
+
+def window(size=(1280, 720)) -> GameWindow:
+    env = Environment(width_m=TABLE[0], height_m=TABLE[1])
+    return GameWindow(env, headless=True, size_px=size)
+
+
+def scene(**kw) -> Scene:
+    base = dict(
+        width_m=TABLE[0],
+        height_m=TABLE[1],
+        pos_m=np.array([[5.0, 4.0], [2.0, 2.0]]),
+        radius_m=np.array([0.5, 0.25]),
+        color_rgb=np.array([[255, 165, 0], [255, 255, 255]], np.uint8),
+    )
+    base.update(kw)
+    return Scene(**base)
+
+
+def pixels(win: GameWindow) -> np.ndarray:
+    return pygame.surfarray.array3d(win.surface)
+
+
+@pytest.mark.parametrize("size", [(1280, 720), (739, 648), (3840, 2160)])
+def test_text_scales_with_the_height_and_is_never_small(size) -> None:
+    win = window(size)
+    smallest = min(f.get_height() for f in (win.label_font, win.font, win.big_font))
+    assert smallest >= 14  # readable at 720p from the back of a room
+    if size[1] == 2160:
+        assert smallest >= 3 * 14 * 0.9  # proportionally larger at 4K
+        assert win.line_px(2) == 6
+
+
+def test_a_resize_event_refits_the_table() -> None:
+    win = window((900, 788))
+    pygame.event.post(pygame.event.Event(pygame.VIDEORESIZE, size=(1600, 700), w=1600, h=700))
+    for event in pygame.event.get():
+        win.handle_event(event)
+    assert win.surface.get_size() == (1600, 700) and win.env.size_px == (1600, 700)
+    win.draw(scene())
+    img = pixels(win)
+    # The table is 700 px tall, 799 px wide, centred: walls at x = 400 and 1199, margins outside.
+    x0 = round((1600 - 700 * TABLE[0] / TABLE[1]) / 2)
+    assert tuple(img[x0 + 1, 350]) == (255, 69, 0)
+    assert tuple(img[1600 - x0 - 2, 350]) == (255, 69, 0)
+    assert tuple(img[x0 - 20, 350]) != (0, 0, 0) or tuple(img[x0 + 20, 350]) == (0, 0, 0)
+
+
+def test_status_line_never_overflows_and_drops_the_least_important_parts() -> None:
+    pygame.font.init()
+    font = pygame.font.Font(None, 22)
+    parts = ["gravity on", "correction: two-step", "8 pucks", "t = 3.00 s", "F1: help"]
+    for width in (30, 80, 200, 400, 2000):
+        text = fit_parts(font, parts, width)
+        assert font.size(text)[0] <= width
+    assert fit_parts(font, parts, 2000) == "   ".join(parts)
+    assert (
+        fit_parts(font, parts, font.size("gravity on   correction: two-step")[0]) == "gravity on   correction: two-step"
+    )
+    assert fit_parts(font, parts, 60).endswith("...")
+
+
+@pytest.mark.parametrize("width", [320, 700, 1280, 3840])
+def test_status_bar_fits_every_width_and_paused_is_large_and_centred(width) -> None:
+    win = window((width, 720))
+    status = ["PAUSED", "slow motion x1/4", "gravity off", "correction: two-step", "restitution: pucks 1, walls 1"]
+    win.draw(scene(status="   ".join(status), title="Demo 1: a very long title " * 3))
+    img = pixels(win)
+    yellow = np.argwhere(np.all(img == PAUSED_COLOR, axis=2))
+    assert len(yellow) > 0
+    assert abs(yellow[:, 0].mean() - width / 2) < width * 0.05  # centred
+    assert np.ptp(yellow[:, 1]) >= 40  # large: its box is at least 40 px tall at 720p
+
+
+def test_sprite_cache_stays_bounded_at_extreme_zoom() -> None:
+    win = window((1920, 1080))
+    many = scene(
+        pos_m=np.random.default_rng(1).uniform(0.5, 8, (300, 2)),
+        radius_m=np.linspace(0.01, 0.6, 300),
+        color_rgb=np.random.default_rng(2).integers(10, 255, (300, 3)).astype(np.uint8),
+    )
+    for zoom in np.geomspace(1.0, 1e6, 60):  # 1e6 is clamped to the largest zoom
+        win.env.zoom_about((960, 540), zoom / win.env.zoom)
+        win.draw(many)
+        assert win.sprites.bytes <= SPRITE_CACHE_BYTES
+    assert win.env.zoom == 200.0
+
+
+def test_a_puck_larger_than_the_window_is_drawn_directly() -> None:
+    win = window((1280, 720))
+    s = scene()
+    win.env.zoom = 200.0
+    win.env.origin_m = np.array([5.0, 4.0]) - np.array([640, 360]) / win.env.px_per_m  # the big puck in the middle
+    win.draw(s)
+    assert tuple(pixels(win)[640, 360]) == core_color((255, 165, 0))
+    assert win.sprites.bytes < 1024 * 1024
+
+
+def test_help_fits_720p_with_nothing_cut_and_demos_in_natural_order() -> None:
+    pygame.font.init()
+    win = window((1280, 720))
+    win.draw(scene(status="gravity off   F1: help"), hud=["join with: airtable-client 10.0.0.7:8888", "C1 Ann"])
+    keys = [(f"key {k}", f"does thing number {k}, which takes a few words to say") for k in range(28)]
+    demo_keys = sorted([f"t{k}" for k in range(1, 26)] + [str(k) for k in range(10)], key=key_order)
+    assert demo_keys.index("t2") < demo_keys.index("t10")
+    demos = [(k, f"Demo {k}: a title") for k in demo_keys]
+    rect = win.panel_rect()
+    assert rect.top >= win.hud_bottom_px  # the join line stays visible
+    body = panel_view.body_rect(rect.size, win.font, win.big_font, win.label_font)
+    assert body.bottom <= rect.height and body.right <= rect.width
+    pages = panel_view.layout(win.font, [("", keys), ("Demos", demos)], body.size)
+    shown = " ".join(p.text for page in pages for p in page)
+    for k, text in keys + demos:
+        assert f" {k} {text} " in f" {shown} "  # every row, whole, on some page
+    for page in pages:
+        for p in page:
+            assert p.x + win.font.size(p.text)[0] <= body.width
+            assert p.y + win.font.get_linesize() <= body.height
+    # The window picks smaller (but still readable) type to save a page.
+    assert win.draw_panel("Keys", keys, side_title="Demos", side_rows=demos) <= len(pages)
+
+
+@pytest.mark.parametrize("size", [(1280, 720), (1920, 1080), (3840, 2160), (900, 788)])
+def test_the_apps_help_fits_one_page_on_common_screens(size) -> None:
+    from airtable.app.app import App
+    from airtable.app.demo_loader import BUILTIN_DIR, discover
+
+    demos, _ = discover([BUILTIN_DIR])
+    app = App(demos, headless=True, window_size_px=size)
+    app.show_help = True
+    app.frame(1 / 60)
+    assert app.help_pages == 1
