@@ -416,7 +416,11 @@ class App:
         elif panel == "error":
             error = self.build_error
             title = ERROR_TITLES[error.stage].format(key=key_label(self.demo_key))
-            w.draw_panel(title, [str(error), "Fix the file and press the demo's key again (Esc hides this)."])
+            label = key_label(self.demo_key)  # "7", "Shift+1"; keys like "t1" have no key of their own
+            again = (
+                f"press {label} again" if len(self.demo_key) == 1 or label != self.demo_key else "pick it in Tab's menu"
+            )
+            w.draw_panel(title, [str(error), f"Fix the file, then {again}. Esc hides this."])
         elif panel == "notice":
             w.draw_panel("Some demo files could not be loaded", [*self.notice, "Press any key to go on."])
         elif panel == "help":
