@@ -29,6 +29,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from airtable.bench_cpu import cpu_section
+from airtable.bench_frames import window_section
 from airtable.memory import keep_freed_memory
 from airtable.physics import broadphase, vectors
 from airtable.physics.table import AirTable, kinetic_energy_J
@@ -474,6 +475,7 @@ SECTIONS: dict[str, Callable[[argparse.Namespace], bool]] = {
     "physics": physics_section,
     "frames": frames_section,
     "cpu": cpu_section,
+    "window": window_section,
 }
 
 

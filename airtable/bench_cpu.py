@@ -33,11 +33,11 @@ def cpu_seconds(pid: int) -> float:
     return (int(fields[11]) + int(fields[12])) / os.sysconf("SC_CLK_TCK")
 
 
-def start_xvfb() -> tuple[subprocess.Popen, str]:
-    """A private Xvfb at 1280x720 on a display number it picks itself; returns it and ':N'."""
+def start_xvfb(size: str = "1280x720") -> tuple[subprocess.Popen, str]:
+    """A private Xvfb of `size` (WxH) on a display number it picks itself; returns it and ':N'."""
     read_fd, write_fd = os.pipe()
     xvfb = subprocess.Popen(
-        ["Xvfb", "-displayfd", str(write_fd), "-screen", "0", "1280x720x24", "-nolisten", "tcp"],
+        ["Xvfb", "-displayfd", str(write_fd), "-screen", "0", f"{size}x24", "-nolisten", "tcp"],
         pass_fds=(write_fd,),
         stdout=subprocess.DEVNULL,
         stderr=subprocess.DEVNULL,
@@ -75,8 +75,11 @@ def _child_app(how: str) -> None:
     """`python -m airtable.bench_cpu still|paused|server`: the app with its server on, until killed."""
     from airtable.app.app import App
     from airtable.app.demo_loader import BUILTIN_DIR, DemoShelf
+    from airtable.app.window import prefer_plain_framebuffer
     from airtable.net.server import GameServer
 
+    if how != "server":
+        prefer_plain_framebuffer()  # as the app's own entry point does (cli.main)
     server = GameServer(host="127.0.0.1", port=0)
     server.start()
     app = App(DemoShelf([BUILTIN_DIR]), demo_key="2", headless=how == "server", server=server)

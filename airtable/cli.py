@@ -55,6 +55,13 @@ def build_parser() -> argparse.ArgumentParser:
         metavar="FILE.png",
         help="save the last frame to FILE.png at exit (.png is added if the name lacks it)",
     )
+    p.add_argument("--fullscreen", action="store_true", help="open on the whole screen (F11 switches)")
+    p.add_argument(
+        "--stats",
+        action="store_true",
+        help="at exit, print one line: frames, frame rate (median and slowest 5 %%), physics steps, CPU time"
+        " and peak memory",
+    )
     p.add_argument(
         "--record",
         default=None,
@@ -241,6 +248,10 @@ def main(argv: Sequence[str] | None = None) -> int:
     if problem:
         print(f"airtable: {problem}", file=sys.stderr)
         return 1
+    if not args.headless:
+        from airtable.app.window import prefer_plain_framebuffer
+
+        prefer_plain_framebuffer()  # software OpenGL behind the window costs 11-35 ms a flip at 1920x1080
     return run_app(args, shelf, shot)
 
 
@@ -279,9 +290,16 @@ def run_app(args: argparse.Namespace, shelf: DemoShelf, shot: Path | None) -> in
     # A timed headless run with nobody to serve simulates its time: it takes as long as the machine needs.
     simulated = args.headless and server is None and args.seconds is not None
     frame_dt_s = HEADLESS_FRAME_S if simulated else None
-    status = 0
+    status, app = 0, None
     try:
-        app = App(shelf, demo_key=args.demo, variation=args.variation, headless=args.headless, server=server)
+        app = App(
+            shelf,
+            demo_key=args.demo,
+            variation=args.variation,
+            headless=args.headless,
+            server=server,
+            fullscreen=args.fullscreen,
+        )
         app.run(seconds=args.seconds, frame_dt_s=frame_dt_s)
         if shot is not None:
             try:
@@ -297,5 +315,7 @@ def run_app(args: argparse.Namespace, shelf: DemoShelf, shot: Path | None) -> in
     finally:
         if server is not None:
             server.stop()
+        if args.stats and app is not None:
+            print(app.stats.line(), flush=True)
         pygame.quit()
     return status

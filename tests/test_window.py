@@ -146,3 +146,22 @@ def test_the_apps_help_fits_one_page_on_common_screens(size) -> None:
     app.show_help = True
     app.frame(1 / 60)
     assert app.help_pages == 1
+
+
+def test_the_framebuffer_hint_is_set_only_by_the_entry_points_and_only_on_x11(monkeypatch) -> None:
+    import os
+    import subprocess
+    import sys
+
+    from airtable import cli
+    from airtable.app.window import FRAMEBUFFER_HINT, prefer_plain_framebuffer
+
+    env = {k: v for k, v in os.environ.items() if k != FRAMEBUFFER_HINT}
+    imports = "import os, airtable.cli, airtable.app.app, airtable.app.window, airtable.net.player;"
+    check = f"print(os.environ.get({FRAMEBUFFER_HINT!r}))"
+    out = subprocess.run([sys.executable, "-c", imports + check], env=env, capture_output=True, text=True, timeout=60)
+    assert out.stdout.strip() == "None", out.stderr  # importing sets nothing
+    monkeypatch.delenv(FRAMEBUFFER_HINT, raising=False)
+    assert prefer_plain_framebuffer() is False and FRAMEBUFFER_HINT not in os.environ  # the dummy driver: left alone
+    assert cli.main(["--headless", "--no-server", "--seconds", "0.05"]) == 0
+    assert FRAMEBUFFER_HINT not in os.environ  # no window, no hint

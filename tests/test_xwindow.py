@@ -233,3 +233,18 @@ def test_f11_in_the_app_fills_the_screen(display, tmp_path):
     left = round((1024 - 900 * TABLE_ASPECT) / 2)
     xs = wall_columns(image, 450)
     assert abs(xs.min() - left) <= 2 and abs(xs.max() - (1023 - left)) <= 2
+
+
+def test_on_x11_the_window_keeps_its_pixels_in_the_plain_framebuffer(display):
+    # The entry points ask for it on X11 (a flip of software OpenGL costs 11-35 ms at 1920x1080); a user's value stays.
+    code = (
+        "import os; from airtable.app.window import prefer_plain_framebuffer as p; "
+        "print(os.environ.get('SDL_FRAMEBUFFER_ACCELERATION'), p(), os.environ.get('SDL_FRAMEBUFFER_ACCELERATION'))"
+    )
+    env = {k: v for k, v in os.environ.items() if k != "SDL_FRAMEBUFFER_ACCELERATION"}
+    env.update(DISPLAY=display, SDL_VIDEODRIVER="x11")
+    out = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True, timeout=60)
+    assert out.stdout.split() == ["None", "True", "0"], out.stderr
+    env["SDL_FRAMEBUFFER_ACCELERATION"] = "1"
+    out = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True, timeout=60)
+    assert out.stdout.split() == ["1", "False", "1"], out.stderr

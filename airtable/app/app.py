@@ -27,6 +27,7 @@ from airtable.app.lessons_view import draw_lessons
 from airtable.app.loop import FixedStep, FpsCounter, FrameLoop
 from airtable.app.menu import DemoMenu
 from airtable.app.scene import STATUS_SEPARATOR, Scene
+from airtable.app.stats import RunStats
 from airtable.app.window import AidsPainter, GameWindow
 from airtable.physics.table import TABLE_HEIGHT_M, TABLE_WIDTH_M, AirTable
 
@@ -95,6 +96,7 @@ class App:
         if not headless:
             pygame.mouse.set_visible(False)  # the local client's arrow is the pointer
         self.server = server
+        self.stats = RunStats()  # frames, steps and their cost, for --stats
         self._init_state()
         self.errors: list[DemoError] = []  # every error reported, in order
         for error in [*demo_errors, *self.shelf.errors]:
@@ -323,6 +325,7 @@ class App:
             self._demo_failed(exc, "event")
             self.paused = True
             return False
+        self.stats.steps += 1
         self.chart.sample(self.table)
         self.lessons.after_step(self.table)
         if self.show_annotations:
@@ -350,6 +353,7 @@ class App:
         if self.server is not None:
             self.server.publish(scene)
         self.draw(scene)
+        self.stats.frame()
 
     def scene(self) -> Scene:
         return Scene.from_table(

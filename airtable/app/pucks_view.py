@@ -1,12 +1,23 @@
 """Drawing pucks: small ones from cached sprites, large ones directly, clipped.
 
 Most scenes have thousands of small pucks in a handful of sizes and colours, so
-one sprite per (radius, colour) blitted with `Surface.fblits` keeps them at
-full frame rate. Zooming in makes every frame's radius new and a sprite of a
-puck 1000 px across weighs 16 MB, so sprites are kept only up to
-`SPRITE_MAX_RADIUS_PX` and the cache is bounded by bytes, least recently used
-first out. Larger pucks are drawn with `pygame.draw.circle`, which clips to the
-target, and a puck that covers the whole target is a fill.
+there is one sprite per (radius, colour), and the pucks are drawn in groups,
+one group per sprite:
+
+- A few pucks: `Surface.fblits`, which clips.
+- Many pucks of a small sprite (the burst's 10000 pucks of 6 px): the
+  sprite's pixels are stamped straight into the target with numpy, a
+  thousand pucks per array assignment. Handing fblits 10000 (sprite,
+  position) pairs made 10000 Python tuples a frame, which cost more than the
+  blitting itself (8.4 ms against 4.0 ms a frame at 1920x1080). Stamped
+  pucks overlap in their own order, as blitted ones do; blitted pucks are on
+  top of stamped ones, and pucks cut by the clip's edge are blitted.
+
+Zooming in makes every frame's radius new and a sprite of a puck 1000 px
+across weighs 16 MB, so sprites are kept only up to `SPRITE_MAX_RADIUS_PX`
+and the cache is bounded by bytes, least recently used first out. Larger
+pucks are drawn with `pygame.draw.circle`, which clips to the target, and a
+puck that covers the whole target is a fill.
 """
 
 from __future__ import annotations
@@ -20,6 +31,13 @@ MIN_PUCK_RADIUS_PX = 2
 SPRITE_MAX_RADIUS_PX = 96
 SPRITE_CACHE_BYTES = 16 * 1024 * 1024
 COLORKEY = (1, 2, 3)  # sprite background; no puck uses this colour
+# A group of one sprite is stamped with numpy when it has this many pucks and
+# the sprite at most this many pixels. Measured (CPU ms for N pucks, stamped
+# against fblits): radius 6 (104 pixels) 0.23/0.26 at 1000, 2.1/4.8 at 10000;
+# radius 10 (308 pixels) 1.9/1.4 at 3000, 5.4/5.9 at 10000.
+STAMP_MIN_PUCKS = 1000
+STAMP_MAX_PIXELS = 200
+STAMP_CHUNK_PIXELS = 65536  # pixels written per numpy call: a few pucks' worth, 256 kB of values
 
 
 def ring_width_px(r_px: int) -> int:
@@ -56,12 +74,14 @@ class PuckSprites:
         self.limit_bytes = limit_bytes
         self.bytes = 0
         self._cache: OrderedDict[tuple, pygame.Surface] = OrderedDict()
+        self._stamps: dict[tuple, tuple[np.ndarray, np.ndarray]] = {}  # 256 kB each at most
 
     def __len__(self) -> int:
         return len(self._cache)
 
     def clear(self) -> None:
         self._cache.clear()
+        self._stamps.clear()
         self.bytes = 0
 
     def get(self, r_px: int, color: tuple[int, int, int]) -> pygame.Surface:
@@ -81,6 +101,25 @@ class PuckSprites:
             _, old = self._cache.popitem(last=False)
             self.bytes -= _bytes(old)
         return sprite
+
+    def stamp(self, r_px: int, color: tuple[int, int, int], target: pygame.Surface) -> tuple[np.ndarray, np.ndarray]:
+        """The sprite's opaque pixels for a 32-bit `target`: their offsets from its
+        corner in the target's pixels, row after row, and the values to write there
+        in the target's pixel format, repeated for as many pucks as one numpy call
+        takes (`STAMP_CHUNK_PIXELS`)."""
+        pitch = target.get_pitch() // 4
+        key = (r_px, *color, pitch, target.get_masks())
+        stamp = self._stamps.get(key)
+        if stamp is None:
+            rgb = pygame.surfarray.array3d(self.get(r_px, color)).transpose(1, 0, 2)
+            ys, xs = np.nonzero(np.any(rgb != COLORKEY, axis=2))
+            mapped = {c: target.map_rgb(c) for c in set(map(tuple, rgb[ys, xs].tolist()))}
+            values = np.array([mapped[tuple(c)] for c in rgb[ys, xs].tolist()], dtype=np.uint32)
+            if len(self._stamps) >= 16:
+                self._stamps.clear()
+            per_call = max(1, STAMP_CHUNK_PIXELS // len(values))
+            stamp = self._stamps[key] = (ys.astype(np.int64) * pitch + xs, np.tile(values, per_call))
+        return stamp
 
 
 def _bytes(surface: pygame.Surface) -> int:
@@ -109,9 +148,57 @@ def draw_pucks(target: pygame.Surface, sprites: PuckSprites, centers: np.ndarray
     # One sprite per distinct (radius, colour); usually a handful.
     c = colors.astype(np.int64)
     keys = (r_px << 24) | (c[:, 0] << 16) | (c[:, 1] << 8) | c[:, 2]
-    uniq, inverse = np.unique(keys, return_inverse=True)
-    images = [sprites.get(int(k >> 24), (int(k >> 16) & 255, int(k >> 8) & 255, int(k) & 255)) for k in uniq]
+    uniq, inverse, counts = np.unique(keys, return_inverse=True, return_counts=True)
+    inverse = inverse.ravel()
+    sprite_of = [(k >> 24, ((k >> 16) & 255, (k >> 8) & 255, k & 255)) for k in uniq.tolist()]
     corner = np.rint(centers).astype(np.int64) - r_px[:, None]
-    target.fblits(
-        [(images[k], (x, y)) for k, x, y in zip(inverse.ravel().tolist(), corner[:, 0].tolist(), corner[:, 1].tolist())]
+    if _stampable(target) and counts.max() >= STAMP_MIN_PUCKS:
+        left = _stamp_groups(target, sprites, sprite_of, inverse, counts, corner)
+        if not left.all():
+            corner, inverse = corner[left], inverse[left]
+    if len(corner):  # the rest in their own order, so overlaps look as they always did
+        images = [sprites.get(r, color) for r, color in sprite_of]
+        sources = map(images.__getitem__, inverse.tolist())
+        target.fblits(list(zip(sources, zip(corner[:, 0].tolist(), corner[:, 1].tolist()))))
+
+
+def _stampable(target: pygame.Surface) -> bool:
+    """Pixels written straight into `target` look as blitted: 32 bits, no alpha, not a view of another surface."""
+    return target.get_bytesize() == 4 and not target.get_flags() & pygame.SRCALPHA and target.get_parent() is None
+
+
+def _stamp_groups(
+    target: pygame.Surface, sprites: PuckSprites, sprite_of, inverse: np.ndarray, counts, corner: np.ndarray
+) -> np.ndarray:
+    """Stamp every group big enough for it, of a sprite small enough; returns which pucks are left to blit."""
+    left = np.ones(len(corner), dtype=bool)
+    for i, ((r, color), count) in enumerate(zip(sprite_of, counts.tolist())):
+        if count < STAMP_MIN_PUCKS or (r + 1) ** 2 > STAMP_MAX_PIXELS:  # too big, as a disc has more pixels
+            continue
+        stamp = sprites.stamp(r, color, target)
+        if len(stamp[0]) <= STAMP_MAX_PIXELS:
+            members = np.flatnonzero(inverse == i)
+            left[members[_stamp(target, stamp, corner[members], 2 * r + 1)]] = False
+    return left
+
+
+def _stamp(target: pygame.Surface, stamp: tuple[np.ndarray, np.ndarray], corner: np.ndarray, size: int) -> np.ndarray:
+    """Write the stamp at each `corner` (N, 2 px) whose sprite lies wholly inside the
+    target's clip (the others are left for fblits, which clips); returns which it wrote."""
+    clip = target.get_clip()
+    inside = (
+        (corner[:, 0] >= clip.left)
+        & (corner[:, 1] >= clip.top)
+        & (corner[:, 0] + size <= clip.right)
+        & (corner[:, 1] + size <= clip.bottom)
     )
+    base = corner[inside, 1] * (target.get_pitch() // 4) + corner[inside, 0]
+    offsets, values = stamp
+    per_call = len(values) // len(offsets)
+    pixels = np.frombuffer(target.get_buffer(), dtype=np.uint32)  # row after row; locks the target
+    for start in range(0, len(base), per_call):
+        # Puck after puck, so a later puck covers an earlier one, as when blitted.
+        where = (base[start : start + per_call, None] + offsets).ravel()
+        pixels[where] = values[: len(where)]
+    del pixels  # unlocks it
+    return inside

@@ -534,6 +534,10 @@ def main(argv: Sequence[str] | None = None) -> int:
     except KeyboardInterrupt:
         return 1
     print(f"airtable-client: connected to {net.address}; you are {welcome.client}")
+    if not args.headless:
+        from airtable.app.window import prefer_plain_framebuffer
+
+        prefer_plain_framebuffer()  # software OpenGL behind the window costs 11-35 ms a flip at 1920x1080
     try:
         return PlayerApp(net, headless=args.headless).run(seconds=args.seconds, screenshot=args.screenshot)
     finally:

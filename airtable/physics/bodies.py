@@ -121,6 +121,11 @@ class Spring:
         return self._get("spring_k_Npm")
 
     @property
+    def k_effective_Npm(self) -> float:
+        """The stiffness the step uses: k_Npm unless the spring had to be softened (see AirTable.notices)."""
+        return self._get("spring_k_effective_Npm")
+
+    @property
     def damper_Nspm(self) -> float:
         return self._get("spring_damper_Nspm")
 

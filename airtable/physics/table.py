@@ -7,9 +7,11 @@ and Spring objects are handles onto those rows (see bodies.py).
 `step(dt_s, pulls)` is the course's game loop; each stage is a method below,
 and the numpy work of each is in a module of its own:
 0. timed events (a demo's throw) that are due;
-1. forces: pulls (cursor strings) and springs (forces.py);
-2. integrate, semi-implicit Euler: v += (F/m + g) dt, the pulls' drag taken
-   implicitly, then x += v dt;
+1. forces: pulls (cursor strings) and springs (forces.py); what a puck's
+   springs have beyond what an explicit step can hold is marked implicit;
+2. integrate, semi-implicit Euler: v += (F/m + g) dt, then x += v dt; the
+   pulls' drag and the stiff springs' implicit parts are solved for
+   (implicit.py), so springs hold at any stiffness;
 3. walls: push pucks back inside and bounce them (walls.py);
 4. puck pairs: the candidates from a neighbour list (broadphase.py), then
    collision + position correction one pair at a time (pairs.py), then a
@@ -28,6 +30,7 @@ import numpy as np
 
 from airtable.colors import rgb
 from airtable.physics import broadphase, forces, pairs, vectors, walls
+from airtable.physics import implicit as implicit_solve
 from airtable.physics.bodies import Puck, Spring, as_vector
 from airtable.physics.forces import GRAVITY_MPS2, Pull
 
@@ -40,6 +43,13 @@ TABLE_HEIGHT_M = 8.7556
 EXTRA_PASSES = 2
 # Overlaps smaller than this (m) are left to the next step: round-off only.
 OVERLAP_SLOP_M = 1e-9
+# Said once (in `notices`) when springs are first solved implicitly.
+IMPLICIT_NOTICE = (
+    "Some springs vibrate faster than a step can follow: the step solves them implicitly,"
+    " so they hold and sag as their k says, but their fastest wobble is damped away."
+)
+# Passes that add walls to the implicit solve (see _brace_walls).
+BRACE_PASSES = 4
 # A last guard against runaway values: nothing real on a table moves this fast.
 MAX_SPEED_MPS = 1e8
 
@@ -316,6 +326,9 @@ class AirTable:
         self._pucks.clear()
         self._springs.clear()
         self._events = []
+        self.notices: list[str] = []  # sentences for the user, appended once each (see _notice)
+        self._noticed: set = set()
+        self._spring_dt_s = 1 / 240  # the dt the springs' effective stiffness was last worked out for
         self.time_s = 0.0
         self.steps = 0
         self.collision_count = 0
@@ -340,16 +353,20 @@ class AirTable:
         inside = np.flatnonzero(vectors.squared_lengths(d) <= self.radius_m**2)
         return self._puck_handles[int(inside[-1])] if len(inside) else None
 
+    def springs_on(self, puck: Puck) -> tuple[Spring, ...]:
+        """The springs attached to `puck`, in creation order."""
+        return tuple(s for s in self._spring_handles if s.p1 is puck or s.p2 is puck)
+
     def kinetic_energy_J(self) -> float:
         return kinetic_energy_J(self.mass_kg, self.vel_mps)
 
     def spring_energy_J(self) -> float:
-        """Elastic energy stored in the springs, sum of k (d - L)^2 / 2."""
+        """Elastic energy stored in the springs, sum of k (d - L)^2 / 2, with the k the step uses."""
         if self._springs.n == 0:
             return 0.0
         d = vectors.take(self.pos_m, self._springs.view("i")) - vectors.take(self.pos_m, self._springs.view("j"))
         stretch = vectors.lengths(d) - self.spring_length_m
-        return float(0.5 * np.dot(self.spring_k_Npm, stretch * stretch))
+        return float(0.5 * np.dot(self.spring_k_effective_Npm, stretch * stretch))
 
     def gravity_energy_J(self) -> float:
         """m g y summed over pucks (floor at y = 0); 0 while gravity is off."""
@@ -392,8 +409,8 @@ class AirTable:
         self._collision_records, self._last_collisions = [], None
         if self._pucks.n:
             if dt > 0.0:
-                drag = self._add_forces(pulls, dt)  # 1. forces
-                self._integrate(drag, dt)  # 2. semi-implicit Euler
+                implicit = self._add_forces(pulls, dt)  # 1. forces
+                self._integrate(implicit, dt)  # 2. semi-implicit Euler
             self.force_N[:] = 0.0  # the accumulators hold one step's forces
             self._resolve_walls()  # 3. walls
             if self.puck_collisions:
@@ -409,35 +426,60 @@ class AirTable:
             _, _, fn = heapq.heappop(self._events)
             fn(self)
 
-    def _add_forces(self, pulls: Sequence[Pull], dt: float) -> np.ndarray | None:
-        """Add the pulls' and springs' forces to force_N; return the pulls' drag per puck (None: no pulls)."""
+    def _add_forces(self, pulls: Sequence[Pull], dt: float) -> forces.Implicit:
+        """Add the pulls' and springs' forces to force_N; return what the step takes implicitly."""
         force = self.force_N
-        drag = None
+        implicit = forces.Implicit.empty(self._pucks.n)
         if pulls:
-            drag = np.zeros(self._pucks.n)
-            forces.add_pull_forces(force, drag, pulls, self.pos_m, self.mass_kg, dt)
+            forces.add_pull_forces(force, implicit, pulls, self.pos_m, self.vel_mps, self.mass_kg, dt)
         if self._springs.n:
-            a, b, f1 = self._spring_forces(dt)
+            a, b, f1 = self._spring_forces(dt, implicit)
             forces.add_spring_forces(force, a, b, f1)
-        return drag
+        return implicit
 
-    def _integrate(self, drag: np.ndarray | None, dt: float) -> None:
-        """Semi-implicit Euler: v += (F/m + g) dt, the drag taken implicitly, then x += v dt."""
+    def _integrate(self, implicit: forces.Implicit, dt: float) -> None:
+        """Semi-implicit Euler: v += (F/m + g) dt (the implicit parts solved for), then x += v dt."""
         pos, vel, force, mass = self.pos_m, self.vel_mps, self.force_N, self.mass_kg
-        if np.count_nonzero(force):  # usually nothing pushes: skip the (N, 2) update
-            vel += force * (dt / mass)[:, None]
-        if self.gravity_on:
-            vel[:, 1] -= self.gravity_mps2 * dt
-        if drag is not None and drag.any():
-            # The drag -c v is taken at the end of the step (backward Euler):
-            # v_new = v - c v_new dt / m, stable for any c and mass.
-            vel /= (1.0 + drag * dt / mass)[:, None]
+        if implicit.any:
+            rhs = dt * (force + implicit.lag)
+            if self.gravity_on:
+                rhs[:, 1] -= self.gravity_mps2 * dt * mass
+            vel += self._implicit_velocity_change(implicit, rhs, dt)
+        else:
+            if np.count_nonzero(force):  # usually nothing pushes: skip the (N, 2) update
+                vel += force * (dt / mass)[:, None]
+            if self.gravity_on:
+                vel[:, 1] -= self.gravity_mps2 * dt
         # A last guard against runaway values; a cheap bound first: a speed
         # over the limit has a component over limit / sqrt(2).
         if np.abs(vel).max() > MAX_SPEED_MPS / math.sqrt(2.0):
             speed = np.hypot(vel[:, 0], vel[:, 1])  # not lengths(): v^2 may overflow here
             vel *= np.minimum(1.0, MAX_SPEED_MPS / np.maximum(speed, 1e-300))[:, None]
         pos += vel * dt
+
+    def _implicit_velocity_change(self, implicit: forces.Implicit, rhs: np.ndarray, dt: float) -> np.ndarray:
+        """dv from the implicit solve (implicit.py), with walls braced and the springs' turning taken in."""
+        mass = self.mass_kg
+        dv = implicit_solve.velocity_change(mass, implicit, rhs)
+        released = np.zeros(dv.shape, dtype=bool)
+        for _ in range(BRACE_PASSES):  # bracing one puck can push another of its body into a wall
+            if not self._brace_walls(implicit, dv, released, dt):
+                break
+            dv = implicit_solve.velocity_change(mass, implicit, rhs)
+            # A wall only pushes: let go where it had to pull the puck to keep it bouncing.
+            pulled = implicit_solve.wall_impulses(mass, implicit, rhs, dv) * implicit.fixed_side < 0.0
+            if pulled.any():
+                implicit.fixed &= ~pulled
+                released |= pulled
+                dv = implicit_solve.velocity_change(mass, implicit, rhs)
+        if implicit_solve.correct_for_turning(self.pos_m, self.vel_mps + dv, mass, implicit, rhs, dt):
+            dv = implicit_solve.velocity_change(mass, implicit, rhs)
+        return dv
+
+    def _brace_walls(self, implicit: forces.Implicit, dv: np.ndarray, released: np.ndarray, dt: float) -> bool:
+        """Put the walls that pucks on implicit springs would cross into the solve (implicit.brace_walls)."""
+        walls = (self.size_m, self.cr_wall)
+        return implicit_solve.brace_walls(self.pos_m, self.vel_mps, dv, self.radius_m, walls, implicit, released, dt)
 
     def _resolve_walls(self, only: np.ndarray | None = None) -> None:
         """Push pucks back inside the walls and bounce them (only the rows `only`, if given)."""
@@ -471,32 +513,78 @@ class AirTable:
         self.collision_count += sum(len(r) for r in records)
         return np.concatenate(moved)
 
-    def _spring_forces(self, dt: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """(rows of p1, rows of p2, force on p1) for every spring; p2 gets minus that."""
+    def _spring_forces(
+        self, dt: float, implicit: forces.Implicit | None = None
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(rows of p1, rows of p2, force on p1) for every spring; p2 gets minus that.
+
+        With `implicit`, a step is being taken: each spring's share beyond its
+        pucks' explicit budget is recorded there, with its lag forces added in.
+        """
         a, b = self._springs.view("i"), self._springs.view("j")
-        f1 = forces.spring_forces(
-            self.pos_m,
-            self.vel_mps,
-            self.mass_kg,
-            a,
-            b,
-            self.spring_length_m,
-            self.spring_k_Npm,
-            self.spring_damper_Nspm,
-            dt,
-        )
+        mass, length = self.mass_kg, self.spring_length_m
+        mu = forces.reduced_masses(mass, a, b)
+        k, c = forces.effective_spring(self.spring_k_Npm, self.spring_damper_Nspm, mu, dt)
+        n, f1 = forces.spring_forces(self.pos_m, self.vel_mps, a, b, length, k, c)
+        if implicit is not None:
+            self._spring_dt_s = dt
+            frac_k, frac_c = forces.explicit_fractions(mass, a, b, k, c, dt)
+            if frac_k.min() < 1.0 or frac_c.min() < 1.0:  # else all explicit, as soft springs usually are
+                k_i, c_i = (1.0 - frac_k) * k, (1.0 - frac_c) * c
+                ia, ib, lag = forces.implicit_springs(implicit, self.vel_mps, (a, b, n), k_i, c_i, dt)
+                forces.add_spring_forces(implicit.lag, ia, ib, lag)
+                if frac_k.min() < 1.0:
+                    self._notice("implicit", IMPLICIT_NOTICE)
+            if (k < self.spring_k_Npm).any():
+                self._notice_softened(k)
         return a, b, f1
+
+    @property
+    def spring_k_effective_Npm(self) -> np.ndarray:
+        """(S,) the stiffness each spring acts with at the last step's dt (or 1/240 s before any step).
+
+        It is the k asked for, unless that is beyond what a step can compute
+        (forces.SOFTENING_LIMIT); then the spring is softened to this, and
+        `notices` says so.
+        """
+        a, b = self._springs.view("i"), self._springs.view("j")
+        mu = forces.reduced_masses(self.mass_kg, a, b)
+        return forces.effective_spring(self.spring_k_Npm, self.spring_damper_Nspm, mu, self._spring_dt_s)[0]
+
+    @property
+    def spring_damper_effective_Nspm(self) -> np.ndarray:
+        """(S,) the damper each spring acts with (as spring_k_effective_Npm)."""
+        a, b = self._springs.view("i"), self._springs.view("j")
+        mu = forces.reduced_masses(self.mass_kg, a, b)
+        return forces.effective_spring(self.spring_k_Npm, self.spring_damper_Nspm, mu, self._spring_dt_s)[1]
+
+    def _notice(self, key, sentence: str) -> None:
+        """Add `sentence` to `notices`, once for each `key` (until clear())."""
+        if key not in self._noticed:
+            self._noticed.add(key)
+            self.notices.append(sentence)
+
+    def _notice_softened(self, k: np.ndarray) -> None:
+        for s in np.flatnonzero(k < self.spring_k_Npm):
+            self._notice(
+                ("softened", int(s)),
+                f"Spring {s} asks for k = {self.spring_k_Npm[s]:.3g} N/m, more than a step can compute;"
+                f" it acts with k = {k[s]:.3g} N/m (its k_effective_Npm).",
+            )
 
     def forces_on(self, puck: Puck, dt_s: float = 1 / 240, pulls: Sequence[Pull] = ()) -> dict[str, np.ndarray]:
         """The forces (N) the next step will apply to `puck`, by source, if `pulls` act on it.
 
         Keys: "cursor strings", "springs", "gravity" (only the non-zero ones).
-        `dt_s` matters only for springs and pulls stiffer than the step can integrate.
+        `dt_s` matters only for springs stiffer than a step can compute (see
+        spring_k_effective_Npm). These are the forces at the start of the step;
+        a spring stiff enough to be solved implicitly acts with what it will
+        have at the end.
         """
         row = puck.index
         out: dict[str, np.ndarray] = {}
         v = self.vel_mps[row]
-        strings = [f - c * v for r, f, c in forces.pull_forces(pulls, self.pos_m, self.mass_kg, dt_s) if r == row]
+        strings = [f - c * v for r, f, c, _ in forces.pull_forces(pulls, self.pos_m) if r == row]
         if strings:
             out["cursor strings"] = np.sum(strings, axis=0)
         if self._springs.n:

@@ -1,0 +1,45 @@
+"""Demo 6p: a block of jelly, pucks held by springs along the edges and diagonals, dropped under gravity."""
+
+import math
+
+KEY = "6p"
+TITLE = "Jelly"
+NOTES = """
+Twenty-five pucks joined by springs along every edge and diagonal act like a block of
+jelly: it falls, lands, wobbles and settles, and you can grab a puck and throw it at a wall.
+The diagonals stop the squares from folding flat. The stiffer jellies vibrate faster than a
+step can follow, so the step solves their springs implicitly: the block keeps its shape and
+sags just as k says, but its fastest wobble is damped away. Left and Right change the stiffness.
+"""
+
+VARIATIONS = ("k 300 N/m", "soft: k 60 N/m", "stiff: k 1500 N/m")
+STIFFNESS_NPM = (300.0, 60.0, 1500.0)
+DAMPER_NSPM = (0.5, 0.1, 1.0)
+SIDE = 5  # pucks along each side of the block
+PITCH_M = 0.5  # their spacing
+RADIUS_M = 0.15
+DENSITY_KGPM2 = 0.3  # a puck of 21 g
+SPIN_RADPS = 1.5  # the block is thrown up and sideways, turning
+
+
+def build(table, variation=0):
+    """A 5 x 5 block at the table's upper left, thrown up to the right while turning, gravity on."""
+    table.gravity_on = True
+    table.cr_wall = 0.7
+    table.cr_puck = 0.7
+    k, c = STIFFNESS_NPM[variation], DAMPER_NSPM[variation]
+    centre = (2.5, 5.5)
+    grid = {}
+    for i in range(SIDE):
+        for j in range(SIDE):
+            x = centre[0] + PITCH_M * (i - (SIDE - 1) / 2)
+            y = centre[1] + PITCH_M * (j - (SIDE - 1) / 2)
+            # Thrown at (2, 2) m/s and turning: v = v_centre + omega x r.
+            vel = (2.0 - SPIN_RADPS * (y - centre[1]), 2.0 + SPIN_RADPS * (x - centre[0]))
+            grid[i, j] = table.add_puck((x, y), RADIUS_M, DENSITY_KGPM2, vel, color="palegreen3")
+    for (i, j), p in grid.items():
+        for di, dj in ((1, 0), (0, 1), (1, 1), (1, -1)):
+            q = grid.get((i + di, j + dj))
+            if q is not None:
+                length = PITCH_M * math.hypot(di, dj)
+                table.add_spring(p, q, length_m=length, k_Npm=k, damper_Nspm=c, width_m=0.04, color="green")

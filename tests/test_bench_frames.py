@@ -1,0 +1,25 @@
+"""The "window" bench section: skipped with a reason where Xvfb is missing; reads the app's --stats line."""
+
+from __future__ import annotations
+
+import argparse
+import shutil
+
+from airtable import bench_frames
+
+
+def test_without_xvfb_the_section_says_why_and_passes(monkeypatch, capsys) -> None:
+    monkeypatch.setattr(shutil, "which", lambda name: None)
+    assert bench_frames.window_section(argparse.Namespace(quick=True)) is True
+    assert "skipped: needs Xvfb" in capsys.readouterr().out
+
+
+def test_the_stats_line_is_read_and_judged_against_60_fps(capsys) -> None:
+    line = "stats: frames 360, fps median 60.1 p5 43.0, steps 1440, cpu 1.4 s, peak memory 56 MB"
+    frames, median, p5, _, cpu = bench_frames.STATS.search(line).groups()
+    assert (frames, median, p5, cpu) == ("360", "60.1", "43.0", "1.4")
+    assert bench_frames._report("app", (360, 60.1, 43.0, 3.9), checked=True) is True
+    assert bench_frames._report("app", (300, 50.0, 30.0, 9.0), checked=True) is False
+    assert bench_frames._report("OpenGL", (100, 16.0, 11.0, 18.0), checked=False) is True
+    out = capsys.readouterr().out
+    assert "PASS" in out and "MISS" in out and "(for comparison)" in out
