@@ -12,6 +12,7 @@ from collections.abc import Callable  # noqa: E402
 import pytest  # noqa: E402
 
 FRAME_S = 1 / 60  # one frame of the app in tests: simulated time, never the clock
+WAIT_S = 5.0  # the bound on every wait for a condition (generous: never a measurement)
 
 
 @pytest.fixture(scope="session")
@@ -40,7 +41,7 @@ def press(app, key: int, mod: int = 0, frames: int = 1, unicode: str = "") -> No
         app.frame(FRAME_S)
 
 
-def wait_until(condition: Callable[[], object], timeout_s: float = 5.0, what: str = "condition") -> object:
+def wait_until(condition: Callable[[], object], timeout_s: float = WAIT_S, what: str = "condition") -> object:
     """Poll `condition` until it is truthy and return it; fail after `timeout_s` (a bound, not a delay)."""
     deadline = time.monotonic() + timeout_s
     while True:

@@ -2,20 +2,25 @@
 
 from __future__ import annotations
 
+import os
 import socket
+import struct
 import threading
 import time
 
 import numpy as np
 import pygame
 import pytest
-from test_server import RawClient, wait_until
+from conftest import wait_until
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+from test_server import RawClient
 
-from airtable.app.scene import CursorView
+from airtable.app.scene import CursorView, Scene
 from airtable.app.window import background_for
 from airtable.net import protocol as proto
 from airtable.net.loadtest import TableLoop, grid_table
-from airtable.net.player import InputThrottle, NetPlayer, PlayerApp, PlayerError, _own_cursor_live, main
+from airtable.net.player import InputThrottle, NetPlayer, PlayerApp, PlayerError, main, own_cursor_live
 from airtable.net.server import GameServer
 
 
@@ -107,10 +112,10 @@ def test_own_cursor_is_drawn_at_the_live_mouse_position_with_its_string():
     welcome = proto.Welcome("C2", (210, 180, 140), 10.0, 8.7556)
     other = CursorView("C1", (255, 52, 179), (1.0, 1.0), 1, 0)
     mine = CursorView("C2", (210, 180, 140), (2.0, 2.0), 1, 3)
-    cursors, extra = _own_cursor_live((mine, other), welcome, np.array([2.5, 2.25]), 1, focused=True)
+    cursors, extra = own_cursor_live((mine, other), welcome.client, np.array([2.5, 2.25]), 1, focused=True)
     assert cursors == (other, CursorView("C2", (210, 180, 140), (2.5, 2.25), 1, 3)) and not extra
-    assert _own_cursor_live((other,), welcome, (2.5, 2.25), 0, focused=True) == ((other,), True)
-    assert _own_cursor_live((mine, other), welcome, (2.5, 2.25), 0, focused=False) == ((other, mine), False)
+    assert own_cursor_live((other,), welcome.client, (2.5, 2.25), 0, focused=True) == ((other,), True)
+    assert own_cursor_live((mine, other), welcome.client, (2.5, 2.25), 0, focused=False) == ((other, mine), False)
 
 
 # ---------------------------------------------------------------- NetPlayer
@@ -143,7 +148,10 @@ def test_update_input_clamps_what_the_server_would_refuse(cleanup):
     net = player(cleanup, server.port)
     net.connect()
     assert net.update_input((1e300, -1e300), 7, ["ok", "x" * 40])
-    time.sleep(0.2)
+    # The server took it: the cursor shows up in the snapshots, where the clamp put it.
+    x0, y0, x1, y1 = proto.cursor_limits(10.0, 8.7556)
+    mine = wait_until(lambda: net.latest() and net.latest().cursors, what="our cursor in a snapshot")
+    assert mine[0].cursor_m == (x1, y0) and mine[0].button == 0
     assert net.state == net.CONNECTED and server.player_names() == ["C1"]
 
 
@@ -157,12 +165,32 @@ def test_player_reconnects_when_the_server_comes_back(cleanup):
     server.stop()
     wait_until(lambda: net.state == net.RETRYING, what="server gone, retrying")
     assert net.status_text == "server gone, retrying..."
-    time.sleep(0.5)  # a few refused attempts while the server is away
+    first_try = net.next_try
+    wait_until(lambda: net.next_try > first_try, what="a refused attempt while the server is away")
     assert net.state == net.RETRYING
     server2, _ = start_table(cleanup, port=port)
     wait_until(lambda: net.state == net.CONNECTED, what="the reconnect")
     seen = net.snapshots
     wait_until(lambda: net.snapshots > seen, what="snapshots from the new server")
+    assert net.reconnects == 1 and server2.player_names() == ["C1"]
+
+
+def test_a_player_cut_off_by_a_restart_waits_when_the_table_is_now_full(cleanup):
+    server, loop = start_table(cleanup)
+    port = server.port
+    net = player(cleanup, port, max_backoff_s=0.5)
+    net.connect()
+    loop.stop()
+    server.stop()
+    wait_until(lambda: net.state == net.RETRYING, what="server gone")
+    server2, _ = start_table(cleanup, port=port, max_clients=1)
+    squatter = RawClient(port)
+    cleanup(squatter.close)
+    squatter.hello()
+    wait_until(lambda: net.state == net.WAITING, what="the player to wait for a place, not give up")
+    assert "server full" in net.waiting_because
+    squatter.send(proto.encode_bye())
+    wait_until(lambda: net.state == net.CONNECTED, what="the place to be taken")
     assert net.reconnects == 1 and server2.player_names() == ["C1"]
 
 
@@ -180,13 +208,20 @@ def test_connection_refused(capsys):
     assert "is the server running?" in line and f"is port {port} open in its firewall?" in line
 
 
-def test_server_full(capsys, cleanup):
+def test_a_full_table_is_waited_for_on_screen_and_joined_when_a_place_frees(capsys, cleanup):
     server, _ = start_table(cleanup, max_clients=1)
     first = RawClient(server.port)
     cleanup(first.close)
     first.hello()
-    line = one_line_error(capsys, [f"127.0.0.1:{server.port}"])
-    assert "server full" in line
+    assert main([f"127.0.0.1:{server.port}", "--headless", "--seconds", "0.3"]) == 0
+    out = capsys.readouterr().out
+    assert "server full" in out and "waiting for a place" in out
+    net = player(cleanup, server.port, max_backoff_s=0.5)
+    assert net.connect() is None and net.state == net.WAITING
+    assert net.banner_text.startswith("the table is full: asking again in")
+    first.send(proto.encode_bye())
+    wait_until(lambda: net.state == net.CONNECTED, what="a place at the table")
+    assert net.welcome.client == "C1" and net.reconnects == 0
 
 
 def test_wrong_and_missing_password(capsys, cleanup):
@@ -232,7 +267,7 @@ def test_headless_app_draws_the_table_and_says_bye(cleanup, tmp_path):
     app = PlayerApp(net, headless=True)
     cleanup(pygame.quit)
     shot = tmp_path / "player.png"
-    assert app.run(seconds=0.5, screenshot=str(shot)) == 0
+    assert app.run(seconds=10, screenshot=str(shot), until=lambda: app.frames >= 10) == 0
     assert shot.exists() and app.frames > 0
     surface, env = app.window.surface, app.window.env
     scene = net.latest()
@@ -252,17 +287,17 @@ def test_headless_app_survives_a_server_restart(cleanup):
     cleanup(pygame.quit)
 
     def restart():
-        time.sleep(0.4)
+        wait_until(lambda: app.frames > 5, what="the window to run")
         loop.stop()
         server.stop()
-        time.sleep(0.6)
+        wait_until(lambda: net.RETRYING in app.states_seen, what="the window to show the retry")
         start_table(cleanup, port=port)
 
+    app = PlayerApp(net, headless=True)
     t = threading.Thread(target=restart)
     t.start()
-    app = PlayerApp(net, headless=True)
     try:
-        status = app.run(seconds=2.5)
+        status = app.run(seconds=10, until=lambda: net.reconnects == 1 and net.state == net.CONNECTED)
     finally:
         t.join()
     assert status == 0
@@ -301,3 +336,244 @@ def test_an_error_from_the_server_during_play_ends_with_one_line(capsys, cleanup
     cleanup(pygame.quit)
     assert PlayerApp(net, headless=True).run(seconds=5) == 1
     assert capsys.readouterr().err.strip() == "airtable-client: the teacher closed the table; thanks for playing"
+
+
+# ---------------------------------------------------------------- a server that lies
+
+
+class ScriptedServer:
+    """A malicious server on 127.0.0.1: connection i gets HELLO answered with replies[i]
+    (the last one repeats), then stays open; `send` streams more frames to the newest."""
+
+    def __init__(self, *replies: bytes) -> None:
+        self.listener = socket.create_server(("127.0.0.1", 0))
+        self.listener.settimeout(0.1)
+        self.port = self.listener.getsockname()[1]
+        self.replies = list(replies)
+        self.conns: list[socket.socket] = []
+        self._stop = threading.Event()
+        self.thread = threading.Thread(target=self._serve, daemon=True)
+        self.thread.start()
+
+    def _serve(self) -> None:
+        while not self._stop.is_set():
+            try:
+                conn, _ = self.listener.accept()
+            except OSError:
+                continue
+            conn.settimeout(5.0)
+            reply = self.replies[min(len(self.conns), len(self.replies) - 1)]
+            self.conns.append(conn)
+            try:
+                conn.recv(65536)  # the HELLO
+                conn.sendall(reply)
+            except OSError:
+                pass
+
+    def send(self, data: bytes) -> None:
+        """Send in a thread: the client may stop reading (and hang up) half way."""
+
+        def push():
+            try:
+                self.conns[-1].sendall(data)
+            except OSError:
+                pass
+
+        threading.Thread(target=push, daemon=True).start()
+
+    def cut(self) -> None:
+        """Hang up on the newest connection, as a restarting server would."""
+        self.conns[-1].close()
+
+    def close(self) -> None:
+        self._stop.set()
+        self.thread.join(timeout=5)
+        self.listener.close()
+        for c in self.conns:
+            c.close()
+
+
+def welcome_frame(width_m: float = 10.0, height_m: float = 8.7556) -> bytes:
+    message = {
+        "protocol": 1,
+        "client": "C1",
+        "color": [255, 52, 179],
+        "table": {"width_m": width_m, "height_m": height_m},
+    }
+    return proto.encode_json(proto.WELCOME, message)
+
+
+def snapshot_frame(scene: Scene, **header: float) -> bytes:
+    """A SNAPSHOT of `scene`, with header fields (zoom, origin_x_m, ...) overwritten after encoding."""
+    payload = bytearray(proto.encode_snapshot(scene))
+    fields = ["width_m", "height_m", "time_s", "fps", "zoom", "origin_x_m", "origin_y_m"]
+    for name, value in header.items():
+        struct.pack_into("<d", payload, 20 + 8 * fields.index(name), value)
+    return proto.encode_frame(proto.SNAPSHOT, bytes(payload))
+
+
+def counts_frame(pucks: int = 0, springs: int = 0, cursors: int = 0, padding: int = 0) -> bytes:
+    """A SNAPSHOT that claims huge counts, with `padding` zero bytes of body after the header."""
+    payload = bytearray(proto.encode_snapshot(_one_puck_scene()))
+    struct.pack_into("<III", payload, 8, pucks, springs, cursors)
+    return proto.encode_frame(proto.SNAPSHOT, bytes(payload) + b"\0" * padding)
+
+
+def _one_puck_scene(radius_m: float = 0.3) -> Scene:
+    return Scene(10.0, 8.7556, np.array([[5.0, 4.0]]), np.array([radius_m]), np.array([[255, 165, 0]], np.uint8))
+
+
+@pytest.mark.parametrize("width_m", [1e-10, 5e-324, 1e300])
+def test_a_welcome_with_an_impossible_table_is_refused_in_a_sentence(cleanup, width_m):
+    fake = ScriptedServer(welcome_frame(width_m))
+    cleanup(fake.close)
+    with pytest.raises(PlayerError) as err:
+        player(cleanup, fake.port).connect()
+    assert "table size" in str(err.value) and "cannot be drawn" in str(err.value)
+
+
+def test_an_impossible_table_after_a_reconnect_ends_with_one_line(capsys, cleanup):
+    fake = ScriptedServer(welcome_frame(), welcome_frame(1e-10))
+    cleanup(fake.close)
+    net = player(cleanup, fake.port)
+    net.connect()
+    fake.cut()
+    cleanup(pygame.quit)
+    assert PlayerApp(net, headless=True).run(seconds=10) == 1
+    err = capsys.readouterr().err.strip()
+    assert err.startswith("airtable-client: ") and "table size" in err and "\n" not in err
+
+
+LIES = {
+    "zoom 1e300": snapshot_frame(_one_puck_scene(), zoom=1e300),
+    "origin 1e300": snapshot_frame(_one_puck_scene(), origin_x_m=1e300),
+    "radius 1e5": snapshot_frame(_one_puck_scene(1e5)),
+    "2.4M pucks": counts_frame(pucks=2_400_000),
+    "2M springs": counts_frame(springs=2_000_000),
+    "2.5M cursors": counts_frame(cursors=2_500_000),
+    # Sent whole, under the frame cap: refused by the drawing budget.
+    "600,000 pucks in a frame": counts_frame(pucks=600_000, padding=600_000 * 27),
+}
+
+
+@pytest.mark.parametrize("case", LIES, ids=list(LIES))
+def test_a_lying_snapshot_ends_the_client_with_one_line_not_a_crash(capsys, cleanup, case):
+    fake = ScriptedServer(welcome_frame())
+    cleanup(fake.close)
+    net = player(cleanup, fake.port)
+    net.connect()
+    fake.send(LIES[case])
+    cleanup(pygame.quit)
+    start = time.monotonic()
+    assert PlayerApp(net, headless=True).run(seconds=10) == 1
+    assert time.monotonic() - start < 5
+    err = capsys.readouterr().err.strip()
+    assert err.startswith("airtable-client: ") and "\n" not in err and "Traceback" not in err
+    assert "snapshot" in err or "byte limit" in err
+
+
+def test_a_drawing_error_is_reported_once_and_the_client_plays_on(capsys, cleanup, monkeypatch):
+    from airtable.app.window import GameWindow
+
+    server, _ = start_table(cleanup)
+    net = player(cleanup, server.port)
+    net.connect()
+    wait_until(net.latest, what="a snapshot")
+    real_draw = GameWindow.draw
+    failures = iter([True, True, True])
+
+    def flaky_draw(self, scene, **kw):
+        if next(failures, False):
+            raise pygame.error("Out of memory")
+        real_draw(self, scene, **kw)
+
+    monkeypatch.setattr(GameWindow, "draw", flaky_draw)
+    cleanup(pygame.quit)
+    app = PlayerApp(net, headless=True)
+    assert app.run(seconds=10, until=lambda: app.frames >= 10) == 0
+    err = capsys.readouterr().err
+    assert err.count("could not draw a frame") == 1 and "Out of memory" in err
+
+
+def test_a_client_on_some_other_port_gets_a_hint_for_the_student(capsys, cleanup):
+    fake = FakeServer(b"SSH-2.0-OpenSSH_9.6\r\n")
+    cleanup(fake.close)
+    line = one_line_error(capsys, [f"127.0.0.1:{fake.port}"])
+    assert "some other program" in line and "'join with:' line" in line
+    assert "join with airtable-client" not in line and "web browser" not in line
+
+
+@st.composite
+def extreme_scenes(draw) -> Scene:
+    """Valid snapshots at the edges of what a player accepts: sizes, zoom, origin, radii, counts."""
+    width_m = draw(st.sampled_from([proto.MIN_TABLE_M, 1.0, 10.0, proto.MAX_TABLE_M]))
+    height_m = draw(
+        st.sampled_from([width_m, min(proto.MAX_TABLE_M, width_m * 99), max(proto.MIN_TABLE_M, width_m / 99)])
+    )
+    x0, y0, x1, y1 = proto.cursor_limits(width_m, height_m)
+    size = max(width_m, height_m)
+    n = draw(st.sampled_from([0, 1, 7, 2000, proto.MAX_DRAWN_PUCKS]))
+    s = draw(st.sampled_from([0, 3, proto.MAX_DRAWN_SPRINGS])) if n else 0
+    c = draw(st.sampled_from([0, 2, proto.MAX_DRAWN_CURSORS]))
+    rng = np.random.default_rng(draw(st.integers(0, 2**32 - 1)))
+    corners = np.array([[x0, y0], [x1, y1], [x0, y1], [x1, y0], [width_m / 2, height_m / 2]])
+    pos = corners[rng.integers(0, 5, n)] if draw(st.booleans()) else rng.uniform((x0, y0), (x1, y1), (n, 2))
+    radius = np.full(n, draw(st.sampled_from([1e-9, size / 1000, size])))
+    names = draw(st.sampled_from(["", "C" * 48, "Zoë 李雷 דנה"]))
+    cursors = tuple(
+        CursorView(f"{names}{i}", (255, 0, 0), (float(rng.uniform(x0, x1)), y1), 3, int(rng.integers(-1, n)))
+        for i in range(c)
+    )
+    return Scene(
+        width_m=width_m,
+        height_m=height_m,
+        pos_m=pos,
+        radius_m=radius,
+        color_rgb=rng.integers(0, 256, (n, 3), dtype=np.uint8),
+        spring_pairs=rng.integers(0, max(n, 1), (s, 2)),
+        spring_length_m=np.full(s, draw(st.sampled_from([0.0, 100 * size]))),
+        spring_width_m=np.full(s, draw(st.sampled_from([0.0, size]))),
+        spring_color_rgb=np.zeros((s, 3), np.uint8),
+        cursors=cursors,
+        title="T" * draw(st.sampled_from([0, 5000])),
+        status="S" * 300,
+        time_s=draw(st.sampled_from([0.0, 1e300])),
+        fps=draw(st.sampled_from([0.0, 1e6])),
+        zoom=draw(st.sampled_from([proto.MIN_VIEW_ZOOM, 1.0, proto.MAX_VIEW_ZOOM])),
+        origin_m=tuple(draw(st.sampled_from([(x0, y0), (x1, y1), (0.0, 0.0)]))),
+    )
+
+
+def _rss_mb() -> float:
+    with open("/proc/self/status") as f:
+        line = next(line for line in f if line.startswith("VmRSS:"))
+    return int(line.split()[1]) / 1024
+
+
+@pytest.mark.skipif(not os.path.exists("/proc/self/status"), reason="reads the memory use from /proc")
+def test_extreme_but_valid_snapshots_never_crash_hang_or_bloat_the_client(cleanup):
+    cleanup(pygame.quit)
+    before = _rss_mb()
+    peak = [before]
+
+    @given(st.lists(extreme_scenes(), min_size=1, max_size=3))
+    @settings(max_examples=12, deadline=None, suppress_health_check=list(HealthCheck))
+    def stream(scenes):
+        fake = ScriptedServer(welcome_frame())
+        net = NetPlayer("127.0.0.1", fake.port, max_backoff_s=0.3)
+        try:
+            net.connect()
+            fake.send(b"".join(proto.encode_frame(proto.SNAPSHOT, proto.encode_snapshot(sc)) for sc in scenes))
+            app = PlayerApp(net, headless=True)
+            drawn = lambda: net.snapshots == len(scenes) and app.frames > 1  # noqa: E731
+            start = time.monotonic()
+            assert app.run(seconds=20, until=drawn) == 0, net.error
+            assert drawn(), "every snapshot arrived and was drawn"
+            assert time.monotonic() - start < 20
+            peak[0] = max(peak[0], _rss_mb())
+        finally:
+            net.close()
+            fake.close()
+
+    stream()
+    assert peak[0] - before < 500, f"the client grew by {peak[0] - before:.0f} MB"

@@ -65,7 +65,7 @@ def test_frame_header_is_big_endian_length_then_type():
     "data, hints",
     [
         (b"\x00\x00\x00\x00", ["empty", "airtable-client"]),
-        (struct.pack(">IB", proto.MAX_CLIENT_FRAME + 1, 1), ["65536 byte limit"]),
+        (struct.pack(">IB", proto.MAX_CLIENT_FRAME + 1, 1), ["1024 byte limit"]),
         (b"GET / HTTP/1.1\r\n", ["looks like text", "web browser"]),
         (b"\x00\x00\x00\x02\x09x", ["unknown message type 9", "same airtable version"]),
         (b"\x00\x00\x00\x02\x05x", ["may not send SNAPSHOT"]),
@@ -120,6 +120,36 @@ def test_bad_hello(payload, hints):
     with pytest.raises(proto.ProtocolError) as err:
         proto.parse_hello(payload)
     assert_sentence(str(err.value), *hints)
+
+
+@pytest.mark.parametrize(
+    "name, hints",
+    [
+        ("\u3164", ["no visible letter or digit", "like Ann"]),  # Hangul filler: a letter that draws nothing
+        ("\u3164\u3164 \uffa0", ["no visible letter or digit"]),
+        ("\u2800\u2800", ["no visible letter or digit"]),  # Braille blank
+        ("...", ["no visible letter or digit"]),
+        ("C7 C1", ["looks like a player label", "C7"]),
+        ("c12", ["player label"]),
+        ("Ann C3", ["player label"]),
+        ("a\u0007b", ["U+0007", "not printable", "letters, digits"]),
+        ("Ann\u200b", ["U+200B", "not printable"]),
+        ("line\nbreak", ["U+000A", "not printable"]),
+        ("x" * 21, ["over 20 characters", "shorter"]),
+        ("  ", ["empty"]),
+    ],
+)
+def test_names_need_a_visible_letter_or_digit_and_may_not_imitate_a_player(name, hints):
+    with pytest.raises(proto.ProtocolError) as err:
+        proto.check_name(name)
+    assert_sentence(str(err.value), *hints)
+    if "printable" in hints:
+        assert "shorter" not in str(err.value)
+
+
+@pytest.mark.parametrize("name", ["Ann", "Zoë", "李雷", "Ωmega 2", "C3PO", "Claire 2", "דנה", "  Bo  "])
+def test_ordinary_names_in_any_script_are_welcome(name):
+    assert proto.check_name(name) == name.strip()
 
 
 # ---------------------------------------------------------------- INPUT
@@ -279,29 +309,36 @@ printable_text = st.text(st.characters(blacklist_categories=("C", "Z"), whitelis
 
 @st.composite
 def scenes(draw) -> Scene:
+    """Valid scenes, up to the edges of what a player accepts."""
     n = draw(st.integers(0, 20))
     s = draw(st.integers(0, 10)) if n else 0
     c = draw(st.integers(0, 5))
+    width_m = draw(st.floats(0.1, 1000))
+    height_m = draw(st.floats(max(0.1, width_m / 99), min(1000, width_m * 99)))
+    size = max(width_m, height_m)
+    x = st.floats(-size, width_m + size)
+    y = st.floats(-size, height_m + size)
     color = hnp.arrays(np.uint8, (n, 3))
     cursors = tuple(
         CursorView(
             name=draw(printable_text),
             color=draw(st.tuples(*[st.integers(0, 255)] * 3)),
-            cursor_m=(draw(finite), draw(finite)),
+            cursor_m=(draw(x), draw(y)),
             button=draw(st.integers(0, 3)),
             held=draw(st.integers(-1, n - 1)),
         )
         for _ in range(c)
     )
+    pos = np.column_stack([draw(hnp.arrays(float, (n,), elements=x)), draw(hnp.arrays(float, (n,), elements=y))])
     return Scene(
-        width_m=draw(st.floats(0.1, 1000)),
-        height_m=draw(st.floats(0.1, 1000)),
-        pos_m=draw(hnp.arrays(float, (n, 2), elements=finite)),
-        radius_m=draw(hnp.arrays(float, (n,), elements=st.floats(1e-3, 10))),
+        width_m=width_m,
+        height_m=height_m,
+        pos_m=pos.reshape(n, 2),
+        radius_m=draw(hnp.arrays(float, (n,), elements=st.floats(1e-3, min(10, size)))),
         color_rgb=draw(color),
         spring_pairs=draw(hnp.arrays(np.intp, (s, 2), elements=st.integers(0, max(n - 1, 0)))),
-        spring_length_m=draw(hnp.arrays(float, (s,), elements=st.floats(0, 100))),
-        spring_width_m=draw(hnp.arrays(float, (s,), elements=st.floats(0, 1))),
+        spring_length_m=draw(hnp.arrays(float, (s,), elements=st.floats(0, min(100, size)))),
+        spring_width_m=draw(hnp.arrays(float, (s,), elements=st.floats(0, min(1, size)))),
         spring_color_rgb=draw(hnp.arrays(np.uint8, (s, 3))),
         cursors=cursors,
         title=draw(printable_text),
@@ -311,7 +348,7 @@ def scenes(draw) -> Scene:
         time_s=draw(st.floats(0, 1e6)),
         fps=draw(st.floats(0, 1000)),
         zoom=draw(st.floats(0.05, 200)),
-        origin_m=(draw(finite), draw(finite)),
+        origin_m=(draw(x), draw(y)),
     )
 
 

@@ -3,14 +3,17 @@
 from __future__ import annotations
 
 import json
+import logging
+import os
+import selectors
 import socket
 import struct
 import threading
 import time
-from collections.abc import Callable
 
 import numpy as np
 import pytest
+from conftest import WAIT_S, wait_until
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
@@ -19,22 +22,18 @@ from airtable.app.client import LOCAL_COLOR, cursor_pulls
 from airtable.app.scene import Scene
 from airtable.colors import rgb
 from airtable.net import protocol as proto
+from airtable.net.events import MAX_QUEUED_INPUTS, EventQueue, PlayerInput, PlayerJoined, PlayerLeft
 from airtable.net.loadtest import TableLoop, grid_table, run_load
-from airtable.net.server import COURSE_COLORS, GameServer, client_color, lan_addresses
-
-WAIT_S = 5.0
-
-
-def wait_until(condition: Callable[[], object], timeout_s: float = WAIT_S, what: str = "condition") -> object:
-    """Poll `condition` until it is truthy; fail after a generous timeout."""
-    deadline = time.monotonic() + timeout_s
-    while True:
-        value = condition()
-        if value:
-            return value
-        if time.monotonic() > deadline:
-            pytest.fail(f"timed out after {timeout_s} s waiting for {what}")
-        time.sleep(0.005)
+from airtable.net.server import (
+    COURSE_COLORS,
+    RESERVED_FDS,
+    SELECT_SOCKETS,
+    GameServer,
+    client_color,
+    connection_room,
+    lan_addresses,
+    validate_server_options,
+)
 
 
 def frame(frame_type: int, payload: bytes) -> bytes:
@@ -44,8 +43,10 @@ def frame(frame_type: int, payload: bytes) -> bytes:
 class RawClient:
     """A bare protocol client for tests: send bytes, read frames with deadlines."""
 
-    def __init__(self, port: int) -> None:
-        self.sock = socket.create_connection(("127.0.0.1", port), timeout=WAIT_S)
+    def __init__(self, port: int, source: str | None = None) -> None:
+        """`source` picks this client's own address (127.0.0.2 is another loopback computer)."""
+        where = None if source is None else (source, 0)
+        self.sock = socket.create_connection(("127.0.0.1", port), timeout=WAIT_S, source_address=where)
         self.sock.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
         self.reader = proto.FrameReader(proto.MAX_SERVER_FRAME, sender="the server")
         self.pending: list[tuple[int, bytes]] = []
@@ -162,8 +163,8 @@ def clients():
     """Make RawClients that are closed after the test."""
     made: list[RawClient] = []
 
-    def make(port: int) -> RawClient:
-        c = RawClient(port)
+    def make(port: int, source: str | None = None) -> RawClient:
+        c = RawClient(port, source)
         made.append(c)
         return c
 
@@ -286,18 +287,37 @@ def test_input_drags_the_puck_and_disconnect_lets_go(make_server, make_loop, cli
     assert [cl.name for cl in loop.clients] == ["local"]
 
 
+class GameLoop:
+    """This test is the game loop: it owns the list of clients (index 0 the local user)."""
+
+    def __init__(self, server: GameServer, table: AirTable) -> None:
+        self.server, self.table = server, table
+        self.clients: list[Client] = [Client()]
+
+    def update(self) -> list[Client]:
+        """One frame's update_clients (no physics step, as while paused); the players."""
+        self.server.update_clients(self.clients, self.table)
+        return self.clients[1:]
+
+    def step(self, dt_s: float) -> None:
+        step_with(self.table, self.clients, dt_s)
+
+
+def step_with(table: AirTable, clients: list[Client], dt_s: float) -> None:
+    """One physics step with these clients' cursor strings."""
+    table.step(dt_s, cursor_pulls(clients))
+
+
 def test_two_players_on_one_puck_add_their_forces(make_server, clients):
     server = make_server()
-    table = one_puck_table()
-    people = [Client()]  # the game loop's list; index 0 is the local user
+    game = GameLoop(server, one_puck_table())
     a, b = clients(server.port), clients(server.port)
     a.hello(), b.hello()
     for c in (a, b):
         c.send(proto.encode_input((5.1, 4.0), 1))
 
     def both(cursor_x: float) -> bool:
-        server.apply_inputs(people, table)  # this test is the game loop
-        players = people[1:]
+        players = game.update()
         return len(players) == 2 and all(p.held is not None and p.cursor_m[0] == cursor_x for p in players)
 
     wait_until(lambda: both(5.1), what="both players to grab the puck")
@@ -308,16 +328,17 @@ def test_two_players_on_one_puck_add_their_forces(make_server, clients):
     def pulled_by_local_clients(n: int) -> float:
         """The same pull made by n Clients on a table without any network."""
         ref = one_puck_table()
-        pullers = []
+        local = []
         for _ in range(n):
             c = Client()
             c.set_input(ref, (5.1, 4.0), 1)
             c.set_input(ref, (6.0, 4.0), 1)
-            pullers.append(c)
-        ref.step(1 / 240, cursor_pulls(pullers))
+            local.append(c)
+        step_with(ref, local, 1 / 240)
         return ref.vel_mps[0, 0]
 
-    table.step(1 / 240, cursor_pulls(people))
+    game.step(1 / 240)
+    table = game.table
     assert table.vel_mps[0, 0] == pulled_by_local_clients(2)
     assert table.vel_mps[0, 0] > 1.5 * pulled_by_local_clients(1) > 0
     assert table.vel_mps[0, 1] == pytest.approx(0.0, abs=1e-12)
@@ -325,31 +346,71 @@ def test_two_players_on_one_puck_add_their_forces(make_server, clients):
 
 def test_a_grab_and_a_move_within_one_frame_still_grab(make_server, clients):
     server = make_server()
-    table = one_puck_table()
-    people = [Client()]
+    game = GameLoop(server, one_puck_table())
     c = clients(server.port)
     c.hello()
     # Press over the puck and move away at once: both arrive before the next frame.
     c.send(proto.encode_input((5.1, 4.0), 1) + proto.encode_input((6.0, 4.0), 1) + proto.encode_input((7.0, 4.0), 1))
 
-    def moved() -> bool:
-        server.apply_inputs(people, table)  # this test is the game loop
-        return len(people) == 2 and people[1].cursor_m[0] == 7.0
+    def moved():
+        players = game.update()
+        return len(players) == 1 and players[0].cursor_m[0] == 7.0 and players[0]
 
-    wait_until(moved, what="the last input")
-    assert people[1].held is table.pucks[0]
+    assert wait_until(moved, what="the last input").held is game.table.pucks[0]
 
 
 def test_bye_frees_the_name_and_removes_the_client(make_server, clients):
     server = make_server()
-    table = one_puck_table()
-    people = [Client()]
+    game = GameLoop(server, one_puck_table())
     c = clients(server.port)
     c.hello()
-    wait_until(lambda: (server.apply_inputs(people, table), len(people) == 2)[1], what="the join")
+    wait_until(lambda: len(game.update()) == 1, what="the join")
     c.send(proto.encode_bye())
-    wait_until(lambda: (server.apply_inputs(people, table), len(people) == 1)[1], what="the leave")
-    assert server.player_names() == []
+    wait_until(lambda: len(game.update()) == 0, what="the leave")
+    assert server.player_names() == [] and [cl.name for cl in game.clients] == ["local"]
+
+
+def test_joins_leaves_and_cursors_are_applied_every_frame_even_without_steps(make_server, clients):
+    """While the teacher pauses, no step runs, yet students appear, move and go."""
+    server = make_server()
+    game = GameLoop(server, one_puck_table())
+    c = clients(server.port)
+    name = c.hello("Ann").client
+    c.send(proto.encode_input((2.0, 3.0), 0))
+    player = wait_until(lambda: (p := game.update()) and p[0].active and p[0], what="the join and first input")
+    assert player.name == name and tuple(player.cursor_m) == (2.0, 3.0)
+    c.send(proto.encode_input((4.0, 1.0), 0))
+    wait_until(lambda: game.update() and tuple(player.cursor_m) == (4.0, 1.0), what="the cursor to move")
+    c.close()
+    wait_until(lambda: not game.update(), what="the leave")
+    assert game.table.time_s == 0.0, "no physics step ran"
+
+
+def test_the_event_queue_stays_bounded_while_nobody_takes_it(make_server):
+    """20,000 join/leave cycles while the game loop never calls update_clients."""
+    server = make_server(max_clients=30)
+    for i in range(20_000):
+        with socket.create_connection(("127.0.0.1", server.port), timeout=WAIT_S) as s:
+            s.sendall(proto.encode_hello() + proto.encode_input((1, 1), 0) + proto.encode_bye())
+            s.settimeout(WAIT_S)
+            while s.recv(65536):  # the server closes after the BYE
+                pass
+        if i % 2000 == 0:
+            assert server.pending_events <= 2 * 30 + 30 * MAX_QUEUED_INPUTS
+    wait_until(lambda: server.player_count == 0, what="the last leave")
+    assert server.pending_events == 0, "every join was withdrawn by its leave"
+
+
+def test_event_records_are_typed_and_a_leave_withdraws_an_unseen_join():
+    queue = EventQueue()
+    record = proto.InputRecord((1.0, 2.0), 1)
+    queue.join(1, "C1", (1, 2, 3))
+    queue.input(1, record)
+    queue.join(2, "C2", (4, 5, 6))
+    queue.leave(2)
+    assert queue.take() == [PlayerJoined(1, "C1", (1, 2, 3)), PlayerInput(1, record)]
+    queue.leave(1)
+    assert queue.take() == [PlayerLeft(1)] and len(queue) == 0
 
 
 # ---------------------------------------------------------------- bad clients
@@ -363,10 +424,22 @@ def _input(cursor="[1, 2]", button="1", keys="[]") -> bytes:
     return frame(proto.INPUT, f'{{"cursor_m": {cursor}, "button": {button}, "keys": {keys}}}'.encode())
 
 
+def fat_input() -> bytes:
+    """The most expensive valid INPUT: just under the frame cap, long numbers, escaped keys."""
+    keys = "[" + ", ".join(f'"k{i:x}' + "\\u00e9" * 5 + '"' for i in range(proto.MAX_KEYS)) + "]"
+    head = '{"cursor_m": [1.%s1, 1.%s1], "button": 1, "keys": %s}'
+    room = proto.MAX_CLIENT_FRAME - 1 - len(head % ("", "", keys))
+    zeros = "0" * (room // 2)
+    payload = (head % (zeros, zeros, keys)).encode()
+    assert proto.MAX_CLIENT_FRAME - 4 < len(payload) + 1 <= proto.MAX_CLIENT_FRAME
+    assert len(proto.parse_input(payload).keys) == proto.MAX_KEYS  # valid
+    return frame(proto.INPUT, payload)
+
+
 BAD_CLIENTS = {
     "garbage bytes": ([b"\xde\xad\xbe\xef" * 8], ["limit", "airtable-client"]),
     "a web browser": ([b"GET / HTTP/1.1\r\nHost: teacher\r\n\r\n"], ["web browser", "airtable-client"]),
-    "a frame over 64 KiB": ([struct.pack(">IB", 64 * 1024 + 1, 1) + b"x" * 1000], ["65536 byte limit"]),
+    "a frame over 1 KiB": ([struct.pack(">IB", 1024 + 1, 1) + b"x" * 1000], ["1024 byte limit"]),
     "an empty frame": ([b"\0\0\0\0"], ["empty"]),
     "invalid UTF-8": ([frame(proto.HELLO, b'{"protocol": 1, "name": "\xff"}')], ["UTF-8"]),
     "invalid JSON": ([frame(proto.HELLO, b'{"protocol": 1,')], ["not valid JSON", '{"protocol": 1']),
@@ -375,6 +448,8 @@ BAD_CLIENTS = {
     "unknown HELLO field": ([frame(proto.HELLO, b'{"protocol": 1, "admin": true}')], ["unknown field"]),
     "a 21 character name": ([proto.encode_hello("x" * 21)], ["name", "20"]),
     "a name with a bell": ([proto.encode_hello("a\x07")], ["printable"]),
+    "a blank-looking name": ([proto.encode_hello("\u3164")], ["no visible letter or digit"]),
+    "a name imitating players": ([proto.encode_hello("C7 C1")], ["looks like a player label"]),
     "INPUT before HELLO": ([proto.encode_input((1, 2), 1)], ["before HELLO", "HELLO"]),
     "HELLO twice": (_after_hello(proto.encode_hello()), ["twice"]),
     "unknown frame type": (_after_hello(frame(9, b"{}")), ["unknown message type 9"]),
@@ -389,6 +464,11 @@ BAD_CLIENTS = {
     "INPUT missing a field": (_after_hello(frame(proto.INPUT, b'{"cursor_m": [1, 2]}')), ["missing"]),
     "INPUT that is a list": (_after_hello(frame(proto.INPUT, b"[1, 2, 1]")), ["JSON object"]),
     "a flood of inputs": (_after_hello(proto.encode_input((1, 2), 0) * 2000), ["messages a second"]),
+    "a duplicated field": (
+        _after_hello(frame(proto.INPUT, b'{"cursor_m": [1, 2], "button": 1, "keys": [], "keys": []}')),
+        ["twice"],
+    ),
+    "a flood of bytes": (_after_hello(fat_input() * 60), ["KiB a second"]),
 }
 
 
@@ -460,7 +540,7 @@ def test_half_a_frame_then_silence_is_dropped_after_the_timeout(make_server, cli
 
 
 def test_password(make_server, clients):
-    server = make_server(password="sesame")
+    server = make_server(password="sesame", password_wait_s=0.2)
     c = clients(server.port)
     c.send(proto.encode_hello("Ann"))
     assert "needs a password" in c.expect_error()
@@ -468,7 +548,45 @@ def test_password(make_server, clients):
     c.send(proto.encode_hello("Ann", "open sesame"))
     sentence = c.expect_error()
     assert "wrong password" in sentence and "--password" in sentence and "sesame" not in sentence
-    assert clients(server.port).hello("Ann", "sesame").client == "C1 Ann"
+    # Right after a wrong guess even the right password waits, so guessing is slow.
+    c = clients(server.port)
+    c.send(proto.encode_hello("Ann", "sesame"))
+    assert "wait 1 s" in c.expect_error()
+
+    def joined():
+        c = clients(server.port)
+        c.send(proto.encode_hello("Ann", "sesame"))
+        got = c.next_frame()
+        return got is not None and got[0] == proto.WELCOME and proto.parse_welcome(got[1])
+
+    assert wait_until(joined, what="the wait after a wrong password to end").client == "C1 Ann"
+
+
+def test_wrong_passwords_earn_a_growing_wait_then_a_lockout_and_few_log_lines(make_server, clients, caplog):
+    server = make_server(password="sesame", password_wait_s=0.05)
+    answers = []
+
+    def guess(password: str) -> str:
+        c = clients(server.port)
+        c.send(proto.encode_hello("Eve", password))
+        got = c.next_frame()
+        c.close()
+        sentence = proto.parse_error(got[1]) if got and got[0] == proto.ERROR else "welcome"
+        answers.append(sentence)
+        return sentence
+
+    caplog.set_level(logging.INFO, logger="airtable.net")
+    # Guess as fast as the server answers until it locks us out: only 5 guesses are ever checked.
+    wait_until(lambda: "wait 60 s" in guess("guess"), what="the lockout")
+    checked = [a for a in answers if a.startswith("wrong password")]
+    waits = [a for a in answers if a.startswith("too many wrong passwords")]
+    assert len(checked) == 5 and waits, answers
+    for _ in range(200):
+        guess("guess")
+    assert guess("sesame").startswith("too many wrong passwords"), "locked out: even the right password waits"
+    lines = [r.getMessage() for r in caplog.records if "password" in r.getMessage()]
+    assert len(lines) <= 3, lines
+    assert any("locked out" in line for line in lines)
 
 
 def test_server_full_then_a_freed_name_is_reused(make_server, clients):
@@ -482,6 +600,194 @@ def test_server_full_then_a_freed_name_is_reused(make_server, clients):
     players[6].send(proto.encode_bye())
     wait_until(lambda: len(server.player_names()) == 29, what="C7 to leave")
     assert clients(server.port).hello().client == "C7"
+
+
+# ---------------------------------------------------------------- joining: handshakes and seats
+
+
+def test_handshakes_have_their_own_cap_and_the_refusal_says_busy_not_full(make_server, clients):
+    server = make_server(max_clients=30, max_handshakes=4, hello_timeout_s=30)
+    idle = [clients(server.port) for _ in range(4)]  # connect and never say HELLO
+    wait_until(lambda: server.connection_count == 4, what="the idle handshakes")
+    late = clients(server.port)
+    sentence = late.expect_error()
+    assert "busy" in sentence and "tries again" in sentence and "full" not in sentence
+    idle[0].hello()  # a handshake that finishes frees its slot for the next
+    assert clients(server.port).hello().client == "C2"
+
+
+def test_a_handshake_that_says_nothing_is_dropped_after_its_deadline(make_server, clients):
+    server = make_server(hello_timeout_s=0.3, timeout_s=30)
+    c = clients(server.port)
+    kind, payload = c.next_frame()
+    assert kind == proto.ERROR and "no HELLO came within 0.3 s" in proto.parse_error(payload)
+    c.close()
+    wait_until(lambda: server.connection_count == 0, what="the silent handshake to be gone")
+
+
+def test_one_computer_cannot_keep_others_from_joining(make_server, clients):
+    """A squatter at 127.0.0.2 reopens idle sockets as fast as it can; 20 students still join."""
+    server = make_server(max_clients=30, limit_loopback=True, players_per_address=30, hello_timeout_s=1.0)
+    stop = threading.Event()
+    refused = []
+
+    def squat():
+        held: list[RawClient] = []  # idle sockets, the oldest closed when over 64
+        while not stop.is_set():
+            try:
+                c = RawClient(server.port, source="127.0.0.2")
+            except OSError:
+                continue
+            c.sock.settimeout(0.05)
+            try:
+                refused.append(c.sock.recv(65536))
+                c.close()
+            except (TimeoutError, OSError):
+                held.append(c)  # accepted: keep it idle
+            if len(held) > 64:
+                held.pop(0).close()
+        for c in held:
+            c.close()
+
+    squatter = threading.Thread(target=squat, daemon=True)
+    squatter.start()
+    try:
+        wait_until(lambda: len(refused) >= 10, what="the squatter to be refused")
+        names = [clients(server.port).hello().client for _ in range(20)]
+    finally:
+        stop.set()
+        squatter.join(timeout=WAIT_S)
+    assert names == [f"C{n}" for n in range(1, 21)]
+    assert "your computer already has 4 connections joining" in proto.parse_error(refused[0][5:])
+
+
+def test_seats_per_computer_are_limited_with_a_clear_sentence(make_server, clients):
+    server = make_server(limit_loopback=True, players_per_address=2)
+    first = clients(server.port)
+    first.hello()
+    clients(server.port).hello()
+    third = clients(server.port)
+    third.send(proto.encode_hello())
+    assert "your computer already plays with 2 windows" in third.expect_error()
+    assert clients(server.port, source="127.0.0.2").hello().client == "C3"
+    first.send(proto.encode_bye())  # a freed seat can be taken again from the same computer
+    wait_until(lambda: server.player_count == 2, what="the BYE")
+    assert clients(server.port).hello().client == "C1"
+
+
+# ---------------------------------------------------------------- the teacher's view: roster and remove
+
+
+def test_the_roster_shows_each_seat_and_flags_squatters(make_server, make_loop, clients):
+    server = make_server()
+    make_loop(server, grid_table(), fps=60)
+    squatter = clients(server.port)
+    squatter.hello("\u3164x")
+    squatter.send(proto.encode_input((-40.0, -40.0), 0))
+    honest = Honest(server.port, (5.0, 4.0))
+    try:
+        assert server.player_count == 2
+
+        def both_seen():
+            seats = server.roster()
+            return len(seats) == 2 and seats[0].far_off and seats[1].snapshots_per_s > 10 and seats
+
+        squat, seat = wait_until(both_seen, what="both seats in the roster")
+        assert (squat.number, squat.name, squat.color) == (1, "C1 \u3164x", client_color(1))
+        assert (seat.number, seat.name, seat.far_off) == (2, "C2 honest", False)
+        assert squat.address.startswith("127.0.0.1:") and 0 <= seat.lag_s < 1.0
+        wait_until(lambda: server.roster()[0].idle_s > 0.3 > server.roster()[1].idle_s, what="the squatter idle")
+    finally:
+        honest.close()
+
+
+def test_the_teacher_can_remove_a_player_who_is_told_why(make_server, clients):
+    server = make_server()
+    keep, go = clients(server.port), clients(server.port)
+    keep.hello("Ann"), go.hello("Bo")
+    assert server.remove(2, "please use your own name") is True
+    sentence = go.expect_error()
+    assert sentence == "the teacher removed you from the table: please use your own name"
+    wait_until(lambda: server.player_names() == ["C1 Ann"], what="the seat to be free")
+    assert server.remove(2) is False and server.remove(99) is False
+    assert clients(server.port).hello().client == "C2"
+
+
+# ---------------------------------------------------------------- the network thread
+
+
+def test_a_failing_network_thread_is_logged_shown_and_stops_cleanly(make_server, clients, caplog, monkeypatch):
+    server = make_server()
+    c = clients(server.port)
+    c.hello()
+
+    def broken(now):
+        raise ValueError("filedescriptor out of range in select()")
+
+    caplog.set_level(logging.ERROR, logger="airtable.net")
+    monkeypatch.setattr(server, "_check_timeouts", broken)  # stands in for a select() that fails
+    wait_until(lambda: server.failure, what="the failure to be reported")
+    assert server.failure.startswith("students can no longer join: ")
+    assert "ValueError: filedescriptor out of range" in server.failure
+    assert not server.running
+    assert any(r.exc_info and r.exc_info[0] is ValueError for r in caplog.records), "logged with its traceback"
+    while (got := c.next_frame()) is not None:  # the player is let go, not left hanging
+        assert got[0] in (proto.SNAPSHOT, proto.BYE)
+    server.stop()
+
+
+def test_the_player_cap_stays_below_what_the_selector_can_watch():
+    assert connection_room(selectors.SelectSelector, None) == SELECT_SOCKETS < 512
+    assert connection_room(selectors.SelectSelector, 256) == 256 - RESERVED_FDS
+    assert connection_room(selectors.EpollSelector, None) is None
+
+
+@pytest.mark.skipif(not hasattr(selectors, "EpollSelector"), reason="needs setrlimit and epoll (Linux)")
+def test_more_players_than_descriptors_gives_one_warning_not_a_flood(caplog):
+    resource = pytest.importorskip("resource")
+    soft, hard = resource.getrlimit(resource.RLIMIT_NOFILE)
+    in_use = len(os.listdir("/proc/self/fd"))
+    caplog.set_level(logging.INFO, logger="airtable.net")
+    resource.setrlimit(resource.RLIMIT_NOFILE, (in_use + 120, hard))
+    server = GameServer(host="127.0.0.1", port=0, max_clients=1000)
+    held = []
+    try:
+        server.start()
+        assert server.max_clients + server.max_handshakes <= in_use + 120 - RESERVED_FDS
+        for _ in range(300):  # both ends of each connection live in this process
+            try:
+                held.append(socket.create_connection(("127.0.0.1", server.port), timeout=WAIT_S))
+            except OSError:
+                break
+        wait_until(lambda: server.connection_count > 0, what="some connections")
+    finally:
+        for sock in held:
+            sock.close()
+        server.stop()
+        resource.setrlimit(resource.RLIMIT_NOFILE, (soft, hard))
+    warnings = [r.getMessage() for r in caplog.records if r.levelno >= logging.WARNING]
+    assert len(warnings) <= 3, warnings
+    assert any("only" in w and "ulimit" in w for w in warnings)
+
+
+@pytest.mark.parametrize(
+    "options, hint",
+    [
+        ({"max_clients": 5000}, "--max-clients must be 1-1000, not 5000"),
+        ({"max_clients": 0}, "--max-clients must be 1-1000"),
+        ({"snapshot_hz": 2000.0}, "--snapshot-hz must be above 0 and at most 1000, not 2000.0"),
+        ({"snapshot_hz": float("nan")}, "--snapshot-hz"),
+        ({"port": 70000}, "port must be 0-65535"),
+    ],
+)
+def test_the_command_line_can_refuse_what_the_server_would_with_the_same_sentence(options, hint):
+    with pytest.raises(ValueError) as by_server:
+        GameServer(**options)
+    said = []
+    validate_server_options(**options, error=said.append)
+    assert said == [str(by_server.value)] and hint in said[0] and "\n" not in said[0]
+    with pytest.raises(ValueError):
+        validate_server_options(**options)
 
 
 # ---------------------------------------------------------------- slow clients and rates
@@ -510,8 +816,13 @@ def test_a_stalled_client_only_misses_snapshots(make_server, make_loop, clients)
         assert received >= 10, "the reading client still gets snapshots"
         assert loop.frames - frames0 >= 0.5 * 60 * elapsed, "the game loop never waited for the stalled client"
         assert server.connection_count == 2
-        # The stalled socket really is full: the server holds a part-sent snapshot for it.
-        assert any(conn.out_cur is not None for conn in server._conns.values())
+
+        # The stalled socket really is full: the roster shows it missing snapshots.
+        def missing() -> bool:
+            seats = {seat.name: seat for seat in server.roster()}
+            return seats["C1"].snapshots_per_s < 0.5 * seats["C2"].snapshots_per_s
+
+        wait_until(missing, what="the stalled player to miss snapshots")
     finally:
         sock.close()
 

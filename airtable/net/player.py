@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import argparse
 import dataclasses
+import enum
 import math
 import socket
 import sys
@@ -33,7 +34,12 @@ SILENCE_S = 10.0  # no snapshot for this long: the server is gone (snapshots com
 MAX_INPUT_HZ = 60.0
 HEARTBEAT_S = 1.0
 FIRST_BACKOFF_S = 0.25
+FIRST_FULL_BACKOFF_S = 1.0  # the table is full: ask again after this, then less and less often
 MAX_BACKOFF_S = 4.0
+# Drawing budgets for one frame (see fit_drawing_budget).
+MAX_PUCK_AREA_SCREENS = 40.0
+MAX_PUCK_LOOKS = 1024
+MAX_SPRING_SPAN_PX = 20_000_000
 
 
 class PlayerError(Exception):
@@ -41,11 +47,30 @@ class PlayerError(Exception):
 
 
 class _ConnectError(Exception):
-    """One connection attempt failed; `retry` says whether trying again can help."""
+    """One connection attempt failed; `retry` says whether trying again can help,
+    `full` that the server asked us to wait for a place."""
 
-    def __init__(self, message: str, retry: bool) -> None:
+    def __init__(self, message: str, retry: bool, full: bool = False) -> None:
         super().__init__(message)
         self.retry = retry
+        self.full = full
+
+
+class _ConnectionEndedError(Exception):
+    """The connection ended; `fatal` is a sentence, or None to reconnect."""
+
+    def __init__(self, fatal: str | None = None) -> None:
+        super().__init__(fatal)
+        self.fatal = fatal
+
+
+class PlayerState(enum.Enum):
+    CONNECTING = "connecting"
+    CONNECTED = "connected"
+    RETRYING = "retrying"  # the server went away: reconnecting with backoff
+    WAITING = "waiting"  # the table is full or busy: asking again with backoff
+    FAILED = "failed"
+    CLOSED = "closed"
 
 
 class InputThrottle:
@@ -81,17 +106,20 @@ class NetPlayer:
     """The network side of a player: handshake, newest snapshot, input, reconnect.
 
     `connect()` makes the first connection (raising PlayerError with a sentence
-    when it fails) and starts a reader thread. From then on `state` is
-    CONNECTED, RETRYING (the server went away; it reconnects with backoff) or
-    FAILED (`error` says why); `close()` ends it. `on_snapshot(scene, t)` is
-    called from the reader thread for each snapshot, if given.
+    when it fails for good) and starts a reader thread. When the table is full
+    it returns None and the thread keeps asking, with backoff (state WAITING).
+    From then on `state` (a PlayerState) is CONNECTED, RETRYING (the server went
+    away; it reconnects with backoff), WAITING or FAILED (`error` says why);
+    `close()` ends it. `on_snapshot(scene, t)` is called from the reader thread
+    for each snapshot, if given.
     """
 
-    CONNECTING = "connecting"
-    CONNECTED = "connected"
-    RETRYING = "server gone, retrying..."
-    FAILED = "failed"
-    CLOSED = "closed"
+    CONNECTING = PlayerState.CONNECTING
+    CONNECTED = PlayerState.CONNECTED
+    RETRYING = PlayerState.RETRYING
+    WAITING = PlayerState.WAITING
+    FAILED = PlayerState.FAILED
+    CLOSED = PlayerState.CLOSED
 
     def __init__(
         self,
@@ -112,8 +140,10 @@ class NetPlayer:
         self.on_snapshot = on_snapshot
         self.protocol_version = protocol_version  # other than 1 only to test the server's answer
         self.max_backoff_s = max_backoff_s
-        self.state = self.CONNECTING
+        self.state = PlayerState.CONNECTING
         self.error: str | None = None
+        self.waiting_because: str | None = None  # the server's sentence while WAITING
+        self.next_try: float = 0.0  # time.monotonic() of the next attempt while RETRYING or WAITING
         self.welcome: proto.Welcome | None = None
         self.reconnects = 0
         self.snapshots = 0
@@ -132,29 +162,45 @@ class NetPlayer:
     @property
     def status_text(self) -> str:
         """The connection state as the HUD shows it."""
-        if self.state == self.CONNECTED:
+        if self.state == PlayerState.CONNECTED:
             return f"connected to {self.address}"
-        if self.state == self.FAILED:
+        if self.state == PlayerState.FAILED:
             return self.error or "failed"
-        return self.state
+        if self.state in (PlayerState.RETRYING, PlayerState.WAITING):
+            return self.banner_text or ""
+        return f"{self.state.value} {self.address}"
+
+    @property
+    def banner_text(self) -> str | None:
+        """A line across the window while the player cannot play, else None."""
+        wait = max(0, math.ceil(self.next_try - time.monotonic()))
+        if self.state == PlayerState.RETRYING:
+            return "server gone, retrying..."
+        if self.state == PlayerState.WAITING:
+            return f"the table is full: asking again in {wait} s (Esc quits)"
+        return None
 
     # ---------------------------------------------------------------- connecting
 
-    def connect(self) -> proto.Welcome:
-        """Connect, say HELLO and wait for WELCOME; then keep reading in a thread."""
+    def connect(self) -> proto.Welcome | None:
+        """Connect, say HELLO and wait for WELCOME; then keep reading in a thread.
+
+        Returns None when the table is full: the thread then waits for a place."""
         try:
             opened = self._open()
         except _ConnectError as e:
-            self.state, self.error = self.FAILED, str(e)
-            raise PlayerError(str(e)) from None
-        sock, welcome = opened[0], opened[1]
-        self._adopt(sock, welcome)
+            if not e.full:
+                self.state, self.error = PlayerState.FAILED, str(e)
+                raise PlayerError(str(e)) from None
+            self._wait_for_place(str(e), FIRST_FULL_BACKOFF_S)
+            opened = None
+        if opened is not None:
+            self._adopt(opened[0], opened[1])
         self._thread = threading.Thread(target=self._run, args=(opened,), name="airtable-player", daemon=True)
         self._thread.start()
-        return welcome
+        return self.welcome
 
     def _open(self) -> tuple[socket.socket, proto.Welcome, proto.FrameReader, list]:
-        where = self.address
         try:
             infos = socket.getaddrinfo(self.host, self.port, 0, socket.SOCK_STREAM)
         except (socket.gaierror, UnicodeError):
@@ -169,22 +215,8 @@ class NetPlayer:
             sock.settimeout(self.timeout_s)
             try:
                 sock.connect(addr)
-            except ConnectionRefusedError:
-                failure = _ConnectError(
-                    f"connection refused by {where}: is the server running? is port {self.port} open in its firewall?",
-                    retry=True,
-                )
-            except TimeoutError:
-                failure = _ConnectError(
-                    f"no answer from {where} within {self.timeout_s:g} s: is the address right? "
-                    f"is port {self.port} open in the server's firewall?",
-                    retry=True,
-                )
             except OSError as e:
-                failure = _ConnectError(
-                    f"cannot reach {where} ({e.strerror or e}): is this computer on the teacher's network?",
-                    retry=True,
-                )
+                failure = self._connect_failure(e)
             else:
                 try:
                     return (sock, *self._handshake(sock))
@@ -194,6 +226,21 @@ class NetPlayer:
             sock.close()
         assert failure is not None
         raise failure
+
+    def _connect_failure(self, e: OSError) -> _ConnectError:
+        where = self.address
+        if isinstance(e, ConnectionRefusedError):
+            sentence = (
+                f"connection refused by {where}: is the server running? is port {self.port} open in its firewall?"
+            )
+        elif isinstance(e, TimeoutError):
+            sentence = (
+                f"no answer from {where} within {self.timeout_s:g} s: is the address right? "
+                f"is port {self.port} open in the server's firewall?"
+            )
+        else:
+            sentence = f"cannot reach {where} ({e.strerror or e}): is this computer on the teacher's network?"
+        return _ConnectError(sentence, retry=True)
 
     def _handshake(self, sock: socket.socket) -> tuple[proto.Welcome, proto.FrameReader, list]:
         where = self.address
@@ -209,13 +256,8 @@ class NetPlayer:
                     raise _ConnectError(f"the server at {where} hung up before saying WELCOME", retry=True)
                 frames = reader.feed(data)
                 if frames:
-                    frame_type, payload = frames[0]
-                    if frame_type == proto.ERROR:
-                        raise _ConnectError(proto.parse_error(payload), retry=False)
-                    if frame_type != proto.WELCOME:
-                        raise proto.ProtocolError(f"the first message was {proto.FRAME_NAMES[frame_type]}, not WELCOME")
-                    # Frames that came with the WELCOME go to the reader thread.
-                    return proto.parse_welcome(payload), reader, frames[1:]
+                    welcome, rest = self._first_frame(frames)
+                    return welcome, reader, rest
         except proto.ProtocolError as e:
             raise _ConnectError(
                 f"{where} does not answer like an airtable server ({e}); check the address and port", retry=False
@@ -229,18 +271,40 @@ class NetPlayer:
         except OSError as e:
             raise _ConnectError(f"the connection to {where} broke during the handshake ({e})", retry=True) from None
 
+    def _first_frame(self, frames: list) -> tuple[proto.Welcome, list]:
+        frame_type, payload = frames[0]
+        if frame_type == proto.ERROR:
+            sentence, retry = proto.parse_error_message(payload)
+            raise _ConnectError(sentence, retry=retry, full=retry)
+        if frame_type != proto.WELCOME:
+            raise proto.ProtocolError(f"the first message was {proto.FRAME_NAMES[frame_type]}, not WELCOME")
+        # Frames that came with the WELCOME go to the reader thread.
+        return proto.parse_welcome(payload), frames[1:]
+
     def _adopt(self, sock: socket.socket, welcome: proto.Welcome) -> None:
         sock.settimeout(0.25)  # the reader wakes this often to check for silence and close()
         with self._send_lock:
             self._sock = sock
             self.welcome = welcome
             self._throttle.reset()
-            self.state = self.CONNECTED
+            self.state = PlayerState.CONNECTED
+            self.waiting_because = None
+
+    def _wait_for_place(self, sentence: str, backoff_s: float) -> None:
+        self.waiting_because = sentence
+        self.next_try = time.monotonic() + backoff_s
+        self.state = PlayerState.WAITING
 
     # ---------------------------------------------------------------- reader thread
 
-    def _run(self, opened: tuple) -> None:
-        while True:
+    def _run(self, opened: tuple | None) -> None:
+        while not self._closed.is_set():
+            if opened is None:
+                opened = self._reconnect()
+                if opened is None:
+                    return
+                self.reconnects += self.welcome is not None
+                self._adopt(opened[0], opened[1])
             sock, _, reader, frames = opened
             fatal = self._read(sock, reader, frames)
             with self._send_lock:
@@ -249,64 +313,78 @@ class NetPlayer:
             if self._closed.is_set():
                 return
             if fatal is not None:
-                self.state, self.error = self.FAILED, fatal
+                self.state, self.error = PlayerState.FAILED, fatal
                 return
-            self.state = self.RETRYING
-            opened = self._reconnect()
-            if opened is None:
-                return
-            self.reconnects += 1
-            self._adopt(opened[0], opened[1])
+            self.state = PlayerState.RETRYING
+            opened = None
 
     def _read(self, sock: socket.socket, reader: proto.FrameReader, frames: list) -> str | None:
         """Read until the connection ends; return a fatal sentence, or None to reconnect."""
         last_rx = time.monotonic()
-        while not self._closed.is_set():
-            now = time.monotonic()
-            for frame_type, payload in frames:
-                last_rx = now
-                if frame_type == proto.SNAPSHOT:
-                    try:
-                        scene = proto.decode_snapshot(payload)
-                    except proto.ProtocolError as e:
-                        return str(e)
-                    self._scene = scene  # one reference swap: readers see the old or the new scene
-                    self.snapshots += 1
-                    if self.on_snapshot is not None:
-                        self.on_snapshot(scene, now)
-                elif frame_type == proto.ERROR:
-                    return proto.parse_error(payload)
-                elif frame_type == proto.BYE:
+        try:
+            while not self._closed.is_set():
+                now = time.monotonic()
+                if frames:
+                    last_rx = now
+                    self._take(frames, now)
+                elif now - last_rx > max(SILENCE_S, self.timeout_s):
                     return None
-                else:
-                    return f"{self.address} sent an unexpected {proto.FRAME_NAMES[frame_type]} message"
-            if now - last_rx > max(SILENCE_S, self.timeout_s):
-                return None
-            frames = []
-            try:
-                data = sock.recv(65536)
-            except TimeoutError:
-                continue
-            except OSError:
-                return None
-            if not data:
-                return None
-            try:
-                frames = reader.feed(data)
-            except proto.ProtocolError as e:
-                return f"{self.address} sent something that is not airtable protocol ({e})"
+                frames = self._receive(sock, reader)
+        except _ConnectionEndedError as end:
+            return end.fatal
         return None
 
+    def _receive(self, sock: socket.socket, reader: proto.FrameReader) -> list:
+        try:
+            data = sock.recv(65536)
+        except TimeoutError:
+            return []
+        except OSError:
+            raise _ConnectionEndedError() from None
+        if not data:
+            raise _ConnectionEndedError()
+        try:
+            return reader.feed(data)
+        except proto.ProtocolError as e:
+            raise _ConnectionEndedError(f"{self.address} sent something that is not airtable protocol ({e})") from None
+
+    def _take(self, frames: list, now: float) -> None:
+        for frame_type, payload in frames:
+            if frame_type == proto.SNAPSHOT:
+                try:
+                    scene = proto.decode_snapshot(payload)
+                except proto.ProtocolError as e:
+                    raise _ConnectionEndedError(str(e)) from None
+                self._scene = scene  # one reference swap: readers see the old or the new scene
+                self.snapshots += 1
+                if self.on_snapshot is not None:
+                    self.on_snapshot(scene, now)
+            elif frame_type == proto.ERROR:
+                sentence, retry = proto.parse_error_message(payload)
+                raise _ConnectionEndedError(None if retry else sentence)
+            elif frame_type == proto.BYE:
+                raise _ConnectionEndedError()
+            else:
+                raise _ConnectionEndedError(
+                    f"{self.address} sent an unexpected {proto.FRAME_NAMES[frame_type]} message"
+                )
+
     def _reconnect(self) -> tuple | None:
-        backoff = FIRST_BACKOFF_S
-        while not self._closed.wait(backoff):
+        """Try again with backoff until connected (the tuple of _open), failed or closed (None)."""
+        backoff = FIRST_BACKOFF_S if self.state != PlayerState.WAITING else FIRST_FULL_BACKOFF_S
+        self.next_try = time.monotonic() + backoff
+        while not self._closed.wait(max(0.0, self.next_try - time.monotonic())):
             try:
                 return self._open()
             except _ConnectError as e:
                 if not e.retry:
-                    self.state, self.error = self.FAILED, str(e)
+                    self.state, self.error = PlayerState.FAILED, str(e)
                     return None
-            backoff = min(backoff * 2, self.max_backoff_s)
+                backoff = min(backoff * 2, self.max_backoff_s)
+                if e.full:
+                    self._wait_for_place(str(e), max(backoff, FIRST_FULL_BACKOFF_S))
+                else:
+                    self.next_try = time.monotonic() + backoff
         return None
 
     # ---------------------------------------------------------------- the game side
@@ -332,18 +410,14 @@ class NetPlayer:
 
     def _record(self, cursor_m: Sequence[float], button: int, keys: Iterable[str]) -> proto.InputRecord:
         welcome = self.welcome
-        w, h = (welcome.width_m, welcome.height_m) if welcome else (10.0, 8.7556)
-        # Send only what the server accepts: cursor clamped, known buttons, short key names.
-        cursor = proto.clamp_cursor(cursor_m, w, h)
-        button = button if button in (0, 1, 2, 3) else 0
-        names = sorted(k for k in keys if 1 <= len(k) <= proto.MAX_KEY_CHARS and k.isprintable())
-        return proto.InputRecord(cursor, button, frozenset(names[: proto.MAX_KEYS]))
+        size = (welcome.width_m, welcome.height_m) if welcome else proto.DEFAULT_TABLE_SIZE_M
+        return proto.make_input(cursor_m, button, keys, size)  # only what the server accepts
 
     def _send(self, record: proto.InputRecord, now: float) -> bool:
         frame = proto.encode_input(record.cursor_m, record.button, record.keys)
         with self._send_lock:
             sock = self._sock
-            if sock is None or self.state != self.CONNECTED:
+            if sock is None or self.state != PlayerState.CONNECTED:
                 return False
             try:
                 sock.sendall(frame)
@@ -363,7 +437,7 @@ class NetPlayer:
         with self._send_lock:
             sock = self._sock
             if sock is not None:
-                if bye and self.state == self.CONNECTED:
+                if bye and self.state == PlayerState.CONNECTED:
                     try:
                         sock.sendall(proto.encode_bye())
                     except OSError:
@@ -374,8 +448,8 @@ class NetPlayer:
                     pass
         if self._thread is not None and self._thread is not threading.current_thread():
             self._thread.join(timeout=5.0)
-        if self.state != self.FAILED:
-            self.state = self.CLOSED
+        if self.state != PlayerState.FAILED:
+            self.state = PlayerState.CLOSED
 
 
 # -------------------------------------------------------------------- the window
@@ -389,98 +463,216 @@ class PlayerApp:
         self.headless = headless
         self.fps = fps
         self.window = None  # the GameWindow, once run() has opened it
+        self.env = None
         self.frames = 0
-        self.states_seen: set[str] = set()  # connection states shown, for tests
+        self.states_seen: set[PlayerState] = set()  # connection states shown, for tests
+        self.draw_error: str | None = None  # the first drawing error, reported once
+        self.button = 0
+        self.keys: set[str] = set()
+        self._welcome: proto.Welcome | None = None
 
-    def run(self, seconds: float | None = None, screenshot: str | None = None) -> int:
+    def run(
+        self, seconds: float | None = None, screenshot: str | None = None, until: Callable[[], bool] | None = None
+    ) -> int:
         """The UI loop; returns the process exit status (1 when the connection failed for good).
 
-        Closes the connection when it ends, but leaves pygame running (main() quits it)."""
+        Ends after `seconds`, or after the frame in which `until()` is true, or
+        when the user quits. Closes the connection when it ends, but leaves
+        pygame running (main() quits it)."""
         import pygame
 
-        from airtable.app.environment import DEFAULT_SIZE_PX, Environment
-        from airtable.app.window import GameWindow
-
-        net = self.net
-        welcome = net.welcome
-        assert welcome is not None, "connect() first"
-        env_width_m = welcome.width_m
-        env = Environment(DEFAULT_SIZE_PX, width_m=env_width_m)
-        win = GameWindow(env, caption=f"Air Table - {welcome.client}", headless=self.headless)
-        self.window = win
-        if not self.headless:
-            pygame.mouse.set_visible(False)  # our arrow, drawn each frame, is the pointer
+        self._open_window()
         clock = pygame.time.Clock()
-        button = 0
-        keys: set[str] = set()
         start = time.monotonic()
         status = 0
         try:
-            while True:
-                quit_now = False
-                for event in pygame.event.get():
-                    if event.type == pygame.QUIT:
-                        quit_now = True
-                    elif event.type == pygame.KEYDOWN:
-                        if event.key == pygame.K_ESCAPE:
-                            quit_now = True
-                        else:
-                            keys.add(pygame.key.name(event.key))
-                    elif event.type == pygame.KEYUP:
-                        keys.discard(pygame.key.name(event.key))
-                    elif event.type == pygame.MOUSEBUTTONDOWN and event.button in (1, 2, 3):
-                        button = event.button
-                    elif event.type == pygame.MOUSEBUTTONUP and event.button == button:
-                        held = pygame.mouse.get_pressed(3)
-                        button = next((b for b in (1, 2, 3) if held[b - 1]), 0)
-                if quit_now:
-                    break
-                if net.state == net.FAILED:
-                    print(f"airtable-client: {net.error}", file=sys.stderr)
+            while self._handle_events(pygame.event.get()):
+                if self.net.state == PlayerState.FAILED:
+                    print(f"airtable-client: {self.net.error}", file=sys.stderr)
                     status = 1
                     break
-                if net.welcome is not None and net.welcome is not welcome:  # reconnected
-                    welcome = net.welcome
-                    win.set_caption(f"Air Table - {welcome.client}")
-                    if welcome.width_m != env_width_m:  # the teacher restarted with another table
-                        env_width_m = welcome.width_m
-                        env = Environment(DEFAULT_SIZE_PX, width_m=env_width_m)
-                        win.env = env
-                scene = net.latest()
-                if scene is None:
-                    scene = _empty_scene(welcome.width_m, welcome.height_m)
-                # The teacher's view: the student sees what the projector shows.
-                env.zoom = scene.zoom
-                env.origin_m = np.array(scene.origin_m, dtype=float)
-                cursor_m = env.to_world(np.array(pygame.mouse.get_pos(), dtype=float))
-                net.update_input(cursor_m, button, keys)
-                self.states_seen.add(net.state)
-                self.frames += 1
-                focused = bool(pygame.mouse.get_focused())
-                cursors, extra = _own_cursor_live(scene.cursors, welcome, cursor_m, button, focused)
-                win.draw(
-                    dataclasses.replace(scene, cursors=cursors),
-                    hud=(f"You are {welcome.client}", net.status_text),
-                    banner=net.RETRYING if net.state == net.RETRYING else None,
-                    hud_color=welcome.color,
-                )
-                if extra:  # not in the snapshots yet: the arrow alone
-                    win.draw_cursor(welcome.client, welcome.color, cursor_m)
-                win.present()
+                self._frame()
                 if seconds is not None and time.monotonic() - start >= seconds:
+                    break
+                if until is not None and until():
                     break
                 clock.tick(self.fps)
         except KeyboardInterrupt:
             pass
         finally:
             if screenshot:
-                win.save_screenshot(screenshot)
-            net.close(bye=True)
+                self.window.save_screenshot(screenshot)
+            self.net.close(bye=True)
         return status
 
+    def _open_window(self) -> None:
+        import pygame
 
-def _own_cursor_live(
-    cursors: Sequence[CursorView], welcome: proto.Welcome, cursor_m: Sequence[float], button: int, focused: bool
+        from airtable.app.window import GameWindow
+
+        self._welcome = self.net.welcome
+        self.window = GameWindow(self._new_env(), caption=self._caption(), headless=self.headless)
+        if not self.headless:
+            pygame.mouse.set_visible(False)  # our arrow, drawn each frame, is the pointer
+
+    def _table_size(self) -> tuple[float, float]:
+        w = self._welcome
+        return (w.width_m, w.height_m) if w is not None else proto.DEFAULT_TABLE_SIZE_M
+
+    def _new_env(self):
+        from airtable.app.environment import DEFAULT_SIZE_PX, Environment
+
+        self.env = Environment(DEFAULT_SIZE_PX, width_m=self._table_size()[0])
+        return self.env
+
+    def _caption(self) -> str:
+        return f"Air Table - {self._welcome.client}" if self._welcome else "Air Table - waiting for a place"
+
+    def _handle_events(self, events) -> bool:
+        """Mouse buttons and keys; False when the user quits (window closed or Esc)."""
+        import pygame
+
+        for event in events:
+            if event.type == pygame.QUIT or (event.type == pygame.KEYDOWN and event.key == pygame.K_ESCAPE):
+                return False
+            if event.type == pygame.KEYDOWN:
+                self.keys.add(pygame.key.name(event.key))
+            elif event.type == pygame.KEYUP:
+                self.keys.discard(pygame.key.name(event.key))
+            elif event.type == pygame.MOUSEBUTTONDOWN and event.button in (1, 2, 3):
+                self.button = event.button
+            elif event.type == pygame.MOUSEBUTTONUP and event.button == self.button:
+                held = pygame.mouse.get_pressed(3)
+                self.button = next((b for b in (1, 2, 3) if held[b - 1]), 0)
+        return True
+
+    def _follow_welcome(self) -> None:
+        """After a (re)connect: the new name in the caption, the new table size in the view."""
+        welcome = self.net.welcome
+        if welcome is None or welcome is self._welcome:
+            return
+        old_width = self._table_size()[0]
+        self._welcome = welcome
+        self.window.set_caption(self._caption())
+        if welcome.width_m != old_width:  # the teacher restarted with another table
+            self.window.env = self._new_env()
+
+    def _frame(self) -> None:
+        import pygame
+
+        from airtable.app.environment import MAX_ZOOM, MIN_ZOOM
+
+        net, env = self.net, self.env
+        self._follow_welcome()
+        scene = net.latest() or _empty_scene(*self._table_size())
+        # The teacher's view: the student sees what the projector shows.
+        env.zoom = min(max(scene.zoom, MIN_ZOOM), MAX_ZOOM)
+        env.origin_m = np.array(scene.origin_m, dtype=float)
+        cursor_m = env.to_world(np.array(pygame.mouse.get_pos(), dtype=float))
+        net.update_input(cursor_m, self.button, self.keys)
+        self.states_seen.add(net.state)
+        self.frames += 1
+        try:
+            self._draw(fit_drawing_budget(scene, env), cursor_m, bool(pygame.mouse.get_focused()))
+        except Exception as exc:  # a scene this window cannot draw must not end the student's session
+            if self.draw_error is None:
+                self.draw_error = f"{type(exc).__name__}: {exc}"
+                print(f"airtable-client: could not draw a frame ({self.draw_error}); carrying on", file=sys.stderr)
+
+    def _draw(self, scene: Scene, cursor_m: np.ndarray, focused: bool) -> None:
+        net, win, welcome = self.net, self.window, self._welcome
+        me = welcome.client if welcome else ""
+        color = welcome.color if welcome else (200, 200, 200)
+        cursors, extra = own_cursor_live(scene.cursors, me, cursor_m, self.button, focused)
+        win.draw(
+            dataclasses.replace(scene, cursors=cursors),
+            hud=(f"You are {me}" if me else "Not at the table yet", net.status_text),
+            banner=net.banner_text,
+            hud_color=color,
+        )
+        if extra and me:  # not in the snapshots yet: the arrow alone
+            win.draw_cursor(me, color, cursor_m)
+        win.present()
+
+
+def fit_drawing_budget(scene: Scene, env) -> Scene:
+    """The scene cut down, if needed, so that one frame stays cheap to draw.
+
+    A server could send thousands of pucks or springs each as big as the
+    window, or every puck in its own colour; drawing them would take minutes a
+    frame. Honest scenes are far inside these budgets and come back unchanged:
+    - pucks in view cover the window at most MAX_PUCK_AREA_SCREENS times over,
+      and none is drawn wider than the window's diagonal;
+    - at most MAX_PUCK_LOOKS distinct colours (beyond that, colours are rounded);
+    - springs span at most MAX_SPRING_SPAN_PX pixels in all (the longest go
+      first), and so do cursor strings.
+    """
+    changes: dict = {}
+    if len(scene.radius_m):
+        changes.update(_fit_pucks(scene, env))
+    if len(scene.spring_pairs):
+        changes.update(_fit_springs(scene, env))
+    if scene.cursors:
+        changes.update(_fit_cursor_strings(scene, env))
+    return dataclasses.replace(scene, **changes) if changes else scene
+
+
+def _fit_pucks(scene: Scene, env) -> dict:
+    w, h = env.size_px
+    px_per_m = float(env.length_to_px(1.0))
+    r_px = scene.radius_m * px_per_m
+    centers = env.to_screen(scene.pos_m)
+    visible = (
+        (centers[:, 0] + r_px >= 0)
+        & (centers[:, 0] - r_px <= w)
+        & (centers[:, 1] + r_px >= 0)
+        & (centers[:, 1] - r_px <= h)
+    )
+    changes: dict = {}
+    colors = scene.color_rgb
+    if len(np.unique(colors[visible], axis=0)) > MAX_PUCK_LOOKS:
+        changes["color_rgb"] = (colors & 0xE0) | 0x10  # 512 colours at most
+    area_px = float(np.minimum(np.pi * r_px[visible] ** 2, w * h).sum())
+    budget_px = MAX_PUCK_AREA_SCREENS * w * h
+    largest_m = math.hypot(w, h) / px_per_m
+    if area_px > budget_px or float(scene.radius_m.max()) > largest_m:
+        shrink = math.sqrt(budget_px / area_px) if area_px > budget_px else 1.0
+        changes["radius_m"] = np.minimum(scene.radius_m, largest_m) * shrink
+    return changes
+
+
+def _fit_springs(scene: Scene, env) -> dict:
+    d = scene.pos_m[scene.spring_pairs[:, 0]] - scene.pos_m[scene.spring_pairs[:, 1]]
+    # Drawing a spring costs about its length in pixels, even where it is off screen.
+    span_px = (np.abs(d[:, 0]) + np.abs(d[:, 1])) * float(env.length_to_px(1.0))
+    if float(span_px.sum()) <= MAX_SPRING_SPAN_PX:
+        return {}
+    order = np.argsort(span_px, kind="stable")
+    keep = np.sort(order[np.cumsum(span_px[order]) <= MAX_SPRING_SPAN_PX])
+    return {
+        "spring_pairs": scene.spring_pairs[keep],
+        "spring_length_m": scene.spring_length_m[keep],
+        "spring_width_m": scene.spring_width_m[keep],
+        "spring_color_rgb": scene.spring_color_rgb[keep],
+    }
+
+
+def _fit_cursor_strings(scene: Scene, env) -> dict:
+    held = [i for i, c in enumerate(scene.cursors) if 0 <= c.held < len(scene.pos_m)]
+    if not held:
+        return {}
+    ends = np.array([scene.cursors[i].cursor_m for i in held]) - scene.pos_m[[scene.cursors[i].held for i in held]]
+    span_px = (np.abs(ends[:, 0]) + np.abs(ends[:, 1])) * float(env.length_to_px(1.0))
+    if float(span_px.sum()) <= MAX_SPRING_SPAN_PX:
+        return {}
+    order = np.argsort(span_px, kind="stable")
+    dropped = {held[i] for i in order[np.cumsum(span_px[order]) > MAX_SPRING_SPAN_PX]}
+    cursors = tuple(dataclasses.replace(c, held=-1) if i in dropped else c for i, c in enumerate(scene.cursors))
+    return {"cursors": cursors}
+
+
+def own_cursor_live(
+    cursors: Sequence[CursorView], me: str, cursor_m: Sequence[float], button: int, focused: bool
 ) -> tuple[tuple[CursorView, ...], bool]:
     """The snapshot's cursors with ours moved to where the mouse is now.
 
@@ -489,8 +681,8 @@ def _own_cursor_live(
     without delay. Returns the cursors and whether ours still needs drawing
     on its own (it is not in the snapshots yet).
     """
-    others = tuple(c for c in cursors if c.name != welcome.client)
-    mine = next((c for c in cursors if c.name == welcome.client), None)
+    others = tuple(c for c in cursors if c.name != me)
+    mine = next((c for c in cursors if c.name == me), None)
     if not focused:  # the mouse is in another window: show what the server has
         return others + ((mine,) if mine else ()), False
     if mine is None:
@@ -533,7 +725,10 @@ def main(argv: Sequence[str] | None = None) -> int:
         return 1
     except KeyboardInterrupt:
         return 1
-    print(f"airtable-client: connected to {net.address}; you are {welcome.client}")
+    if welcome is None:
+        print(f"airtable-client: {net.waiting_because}; waiting for a place (Esc quits)")
+    else:
+        print(f"airtable-client: connected to {net.address}; you are {welcome.client}")
     if not args.headless:
         from airtable.app.window import prefer_plain_framebuffer
 

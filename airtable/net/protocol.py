@@ -15,16 +15,20 @@ from __future__ import annotations
 
 import json
 import math
+import re
 import struct
+import unicodedata
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
 
 import numpy as np
 
 from airtable.app.scene import CursorView, Scene
+from airtable.physics.table import TABLE_HEIGHT_M, TABLE_WIDTH_M
 
 PROTOCOL_VERSION = 1
 DEFAULT_PORT = 8888
+DEFAULT_TABLE_SIZE_M = (TABLE_WIDTH_M, TABLE_HEIGHT_M)  # until the game loop (or a WELCOME) says otherwise
 
 HELLO = 1
 WELCOME = 2
@@ -35,20 +39,34 @@ BYE = 6
 FRAME_NAMES = {HELLO: "HELLO", WELCOME: "WELCOME", ERROR: "ERROR", INPUT: "INPUT", SNAPSHOT: "SNAPSHOT", BYE: "BYE"}
 CLIENT_FRAMES = frozenset({HELLO, INPUT, BYE})
 
-MAX_CLIENT_FRAME = 64 * 1024  # bytes of L (type + payload) a client may send
-# Snapshots grow with the number of pucks (27 bytes each); this still allows
-# about two million of them while stopping a bogus length from eating memory.
-MAX_SERVER_FRAME = 64 * 1024 * 1024
+# Bytes of L (type + payload) a client may send. A real INPUT is under 400
+# bytes and a HELLO with the longest name and password under 1000, so a
+# client cannot make the server parse more than it needs.
+MAX_CLIENT_FRAME = 1024
+# Snapshots grow with the number of pucks (27 bytes each); this allows the
+# drawing budget below with room to spare, while a bogus length cannot eat memory.
+MAX_SERVER_FRAME = 16 * 1024 * 1024
 
 MAX_NAME_CHARS = 20
-MAX_PASSWORD_CHARS = 200
+MAX_PASSWORD_CHARS = 100
 MAX_KEYS = 16
 MAX_KEY_CHARS = 16
 MAX_ERROR_CHARS = 500
 # A cursor may wander off the table (the view can be zoomed out), but not
 # further than this many table sizes from it; the player clamps to the same box.
 CURSOR_MARGIN_TABLES = 5.0
-MAX_TABLE_M = 1e6
+# What a player accepts from a server before it draws anything: a table from
+# 1 cm to 10 km on a side, no longer than 100 times its width (or the other
+# way round), and at most this many things to draw in one frame.
+MIN_TABLE_M = 0.01
+MAX_TABLE_M = 1e4
+MAX_TABLE_ASPECT = 100.0
+MAX_DRAWN_PUCKS = 20_000
+MAX_DRAWN_SPRINGS = 10_000
+MAX_DRAWN_CURSORS = 1_000
+MIN_VIEW_ZOOM = 0.01
+MAX_VIEW_ZOOM = 1000.0
+MAX_DRAWN_TEXT_CHARS = 300  # a title or status line longer than this is cut, not drawn a mile wide
 
 _HEADER = struct.Struct(">IB")
 
@@ -78,7 +96,8 @@ class FrameReader:
     the player MAX_SERVER_FRAME. `allowed` lists the frame types the peer may
     send. Errors are raised as early as the bytes show them (a huge length or a
     bad type byte before the payload arrives). After an error the reader is
-    dead: the connection must be dropped.
+    dead: the connection must be dropped. `sender` is "the server" on the
+    player's side, which changes the hints to ones a student can act on.
     """
 
     def __init__(
@@ -87,6 +106,7 @@ class FrameReader:
         self.max_frame = int(max_frame)
         self.allowed = frozenset(allowed)
         self.sender = sender
+        self._from_server = sender == "the server"
         self._buf = bytearray()
         self._checked_header = False  # the frame at the buffer start has passed the checks
 
@@ -116,9 +136,16 @@ class FrameReader:
         return frames
 
     def _check_length(self, length: int, head: bytes) -> None:
-        hint = "this port speaks the airtable protocol: join with airtable-client"
-        if _looks_like_text(head):
-            hint = f"the data looks like text ({head!r}), not an airtable message; {hint}, not a web browser or telnet"
+        if self._from_server:
+            hint = "this address and port run some other program: check them in the teacher's 'join with:' line"
+            if _looks_like_text(head):
+                hint = f"the answer looks like text ({head!r}), not an airtable message; {hint}"
+        else:
+            hint = "this port speaks the airtable protocol: join with airtable-client"
+            if _looks_like_text(head):
+                hint = (
+                    f"the data looks like text ({head!r}), not an airtable message; {hint}, not a web browser or telnet"
+                )
         if length == 0:
             raise ProtocolError(f"received an empty message (length 0); {hint}")
         if length > self.max_frame:
@@ -146,6 +173,19 @@ class _NonFiniteError(Exception):
     pass
 
 
+class _DuplicateKeyError(Exception):
+    pass
+
+
+def _unique_keys(pairs: list[tuple[str, object]]) -> dict:
+    """JSON keeps the last of two equal keys; we refuse them (they only hide data)."""
+    message = dict(pairs)
+    if len(message) != len(pairs):
+        seen: set[str] = set()
+        raise _DuplicateKeyError(next(k for k, _ in pairs if k in seen or seen.add(k)))
+    return message
+
+
 def _reject_constant(name: str):
     raise _NonFiniteError(name)
 
@@ -168,9 +208,11 @@ def parse_json(payload: bytes, what: str, example: str) -> dict:
     except UnicodeDecodeError as e:
         raise ProtocolError(f"{what} is not UTF-8 text (bad byte at position {e.start}); send UTF-8 JSON") from None
     try:
-        message = json.loads(text, parse_constant=_reject_constant)
+        message = json.loads(text, parse_constant=_reject_constant, object_pairs_hook=_unique_keys)
     except _NonFiniteError as e:
         raise ProtocolError(f"{what} contains {e.args[0]}, which is not a finite number; send finite numbers") from None
+    except _DuplicateKeyError as e:
+        raise ProtocolError(f"{what} has the field {_short(e.args[0])} twice; send each field once") from None
     except (ValueError, RecursionError) as e:  # JSONDecodeError is a ValueError; so is a 5000-digit int
         detail = str(e)[:60]
         raise ProtocolError(f"{what} is not valid JSON ({detail}); send an object like {example}") from None
@@ -207,14 +249,38 @@ def _integer(value: object, what: str) -> int:
     return value
 
 
+# Hangul fillers count as letters but draw nothing; a name of them looks blank.
+_INVISIBLE_LETTERS = frozenset("\u115f\u1160\u3164\uffa0")
+# "C7" on its own: the table labels players "C<n> name", so a name must not imitate one.
+_PLAYER_LABEL = re.compile(r"\bc\s*\d+\b", re.IGNORECASE)
+
+
+def _visible(char: str) -> bool:
+    return unicodedata.category(char)[0] in "LN" and char not in _INVISIBLE_LETTERS
+
+
 def check_name(name: object) -> str:
-    """A player name: printable text of 1-20 characters (spaces around are dropped)."""
+    """A player name: 1-20 printable characters with a visible letter or digit, not
+    like another player's "C<n>" label (spaces around are dropped)."""
     if not isinstance(name, str):
         raise ProtocolError(f"the name must be text, not {_short(name)}")
     name = name.strip()
-    if not (1 <= len(name) <= MAX_NAME_CHARS and name.isprintable()):
+    if not name:
+        raise ProtocolError("the name is empty; pick a name with a letter or digit, like Ann")
+    if len(name) > MAX_NAME_CHARS:
+        raise ProtocolError(f"the name {_short(name)} is over {MAX_NAME_CHARS} characters; pick a shorter name")
+    bad = next((c for c in name if not c.isprintable()), None)
+    if bad is not None:
         raise ProtocolError(
-            f"the name must be 1 to {MAX_NAME_CHARS} printable characters, not {_short(name)}; pick a shorter name"
+            f"the name contains U+{ord(bad):04X}, which is not printable; use letters, digits and spaces"
+        )
+    if not any(_visible(c) for c in name):
+        raise ProtocolError(
+            f"the name {_short(name)} has no visible letter or digit; pick a name others can read, like Ann"
+        )
+    if _PLAYER_LABEL.search(name):
+        raise ProtocolError(
+            f"the name {_short(name)} looks like a player label such as C7; pick a name without C and a number"
         )
     return name
 
@@ -335,6 +401,25 @@ def clamp_cursor(cursor_m: Sequence[float], width_m: float, height_m: float) -> 
     return (x, y)
 
 
+def is_button(value: object) -> bool:
+    """0 (none) or a mouse button 1-3."""
+    return not isinstance(value, bool) and isinstance(value, int) and 0 <= value <= 3
+
+
+def is_key_name(value: object) -> bool:
+    """A key name like "a" or "left shift": 1 to MAX_KEY_CHARS printable characters."""
+    return isinstance(value, str) and 1 <= len(value) <= MAX_KEY_CHARS and value.isprintable()
+
+
+def make_input(
+    cursor_m: Sequence[float], button: int, keys: Iterable[str], table_size_m: Sequence[float]
+) -> InputRecord:
+    """An InputRecord the server accepts, whatever the local input: the cursor is
+    clamped, an unknown button is 0, and only valid key names are kept."""
+    names = sorted(k for k in keys if is_key_name(k))[:MAX_KEYS]
+    return InputRecord(clamp_cursor(cursor_m, *table_size_m), button if is_button(button) else 0, frozenset(names))
+
+
 def encode_input(cursor_m: Sequence[float], button: int = 0, keys: Iterable[str] = ()) -> bytes:
     """An INPUT frame."""
     return encode_json(
@@ -343,7 +428,7 @@ def encode_input(cursor_m: Sequence[float], button: int = 0, keys: Iterable[str]
     )
 
 
-def validate_input(message: dict, table_size_m: Sequence[float] = (10.0, 8.7556)) -> InputRecord:
+def validate_input(message: dict, table_size_m: Sequence[float] = DEFAULT_TABLE_SIZE_M) -> InputRecord:
     """Check an INPUT object against the table size (width_m, height_m)."""
     try:
         return _validate_input(message, table_size_m)
@@ -363,20 +448,20 @@ def _validate_input(message: dict, table_size_m: Sequence[float]) -> InputRecord
     if not (x0 <= x <= x1 and y0 <= y <= y1):
         raise ProtocolError(f"INPUT cursor_m {_short(cursor)} is too far off the table; it must be {where}")
     button = message["button"]
-    if isinstance(button, bool) or not isinstance(button, int) or not 0 <= button <= 3:
+    if not is_button(button):
         raise ProtocolError(f"INPUT button must be 0 (none) or 1, 2, 3 (the mouse buttons), not {_short(button)}")
     keys = message["keys"]
     if not (isinstance(keys, list) and len(keys) <= MAX_KEYS):
         raise ProtocolError(f'INPUT keys must be a list of at most {MAX_KEYS} key names like ["a", "w"]')
     for key in keys:
-        if not (isinstance(key, str) and 1 <= len(key) <= MAX_KEY_CHARS and key.isprintable()):
+        if not is_key_name(key):
             raise ProtocolError(
                 f"INPUT keys must be key names of 1 to {MAX_KEY_CHARS} printable characters, not {_short(key)}"
             )
     return InputRecord((x, y), button, frozenset(keys))
 
 
-def parse_input(payload: bytes, table_size_m: Sequence[float] = (10.0, 8.7556)) -> InputRecord:
+def parse_input(payload: bytes, table_size_m: Sequence[float] = DEFAULT_TABLE_SIZE_M) -> InputRecord:
     return validate_input(parse_json(payload, "INPUT", INPUT_EXAMPLE), table_size_m)
 
 
@@ -427,26 +512,37 @@ def parse_welcome(payload: bytes) -> Welcome:
     _check_fields(table, "the server's WELCOME table", ("width_m", "height_m"))
     w = _number(table["width_m"], "the table width")
     h = _number(table["height_m"], "the table height")
-    if not (0 < w <= MAX_TABLE_M and 0 < h <= MAX_TABLE_M):
-        raise ProtocolError(f"the server's WELCOME has a bad table size {w:g} x {h:g} m")
+    problem = table_size_problem(w, h)
+    if problem:
+        raise ProtocolError(f"the server's WELCOME has {problem}")
     return Welcome(client, color, w, h, protocol)
 
 
-def encode_error(sentence: str) -> bytes:
-    """An ERROR frame (the server closes the connection after it)."""
-    return encode_json(ERROR, {"error": sentence[:MAX_ERROR_CHARS]})
+def encode_error(sentence: str, retry: bool = False) -> bytes:
+    """An ERROR frame (the server closes the connection after it). `retry` tells the
+    client that trying again later can work (the table is full or busy)."""
+    message: dict = {"error": sentence[:MAX_ERROR_CHARS]}
+    if retry:
+        message["retry"] = True
+    return encode_json(ERROR, message)
+
+
+def parse_error_message(payload: bytes) -> tuple[str, bool]:
+    """(sentence, retry) of an ERROR; the sentence is made safe to print on one line."""
+    try:
+        message = parse_json(payload, "the server's ERROR", '{"error": "..."}')
+    except ProtocolError as e:
+        return f"the server sent an unreadable error ({e})", False
+    sentence = message.get("error")
+    retry = message.get("retry") is True
+    if not isinstance(sentence, str) or not sentence:
+        return "the server sent an error without a reason", retry
+    return printable(sentence[:MAX_ERROR_CHARS]), retry
 
 
 def parse_error(payload: bytes) -> str:
     """The sentence of an ERROR, made safe to print on one line."""
-    try:
-        message = parse_json(payload, "the server's ERROR", '{"error": "..."}')
-        sentence = message.get("error")
-    except ProtocolError as e:
-        return f"the server sent an unreadable error ({e})"
-    if not isinstance(sentence, str) or not sentence:
-        return "the server sent an error without a reason"
-    return printable(sentence[:MAX_ERROR_CHARS])
+    return parse_error_message(payload)[0]
 
 
 def encode_bye() -> bytes:
@@ -578,9 +674,33 @@ def _bad(what: str) -> ProtocolError:
     return ProtocolError(f"the snapshot has {what}; the server may run a different airtable version")
 
 
-def decode_snapshot(payload: bytes) -> Scene:
-    """Check and decode a SNAPSHOT payload into a Scene; anything wrong raises ProtocolError."""
-    payload = bytes(payload)
+def table_size_problem(width_m: float, height_m: float) -> str | None:
+    """What is wrong with a table size a server sent (None: it can be drawn)."""
+    ok = all(math.isfinite(v) and MIN_TABLE_M <= v <= MAX_TABLE_M for v in (width_m, height_m))
+    if not ok or max(width_m, height_m) > MAX_TABLE_ASPECT * min(width_m, height_m):
+        return (
+            f"a table size of {width_m:g} x {height_m:g} m, which cannot be drawn (sides must be "
+            f"{MIN_TABLE_M:g} to {MAX_TABLE_M:g} m and at most {MAX_TABLE_ASPECT:g} times each other)"
+        )
+    return None
+
+
+@dataclass(frozen=True)
+class _Header:
+    flags: int
+    n: int  # pucks
+    s: int  # springs
+    c: int  # cursors
+    width_m: float
+    height_m: float
+    time_s: float
+    fps: float
+    zoom: float
+    origin_m: tuple[float, float]
+
+
+def _read_header(payload: bytes) -> _Header:
+    """The header, with counts checked against the drawing budget and the payload size."""
     if len(payload) < _SNAP_HEADER.size:
         raise ProtocolError(f"the snapshot is only {len(payload)} bytes, less than its {_SNAP_HEADER.size} byte header")
     magic, version, flags, _, n, s, c, *floats = _SNAP_HEADER.unpack_from(payload)
@@ -591,6 +711,11 @@ def decode_snapshot(payload: bytes) -> Scene:
             f"the snapshot format is version {version} but this client reads version {SNAPSHOT_VERSION}; "
             "install the same airtable version as the teacher's"
         )
+    if n > MAX_DRAWN_PUCKS or s > MAX_DRAWN_SPRINGS or c > MAX_DRAWN_CURSORS:
+        raise _bad(
+            f"{n} pucks, {s} springs and {c} cursors, more than this client draws "
+            f"({MAX_DRAWN_PUCKS}, {MAX_DRAWN_SPRINGS} and {MAX_DRAWN_CURSORS})"
+        )
     fixed = _SNAP_HEADER.size + n * _PUCK_BYTES + s * _SPRING_BYTES + c * _CURSOR_BYTES
     # Each text section needs at least its 2-byte count.
     if fixed + 2 * (3 + c) > len(payload):
@@ -600,68 +725,112 @@ def decode_snapshot(payload: bytes) -> Scene:
     if not all(math.isfinite(v) for v in floats):
         raise _bad("a number that is not finite in its header")
     width_m, height_m, time_s, fps, zoom, ox, oy = floats
-    if not (0 < width_m <= MAX_TABLE_M and 0 < height_m <= MAX_TABLE_M and zoom > 0):
-        raise _bad(f"a bad table size or zoom ({width_m:g} x {height_m:g} m, zoom {zoom:g})")
-    cut = _Cut(payload, _SNAP_HEADER.size)
-    pos = cut.array(_F8, (n, 2))
-    radius = cut.array(_F8, (n,))
-    color = cut.array(_U1, (n, 3))
-    pairs = cut.array(_U4, (s, 2))
-    spring_length = cut.array(_F8, (s,))
-    spring_width = cut.array(_F8, (s,))
-    spring_color = cut.array(_U1, (s, 3))
-    cursor_pos = cut.array(_F8, (c, 2))
-    cursor_color = cut.array(_U1, (c, 3))
-    cursor_button = cut.array(_U1, (c,))
-    cursor_held = cut.array(_I4, (c,))
-    title = cut.text("title")
-    status = cut.text("status")
-    correction = cut.text("puck correction mode")
-    names = [cut.text("cursor names") for _ in range(c)]
-    if cut.offset != len(payload):
-        raise _bad(f"{len(payload) - cut.offset} bytes too many at its end")
-    if not (np.isfinite(pos).all() and np.isfinite(cursor_pos).all()):
-        raise _bad("a position that is not finite")
-    if not (np.isfinite(radius).all() and (radius > 0).all()):
-        raise _bad("a puck radius that is not a positive number")
-    if not (np.isfinite(spring_length).all() and np.isfinite(spring_width).all()):
+    header = _Header(flags, n, s, c, width_m, height_m, time_s, fps, zoom, (ox, oy))
+    _check_view(header)
+    return header
+
+
+def _check_view(h: _Header) -> None:
+    problem = table_size_problem(h.width_m, h.height_m)
+    if problem:
+        raise _bad(problem)
+    if not MIN_VIEW_ZOOM <= h.zoom <= MAX_VIEW_ZOOM:
+        raise _bad(f"a zoom of {h.zoom:g}, outside {MIN_VIEW_ZOOM:g} to {MAX_VIEW_ZOOM:g}")
+    x0, y0, x1, y1 = cursor_limits(h.width_m, h.height_m)
+    if not (x0 <= h.origin_m[0] <= x1 and y0 <= h.origin_m[1] <= y1):
+        raise _bad(f"a view origin {h.origin_m} far off the table")
+    if not 0 <= h.fps <= 1e6:
+        raise _bad(f"a frame rate of {h.fps:g}")
+
+
+def _within(points: np.ndarray, h: _Header) -> bool:
+    x0, y0, x1, y1 = cursor_limits(h.width_m, h.height_m)
+    return bool(((points[:, 0] >= x0) & (points[:, 0] <= x1) & (points[:, 1] >= y0) & (points[:, 1] <= y1)).all())
+
+
+def _read_bodies(cut: _Cut, h: _Header) -> dict:
+    """Pucks and springs, each checked against the table before anything uses them."""
+    size = max(h.width_m, h.height_m)
+    pos, radius, color = cut.array(_F8, (h.n, 2)), cut.array(_F8, (h.n,)), cut.array(_U1, (h.n, 3))
+    pairs, length, width = cut.array(_U4, (h.s, 2)), cut.array(_F8, (h.s,)), cut.array(_F8, (h.s,))
+    spring_color = cut.array(_U1, (h.s, 3))
+    if not (np.isfinite(pos).all() and _within(pos, h)):
+        raise _bad("a puck position that is not finite or far off the table")
+    if not (np.isfinite(radius).all() and ((radius > 0) & (radius <= size)).all()):
+        raise _bad("a puck radius that is not between 0 and the table's size")
+    if not (np.isfinite(length).all() and np.isfinite(width).all()):
         raise _bad("a spring size that is not finite")
-    if s and int(pairs.max()) >= n:
+    if not (((length >= 0) & (length <= 100 * size)).all() and ((width >= 0) & (width <= size)).all()):
+        raise _bad("a spring longer or wider than the table allows")
+    if h.s and int(pairs.max()) >= h.n:
         raise _bad("a spring joined to a puck that is not there")
-    if c and (int(cursor_button.max()) > 3 or int(cursor_held.min()) < -1 or int(cursor_held.max()) >= n):
-        raise _bad("a cursor with a bad button or held puck")
-    if not all(t.isprintable() for t in (title, status, correction, *names)):
-        raise _bad("unprintable text")
-    cursors = tuple(
-        CursorView(
-            name=names[i],
-            color=(int(cursor_color[i, 0]), int(cursor_color[i, 1]), int(cursor_color[i, 2])),
-            cursor_m=(float(cursor_pos[i, 0]), float(cursor_pos[i, 1])),
-            button=int(cursor_button[i]),
-            held=int(cursor_held[i]),
-        )
-        for i in range(c)
-    )
     # frombuffer views are read-only and may be unaligned: copy into owned native arrays.
-    return Scene(
-        width_m=width_m,
-        height_m=height_m,
+    return dict(
         pos_m=pos.astype(float),
         radius_m=radius.astype(float),
         color_rgb=color.copy(),
         spring_pairs=pairs.astype(np.intp),
-        spring_length_m=spring_length.astype(float),
-        spring_width_m=spring_width.astype(float),
+        spring_length_m=length.astype(float),
+        spring_width_m=width.astype(float),
         spring_color_rgb=spring_color.copy(),
-        cursors=cursors,
+    )
+
+
+def _read_cursors(cut: _Cut, h: _Header) -> tuple[np.ndarray, ...]:
+    pos, color = cut.array(_F8, (h.c, 2)), cut.array(_U1, (h.c, 3))
+    button, held = cut.array(_U1, (h.c,)), cut.array(_I4, (h.c,))
+    if not (np.isfinite(pos).all() and _within(pos, h)):
+        raise _bad("a cursor position that is not finite or far off the table")
+    if h.c and (int(button.max()) > 3 or int(held.min()) < -1 or int(held.max()) >= h.n):
+        raise _bad("a cursor with a bad button or held puck")
+    return pos, color, button, held
+
+
+def _cursor_views(arrays: tuple[np.ndarray, ...], names: list[str]) -> tuple[CursorView, ...]:
+    pos, color, button, held = arrays
+    return tuple(
+        CursorView(
+            name=names[i],
+            color=(int(color[i, 0]), int(color[i, 1]), int(color[i, 2])),
+            cursor_m=(float(pos[i, 0]), float(pos[i, 1])),
+            button=int(button[i]),
+            held=int(held[i]),
+        )
+        for i in range(len(names))
+    )
+
+
+def decode_snapshot(payload: bytes) -> Scene:
+    """Check and decode a SNAPSHOT payload into a Scene; anything wrong raises ProtocolError.
+
+    Every number is bounded before use (table size, zoom, origin, positions and
+    radii against the table, counts against the drawing budget), so a scene
+    that decodes can be drawn."""
+    payload = bytes(payload)
+    h = _read_header(payload)
+    cut = _Cut(payload, _SNAP_HEADER.size)
+    bodies = _read_bodies(cut, h)
+    cursor_arrays = _read_cursors(cut, h)
+    title, status, correction = cut.text("title"), cut.text("status"), cut.text("puck correction mode")
+    names = [cut.text("cursor names")[: 2 * MAX_NAME_CHARS + 8] for _ in range(h.c)]
+    title, status = title[:MAX_DRAWN_TEXT_CHARS], status[:MAX_DRAWN_TEXT_CHARS]
+    if cut.offset != len(payload):
+        raise _bad(f"{len(payload) - cut.offset} bytes too many at its end")
+    if not all(t.isprintable() for t in (title, status, correction, *names)):
+        raise _bad("unprintable text")
+    return Scene(
+        width_m=h.width_m,
+        height_m=h.height_m,
+        **bodies,
+        cursors=_cursor_views(cursor_arrays, names),
         title=title,
         status=status,
-        gravity_on=bool(flags & FLAG_GRAVITY),
+        gravity_on=bool(h.flags & FLAG_GRAVITY),
         puck_correction=correction,
-        time_s=time_s,
-        fps=fps,
-        zoom=zoom,
-        origin_m=(ox, oy),
+        time_s=h.time_s,
+        fps=h.fps,
+        zoom=h.zoom,
+        origin_m=h.origin_m,
     )
 
 

@@ -1,19 +1,21 @@
 """GameServer: lets students join the teacher's table over the LAN.
 
 One network thread runs a `selectors` loop over every socket. It turns bytes
-into validated, immutable `InputRecord`s and keeps only the newest one per
-player (plus any button change since the last frame, so a quick click is not
-lost); it never touches the table (STYLE.md item 12). The game loop calls
+into validated, immutable event records (airtable/net/events.py) and never
+touches the table or the loop's clients. The game loop calls, every frame:
 
-    server.apply_inputs(clients, table)   # before each step: joins, newest inputs, leaves
-    server.publish(scene)        # every frame: at most snapshot_hz snapshots a second
+    server.update_clients(clients, table)  # joins, leaves, newest inputs (even while paused)
+    server.publish(scene)                  # after the physics steps: at most snapshot_hz a second
 
 and neither call ever waits on a socket. A snapshot is encoded once and the
 same bytes go to every player; a player whose connection is slow keeps only
 the newest snapshot waiting, so it misses frames instead of slowing anyone.
 
-A client that breaks the protocol gets an ERROR with a sentence it can act on
-and is dropped; nobody else notices.
+Joining is guarded (see gate.py): handshakes have their own cap and a short
+deadline, one computer may hold only a few handshakes and seats, and wrong
+passwords earn a growing wait. A client that breaks the protocol gets an
+ERROR with a sentence it can act on and is dropped; nobody else notices.
+The teacher sees the seats with `roster()` and can `remove()` a player.
 """
 
 from __future__ import annotations
@@ -27,12 +29,16 @@ import selectors
 import socket
 import threading
 import time
-from collections import deque
+from collections.abc import Callable
+from dataclasses import dataclass
 
 from airtable.app.client import Client
 from airtable.app.scene import Scene
 from airtable.colors import rgb
 from airtable.net import protocol as proto
+from airtable.net.connection import Connection, State
+from airtable.net.events import EventQueue, PlayerInput, PlayerJoined, PlayerLeft
+from airtable.net.gate import FIRST_PASSWORD_WAIT_S, HANDSHAKES_PER_ADDRESS, PLAYERS_PER_ADDRESS, Gate, QuietLog
 
 log = logging.getLogger("airtable.net")
 
@@ -50,13 +56,14 @@ COURSE_COLORS = (
     "rosybrown3",
 )
 
-DEFAULT_TABLE_SIZE_M = (10.0, 8.7556)  # until the game loop tells us the real size
-LINGER_S = 2.0  # after an ERROR: time to let it reach the client before closing
-RATE_PER_S = 240.0  # sustained messages a second per client (a player sends <= 61)
-RATE_BURST = 480.0
-EXTRA_CONNECTIONS = 32  # connections still saying HELLO, beyond max_clients
-RECV_BYTES = 65536
-MAX_QUEUED_INPUTS = 6  # records kept per player between two frames (see _queue_input)
+HELLO_TIMEOUT_S = 3.0  # a connection must be welcomed this soon after it opens
+MAX_HANDSHAKES = 32  # connections still saying HELLO, beyond the players
+MAX_PLAYERS = 1000
+MAX_SNAPSHOT_HZ = 1000.0
+SELECT_SOCKETS = 500  # select() watches at most 512 sockets on Windows (1024 fds on POSIX)
+RESERVED_FDS = 32  # descriptors kept for the app itself (files, the display, the listener)
+FAR_OFF_TABLES = 1.0  # a cursor this many table sizes beyond the edge is "far off" in the roster
+ACCEPT_PAUSE_S = 0.5  # out of descriptors: stop accepting for this long
 
 
 def client_color(number: int) -> tuple[int, int, int]:
@@ -108,35 +115,68 @@ def lan_addresses() -> list[str]:
     return usable or ["127.0.0.1"]
 
 
-class _Conn:
-    """One connection, owned by the network thread."""
+@dataclass(frozen=True)
+class Seat:
+    """One player in the roster: who, and how their connection is doing."""
 
-    HELLO, PLAYING, CLOSING = "hello", "playing", "closing"
+    number: int  # n of "Cn"
+    name: str  # as shown on the table, e.g. "C3 Ann"
+    color: tuple[int, int, int]
+    address: str
+    snapshots_per_s: float  # snapshots that went out whole, over the last 2 s
+    lag_s: float  # how long a snapshot waits at the server before it is out (smoothed)
+    idle_s: float  # since the player's input last changed
+    far_off: bool  # the cursor is more than a table size beyond the table's edge
 
-    def __init__(self, cid: int, sock: socket.socket, peer: str, now: float) -> None:
-        self.cid = cid
-        self.sock = sock
-        self.peer = peer
-        self.reader = proto.FrameReader(proto.MAX_CLIENT_FRAME, proto.CLIENT_FRAMES, sender="a client")
-        self.state = self.HELLO
-        self.number = 0  # player number n of "Cn", 0 before WELCOME
-        self.name = ""
-        self.last_rx = now
-        self.tokens = RATE_BURST
-        self.tokens_t = now
-        self.out_cur: memoryview | None = None  # the frame being sent
-        self.out_ctrl: deque[bytes] = deque()  # WELCOME / ERROR / BYE, before any snapshot
-        self.out_snap: bytes | None = None  # the newest snapshot not yet started
-        self.shut = False  # our side is shut down after an ERROR
-        self.deadline = math.inf
-        self.events = selectors.EVENT_READ
 
-    @property
-    def who(self) -> str:
-        return f"{self.name} ({self.peer})" if self.name else self.peer
+def validate_server_options(
+    port: int = proto.DEFAULT_PORT,
+    max_clients: int = 30,
+    snapshot_hz: float = 30.0,
+    timeout_s: float = 10.0,
+    error: Callable[[str], object] | None = None,
+) -> None:
+    """Raise ValueError with a one-line sentence if GameServer would refuse these.
 
-    def has_output(self) -> bool:
-        return self.out_cur is not None or bool(self.out_ctrl) or self.out_snap is not None
+    With `error` (e.g. an ArgumentParser's error), call it with the sentence instead,
+    so a command line refuses exactly what the server would."""
+    try:
+        _check_options(port, max_clients, snapshot_hz, timeout_s)
+    except ValueError as e:
+        if error is None:
+            raise
+        error(str(e))
+
+
+def _check_options(port: int, max_clients: int, snapshot_hz: float, timeout_s: float) -> None:
+    if not 0 <= int(port) <= 65535:
+        raise ValueError(f"the port must be 0-65535, not {port!r}")
+    if not 1 <= int(max_clients) <= MAX_PLAYERS:
+        raise ValueError(f"--max-clients must be 1-{MAX_PLAYERS}, not {max_clients!r}")
+    if not (math.isfinite(snapshot_hz) and 0 < snapshot_hz <= MAX_SNAPSHOT_HZ):
+        raise ValueError(f"--snapshot-hz must be above 0 and at most {MAX_SNAPSHOT_HZ:g}, not {snapshot_hz!r}")
+    if not (math.isfinite(timeout_s) and timeout_s > 0):
+        raise ValueError(f"the timeout must be a positive number of seconds, not {timeout_s!r}")
+
+
+def connection_room(selector_class: type, open_file_limit: int | None) -> int | None:
+    """How many client sockets this process can watch at once (None: no known limit)."""
+    room = None
+    if issubclass(selector_class, selectors.SelectSelector):
+        room = SELECT_SOCKETS
+    if open_file_limit is not None and open_file_limit > 0:
+        by_fds = max(1, open_file_limit - RESERVED_FDS)
+        room = by_fds if room is None else min(room, by_fds)
+    return room
+
+
+def _open_file_limit() -> int | None:
+    try:
+        import resource
+    except ImportError:  # Windows: select() is the limit there
+        return None
+    soft, _ = resource.getrlimit(resource.RLIMIT_NOFILE)
+    return None if soft == resource.RLIM_INFINITY else int(soft)
 
 
 class GameServer:
@@ -150,42 +190,46 @@ class GameServer:
         max_clients: int = 30,
         snapshot_hz: float = 30.0,
         timeout_s: float = 10.0,
+        hello_timeout_s: float = HELLO_TIMEOUT_S,
+        max_handshakes: int = MAX_HANDSHAKES,
+        handshakes_per_address: int = HANDSHAKES_PER_ADDRESS,
+        players_per_address: int = PLAYERS_PER_ADDRESS,
+        limit_loopback: bool = False,
+        password_wait_s: float = FIRST_PASSWORD_WAIT_S,
     ) -> None:
-        if not 0 <= int(port) <= 65535:
-            raise ValueError(f"port must be 0-65535, not {port!r}")
-        if not 1 <= int(max_clients) <= 1000:
-            raise ValueError(f"max_clients must be 1-1000, not {max_clients!r}")
-        if not (math.isfinite(snapshot_hz) and 0 < snapshot_hz <= 1000):
-            raise ValueError(f"snapshot_hz must be a rate above 0 and at most 1000, not {snapshot_hz!r}")
-        if not (math.isfinite(timeout_s) and timeout_s > 0):
-            raise ValueError(f"timeout_s must be a positive number of seconds, not {timeout_s!r}")
-        if password is not None and not password:
-            password = None
+        validate_server_options(port, max_clients, snapshot_hz, timeout_s)
         self.host = host
         self.port = int(port)
-        self.password = password
+        self.password = password or None
         self.max_clients = int(max_clients)
         self.snapshot_hz = float(snapshot_hz)
         self.timeout_s = float(timeout_s)
+        self.hello_timeout_s = float(hello_timeout_s)
+        self.max_handshakes = int(max_handshakes)
+        self.failure: str | None = None  # set when the network thread died: a sentence for the teacher
 
-        # Shared between the network thread and the game loop, under _lock.
-        self._lock = threading.Lock()
-        self._events: list[tuple] = []  # ("join", cid, name, color) / ("leave", cid)
-        self._inputs: dict[int, list[proto.InputRecord]] = {}  # per connection, see _queue_input
+        # Shared between the network thread and the game loop.
+        self._events = EventQueue()
+        self._lock = threading.Lock()  # guards the fields below
         self._snapshot: bytes | None = None  # newest SNAPSHOT frame
         self._snapshot_seq = 0
         self._names: dict[int, str] = {}  # player number -> name, for player_names()
-        self._table_size_m: tuple[float, float] = DEFAULT_TABLE_SIZE_M  # plain tuple: replaced, never mutated
+        self._roster: tuple[Seat, ...] = ()
+        self._commands: list[Callable[[], None]] = []  # from the game loop, run by the network thread
+        self._table_size_m: tuple[float, float] = proto.DEFAULT_TABLE_SIZE_M  # plain tuple: replaced, never mutated
 
         # Game loop only.
         self._clients: dict[int, Client] = {}
         self._next_publish = 0.0
 
         # Network thread only.
-        self._conns: dict[int, _Conn] = {}
+        self._conns: dict[int, Connection] = {}
         self._numbers: dict[int, int] = {}  # player number -> cid
+        self._gate = Gate(handshakes_per_address, players_per_address, limit_loopback, password_wait_s)
+        self._quiet = QuietLog(log)
         self._sent_seq = 0
         self._next_cid = 1
+        self._accept_paused_until = 0.0
 
         self._listener: socket.socket | None = None
         self._selector: selectors.BaseSelector | None = None
@@ -203,6 +247,7 @@ class GameServer:
             raise RuntimeError("the server is already started")
         self._listener = self._bind()
         self._stopping.clear()
+        self.failure = None
         self.port = self._listener.getsockname()[1]
         self._wake_r, self._wake_w = socket.socketpair()
         self._wake_r.setblocking(False)
@@ -210,22 +255,36 @@ class GameServer:
         self._selector = selectors.DefaultSelector()
         self._selector.register(self._listener, selectors.EVENT_READ, "listen")
         self._selector.register(self._wake_r, selectors.EVENT_READ, "wake")
+        self._fit_to_room(connection_room(type(self._selector), _open_file_limit()))
         self._thread = threading.Thread(target=self._run, name="airtable-server", daemon=True)
         self._thread.start()
         log.info("airtable server listening on %s port %d", self.host or "0.0.0.0", self.port)
 
+    def _fit_to_room(self, room: int | None) -> None:
+        """Keep players plus handshakes below what this process can watch (one warning)."""
+        if room is None or self.max_clients + self.max_handshakes <= room:
+            return
+        self.max_handshakes = max(1, min(self.max_handshakes, room // 10))
+        wanted, self.max_clients = self.max_clients, max(1, room - self.max_handshakes)
+        log.warning(
+            "only %d of the %d players asked for can join: this computer can watch about %d connections "
+            "(its open-file limit or select()); raise the limit with 'ulimit -n' or use a lower --max-clients",
+            self.max_clients,
+            wanted,
+            room,
+        )
+
     def _bind(self) -> socket.socket:
         host = self.host or "0.0.0.0"
-        where = f"{host}:{self.port}"
         try:
-            family, kind, proto, _, addr = socket.getaddrinfo(
+            family, kind, protocol, _, addr = socket.getaddrinfo(
                 host, self.port, 0, socket.SOCK_STREAM, 0, socket.AI_PASSIVE
             )[0]
         except OSError as e:
             raise OSError(
                 e.errno, f"cannot listen on {host!r}: it is not an address of this computer; try --host 0.0.0.0"
             ) from e
-        sock = socket.socket(family, kind, proto)
+        sock = socket.socket(family, kind, protocol)
         try:
             if hasattr(socket, "SO_EXCLUSIVEADDRUSE"):  # Windows: SO_REUSEADDR would let two servers share a port
                 sock.setsockopt(socket.SOL_SOCKET, socket.SO_EXCLUSIVEADDRUSE, 1)
@@ -236,19 +295,20 @@ class GameServer:
             sock.setblocking(False)
         except OSError as e:
             sock.close()
-            if e.errno in (errno.EADDRINUSE, getattr(errno, "WSAEADDRINUSE", -1)):
-                msg = (
-                    f"port {self.port} is already in use on {host}: is another airtable server running? "
-                    "Stop it or pick another port with --port"
-                )
-            elif e.errno in (errno.EACCES, errno.EPERM):
-                msg = f"not allowed to listen on {where}; use a port above 1023 with --port"
-            elif e.errno == errno.EADDRNOTAVAIL:
-                msg = f"{host} is not an address of this computer; use --host 0.0.0.0 to listen on all of them"
-            else:
-                msg = f"cannot listen on {where}: {e.strerror or e}"
-            raise OSError(e.errno, msg) from e
+            raise OSError(e.errno, self._bind_sentence(e, host)) from e
         return sock
+
+    def _bind_sentence(self, e: OSError, host: str) -> str:
+        if e.errno in (errno.EADDRINUSE, getattr(errno, "WSAEADDRINUSE", -1)):
+            return (
+                f"port {self.port} is already in use on {host}: is another airtable server running? "
+                "Stop it or pick another port with --port"
+            )
+        if e.errno in (errno.EACCES, errno.EPERM):
+            return f"not allowed to listen on {host}:{self.port}; use a port above 1023 with --port"
+        if e.errno == errno.EADDRNOTAVAIL:
+            return f"{host} is not an address of this computer; use --host 0.0.0.0 to listen on all of them"
+        return f"cannot listen on {host}:{self.port}: {e.strerror or e}"
 
     def stop(self) -> None:
         """Say BYE to every player, close every socket and join the network thread."""
@@ -260,7 +320,8 @@ class GameServer:
         if self._thread.is_alive():  # should not happen; do not leave sockets behind anyway
             log.warning("the network thread did not stop in time")
         for conn in list(self._conns.values()):
-            self._close(conn)
+            conn.close()
+            self._settle(conn)
         for sock in (self._listener, self._wake_r, self._wake_w):
             if sock is not None:
                 sock.close()
@@ -279,7 +340,7 @@ class GameServer:
 
     @property
     def running(self) -> bool:
-        return self._thread is not None and not self._stopping.is_set()
+        return self._thread is not None and self._thread.is_alive() and not self._stopping.is_set()
 
     def join_lines(self) -> list[str]:
         """What students type to join, e.g. ["join with: airtable-client 192.168.1.23"].
@@ -299,51 +360,83 @@ class GameServer:
             lines.append(f"join with: airtable-client {h}")
         return lines
 
+    # ---------------------------------------------------------------- the teacher's view
+
     @property
     def connection_count(self) -> int:
         """Open connections, including ones still saying HELLO or being closed."""
         return len(self._conns)
+
+    @property
+    def player_count(self) -> int:
+        """Players now welcomed."""
+        with self._lock:
+            return len(self._names)
+
+    @property
+    def pending_events(self) -> int:
+        """Event records waiting for the game loop's next update_clients (bounded)."""
+        return len(self._events)
 
     def player_names(self) -> list[str]:
         """Names of the players now welcomed, in player-number order."""
         with self._lock:
             return [self._names[n] for n in sorted(self._names)]
 
+    def roster(self) -> list[Seat]:
+        """Every seat in player-number order (refreshed ten times a second)."""
+        with self._lock:
+            return list(self._roster)
+
+    def remove(self, number: int, reason: str = "") -> bool:
+        """Remove player C<number>, who gets an ERROR saying so; False if no such player."""
+        with self._lock:
+            if number not in self._names:
+                return False
+        sentence = "the teacher removed you from the table" + (f": {reason}" if reason else "")
+        self._command(lambda: self._remove(number, sentence))
+        return True
+
+    def _command(self, fn: Callable[[], None]) -> None:
+        with self._lock:
+            self._commands.append(fn)
+        self._wake()
+
     # ---------------------------------------------------------------- game loop side
 
-    def apply_inputs(self, clients: list[Client], table) -> None:
-        """Main thread, before each step: add joined players' Clients to `clients`,
-        apply each player's newest input (after any button change it skipped over),
-        remove departed players' Clients. Never blocks on the network (the lock is
-        only held to swap two containers)."""
+    def update_clients(self, clients: list[Client], table) -> None:
+        """Game loop, every frame (paused or not): apply joins, leaves and inputs to `clients`.
+
+        A joined player gets a Client (hidden until its first INPUT says where
+        its cursor is); one that left lets go of its puck and is removed.
+        `table` is where a pressed button grabs a puck. Never waits on the network."""
         self._table_size_m = (float(table.width_m), float(table.height_m))
-        with self._lock:
-            events, self._events = self._events, []
-            inputs, self._inputs = self._inputs, {}
-        for event in events:
-            if event[0] == "join":
-                _, cid, name, color = event
-                # Hidden until its first INPUT says where its cursor is.
-                client = Client(name=name, color=color, active=False)
-                self._clients[cid] = client
-                clients.append(client)
-            else:
-                client = self._clients.pop(event[1], None)
-                if client is not None:
-                    client.release()
-                    client.active = False
-                    if client in clients:  # by identity: Client has eq=False
-                        clients.remove(client)
-        for cid, records in inputs.items():
-            client = self._clients.get(cid)
-            if client is not None:
-                for record in records:
-                    client.set_input(table, record.cursor_m, record.button)  # INPUT's keys are not used
-                client.active = True
+        for event in self._events.take():
+            match event:
+                case PlayerJoined(cid, name, color):
+                    client = Client(name=name, color=color, active=False)
+                    self._clients[cid] = client
+                    clients.append(client)
+                case PlayerLeft(cid):
+                    client = self._clients.pop(cid, None)
+                    if client is not None:
+                        client.release()
+                        client.active = False
+                        if client in clients:  # by identity: Client has eq=False
+                            clients.remove(client)
+                case PlayerInput(cid, record):
+                    client = self._clients.get(cid)
+                    if client is not None:
+                        client.set_input(table, record.cursor_m, record.button)  # INPUT's keys are not used
+                        client.active = True
+
+    def apply_inputs(self, clients: list[Client], table) -> None:
+        """The old name of update_clients, for game loops not yet moved over."""
+        self.update_clients(clients, table)
 
     def publish(self, scene: Scene) -> None:
-        """Main thread, every frame: at most snapshot_hz times a second, encode `scene`
-        once and hand the bytes to every player's sender. Never blocks."""
+        """Game loop, after the frame's physics steps: at most snapshot_hz times a second,
+        encode `scene` once and hand the bytes to every player's sender. Never blocks."""
         if not self.running:
             return
         now = time.monotonic()
@@ -372,36 +465,61 @@ class GameServer:
     # ---------------------------------------------------------------- network thread
 
     def _run(self) -> None:
+        """The network thread: serve until stop(); a failure is logged and shown, not silent."""
+        try:
+            self._serve()
+        except Exception as exc:
+            log.exception("the network thread failed")
+            if self._listener is not None:  # new students get "refused" at once, not a hang
+                self._listener.close()
+            self.failure = (
+                f"students can no longer join: the network thread failed ({type(exc).__name__}: {exc}); "
+                "restart the app to let them in again"
+            )
+            for conn in list(self._conns.values()):
+                conn.close()
+                self._settle(conn)
+            return
+        self._say_bye()
+
+    def _serve(self) -> None:
         sel = self._selector
         assert sel is not None
         next_check = 0.0
         while not self._stopping.is_set():
             try:
                 ready = sel.select(timeout=0.1)
-            except OSError:  # selector closed under us during stop
-                break
+            except OSError:  # the selector was closed under us during stop
+                if self._stopping.is_set():
+                    break
+                raise
             for key, mask in ready:
-                try:
-                    if key.data == "listen":
-                        self._accept()
-                    elif key.data == "wake":
-                        self._drain_wake()
-                        self._distribute_snapshot()
-                    else:
-                        conn: _Conn = key.data
-                        if mask & selectors.EVENT_READ and conn.cid in self._conns:
-                            self._on_readable(conn)
-                        if mask & selectors.EVENT_WRITE and conn.cid in self._conns:
-                            self._flush(conn)
-                except Exception:  # a bug must cost one connection, not the whole server
-                    log.exception("network error")
-                    if isinstance(key.data, _Conn) and key.data.cid in self._conns:
-                        self._close(key.data)
+                self._on_ready(key, mask)
             now = time.monotonic()
             if now >= next_check:
                 next_check = now + 0.1
                 self._check_timeouts(now)
-        self._say_bye()
+                self._refresh_roster(now)
+
+    def _on_ready(self, key: selectors.SelectorKey, mask: int) -> None:
+        if key.data == "listen":
+            self._accept()
+            return
+        if key.data == "wake":
+            self._drain_wake()
+            self._run_commands()
+            self._distribute_snapshot()
+            return
+        conn: Connection = key.data
+        try:
+            if mask & selectors.EVENT_READ and not conn.closed:
+                self._on_readable(conn)
+            if mask & selectors.EVENT_WRITE and not conn.closed:
+                conn.flush()
+        except Exception:  # a bug must cost one connection, not the whole server
+            log.exception("network error with %s", conn.who)
+            conn.close()
+        self._settle(conn)
 
     def _accept(self) -> None:
         assert self._listener is not None
@@ -410,26 +528,45 @@ class GameServer:
                 sock, addr = self._listener.accept()
             except (BlockingIOError, InterruptedError):
                 return
-            except OSError as e:  # e.g. out of file descriptors: try again on the next round
-                log.warning("cannot accept a connection: %s", e)
-                time.sleep(0.01)
+            except OSError as e:  # e.g. out of file descriptors: stop accepting for a moment
+                self._quiet.note("cannot accept connections", "cannot accept a connection: %s", e)
+                self._pause_accepting()
                 return
-            peer = f"{addr[0]}:{addr[1]}"
-            sock.setblocking(False)
-            sock.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
-            if len(self._conns) >= self.max_clients + EXTRA_CONNECTIONS:
-                try:
-                    sock.send(proto.encode_error(self._full_sentence()))
-                except OSError:
-                    pass
-                sock.close()
-                log.info("refused %s: too many connections", peer)
-                continue
-            conn = _Conn(self._next_cid, sock, peer, time.monotonic())
-            self._next_cid += 1
-            self._conns[conn.cid] = conn
-            assert self._selector is not None
-            self._selector.register(sock, conn.events, conn)
+            self._admit(sock, addr)
+
+    def _pause_accepting(self) -> None:
+        assert self._selector is not None and self._listener is not None
+        self._selector.unregister(self._listener)
+        self._accept_paused_until = time.monotonic() + ACCEPT_PAUSE_S
+
+    def _admit(self, sock: socket.socket, addr: tuple) -> None:
+        """A new connection: refuse it with a true sentence, or start its handshake."""
+        sock.setblocking(False)
+        sock.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
+        host = str(addr[0])
+        refusal = self._gate.handshake_refusal(host)
+        if len(self._numbers) >= self.max_clients:
+            refusal = self._full_sentence()
+        elif self._gate.handshakes_open >= self.max_handshakes:
+            refusal = (
+                f"the table is busy: {self.max_handshakes} computers are joining at once; "
+                "your client tries again by itself in a few seconds"
+            )
+        if refusal is not None:
+            try:
+                sock.send(proto.encode_error(refusal, retry=True))
+            except OSError:
+                pass
+            sock.close()
+            self._quiet.note(f"connections refused from {host}", "refused %s: %s", host, refusal)
+            return
+        assert self._selector is not None
+        now = time.monotonic()
+        conn = Connection(self._next_cid, sock, addr, now, self._selector)
+        conn.deadline = now + self.hello_timeout_s
+        self._next_cid += 1
+        self._conns[conn.cid] = conn
+        self._gate.handshake_started(host)
 
     def _drain_wake(self) -> None:
         assert self._wake_r is not None
@@ -439,210 +576,212 @@ class GameServer:
         except (BlockingIOError, InterruptedError):
             pass
 
+    def _run_commands(self) -> None:
+        with self._lock:
+            commands, self._commands = self._commands, []
+        for command in commands:
+            command()
+
     def _distribute_snapshot(self) -> None:
         with self._lock:
             frame, seq = self._snapshot, self._snapshot_seq
         if frame is None or seq == self._sent_seq:
             return
         self._sent_seq = seq
+        now = time.monotonic()
         for conn in list(self._conns.values()):
-            if conn.state == _Conn.PLAYING:
-                conn.out_snap = frame  # replaces an older one that never started
-                self._flush(conn)
+            conn.offer_snapshot(frame, now)
+            self._settle(conn)
 
-    def _on_readable(self, conn: _Conn) -> None:
+    def _on_readable(self, conn: Connection) -> None:
+        now = time.monotonic()
         try:
-            data = conn.sock.recv(RECV_BYTES)
-        except (BlockingIOError, InterruptedError):
-            return
-        except OSError:  # reset by the peer
-            self._close(conn)
-            return
-        if not data:
-            if conn.state != _Conn.CLOSING:
-                log.info("%s left", conn.who)
-            self._close(conn)
-            return
-        if conn.state == _Conn.CLOSING:
-            return  # reading only so that closing does not reset the connection
-        try:
-            frames = conn.reader.feed(data)
-            now = time.monotonic()
+            frames = conn.receive(now)
+            if frames is None:
+                if conn.state != State.CLOSING:
+                    self._log_seat(conn, "%s left", conn.who)
+                conn.close()
+                return
             for frame_type, payload in frames:
-                conn.last_rx = now
-                self._check_rate(conn, now)
-                self._handle(conn, frame_type, payload)
-                if conn.state == _Conn.CLOSING or conn.cid not in self._conns:
+                self._handle(conn, frame_type, payload, now)
+                if conn.state == State.CLOSING or conn.closed:
                     return
         except proto.ProtocolError as e:
             self._fail(conn, str(e))
 
-    def _check_rate(self, conn: _Conn, now: float) -> None:
-        conn.tokens = min(RATE_BURST, conn.tokens + (now - conn.tokens_t) * RATE_PER_S)
-        conn.tokens_t = now
-        conn.tokens -= 1.0
-        if conn.tokens < 0:
-            raise proto.ProtocolError(
-                f"more than {RATE_PER_S:g} messages a second were received; a client sends at most 60 inputs a second"
-            )
-
-    def _handle(self, conn: _Conn, frame_type: int, payload: bytes) -> None:
+    def _handle(self, conn: Connection, frame_type: int, payload: bytes, now: float) -> None:
         if frame_type == proto.BYE:
-            log.info("%s said goodbye", conn.who)
-            self._close(conn)
+            self._log_seat(conn, "%s said goodbye", conn.who)
+            conn.close()
         elif frame_type == proto.HELLO:
-            if conn.state != _Conn.HELLO:
+            if conn.state != State.HELLO:
                 raise proto.ProtocolError("HELLO was sent twice; say HELLO once, then send INPUT")
-            self._welcome(conn, proto.parse_hello(payload))
+            self._welcome(conn, proto.parse_hello(payload), now)
         elif frame_type == proto.INPUT:
-            if conn.state != _Conn.PLAYING:
+            if conn.state != State.PLAYING:
                 raise proto.ProtocolError(
                     'INPUT came before HELLO; a client must first send HELLO like {"protocol": 1} and wait for WELCOME'
                 )
             record = proto.parse_input(payload, self._table_size_m)
-            with self._lock:
-                self._queue_input(conn.cid, record)
-
-    def _queue_input(self, cid: int, record: proto.InputRecord) -> None:
-        """Keep the newest record, plus the first record after each button change.
-
-        Motion between two frames collapses into the newest position, but a
-        press (and where it happened) survives even when the press and the
-        next move arrive within one frame, so a quick grab is not lost.
-        """
-        queue = self._inputs.get(cid)
-        if queue is None:
-            self._inputs[cid] = [record]
-        elif len(queue) >= 2 and queue[-1].button == queue[-2].button == record.button:
-            queue[-1] = record  # same run of one button: only its first and newest matter
-        else:
-            queue.append(record)
-            if len(queue) > MAX_QUEUED_INPUTS:
-                del queue[0]
+            conn.note_input(record, now)
+            self._events.input(conn.cid, record)
 
     def _full_sentence(self) -> str:
         return (
-            f"server full: all {self.max_clients} places are taken; try again when someone leaves, "
+            f"server full: all {self.max_clients} places are taken; your client tries again by itself, "
             "or ask the teacher to start the table with a higher --max-clients"
         )
 
-    def _welcome(self, conn: _Conn, hello: proto.Hello) -> None:
-        if self.password is not None:
-            if hello.password is None:
-                raise proto.ProtocolError(
-                    "this table needs a password: ask the teacher for it and join with --password"
-                )
-            if not hmac.compare_digest(hello.password.encode("utf-8"), self.password.encode("utf-8")):
-                raise proto.ProtocolError(
-                    "wrong password: ask the teacher for the table's password and join again with --password"
-                )
+    def _welcome(self, conn: Connection, hello: proto.Hello, now: float) -> None:
+        if not self._password_ok(conn, hello, now):
+            return
+        refusal = self._gate.seat_refusal(conn.host)
+        if refusal is not None:
+            self._fail(conn, refusal)
+            return
         if len(self._numbers) >= self.max_clients:
-            raise proto.ProtocolError(self._full_sentence())
+            self._fail(conn, self._full_sentence(), retry=True)
+            return
         number = 1
         while number in self._numbers:  # the lowest free number, so names get reused
             number += 1
         name = f"C{number}" + (f" {hello.name}" if hello.name else "")
         color = client_color(number)
-        conn.number, conn.name, conn.state = number, name, _Conn.PLAYING
+        self._gate.handshake_ended(conn.host, seated=True)
+        conn.number, conn.name, conn.state = number, name, State.PLAYING
         self._numbers[number] = conn.cid
-        width_m, height_m = self._table_size_m
-        conn.out_ctrl.append(proto.encode_welcome(name, color, width_m, height_m))
         with self._lock:
             self._names[number] = name
-            self._events.append(("join", conn.cid, name, color))
-            conn.out_snap = self._snapshot  # the newest picture straight away, if there is one
-        log.info("%s joined from %s", name, conn.peer)
-        self._flush(conn)
+            snapshot = self._snapshot
+        self._events.join(conn.cid, name, color)
+        width_m, height_m = self._table_size_m
+        conn.send_control(proto.encode_welcome(name, color, width_m, height_m))
+        conn.offer_snapshot(snapshot, now)  # the newest picture straight away, if there is one
+        self._log_seat(conn, "%s joined from %s", name, conn.peer)
 
-    def _release_slot(self, conn: _Conn) -> None:
-        """Forget the player behind `conn` (its Client goes at the next apply_inputs)."""
+    def _log_seat(self, conn: Connection, line: str, *args) -> None:
+        """Joins and leaves, one line each, but summarised when one computer churns."""
+        self._quiet.note(f"joins and leaves from {conn.host}", line, *args, level=logging.INFO)
+
+    def _password_ok(self, conn: Connection, hello: proto.Hello, now: float) -> bool:
+        if self.password is None:
+            return True
+        if hello.password is None:
+            self._fail(conn, "this table needs a password: ask the teacher for it and join with --password", quiet=True)
+            return False
+        wait = self._gate.password_wait(conn.host, now)
+        if wait > 0:
+            self._fail(
+                conn,
+                f"too many wrong passwords from your computer: wait {math.ceil(wait)} s, "
+                "then join again with the teacher's password",
+                quiet=True,
+            )
+            return False
+        if not hmac.compare_digest(hello.password.encode("utf-8"), self.password.encode("utf-8")):
+            self._gate.wrong_password(conn.host, now, log)
+            self._fail(
+                conn,
+                "wrong password: ask the teacher for the table's password and join again with --password",
+                quiet=True,
+            )
+            return False
+        self._gate.right_password(conn.host)
+        return True
+
+    def _fail(self, conn: Connection, sentence: str, retry: bool = False, quiet: bool = False) -> None:
+        """Send ERROR `sentence`, then close once it is out (or after LINGER_S).
+
+        Logged once per address and summarised after that (`quiet`: not at all)."""
+        if not quiet:
+            self._quiet.note(
+                f"connections dropped from {conn.host}", "dropped %s: %s", conn.who, sentence, level=logging.INFO
+            )
+        self._release_slot(conn)
+        conn.fail(sentence, time.monotonic(), retry=retry)
+
+    def _remove(self, number: int, sentence: str) -> None:
+        cid = self._numbers.get(number)
+        conn = self._conns.get(cid) if cid is not None else None
+        if conn is not None:
+            self._fail(conn, sentence)
+            self._settle(conn)
+
+    def _release_slot(self, conn: Connection) -> None:
+        """Forget the seat or handshake behind `conn` (its Client goes at the next update_clients)."""
+        if conn.state == State.HELLO:
+            self._gate.handshake_ended(conn.host, seated=False)
+            conn.state = State.CLOSING
         if conn.number and self._numbers.get(conn.number) == conn.cid:
             del self._numbers[conn.number]
+            self._gate.seat_freed(conn.host)
             with self._lock:
                 self._names.pop(conn.number, None)
-                self._inputs.pop(conn.cid, None)
-                self._events.append(("leave", conn.cid))
                 if not self._names:
                     # publish() stops encoding when nobody plays: do not greet the
                     # next player with a picture from long ago.
                     self._snapshot = None
+            self._events.leave(conn.cid)
         conn.number = 0
 
-    def _fail(self, conn: _Conn, sentence: str) -> None:
-        """Send ERROR `sentence`, then close once it is out (or after LINGER_S)."""
-        log.info("dropped %s: %s", conn.who, sentence)
-        self._release_slot(conn)
-        conn.state = _Conn.CLOSING
-        conn.out_snap = None
-        conn.out_ctrl.append(proto.encode_error(sentence))
-        conn.deadline = time.monotonic() + LINGER_S
-        self._flush(conn)
-
-    def _flush(self, conn: _Conn) -> None:
-        """Send what the socket takes now; wait for EVENT_WRITE for the rest."""
-        while not conn.shut:
-            if conn.out_cur is None:
-                # Control frames first; frames are never interleaved, because the
-                # next one starts only when out_cur is fully sent.
-                if conn.out_ctrl:
-                    conn.out_cur = memoryview(conn.out_ctrl.popleft())
-                elif conn.out_snap is not None:
-                    conn.out_cur, conn.out_snap = memoryview(conn.out_snap), None
-                else:
-                    break
-            try:
-                sent = conn.sock.send(conn.out_cur)
-            except (BlockingIOError, InterruptedError):
-                break
-            except OSError:
-                self._close(conn)
-                return
-            conn.out_cur = conn.out_cur[sent:] if sent < len(conn.out_cur) else None
-        if conn.state == _Conn.CLOSING and not conn.shut and not conn.has_output():
-            # The ERROR is out: shut our side and read until the client hangs up,
-            # so that unread client bytes do not turn the close into a reset
-            # that could discard the ERROR before the client reads it.
-            conn.shut = True
-            try:
-                conn.sock.shutdown(socket.SHUT_WR)
-            except OSError:
-                self._close(conn)
-                return
-        events = selectors.EVENT_READ
-        if conn.has_output() and not conn.shut:
-            events |= selectors.EVENT_WRITE
-        if events != conn.events and self._selector is not None:
-            conn.events = events
-            self._selector.modify(conn.sock, events, conn)
+    def _settle(self, conn: Connection) -> None:
+        """Bookkeeping after a connection closed itself (or was closed)."""
+        if conn.closed and self._conns.get(conn.cid) is conn:
+            self._release_slot(conn)
+            del self._conns[conn.cid]
 
     def _check_timeouts(self, now: float) -> None:
         for conn in list(self._conns.values()):
-            if conn.state == _Conn.CLOSING:
+            if conn.state == State.CLOSING:
                 if now > conn.deadline:
-                    self._close(conn)
+                    conn.close()
+            elif conn.state == State.HELLO and now > conn.deadline:
+                self._fail(
+                    conn,
+                    f"no HELLO came within {self.hello_timeout_s:g} s of connecting; "
+                    "join with airtable-client, which says HELLO at once",
+                    quiet=True,
+                )
             elif now - conn.last_rx > self.timeout_s:
                 self._fail(
                     conn,
                     f"nothing complete was received for {self.timeout_s:g} s (a client sends at least one INPUT "
                     "a second), so the connection was closed; check the network and join again",
                 )
+            self._settle(conn)
+        if self._accept_paused_until and now >= self._accept_paused_until:
+            self._accept_paused_until = 0.0
+            assert self._selector is not None and self._listener is not None
+            self._selector.register(self._listener, selectors.EVENT_READ, "listen")
+        self._gate.forget_old_guesses(now, log)
+        self._quiet.flush(now)
 
-    def _close(self, conn: _Conn) -> None:
-        self._release_slot(conn)
-        self._conns.pop(conn.cid, None)
-        if self._selector is not None:
-            try:
-                self._selector.unregister(conn.sock)
-            except (KeyError, ValueError):
-                pass
-        conn.sock.close()
+    def _refresh_roster(self, now: float) -> None:
+        width_m, height_m = self._table_size_m
+        reach = FAR_OFF_TABLES * max(width_m, height_m)
+        seats = []
+        for number in sorted(self._numbers):
+            conn = self._conns[self._numbers[number]]
+            cursor = conn.last_input.cursor_m if conn.last_input else None
+            far_off = cursor is not None and not (
+                -reach <= cursor[0] <= width_m + reach and -reach <= cursor[1] <= height_m + reach
+            )
+            seats.append(
+                Seat(
+                    number,
+                    conn.name,
+                    client_color(number),
+                    conn.peer,
+                    conn.snapshot_rate(now),
+                    conn.lag_s,
+                    now - conn.last_change,
+                    far_off,
+                )
+            )
+        with self._lock:
+            self._roster = tuple(seats)
 
     def _say_bye(self) -> None:
         """Best effort: tell players the server is going, so they show 'server gone'."""
-        bye = proto.encode_bye()
         for conn in list(self._conns.values()):
-            if conn.state == _Conn.PLAYING and conn.out_cur is None:
-                try:
-                    conn.sock.send(bye)
-                except OSError:
-                    pass
+            conn.say_bye()

@@ -1,0 +1,237 @@
+"""One client connection on the server: its reading, rate limit and sending.
+
+Owned by the server's network thread. A `Connection` reads frames (at most a
+message and byte budget a second, see `RateLimit`), and sends in this order:
+control frames (WELCOME, ERROR, BYE) first, then only the newest snapshot,
+so a slow reader misses snapshots instead of piling them up. After an ERROR
+it shuts its side and waits for the client to hang up (`closing`).
+"""
+
+from __future__ import annotations
+
+import enum
+import selectors
+import socket
+import time
+from collections import deque
+
+from airtable.net import protocol as proto
+
+RATE_PER_S = 240.0  # sustained messages a second per client (a player sends <= 61)
+RATE_BURST = 480.0
+BYTES_PER_S = 24 * 1024  # sustained bytes a second (a player sends about 6 KB/s)
+BYTES_BURST = 48 * 1024
+RECV_BYTES = 16384
+LINGER_S = 2.0  # after an ERROR: time to let it reach the client before closing
+RATE_WINDOW_S = 2.0  # snapshot rates are measured over this many seconds
+
+
+class State(enum.Enum):
+    HELLO = "saying hello"
+    PLAYING = "playing"
+    CLOSING = "closing"
+
+
+class RateLimit:
+    """Two token buckets: messages a second and bytes a second."""
+
+    def __init__(self, now: float) -> None:
+        self.messages = RATE_BURST
+        self.bytes = float(BYTES_BURST)
+        self.t = now
+
+    def spend(self, now: float, messages: int, nbytes: int) -> str | None:
+        """Take what was received from the budget; a sentence when it overflows."""
+        dt = max(0.0, now - self.t)
+        self.t = now
+        self.messages = min(RATE_BURST, self.messages + dt * RATE_PER_S) - messages
+        self.bytes = min(float(BYTES_BURST), self.bytes + dt * BYTES_PER_S) - nbytes
+        if self.messages < 0:
+            return (
+                f"more than {RATE_PER_S:g} messages a second were received; a client sends at most 60 inputs a second"
+            )
+        if self.bytes < 0:
+            return f"more than {BYTES_PER_S // 1024} KiB a second were received; a client sends about 6 KiB a second"
+        return None
+
+
+class Connection:
+    """One client socket, owned by the network thread."""
+
+    def __init__(
+        self, cid: int, sock: socket.socket, addr: tuple, now: float, selector: selectors.BaseSelector
+    ) -> None:
+        self.cid = cid
+        self.sock = sock
+        self.host = str(addr[0])
+        self.peer = f"{addr[0]}:{addr[1]}"
+        self.selector = selector
+        self.reader = proto.FrameReader(proto.MAX_CLIENT_FRAME, proto.CLIENT_FRAMES, sender="a client")
+        self.rate = RateLimit(now)
+        self.state = State.HELLO
+        self.number = 0  # player number n of "Cn", 0 before WELCOME
+        self.name = ""
+        self.opened = now
+        self.last_rx = now
+        self.deadline = now  # set by the server: when the HELLO or the closing must be done
+        self.last_input: proto.InputRecord | None = None
+        self.last_change = now  # when the input last changed (for "idle" in the roster)
+        self.snapshot_times: deque[float] = deque()  # when each snapshot went out whole
+        self.lag_s = 0.0  # smoothed time a snapshot waited here before it was sent
+        self._out_cur: memoryview | None = None  # the frame being sent
+        self._out_ctrl: deque[bytes] = deque()  # WELCOME / ERROR / BYE, before any snapshot
+        self._out_snap: bytes | None = None  # the newest snapshot not yet started
+        self._snap_offered = now
+        self._sending_snap = False
+        self._shut = False  # our side is shut down after an ERROR
+        self._events = selectors.EVENT_READ
+        self.closed = False
+        selector.register(sock, self._events, self)
+
+    @property
+    def who(self) -> str:
+        return f"{self.name} ({self.peer})" if self.name else self.peer
+
+    @property
+    def stalled(self) -> bool:
+        """A frame is part-sent: the client's socket is full."""
+        return self._out_cur is not None
+
+    def has_output(self) -> bool:
+        return self._out_cur is not None or bool(self._out_ctrl) or self._out_snap is not None
+
+    # ------------------------------------------------------------ receiving
+
+    def receive(self, now: float) -> list[tuple[int, bytes]] | None:
+        """Frames now complete ([] when none), or None when the peer has gone.
+
+        Raises ProtocolError for bad bytes or a client over its rate limit."""
+        try:
+            data = self.sock.recv(RECV_BYTES)
+        except (BlockingIOError, InterruptedError):
+            return []
+        except OSError:  # reset by the peer
+            return None
+        if not data:
+            return None
+        if self.state == State.CLOSING:
+            return []  # reading only so that closing does not reset the connection
+        frames = self.reader.feed(data)
+        too_much = self.rate.spend(now, len(frames), len(data))
+        if too_much:
+            raise proto.ProtocolError(too_much)
+        if frames:
+            self.last_rx = now
+        return frames
+
+    def note_input(self, record: proto.InputRecord, now: float) -> None:
+        if record != self.last_input:
+            self.last_change = now
+        self.last_input = record
+
+    # ------------------------------------------------------------ sending
+
+    def send_control(self, frame: bytes) -> None:
+        self._out_ctrl.append(frame)
+        self.flush()
+
+    def offer_snapshot(self, frame: bytes | None, now: float) -> None:
+        """The newest snapshot replaces one that never started going out."""
+        if frame is None or self.state != State.PLAYING:
+            return
+        if self._out_snap is None:
+            self._snap_offered = now
+        self._out_snap = frame
+        self.flush()
+
+    def fail(self, sentence: str, now: float, retry: bool = False) -> None:
+        """Send ERROR `sentence`; close once it is out (the server closes it after LINGER_S)."""
+        self.state = State.CLOSING
+        self._out_snap = None
+        self._out_ctrl.append(proto.encode_error(sentence, retry=retry))
+        self.deadline = now + LINGER_S
+        self.flush()
+
+    def flush(self) -> None:
+        """Send what the socket takes now; wait for EVENT_WRITE for the rest."""
+        while not self._shut and not self.closed and self._next_frame():
+            try:
+                sent = self.sock.send(self._out_cur)
+            except (BlockingIOError, InterruptedError):
+                break
+            except OSError:
+                self.close()
+                return
+            if sent < len(self._out_cur):
+                self._out_cur = self._out_cur[sent:]
+            else:
+                self._frame_done()
+        if self.closed:
+            return
+        if self.state == State.CLOSING and not self._shut and not self.has_output():
+            self._shut_down()
+        events = selectors.EVENT_READ
+        if self.has_output() and not self._shut:
+            events |= selectors.EVENT_WRITE
+        if events != self._events and not self.closed:
+            self._events = events
+            self.selector.modify(self.sock, events, self)
+
+    def _next_frame(self) -> bool:
+        """Start the next frame unless one is part-sent; False when there is nothing to send.
+
+        Control frames first; frames are never interleaved, because the next one
+        starts only when the current one is fully sent."""
+        if self._out_cur is not None:
+            return True
+        if self._out_ctrl:
+            self._out_cur, self._sending_snap = memoryview(self._out_ctrl.popleft()), False
+        elif self._out_snap is not None:
+            self._out_cur, self._out_snap, self._sending_snap = memoryview(self._out_snap), None, True
+        else:
+            return False
+        return True
+
+    def _frame_done(self) -> None:
+        self._out_cur = None
+        if self._sending_snap:
+            now = time.monotonic()
+            self.lag_s += 0.2 * ((now - self._snap_offered) - self.lag_s)
+            times = self.snapshot_times
+            times.append(now)
+            while now - times[0] > RATE_WINDOW_S:
+                times.popleft()
+
+    def snapshot_rate(self, now: float) -> float:
+        """Snapshots a second that went out whole, over the last RATE_WINDOW_S."""
+        window = min(RATE_WINDOW_S, now - self.opened)
+        recent = sum(1 for t in self.snapshot_times if now - t <= RATE_WINDOW_S)
+        return recent / window if window > 0 else 0.0
+
+    def _shut_down(self) -> None:
+        # The ERROR is out: shut our side and read until the client hangs up,
+        # so that unread client bytes do not turn the close into a reset
+        # that could discard the ERROR before the client reads it.
+        self._shut = True
+        try:
+            self.sock.shutdown(socket.SHUT_WR)
+        except OSError:
+            self.close()
+
+    def say_bye(self) -> None:
+        """Best effort, when the server stops: BYE unless a frame is half sent."""
+        if self.state == State.PLAYING and self._out_cur is None and not self.closed:
+            try:
+                self.sock.send(proto.encode_bye())
+            except OSError:
+                pass
+
+    def close(self) -> None:
+        if self.closed:
+            return
+        self.closed = True
+        try:
+            self.selector.unregister(self.sock)
+        except (KeyError, ValueError):
+            pass
+        self.sock.close()

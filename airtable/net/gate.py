@@ -1,0 +1,167 @@
+"""Who may come in: per-address limits, the password brake and a quiet log.
+
+Used by the server's network thread only. One computer (one address) may
+hold only a few handshakes and a few seats at once, so one student cannot
+fill the table. Connections from this computer itself (loopback) are the
+teacher's own and are not limited unless `limit_loopback` is set.
+
+Wrong passwords from an address earn a growing wait before the next guess
+is even checked, then a lockout; the log gets one line per address, not one
+per guess.
+"""
+
+from __future__ import annotations
+
+import ipaddress
+import logging
+import time
+from collections import Counter
+from dataclasses import dataclass
+
+HANDSHAKES_PER_ADDRESS = 4
+PLAYERS_PER_ADDRESS = 3
+FIRST_PASSWORD_WAIT_S = 1.0  # after the first wrong password; doubles with each one
+LOCKOUT_AFTER = 5  # wrong passwords in a row before the lockout
+LOCKOUT_S = 60.0
+SUMMARY_EVERY_S = 30.0
+
+
+def is_loopback(host: str) -> bool:
+    try:
+        return ipaddress.ip_address(host.split("%")[0]).is_loopback
+    except ValueError:
+        return False
+
+
+@dataclass
+class _Guesses:
+    wrong: int = 0
+    next_try: float = 0.0  # no guess is checked before this time
+    refused: int = 0  # guesses refused unchecked since the last log line
+
+
+class Gate:
+    """Per-address counts of handshakes and players, and wrong-password history."""
+
+    def __init__(
+        self,
+        handshakes_per_address: int = HANDSHAKES_PER_ADDRESS,
+        players_per_address: int = PLAYERS_PER_ADDRESS,
+        limit_loopback: bool = False,
+        password_wait_s: float = FIRST_PASSWORD_WAIT_S,
+    ) -> None:
+        self.password_wait_s = password_wait_s
+        self.handshakes_per_address = handshakes_per_address
+        self.players_per_address = players_per_address
+        self.limit_loopback = limit_loopback
+        self.handshakes: Counter[str] = Counter()
+        self.players: Counter[str] = Counter()
+        self._guesses: dict[str, _Guesses] = {}
+        self._open = 0
+
+    def _limited(self, host: str) -> bool:
+        return self.limit_loopback or not is_loopback(host)
+
+    def handshake_refusal(self, host: str) -> str | None:
+        """Why a new connection from `host` is refused, or None."""
+        if self._limited(host) and self.handshakes[host] >= self.handshakes_per_address:
+            return (
+                f"your computer already has {self.handshakes[host]} connections joining at once; "
+                "wait for them to finish and try again"
+            )
+        return None
+
+    def seat_refusal(self, host: str) -> str | None:
+        """Why `host` may not take one more seat, or None."""
+        if self._limited(host) and self.players[host] >= self.players_per_address:
+            return (
+                f"your computer already plays with {self.players[host]} windows, the most one computer may; "
+                "close one of them to join with another"
+            )
+        return None
+
+    @property
+    def handshakes_open(self) -> int:
+        """Handshakes under way, from every address."""
+        return self._open
+
+    def handshake_started(self, host: str) -> None:
+        self.handshakes[host] += 1
+        self._open += 1
+
+    def handshake_ended(self, host: str, seated: bool) -> None:
+        """A handshake finished: welcomed into a seat (`seated`) or dropped."""
+        _down(self.handshakes, host)
+        self._open -= 1
+        if seated:
+            self.players[host] += 1
+
+    def seat_freed(self, host: str) -> None:
+        _down(self.players, host)
+
+    # ------------------------------------------------------------ passwords
+
+    def password_wait(self, host: str, now: float) -> float:
+        """Seconds before a password from `host` is checked again (0: check it now)."""
+        guesses = self._guesses.get(host)
+        if guesses is None or now >= guesses.next_try:
+            return 0.0
+        guesses.refused += 1
+        return guesses.next_try - now
+
+    def wrong_password(self, host: str, now: float, log: logging.Logger) -> None:
+        guesses = self._guesses.setdefault(host, _Guesses())
+        guesses.wrong += 1
+        if guesses.wrong >= LOCKOUT_AFTER:
+            guesses.next_try = now + LOCKOUT_S
+            if guesses.wrong == LOCKOUT_AFTER:
+                log.warning("%s gave %d wrong passwords: locked out for %g s", host, guesses.wrong, LOCKOUT_S)
+        else:
+            guesses.next_try = now + self.password_wait_s * 2 ** (guesses.wrong - 1)
+            if guesses.wrong == 1:
+                log.info("wrong password from %s", host)
+
+    def right_password(self, host: str) -> None:
+        self._guesses.pop(host, None)
+
+    def forget_old_guesses(self, now: float, log: logging.Logger) -> None:
+        """Drop addresses whose wait is long over; log what was refused meanwhile."""
+        for host, guesses in list(self._guesses.items()):
+            if guesses.refused and now >= guesses.next_try:
+                log.info("%s tried %d more passwords while it had to wait", host, guesses.refused)
+                guesses.refused = 0
+            if now > guesses.next_try + LOCKOUT_S:
+                del self._guesses[host]
+
+
+def _down(counter: Counter[str], host: str) -> None:
+    counter[host] -= 1
+    if counter[host] <= 0:
+        del counter[host]
+
+
+class QuietLog:
+    """Logs the first line of a kind at once, then one summary every SUMMARY_EVERY_S,
+    so a flood of refusals cannot flood the teacher's log."""
+
+    def __init__(self, log: logging.Logger) -> None:
+        self.log = log
+        self._counts: Counter[str] = Counter()
+        self._levels: dict[str, int] = {}
+        self._since = time.monotonic()
+
+    def note(self, kind: str, line: str, *args, level: int = logging.WARNING) -> None:
+        if self._counts[kind] == 0:
+            self.log.log(level, line, *args)
+            self._levels[kind] = level
+        self._counts[kind] += 1
+
+    def flush(self, now: float) -> None:
+        if now - self._since < SUMMARY_EVERY_S:
+            return
+        for kind, count in self._counts.items():
+            if count > 1:
+                self.log.log(self._levels[kind], "%d more in %.0f s: %s", count - 1, now - self._since, kind)
+        self._counts.clear()
+        self._levels.clear()
+        self._since = now
