@@ -343,7 +343,7 @@ class App:
         # Recomputed every frame: zooming moves the world under a still mouse.
         self.local.set_input(self.table, self.env.to_world(self.mouse_px), self.mouse_button)
         if self.server is not None:
-            self.server.apply_inputs(self.clients, self.table)  # joins, leaves and inputs, even while paused
+            self.server.update_clients(self.clients, self.table)  # joins, leaves and inputs, even while paused
         if not self.paused:
             for _ in range(self.stepper.steps(frame_dt_s, self.speed)):
                 if not self.physics_step():
