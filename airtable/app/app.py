@@ -343,7 +343,7 @@ class App:
         # Recomputed every frame: zooming moves the world under a still mouse.
         self.local.set_input(self.table, self.env.to_world(self.mouse_px), self.mouse_button)
         if self.server is not None:
-            self.server.apply_inputs(self.clients, self.table)  # joins, leaves and inputs, even while paused
+            self.server.update_clients(self.clients, self.table)  # joins, leaves and inputs, even while paused
         if not self.paused:
             for _ in range(self.stepper.steps(frame_dt_s, self.speed)):
                 if not self.physics_step():
@@ -420,7 +420,11 @@ class App:
         elif panel == "error":
             error = self.build_error
             title = ERROR_TITLES[error.stage].format(key=key_label(self.demo_key))
-            w.draw_panel(title, [str(error), "Fix the file and press the demo's key again (Esc hides this)."])
+            label = key_label(self.demo_key)  # "7", "Shift+1"; keys like "t1" have no key of their own
+            again = (
+                f"press {label} again" if len(self.demo_key) == 1 or label != self.demo_key else "pick it in Tab's menu"
+            )
+            w.draw_panel(title, [str(error), f"Fix the file, then {again}. Esc hides this."])
         elif panel == "notice":
             w.draw_panel("Some demo files could not be loaded", [*self.notice, "Press any key to go on."])
         elif panel == "help":
