@@ -113,7 +113,8 @@ def test_every_table_attribute_is_captured():
     table.step(1 / 120)
     for name, value in vars(table).items():
         assert name in HANDLED or isinstance(value, PLAIN_TYPES), name
-    values = dict(capture(table).values)
+    state = capture(table)
+    values = dict(zip(state.names, state.values, strict=True))
     for name in ("gravity_on", "gravity_mps2", "cr_puck", "cr_wall", "wall_correction", "_puck_correction"):
         assert name in values
     for name in ("time_s", "steps", "collision_count", "_spring_dt_s", "puck_collisions", "width_m"):

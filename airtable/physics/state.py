@@ -36,6 +36,7 @@ states costs little more than the positions and velocities that changed.
 from __future__ import annotations
 
 import itertools
+import sys
 from collections.abc import Iterator
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
@@ -63,8 +64,8 @@ HANDLED = frozenset(
 )
 PLAIN_TYPES = (bool, int, float, str, type(None))
 # The Python objects of one state beside its arrays' data (the state, its dicts and tuples,
-# the arrays' headers), as tracemalloc measures them for a table of pucks and springs.
-STATE_OVERHEAD_BYTES = 3000
+# the arrays' headers): tracemalloc measures 1.0 to 1.2 kB, with or without springs.
+STATE_OVERHEAD_BYTES = 1600
 
 
 @dataclass(frozen=True, eq=False)
@@ -75,7 +76,8 @@ class TableState:
     springs: dict[str, np.ndarray]  # column name -> (S, ...) array
     puck_handles: tuple
     spring_handles: tuple
-    values: tuple[tuple[str, object], ...]  # (attribute, value) of every plain setting and counter
+    names: tuple[str, ...]  # the table's plain settings and counters ...
+    values: tuple  # ... and their values
     events: tuple  # the scheduled (t_s, seq, fn), in heap order
     next_event_seq: int
     neighbours: tuple[np.ndarray, np.ndarray] | None  # positions and radii of the neighbour list's build
@@ -84,34 +86,49 @@ class TableState:
 
     @property
     def time_s(self) -> float:
-        return dict(self.values)["time_s"]
+        return self.values[self.names.index("time_s")]
 
     @property
     def steps(self) -> int:
-        return dict(self.values)["steps"]
+        return self.values[self.names.index("steps")]
 
-    def arrays(self) -> Iterator[np.ndarray]:
-        """Every array the state holds (one shared with another state included)."""
-        yield from self.pucks.values()
-        yield from self.springs.values()
-        if self.neighbours is not None:
-            yield from self.neighbours
+    def parts(self) -> Iterator[tuple[object, int]]:
+        """(object, bytes) of every sizeable part: the arrays and the handle tuples (some may be shared)."""
+        for a in (*self.pucks.values(), *self.springs.values(), *(self.neighbours or ())):
+            yield a, a.nbytes
+        for t in (self.puck_handles, self.spring_handles):
+            yield t, sys.getsizeof(t)
 
     @property
     def nbytes(self) -> int:
-        """Bytes this state holds on its own: its distinct arrays' data and its Python objects."""
-        return distinct_nbytes(self.arrays()) + STATE_OVERHEAD_BYTES
+        """Bytes this state holds: its distinct parts and its small Python objects."""
+        return own_nbytes(self)
 
 
-def distinct_nbytes(arrays, skip: set[int] | None = None) -> int:
-    """Sum of nbytes over the distinct arrays (by identity), leaving out those whose id is in `skip`."""
-    seen = set(skip or ())
-    total = 0
-    for a in arrays:
-        if id(a) not in seen:
-            seen.add(id(a))
-            total += a.nbytes
+def own_nbytes(state: TableState, previous: TableState | None = None) -> int:
+    """Bytes `state` adds beside `previous` (the parts it shares with it are not counted again)."""
+    seen = {id(obj) for obj, _ in previous.parts()} if previous is not None else set()
+    total = STATE_OVERHEAD_BYTES
+    for obj, size in state.parts():
+        if id(obj) not in seen:
+            seen.add(id(obj))
+            total += size
     return total
+
+
+def unchanged(new: TableState, old: TableState) -> bool:
+    """True if `new` (captured with like=old) is the same moment as `old`: nothing to keep twice."""
+    return (
+        new.pucks is old.pucks
+        and new.springs is old.springs
+        and new.puck_handles is old.puck_handles
+        and new.spring_handles is old.spring_handles
+        and new.values == old.values
+        and new.events == old.events
+        and new.next_event_seq == old.next_event_seq
+        and new.neighbours is old.neighbours
+        and new.notices == old.notices
+    )
 
 
 def same_bits(a: np.ndarray, b: np.ndarray) -> bool:
@@ -133,13 +150,21 @@ def _frozen(a: np.ndarray, like: np.ndarray | None) -> np.ndarray:
 
 
 def _columns(columns, like: dict[str, np.ndarray] | None) -> dict[str, np.ndarray]:
-    like = like or {}
-    return {name: _frozen(columns.view(name), like.get(name)) for name in columns._data}
+    """Every column's live rows, frozen; `like` itself if every one of them is shared with it."""
+    out = {name: _frozen(columns.view(name), (like or {}).get(name)) for name in columns._data}
+    if like is not None and out.keys() == like.keys() and all(out[k] is like[k] for k in out):
+        return like
+    return out
 
 
-def _plain_values(table: AirTable) -> tuple[tuple[str, object], ...]:
-    """Every attribute of the table that is a plain value: its settings, counters and thresholds."""
-    out = []
+def _shared(new: tuple, old: tuple | None) -> tuple:
+    """`old` if it holds the same items as `new` (a tuple kept once for many states)."""
+    return old if old is not None and old == new else new
+
+
+def _plain_values(table: AirTable) -> tuple[tuple[str, ...], tuple]:
+    """The names and values of the table's plain attributes: its settings, counters and thresholds."""
+    names, values = [], []
     for name, value in vars(table).items():
         if name in HANDLED:
             continue
@@ -147,8 +172,9 @@ def _plain_values(table: AirTable) -> tuple[tuple[str, object], ...]:
             raise TypeError(
                 f"AirTable.{name} is a {type(value).__name__}: airtable/physics/state.py must learn to capture it"
             )
-        out.append((name, value))
-    return tuple(out)
+        names.append(name)
+        values.append(value)
+    return tuple(names), tuple(values)
 
 
 def _next_event_seq(table: AirTable) -> int:
@@ -163,25 +189,28 @@ def _neighbour_build(table: AirTable, pucks: dict[str, np.ndarray], like: TableS
     if built is None:
         return None
     old = like.neighbours if like is not None else None
-    pos = old[0] if old is not None and (old[0] is built or same_bits(built, old[0])) else _frozen(built, None)
     radius = table._neighbours._built_radius
     radius = pucks["radius"] if same_bits(radius, pucks["radius"]) else _frozen(radius, None)
-    return pos, radius
+    if old is not None and old[1] is radius and same_bits(built, old[0]):
+        return old
+    return _frozen(built, None if old is None else old[0]), radius
 
 
 def capture(table: AirTable, like: TableState | None = None) -> TableState:
-    """Everything the next step of `table` depends on, copied out; arrays equal to `like`'s are shared with it."""
+    """Everything the next step of `table` depends on, copied out; parts equal to `like`'s are shared with it."""
     pucks = _columns(table._pucks, like.pucks if like is not None else None)
+    names, values = _plain_values(table)
     return TableState(
         pucks=pucks,
         springs=_columns(table._springs, like.springs if like is not None else None),
-        puck_handles=tuple(table._puck_handles),
-        spring_handles=tuple(table._spring_handles),
-        values=_plain_values(table),
+        puck_handles=_shared(tuple(table._puck_handles), like.puck_handles if like is not None else None),
+        spring_handles=_shared(tuple(table._spring_handles), like.spring_handles if like is not None else None),
+        names=_shared(names, like.names if like is not None else None),
+        values=values,
         events=tuple(table._events),
         next_event_seq=_next_event_seq(table),
         neighbours=_neighbour_build(table, pucks, like),
-        notices=tuple(table.notices),
+        notices=_shared(tuple(table.notices), like.notices if like is not None else None),
         noticed=frozenset(table._noticed),
     )
 
@@ -215,7 +244,7 @@ def restore(table: AirTable, state: TableState) -> None:
     _load_columns(table._springs, state.springs)
     table._puck_handles = _give_rows(table._puck_handles, state.puck_handles)
     table._spring_handles = _give_rows(table._spring_handles, state.spring_handles)
-    for name, value in state.values:
+    for name, value in zip(state.names, state.values, strict=True):
         setattr(table, name, value)
     table._events = list(state.events)
     table._event_seq = itertools.count(state.next_event_seq)
