@@ -12,8 +12,8 @@ import pygame
 from airtable.app.history import Timeline
 from airtable.app.panel_view import ACCENT, DIM_TEXT
 
-TRACK_COLOR = (70, 70, 90)
-KEPT_COLOR = (120, 120, 160)
+TRACK_COLOR = (60, 60, 75)  # the moments after the view (dropped if the table runs on from it)
+KEPT_COLOR = (130, 130, 170)  # the moments up to the view
 
 
 class TimelinePainter:
@@ -35,7 +35,7 @@ class TimelinePainter:
         pygame.draw.rect(surface, TRACK_COLOR, rect)
         x = rect.x + round(t.fraction * (rect.width - 1))
         pygame.draw.rect(surface, KEPT_COLOR, pygame.Rect(rect.x, rect.y, x - rect.x + 1, rect.height))
-        mark = pygame.Rect(0, 0, max(3, self.w.line_px(3)), 3 * rect.height)
+        mark = pygame.Rect(0, 0, max(3, self.w.line_px(3)), 4 * rect.height)
         mark.center = (x, rect.centery)
         pygame.draw.rect(surface, ACCENT, mark)
         back_s = t.newest_s - t.view_s
