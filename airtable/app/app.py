@@ -17,18 +17,19 @@ from pathlib import Path
 import numpy as np
 import pygame
 
-from airtable.app import aids, controls, world
+from airtable.app import aids, controls, rewind, world
 from airtable.app.aids_view import draw_aids
 from airtable.app.client import LOCAL_COLOR, Client, cursor_pulls
 from airtable.app.demo_loader import Demo, DemoError, DemoShelf, error_from_exception, key_label
 from airtable.app.environment import Environment
+from airtable.app.history import History
 from airtable.app.lessons import Lessons
 from airtable.app.lessons_view import draw_lessons
 from airtable.app.loop import FixedStep, FpsCounter, FrameLoop
 from airtable.app.menu import DemoMenu
 from airtable.app.scene import STATUS_SEPARATOR, Scene
 from airtable.app.stats import RunStats
-from airtable.app.window import AidsPainter, GameWindow
+from airtable.app.window import AidsPainter, GameWindow, TimelinePainter
 from airtable.physics.table import TABLE_HEIGHT_M, TABLE_WIDTH_M, AirTable
 
 MESSAGE_S = 4.0
@@ -93,6 +94,7 @@ class App:
         self.clients: list[Client] = [self.local]
         self.window = GameWindow(self.env, headless=headless, size_px=window_size_px, fullscreen=fullscreen)
         self.painter = AidsPainter(self.window)
+        self.timeline_painter = TimelinePainter(self.window)
         if not headless:
             pygame.mouse.set_visible(False)  # the local client's arrow is the pointer
         self.server = server
@@ -121,6 +123,7 @@ class App:
         self.collision_log = aids.CollisionLog()
         self.chart = aids.EnergyChart()
         self.lessons = Lessons()  # recording, momenta, saving the moment (lessons.py)
+        self.history = History()  # the table's recent moments, for rewinding (history.py, rewind.py)
         self.keys_down: set[int] = set()
         self.mouse_px = (self.env.size_px[0] / 2, self.env.size_px[1] / 2)
         self.mouse_button = 0
@@ -186,6 +189,8 @@ class App:
         self.trails = demo.trails if demo else False
         self.chart.sample(self.table)
         self.lessons.start(self.table)
+        self.history.clear()
+        self.history.record(self.table)
         self.window.set_caption(f"Air Table - {self.caption()}")
 
     def _clear_table(self) -> None:
@@ -345,15 +350,24 @@ class App:
         if self.server is not None:
             self.server.update_clients(self.clients, self.table)  # joins, leaves and inputs, even while paused
         if not self.paused:
-            for _ in range(self.stepper.steps(frame_dt_s, self.speed)):
-                if not self.physics_step():
-                    break
+            self._run_physics(frame_dt_s)
         self.fps = self._fps_counter.tick(self.clock_s)
         scene = self.scene()
         if self.server is not None:
             self.server.publish(scene)
         self.draw(scene)
         self.stats.frame()
+
+    def _run_physics(self, frame_dt_s: float) -> None:
+        """The frame's physics steps; the table as they left it joins the history."""
+        if self.history.in_past:
+            rewind.run_on(self)  # running again from a moment in the past: its future is dropped
+        steps = self.table.steps
+        for _ in range(self.stepper.steps(frame_dt_s, self.speed)):
+            if not self.physics_step():
+                break
+        if self.table.steps != steps:
+            self.history.record(self.table)
 
     def scene(self) -> Scene:
         return Scene.from_table(
@@ -370,6 +384,9 @@ class App:
         """The status line in parts, most important first (a narrow window drops the last)."""
         t = self.table
         parts = ["PAUSED"] if self.paused else []
+        timeline = self.history.timeline() if self.history.in_past else None
+        if timeline is not None:
+            parts.append(f"rewound {timeline.newest_s - timeline.view_s:.2f} s")
         if self.speed != 1.0:
             parts.append(f"slow motion x1/{round(1 / self.speed)}")
         parts.append(f"t = {t.time_s:.2f} s")
@@ -400,9 +417,16 @@ class App:
         """Draw `scene` (by default the table as it is now), the aids and the panel on top."""
         self.window.draw(scene or self.scene(), trails=self.trails, hud=self.hud_lines())
         draw_lessons(self)  # first: the aids' labels then place themselves around its panels
+        self._draw_timeline()
         draw_aids(self)
         self._draw_panel()
         self.window.present()
+
+    def _draw_timeline(self) -> None:
+        """While paused (or in the past), where the view is in the history."""
+        timeline = self.history.timeline()
+        if (self.paused or self.history.in_past) and timeline is not None and timeline.frames > 1:
+            self.timeline_painter.timeline(timeline)
 
     def _draw_panel(self) -> None:
         panel, w = self.panel(), self.window
