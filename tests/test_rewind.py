@@ -12,6 +12,7 @@ from conftest import FRAME_S, press, wait_until
 from airtable.app.app import App
 from airtable.app.panel_view import ACCENT
 from airtable.net import protocol as proto
+from airtable.net.codec import UNITS_PER_M, SnapshotDecoder
 from airtable.net.server import GameServer
 from airtable.physics.state import same_bits
 
@@ -139,6 +140,7 @@ def test_students_see_the_moment_on_view(demos):
             press(app, pygame.K_COMMA, mod=SHIFT)
             shown = app.table.pos_m.copy()
             seen = {}
+            decoder = SnapshotDecoder()
 
             def snapshot_of_the_past() -> bool:
                 app.frame(FRAME_S)
@@ -147,13 +149,16 @@ def test_students_see_the_moment_on_view(demos):
                 except TimeoutError:
                     return False
                 for kind, payload in reader.feed(data):
-                    if kind == proto.SNAPSHOT:
-                        seen["scene"] = proto.decode_snapshot(payload)
+                    if kind == proto.LAYOUT:
+                        decoder.feed_layout(payload)
+                    elif kind == proto.SNAPSHOT:
+                        seen["scene"] = decoder.feed_tick(payload).scene
                 scene = seen.get("scene")
-                return scene is not None and scene.time_s == app.table.time_s
+                return scene is not None and abs(scene.time_s - app.table.time_s) < 1e-6
 
             wait_until(snapshot_of_the_past, what="a snapshot of the rewound table")
-            assert same_bits(seen["scene"].pos_m, shown)
+            # Snapshots carry positions in whole quarter-millimetres.
+            assert np.abs(seen["scene"].pos_m - shown).max() <= 0.5 / UNITS_PER_M
             assert "rewound 1.00 s" in seen["scene"].status
         finally:
             student.close()
