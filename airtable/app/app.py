@@ -118,6 +118,7 @@ class App:
         self.show_chart = False
         self.vectors = 0  # 0 off, 1 velocity, 2 momentum
         self.inspecting = False
+        self._notices_seen = 0  # how many of table.notices were said
         self.menu: DemoMenu | None = None
         self.quit_armed_until = -1.0  # clock_s until which a second Esc quits
         self.collision_log = aids.CollisionLog()
@@ -351,12 +352,23 @@ class App:
             self.server.update_clients(self.clients, self.table)  # joins, leaves and inputs, even while paused
         if not self.paused:
             self._run_physics(frame_dt_s)
+        self._say_new_notices()
         self.fps = self._fps_counter.tick(self.clock_s)
         scene = self.scene()
         if self.server is not None:
             self.server.publish(scene)
         self.draw(scene)
         self.stats.frame()
+
+    def _say_new_notices(self) -> None:
+        """Each sentence the table adds to its notices (a softened spring, say) is said once, here and on stderr."""
+        notices = self.table.notices
+        if len(notices) < self._notices_seen:  # a new scene started the list again
+            self._notices_seen = 0
+        for sentence in notices[self._notices_seen :]:
+            self.say(sentence)
+            print(f"airtable: {sentence}", file=sys.stderr)
+        self._notices_seen = len(notices)
 
     def _run_physics(self, frame_dt_s: float) -> None:
         """The frame's physics steps; the table as they left it joins the history."""
