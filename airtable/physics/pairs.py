@@ -16,7 +16,9 @@ overlaps).
 * "off": velocities only; the pucks stay overlapping ("stickiness").
 * "two-step": back both pucks up along their normal velocities for the
   penetration time t_p = overlap / |vn|, then forward t_p with the
-  restitution-1 normal velocities: the pair ends as far apart as it overlapped.
+  post-collision normal velocities: the pair parts by (1 + e) times the
+  overlap, so it ends e times the overlap apart (as far apart as it
+  overlapped at e = 1, touching at e = 0).
 * "perfect-kiss": back the pair up along its full relative motion to the
   moment of first contact, take the normal there, collide, and go forward
   again by the same time.
@@ -158,7 +160,7 @@ def push_apart(pos: np.ndarray, radius: np.ndarray, mass: np.ndarray, i: np.ndar
     a puck add their pushes. Used for the small overlaps a correction leaves
     behind; velocities (and so energy and momentum) are untouched.
     """
-    n, dist = vectors.unit_vectors(vectors.take(pos, i) - vectors.take(pos, j))
+    n, dist = vectors.unit_vectors(vectors.take(pos, i) - vectors.take(pos, j), i + j)
     left = np.maximum(radius.take(i) + radius.take(j) - dist, 0.0)
     m_i, m_j = mass.take(i), mass.take(j)
     push = (left / (m_i + m_j))[:, None] * n
@@ -207,7 +209,7 @@ def _gather(pos, vel, radius, mass, a, b) -> _Round | None:
     x1, x2 = vectors.take(pos, a), vectors.take(pos, b)
     r2 = radius.take(b)
     reach = radius.take(a) + r2
-    n, dist = vectors.unit_vectors(x1 - x2)
+    n, dist = vectors.unit_vectors(x1 - x2, a + b)
     overlap = reach - dist
     if np.count_nonzero(overlap > 0.0) < len(overlap):
         keep = np.flatnonzero(overlap > 0.0)
@@ -248,7 +250,7 @@ def separate(g: _Round, n: np.ndarray, move: np.ndarray, approach: np.ndarray):
     x2 = g.x2 - (move * g.share2)[:, None] * n
     d = x1 - x2
     if np.count_nonzero(vectors.squared_lengths(d) < g.reach * g.reach):
-        n_now, dist_now = vectors.unit_vectors(d)
+        n_now, dist_now = vectors.unit_vectors(d, g.a + g.b)
         left = np.maximum(g.reach - dist_now, 0.0)
         x1 = x1 + (left * g.share1)[:, None] * n_now
         x2 = x2 - (left * g.share2)[:, None] * n_now
@@ -262,21 +264,22 @@ def _round_off(g: _Round, cr: float, dt_s: float) -> _Outcome:
     return _Outcome(g.n, g.x2, approach, v1, v2, g.x1, g.x2)
 
 
-def _two_step_move(g: _Round, dt_s: float) -> np.ndarray:
+def _two_step_move(g: _Round, cr: float, dt_s: float) -> np.ndarray:
     """How far the two-step correction parts each pair along the normal.
 
-    Back up t_p = overlap / |vn|, then forward t_p with the restitution-1
-    normal velocities: the pair parts by 2 |vn| t_p = twice the overlap. An
+    Back up t_p = overlap / |vn| (the pair parts by |vn| t_p, the overlap),
+    then forward t_p with the normal velocities after the collision (it
+    parts by another e |vn| t_p): (1 + e) times the overlap in all. An
     overlap deeper than one step of approach can explain is capped there;
     `separate` pushes the rest apart.
     """
-    return 2.0 * np.minimum(g.overlap, -g.vn * dt_s)
+    return (1.0 + cr) * np.minimum(g.overlap, -g.vn * dt_s)
 
 
 def _round_two_step(g: _Round, cr: float, dt_s: float) -> _Outcome:
     approach = g.vn < -REST_SPEED_MPS
     v1, v2 = collide_along_normal(g, g.n, g.vn, approach, cr)
-    x1, x2 = separate(g, g.n, _two_step_move(g, dt_s), approach)
+    x1, x2 = separate(g, g.n, _two_step_move(g, cr, dt_s), approach)
     return _Outcome(g.n, g.x2, approach, v1, v2, x1, x2)
 
 
@@ -302,7 +305,7 @@ def _round_perfect_kiss(g: _Round, cr: float, dt_s: float) -> _Outcome:
         return _round_two_step(g, cr, dt_s)
     t_b = np.where(kiss, t_back, 0.0)[:, None]
     c2 = g.x2 - g.v2 * t_b  # both centres at first contact
-    n_kiss, _ = vectors.unit_vectors(g.x1 - g.v1 * t_b - c2)
+    n_kiss, _ = vectors.unit_vectors(g.x1 - g.v1 * t_b - c2, g.a + g.b)
     vn_kiss = vectors.dot_rows(g.vrel, n_kiss)
     kiss2 = kiss[:, None]
     n = np.where(kiss2, n_kiss, g.n)
@@ -311,7 +314,7 @@ def _round_perfect_kiss(g: _Round, cr: float, dt_s: float) -> _Outcome:
     # after its closest approach. Going forward t_b with the new velocities
     # parts the pair by (1 + cr) |vn| t_b.
     approach = np.where(kiss, vn_kiss < 0.0, g.vn < -REST_SPEED_MPS)
-    move = np.where(kiss, -(1.0 + cr) * vn_kiss * t_b[:, 0], _two_step_move(g, dt_s))
+    move = np.where(kiss, -(1.0 + cr) * vn_kiss * t_b[:, 0], _two_step_move(g, cr, dt_s))
     v1, v2 = collide_along_normal(g, n, vn, approach, cr)
     x1, x2 = separate(g, n, move, approach)
     return _Outcome(n, np.where(kiss2, c2, g.x2), approach, v1, v2, x1, x2)

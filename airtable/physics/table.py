@@ -150,7 +150,7 @@ class AirTable:
         self.cr_puck = 1.0
         self.cr_wall = 1.0
         self.wall_correction = True
-        self.puck_correction = "two-step"
+        self.puck_correction = "perfect-kiss"  # the accurate mode; two-step is taught in demo 2p
         self.puck_collisions = True
 
     @property
@@ -238,8 +238,13 @@ class AirTable:
         vel_mps: Sequence[float] = (0.0, 0.0),
         color="white",
     ) -> Puck:
-        """Add a puck; its mass is density * pi * r^2 (kg)."""
-        pos = as_vector(pos_m, "pos_m")
+        """Add a puck; its mass is density * pi * r^2 (kg).
+
+        A puck asked for outside the walls (or partly through one) is placed
+        at the nearest point inside: its edge on the wall it was beyond (at
+        the centre of the table along an axis the puck is too big for).
+        """
+        pos = self._nearest_inside(as_vector(pos_m, "pos_m"), _positive(radius_m, "radius_m"))
         vel = as_vector(vel_mps, "vel_mps")
         r = _positive(radius_m, "radius_m")
         rho = _positive(density_kgpm2, "density_kgpm2")
@@ -247,6 +252,12 @@ class AirTable:
         handle = Puck(self, row)
         self._puck_handles.append(handle)
         return handle
+
+    def _nearest_inside(self, pos: np.ndarray, r: float) -> np.ndarray:
+        """The point nearest pos where a puck of radius r is inside the walls."""
+        half = 0.5 * self.size_m
+        lo, hi = np.minimum(r, half), np.maximum(self.size_m - r, half)
+        return np.minimum(np.maximum(pos, lo), hi)
 
     def add_spring(
         self,
