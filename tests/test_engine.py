@@ -51,3 +51,58 @@ def test_a_puck_created_outside_the_walls_is_placed_at_the_nearest_point_inside(
 
 def test_the_default_correction_is_the_accurate_one() -> None:
     assert AirTable().puck_correction == "perfect-kiss"
+
+
+# ---------------------------------------------------------------- resting contact
+
+
+@pytest.mark.parametrize("restitution", [0.0, 0.9])
+def test_a_column_of_20_comes_to_rest_on_the_floor(restitution: float) -> None:
+    # 20 pucks of r = 0.2 m stacked on the floor, each touching the next: at
+    # rest the centres are at 0.2 + 0.4 k m. Under gravity each step adds
+    # g dt = 4 cm/s, which the contacts must take out again without a bounce.
+    table = AirTable()
+    table.gravity_on = True
+    table.cr_puck = table.cr_wall = restitution
+    for k in range(20):
+        table.add_puck(pos_m=(5.0, 0.2 + 0.4 * k), radius_m=0.2)
+    for _ in range(3 * 240):  # 3 s
+        table.step(1 / 240)
+    assert np.abs(table.vel_mps).max() < 1e-3  # every speed under 1 mm/s
+    heights = table.pos_m[:, 1]
+    np.testing.assert_allclose(heights, 0.2 + 0.4 * np.arange(20), rtol=0, atol=1e-3)
+    assert 7.8 - heights.max() < 0.02  # the top sunk less than 20 mm
+    np.testing.assert_allclose(table.pos_m[:, 0], 5.0, rtol=0, atol=1e-12)  # not thrown sideways
+    assert table.collision_count == 0  # resting contacts, never collisions
+
+
+@pytest.mark.parametrize("k_Npm", [10.0, 100.0])
+def test_a_spring_pressing_two_touching_pucks_together_gains_no_energy(k_Npm: float) -> None:
+    # Two pucks of r = 0.25 m touching (centres 0.5 m apart) on a spring of
+    # rest length 0.3 m: it presses them together with k * 0.2 N, and the
+    # contact holds them where they are. Energy: k 0.2^2 / 2, all in the spring.
+    table = AirTable()
+    a = table.add_puck(pos_m=(4.75, 4.0), radius_m=0.25)
+    b = table.add_puck(pos_m=(5.25, 4.0), radius_m=0.25)
+    table.add_spring(a, b, length_m=0.3, k_Npm=k_Npm, damper_Nspm=0.0)
+    e0 = 0.5 * k_Npm * 0.2**2
+    for _ in range(20 * 240):  # 20 s
+        table.step(1 / 240)
+    e1 = table.kinetic_energy_J() + table.spring_energy_J()
+    assert abs(e1 - e0) / e0 < 0.01
+
+
+def test_fast_collisions_under_gravity_keep_the_course_model() -> None:
+    # Gravity on, a 3 m/s head-on hit of equal pucks (far above the rest
+    # speed 2 g dt = 8 cm/s): the velocities swap exactly, as without gravity.
+    table = AirTable()
+    table.gravity_on = True
+    a = table.add_puck(pos_m=(3.0, 6.0), radius_m=0.25, vel_mps=(3.0, 0.0))
+    b = table.add_puck(pos_m=(4.0, 6.0), radius_m=0.25)
+    for _ in range(60):
+        table.step(1 / 240)
+        if table.collision_count:
+            break
+    assert table.collision_count == 1
+    assert a.vel_mps[0] == pytest.approx(0.0, abs=1e-12) and b.vel_mps[0] == pytest.approx(3.0, rel=1e-12)
+    assert a.vel_mps[1] == pytest.approx(b.vel_mps[1], rel=1e-12)  # both fell alike

@@ -14,7 +14,11 @@ and the numpy work of each is in a module of its own:
 4. puck pairs: the candidates from a neighbour list (broadphase.py), then
    collision + position correction one pair at a time (pairs.py), then a
    second look at the pairs the corrections pushed into overlap;
-5. walls again, since pushing pairs apart can push a puck into a wall.
+5. resting contacts: pucks pressing on each other or on a wall, approaching
+   slower than the rest speed, held up together by impulses (contacts.py);
+   stages 3 and 4 leave those to this one. Only when something presses:
+   gravity, springs, pulls or a rest speed set by hand;
+6. walls again, since pushing pairs apart can push a puck into a wall.
 """
 
 from __future__ import annotations
@@ -27,7 +31,7 @@ from collections.abc import Callable, Sequence
 import numpy as np
 
 from airtable.colors import rgb
-from airtable.physics import broadphase, forces, pairs, vectors, walls
+from airtable.physics import broadphase, contacts, forces, pairs, vectors, walls
 from airtable.physics.bodies import Puck, Spring, as_vector
 from airtable.physics.forces import GRAVITY_MPS2, Pull
 
@@ -136,6 +140,7 @@ class AirTable:
         )
         self._puck_handles: list[Puck] = []
         self._neighbours = broadphase.NeighbourList()
+        self._contacts = contacts.ContactSolver()
         self._spring_handles: list[Spring] = []
         self._events: list[tuple[float, int, Callable[[AirTable], None]]] = []
         self._event_seq = itertools.count()
@@ -152,6 +157,10 @@ class AirTable:
         self.wall_correction = True
         self.puck_correction = "perfect-kiss"  # the accurate mode; two-step is taught in demo 2p
         self.puck_collisions = True
+        # Contacts approaching slower than this (m/s), or than twice what the
+        # step's forces add to a puck's speed (2 g dt under gravity), are
+        # resting: held up by the contact stage, with no bounce.
+        self.rest_speed_mps = 0.0
 
     @property
     def puck_correction(self) -> str:
@@ -326,6 +335,7 @@ class AirTable:
         self._pucks.clear()
         self._springs.clear()
         self._events = []
+        self._contacts.forget()
         self.time_s = 0.0
         self.steps = 0
         self.collision_count = 0
@@ -401,15 +411,18 @@ class AirTable:
         self._run_due_events()
         self._collision_records, self._last_collisions = [], None
         if self._pucks.n:
+            kick = None
             if dt > 0.0:
                 drag = self._add_forces(pulls, dt)  # 1. forces
-                self._integrate(drag, dt)  # 2. semi-implicit Euler
+                kick = self._integrate(drag, dt)  # 2. semi-implicit Euler
             self.force_N[:] = 0.0  # the accumulators hold one step's forces
-            self._resolve_walls()  # 3. walls
-            if self.puck_collisions:
-                moved = self._resolve_pairs(dt)  # 4. puck pairs
-                if len(moved):
-                    self._resolve_walls(only=moved)  # 5. walls again, for the pucks pairs moved
+            rest = self._rest_speeds(kick, dt)  # below these speeds contacts rest, not bounce
+            self._resolve_walls(rest=None if rest is None else self._contacts.wall_rest(rest))  # 3. walls
+            moved = self._resolve_pairs(dt, rest) if self.puck_collisions else np.empty(0, dtype=np.intp)  # 4. pairs
+            if rest is not None and self._resolve_contacts(rest, dt):  # 5. resting contacts
+                moved = None  # every puck may have moved
+            if moved is None or len(moved):
+                self._resolve_walls(only=moved)  # 6. walls again, for the pucks the last stages moved
         self.time_s += dt
         self.steps += 1
 
@@ -431,13 +444,23 @@ class AirTable:
             forces.add_spring_forces(force, a, b, f1)
         return drag
 
-    def _integrate(self, drag: np.ndarray | None, dt: float) -> None:
-        """Semi-implicit Euler: v += (F/m + g) dt, the drag taken implicitly, then x += v dt."""
+    def _integrate(self, drag: np.ndarray | None, dt: float) -> np.ndarray | float | None:
+        """Semi-implicit Euler: v += (F/m + g) dt, the drag taken implicitly, then x += v dt.
+
+        Returns the speed the forces and gravity added to each puck (a number
+        if the same for all), or None if nothing pushed.
+        """
         pos, vel, force, mass = self.pos_m, self.vel_mps, self.force_N, self.mass_kg
+        kick = None
         if np.count_nonzero(force):  # usually nothing pushes: skip the (N, 2) update
-            vel += force * (dt / mass)[:, None]
-        if self.gravity_on:
+            dv = force * (dt / mass)[:, None]
+            if self.gravity_on:
+                dv[:, 1] -= GRAVITY_MPS2 * dt
+            vel += dv
+            kick = vectors.lengths(dv)
+        elif self.gravity_on:
             vel[:, 1] -= GRAVITY_MPS2 * dt
+            kick = GRAVITY_MPS2 * dt
         if drag is not None and drag.any():
             # The drag -c v is taken at the end of the step (backward Euler):
             # v_new = v - c v_new dt / m, stable for any c and mass.
@@ -448,18 +471,53 @@ class AirTable:
             speed = np.hypot(vel[:, 0], vel[:, 1])  # not lengths(): v^2 may overflow here
             vel *= np.minimum(1.0, MAX_SPEED_MPS / np.maximum(speed, 1e-300))[:, None]
         pos += vel * dt
+        return kick
 
-    def _resolve_walls(self, only: np.ndarray | None = None) -> None:
-        """Push pucks back inside the walls and bounce them (only the rows `only`, if given)."""
-        walls.resolve_walls(
-            self.pos_m, self.vel_mps, self.radius_m, self.size_m, self.cr_wall, self.wall_correction, only=only
+    def _rest_speeds(self, kick: np.ndarray | float | None, dt: float) -> np.ndarray | None:
+        """Each puck's rest speed: rest_speed_mps or twice its kick from this step's forces; None: all zero."""
+        floor = _non_negative(self.rest_speed_mps, "rest_speed_mps")
+        if kick is None and floor == 0.0:
+            return None  # nothing presses: every contact is a collision, as in the course's model
+        rest = np.full(self._pucks.n, floor)
+        if kick is not None:
+            np.maximum(rest, 2.0 * np.asarray(kick), out=rest)
+        return rest
+
+    def _resolve_contacts(self, rest: np.ndarray, dt: float) -> bool:
+        """Hold resting contacts (contacts.py); return whether there were any."""
+        if self.puck_collisions:
+            candidates = self._neighbours.pairs(self.pos_m, self.radius_m)
+        else:
+            none = np.empty(0, dtype=np.intp)
+            candidates = (none, none, np.empty(0))
+        return self._contacts.solve(
+            self.pos_m, self.vel_mps, self.radius_m, self.mass_kg, self.size_m, candidates, rest, dt
         )
 
-    def _resolve_pairs(self, dt: float) -> np.ndarray:
-        """Collide and part the overlapping pairs; return the rows they moved (a row may repeat)."""
+    def _resolve_walls(self, only: np.ndarray | None = None, rest: np.ndarray | None = None) -> None:
+        """Push pucks back inside the walls and bounce them (only the rows `only`, if given).
+
+        With `rest`, slow pucks are left to the contact stage (walls.resolve_walls).
+        """
+        walls.resolve_walls(
+            self.pos_m,
+            self.vel_mps,
+            self.radius_m,
+            self.size_m,
+            self.cr_wall,
+            self.wall_correction,
+            only=only,
+            rest=rest,
+        )
+
+    def _resolve_pairs(self, dt: float, rest: np.ndarray | None = None) -> np.ndarray:
+        """Collide and part the overlapping pairs; return the rows they moved (a row may repeat).
+
+        With `rest`, pairs approaching slower than their rest speed are left to the contact stage.
+        """
         pos, vel, radius, mass = self.pos_m, self.vel_mps, self.radius_m, self.mass_kg
         ci, cj, reach = self._neighbours.pairs(pos, radius)
-        i, j = broadphase.overlapping_pairs(pos, ci, cj, reach)
+        i, j = self._colliding(rest, *broadphase.overlapping_pairs(pos, ci, cj, reach))
         records, moved = [], []
         for attempt in range(1 + EXTRA_PASSES):
             if len(i) == 0:
@@ -474,12 +532,23 @@ class AirTable:
             # Parting a pair can push one of its pucks into a third one that
             # was already handled: look again among the same candidates,
             # collide those pairs too, and at last just push apart what is left.
-            i, j = broadphase.overlapping_pairs(pos, ci, cj, reach - OVERLAP_SLOP_M)
+            i, j = self._colliding(rest, *broadphase.overlapping_pairs(pos, ci, cj, reach - OVERLAP_SLOP_M))
         if not moved:
             return np.empty(0, dtype=np.intp)
         self._collision_records = records
         self.collision_count += sum(len(r) for r in records)
         return np.concatenate(moved)
+
+    def _colliding(self, rest: np.ndarray | None, i: np.ndarray, j: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """The pairs (i, j) that collide: all of them if rest is None, else those that approach
+        faster than their rest speed and did not press on each other in the last step."""
+        if rest is None or len(i) == 0:
+            return i, j
+        pos, vel = self.pos_m, self.vel_mps
+        n, _ = vectors.unit_vectors(vectors.take(pos, i) - vectors.take(pos, j), i + j)
+        vn = vectors.dot_rows(vectors.take(vel, i) - vectors.take(vel, j), n)
+        fast = np.flatnonzero((vn < -np.maximum(rest.take(i), rest.take(j))) & ~self._contacts.held(i, j))
+        return i.take(fast), j.take(fast)
 
     def _spring_forces(self, dt: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """(rows of p1, rows of p2, force on p1) for every spring; p2 gets minus that."""
