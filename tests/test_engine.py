@@ -106,3 +106,71 @@ def test_fast_collisions_under_gravity_keep_the_course_model() -> None:
     assert table.collision_count == 1
     assert a.vel_mps[0] == pytest.approx(0.0, abs=1e-12) and b.vel_mps[0] == pytest.approx(3.0, rel=1e-12)
     assert a.vel_mps[1] == pytest.approx(b.vel_mps[1], rel=1e-12)  # both fell alike
+
+
+# ---------------------------------------------------------------- fast pucks
+
+
+@pytest.mark.parametrize("dt_s", [1 / 60, 1 / 240])
+@pytest.mark.parametrize("mode", ["off", "two-step", "perfect-kiss"])
+@pytest.mark.parametrize("speed", [10.0, 50.0, 200.0])
+def test_a_fast_shot_hits_the_puck_in_its_path(speed: float, mode: str, dt_s: float) -> None:
+    # A 5 cm puck aimed dead centre at an equal still one 2 m away: the hit
+    # is head on, so the shooter stops and the target leaves at `speed`,
+    # however far the shooter moves in one step (up to 3.3 m: 33 diameters).
+    table = AirTable(width_m=60.0, height_m=10.0)
+    table.puck_correction = mode
+    shooter = table.add_puck(pos_m=(27.0 + 0.37 * speed * dt_s, 5.0), radius_m=0.05, vel_mps=(speed, 0.0))
+    target = table.add_puck(pos_m=(30.0, 5.0), radius_m=0.05)
+    for _ in range(int(3.0 / (speed * dt_s)) + 2):  # 3 m of travel
+        table.step(dt_s)
+    assert table.collision_count == 1
+    np.testing.assert_allclose(shooter.vel_mps, (0.0, 0.0), atol=1e-9 * speed)
+    np.testing.assert_allclose(target.vel_mps, (speed, 0.0), rtol=1e-12)
+    assert shooter.pos_m[0] < target.pos_m[0]
+
+
+def test_reverse_time_retraces_three_pucks_that_meet_in_one_step() -> None:
+    # dt = 0.1 s. A (1 kg-ish) at x = 1.0 moves at 2 m/s; B (twice as dense)
+    # at 1.35 and C at 1.58 are still; all r = 0.1. A hits B at t = 0.075 s,
+    # then B hits C at t = 0.075 + 0.03 / vB, still inside the step. Negating
+    # every velocity and stepping again must bring all three back.
+    table = AirTable()
+    a = table.add_puck(pos_m=(1.0, 4.0), radius_m=0.1, vel_mps=(2.0, 0.0))
+    b = table.add_puck(pos_m=(1.35, 4.0), radius_m=0.1, density_kgpm2=0.6)
+    c = table.add_puck(pos_m=(1.58, 4.0), radius_m=0.1)
+    start_pos, start_vel = table.pos_m.copy(), table.vel_mps.copy()
+    table.step(0.1)
+    assert table.collision_count == 2
+    table.vel_mps[:] *= -1.0
+    table.step(0.1)
+    assert table.collision_count == 4
+    np.testing.assert_allclose(table.pos_m, start_pos, rtol=0, atol=1e-12)
+    np.testing.assert_allclose(table.vel_mps, -start_vel, rtol=0, atol=1e-12)
+    del a, b, c
+
+
+# ---------------------------------------------------------------- pi from collisions
+
+
+@pytest.mark.parametrize(("n", "due"), [(0, 3), (1, 31), (2, 314), (3, 3141), (4, 31415)])
+def test_pi_from_collisions(n: int, due: int) -> None:
+    # A light puck at rest between the left wall and a puck 100^n times
+    # heavier coming at 1 m/s: floor(pi 10^n) collisions in all (Galperin),
+    # and the final velocities of the exact event-by-event 1D solution.
+    from airtable.bench_hard import pi_exact, pi_scene
+
+    table = AirTable(width_m=10.0, height_m=4.0)
+    light, heavy = pi_scene(table, n)
+    count, v_light, v_heavy = pi_exact(100.0**n)
+    assert count == due
+    for _ in range(4000):  # the heavy puck is back at x = 8 m by 2256 steps
+        table.step(1 / 240)
+        v1, v2 = light.vel_mps[0], heavy.vel_mps[0]
+        if 0.0 <= v1 <= v2:  # both going right, the heavy one faster: nothing more can happen
+            break
+    assert table.collision_count + table.wall_collision_count == due
+    # Round-off grows with the count; the light puck reaches 100^n / 10^n times its final speed.
+    assert light.vel_mps[0] == pytest.approx(v_light, rel=1e-10 * 10**n)
+    assert heavy.vel_mps[0] == pytest.approx(v_heavy, rel=1e-11)
+    np.testing.assert_allclose(table.vel_mps[:, 1], 0.0, atol=1e-12)

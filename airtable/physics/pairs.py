@@ -126,6 +126,26 @@ def disjoint_rounds(i: np.ndarray, j: np.ndarray, n: int) -> list[np.ndarray]:
     return [order[bounds[r] : bounds[r + 1]] for r in range(len(bounds) - 1)]
 
 
+def order_by_contact_time(pos, vel, radius, i, j, dt_s: float) -> tuple[np.ndarray, np.ndarray]:
+    """The pairs (i, j) sorted by when they first touched during the step, earliest first.
+
+    Only matters where pairs share a puck; elsewhere the order is left as is.
+    A pair whose overlap this step's motion does not explain counts as
+    touching at the start of the step.
+    """
+    if len(i) < 2 or np.bincount(np.concatenate([i, j])).max() < 2:
+        return i, j
+    d = vectors.take(pos, i) - vectors.take(pos, j)
+    w = vectors.take(vel, i) - vectors.take(vel, j)
+    reach = radius.take(i) + radius.take(j)
+    ww, dw = vectors.squared_lengths(w), vectors.dot_rows(d, w)
+    disc = np.maximum(dw * dw - ww * (vectors.squared_lengths(d) - reach * reach), 0.0)
+    back = (dw + np.sqrt(disc)) / np.where(ww > 0.0, ww, 1.0)  # how long ago they touched
+    back = np.where((ww > 0.0) & (back >= 0.0) & (back <= dt_s), back, dt_s)
+    order = np.argsort(-back, kind="stable")
+    return i.take(order), j.take(order)
+
+
 def resolve_pairs(
     pos: np.ndarray,
     vel: np.ndarray,

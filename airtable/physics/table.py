@@ -9,10 +9,13 @@ and the numpy work of each is in a module of its own:
 0. timed events (a demo's throw) that are due;
 1. forces: pulls (cursor strings) and springs (forces.py);
 2. integrate, semi-implicit Euler: v += (F/m + g) dt, the pulls' drag taken
-   implicitly, then x += v dt;
+   implicitly, then x += v dt; then the fast pucks (moving a good part of
+   their radius) are swept over the step, their hits resolved exactly at
+   first contact, in time order (sweep.py), so they never pass through;
 3. walls: push pucks back inside and bounce them (walls.py);
 4. puck pairs: the candidates from a neighbour list (broadphase.py), then
-   collision + position correction one pair at a time (pairs.py), then a
+   collision + position correction one pair at a time, in the order the
+   pairs met during the step (pairs.py), then a
    second look at the pairs the corrections pushed into overlap;
 5. resting contacts: pucks pressing on each other or on a wall, approaching
    slower than the rest speed, held up together by impulses (contacts.py);
@@ -31,7 +34,7 @@ from collections.abc import Callable, Sequence
 import numpy as np
 
 from airtable.colors import rgb
-from airtable.physics import broadphase, contacts, forces, pairs, vectors, walls
+from airtable.physics import broadphase, contacts, forces, pairs, sweep, vectors, walls
 from airtable.physics.bodies import Puck, Spring, as_vector
 from airtable.physics.forces import GRAVITY_MPS2, Pull
 
@@ -65,6 +68,18 @@ def _non_negative(value, what: str) -> float:
     if not (math.isfinite(v) and v >= 0.0):
         raise ValueError(f"{what} must be zero or a positive number, not {value!r}")
     return v
+
+
+def _swept_record(s: sweep.Swept, radius: np.ndarray) -> pairs.Collisions:
+    """The sweep's puck hits as a collision record: the pucks where they touched, overlap 0."""
+    i, j = np.array(s.i), np.array(s.j)
+    xi, xj = (np.array([x[k] for x in s.x]) for k in (0, 1))
+    vi0, vj0 = (np.array([v[k] for v in s.v_before]) for k in (0, 1))
+    vi1, vj1 = (np.array([v[k] for v in s.v_after]) for k in (0, 1))
+    n = np.array(s.normal)
+    reach = radius.take(i) + radius.take(j)
+    contact = xj + n * radius.take(j)[:, None]
+    return pairs.Collisions(i, j, n, contact, np.zeros(len(i)), reach, xi, xj, xi, xj, vi0, vj0, vi1, vj1)
 
 
 class _Columns:
@@ -338,7 +353,8 @@ class AirTable:
         self._contacts.forget()
         self.time_s = 0.0
         self.steps = 0
-        self.collision_count = 0
+        self.collision_count = 0  # puck-puck collisions since the start
+        self.wall_collision_count = 0  # bounces off a wall since the start
         self._collision_records: list[pairs.Collisions] = []
         self._last_collisions: pairs.Collisions | None = None
 
@@ -415,6 +431,7 @@ class AirTable:
             if dt > 0.0:
                 drag = self._add_forces(pulls, dt)  # 1. forces
                 kick = self._integrate(drag, dt)  # 2. semi-implicit Euler
+                self._sweep_fast(dt)  # 2b. fast pucks: their hits in time order, exactly
             self.force_N[:] = 0.0  # the accumulators hold one step's forces
             rest = self._rest_speeds(kick, dt)  # below these speeds contacts rest, not bounce
             self._resolve_walls(rest=None if rest is None else self._contacts.wall_rest(rest))  # 3. walls
@@ -473,6 +490,21 @@ class AirTable:
         pos += vel * dt
         return kick
 
+    def _sweep_fast(self, dt: float) -> None:
+        """Sweep the pucks that move a good part of their radius this step (sweep.py)."""
+        movers = sweep.fast_rows(self.vel_mps, self.radius_m, dt)
+        if len(movers) == 0:
+            return
+        s = sweep.sweep(
+            self.pos_m, self.vel_mps, self.radius_m, self.mass_kg, self.size_m,
+            self.cr_puck, self.cr_wall, dt, pucks=self.puck_collisions, movers=movers,
+            leave=self.puck_correction != "perfect-kiss",
+        )  # fmt: skip
+        self.wall_collision_count += s.walls
+        if s.i:
+            self._collision_records.append(_swept_record(s, self.radius_m))
+            self.collision_count += len(s.i)
+
     def _rest_speeds(self, kick: np.ndarray | float | None, dt: float) -> np.ndarray | None:
         """Each puck's rest speed: rest_speed_mps or twice its kick from this step's forces; None: all zero."""
         floor = _non_negative(self.rest_speed_mps, "rest_speed_mps")
@@ -499,7 +531,7 @@ class AirTable:
 
         With `rest`, slow pucks are left to the contact stage (walls.resolve_walls).
         """
-        walls.resolve_walls(
+        self.wall_collision_count += walls.resolve_walls(
             self.pos_m,
             self.vel_mps,
             self.radius_m,
@@ -523,6 +555,7 @@ class AirTable:
             if len(i) == 0:
                 break
             if attempt < EXTRA_PASSES:
+                i, j = pairs.order_by_contact_time(pos, vel, radius, i, j, dt)  # events in time order
                 records += pairs.resolve_pairs(pos, vel, radius, mass, i, j, self.cr_puck, self.puck_correction, dt)
             else:
                 pairs.push_apart(pos, radius, mass, i, j)
@@ -535,7 +568,7 @@ class AirTable:
             i, j = self._colliding(rest, *broadphase.overlapping_pairs(pos, ci, cj, reach - OVERLAP_SLOP_M))
         if not moved:
             return np.empty(0, dtype=np.intp)
-        self._collision_records = records
+        self._collision_records += records
         self.collision_count += sum(len(r) for r in records)
         return np.concatenate(moved)
 
