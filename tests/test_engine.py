@@ -174,3 +174,15 @@ def test_pi_from_collisions(n: int, due: int) -> None:
     assert light.vel_mps[0] == pytest.approx(v_light, rel=1e-10 * 10**n)
     assert heavy.vel_mps[0] == pytest.approx(v_heavy, rel=1e-11)
     np.testing.assert_allclose(table.vel_mps[:, 1], 0.0, atol=1e-12)
+
+
+def test_the_pi_demo_counts_the_digits_of_pi_and_stops_the_pucks(demos) -> None:
+    demo = demos["t"]
+    assert len(demo.variations) == 5
+    for n, due in enumerate((3, 31, 314, 3141)):
+        table = AirTable()
+        demo.build(table, n)
+        for _ in range(20 * 240):  # 20 s: done within 10
+            table.step(demo.dt_s)
+        assert table.collision_count + table.wall_collision_count == due
+        np.testing.assert_allclose(table.vel_mps, 0.0)  # stopped before the far wall
