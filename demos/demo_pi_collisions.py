@@ -3,11 +3,11 @@
 KEY = "t"
 TITLE = "Pi from collisions"
 NOTES = """
-A heavy puck slides at 1 m/s towards a light one that sits near the left wall. Every
-collision is elastic. Count every hit, puck on puck and puck on wall: with the heavy
-puck 100^n times heavier, the count is 3, 31, 314, 3141, 31415: the first digits of pi
-(G. Galperin, 2003). Left/Right change n. At n = 4 the light puck moves at thousands of
-m/s and bounces many times in one step; the engine finds each hit in time order.
+A heavy puck slides at 1 m/s towards a light one near the left wall, and every hit is
+elastic. Count every hit, puck on puck and puck on wall: with the heavy puck 100^n times
+heavier the count is 3, 31, 314, 3141, 31415, the first digits of pi (G. Galperin, 2003).
+Left/Right change n; at n = 4 the light puck bounces many times in one step, and the
+engine finds each hit in time order.
 """
 
 N_MAX = 4
