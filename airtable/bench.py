@@ -28,6 +28,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from airtable import bench_hard
 from airtable.memory import keep_freed_memory
 from airtable.physics import broadphase, vectors
 from airtable.physics.table import AirTable, kinetic_energy_J
@@ -472,6 +473,7 @@ def frames_section(args: argparse.Namespace) -> bool:
 SECTIONS: dict[str, Callable[[argparse.Namespace], bool]] = {
     "physics": physics_section,
     "frames": frames_section,
+    "hard": bench_hard.hard_section,
 }
 
 
