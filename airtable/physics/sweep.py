@@ -55,14 +55,30 @@ def fast_rows(vel: np.ndarray, radius: np.ndarray, dt: float) -> np.ndarray:
     return np.flatnonzero(vectors.squared_lengths(vel) > lim * lim)
 
 
-def _first_pair_hit(o, vel, radius, movers, t_now, dt):
-    """(t, mover, other) of the earliest hit of a mover with any puck after t_now, or None."""
-    d = o[movers][:, None, :] - o[None, :, :]  # origins: positions at t = 0
-    w = vel[movers][:, None, :] - vel[None, :, :]
-    reach = radius[movers][:, None] + radius[None, :]
-    ww = (w * w).sum(-1)
-    dw = (d * w).sum(-1)
-    dd = (d * d).sum(-1)
+def _near(o, vel, radius, rows, dt) -> tuple[np.ndarray, np.ndarray]:
+    """Pairs (row, other) whose paths over the step come within reach: each of `rows` against every puck.
+
+    Two pucks can touch during the step only if the middles of their paths are
+    closer than their reach plus half of each path.
+    """
+    mid = o + 0.5 * dt * vel
+    half = 0.5 * dt * vectors.lengths(vel)
+    d = mid[rows][:, None, :] - mid[None, :, :]
+    lim = radius[rows][:, None] + radius[None, :] + half[rows][:, None] + half[None, :]
+    near = (d * d).sum(-1) < lim * lim
+    near[np.arange(len(rows)), rows] = False
+    m, k = np.nonzero(near)
+    return rows.take(m), k
+
+
+def _first_pair_hit(o, vel, radius, ci, cj, t_now, dt):
+    """(t, a, b) of the earliest hit among the candidate pairs (ci, cj) after t_now, or None."""
+    if len(ci) == 0:
+        return None
+    d = vectors.take(o, ci) - vectors.take(o, cj)  # origins: positions at t = 0
+    w = vectors.take(vel, ci) - vectors.take(vel, cj)
+    reach = radius.take(ci) + radius.take(cj)
+    ww, dw, dd = vectors.squared_lengths(w), vectors.dot_rows(d, w), vectors.squared_lengths(d)
     # |d + w t|^2 = reach^2: ww t^2 + 2 dw t + dd - reach^2 = 0, the earlier root.
     disc = dw * dw - ww * (dd - reach * reach)
     ok = (disc > 0.0) & (ww > 0.0)
@@ -70,13 +86,11 @@ def _first_pair_hit(o, vel, radius, movers, t_now, dt):
     # Approaching at the hit, and not already touching at t_now (the pair stage's).
     gap_now = dd + 2.0 * dw * t_now + ww * t_now * t_now - reach * reach
     valid = ok & (t >= t_now - 1e-12 * dt) & (t <= dt) & (dw + ww * t < 0.0) & (gap_now > -1e-12 * reach * reach)
-    valid[np.arange(len(movers)), movers] = False
     if not valid.any():
         return None
     t = np.where(valid, t, np.inf)
     k = int(np.argmin(t))
-    m, other = divmod(k, len(o))
-    return float(t.flat[k]), int(movers[m]), other
+    return float(t[k]), int(ci[k]), int(cj[k])
 
 
 def _first_wall_hit(o, vel, radius, size_m, movers, t_now, dt):
@@ -115,8 +129,10 @@ def sweep(pos, vel, radius, mass, size_m, cr_puck, cr_wall, dt, pucks=True, move
     o = pos - vel * dt  # each puck's position at t = 0 of the step
     t_now = 0.0
     touched: set[int] = set()
+    none = np.empty(0, dtype=np.intp)
+    ci, cj = _near(o, vel, radius, movers, dt) if pucks else (none, none)
     for _ in range(MAX_EVENTS):
-        hit = _first_pair_hit(o, vel, radius, movers, t_now, dt) if pucks and len(pos) > 1 else None
+        hit = _first_pair_hit(o, vel, radius, ci, cj, t_now, dt)
         wall = _first_wall_hit(o, vel, radius, size_m, movers, t_now, dt)
         if wall is not None and (hit is None or wall[0] < hit[0]):
             t_now, a, axis = wall
@@ -125,6 +141,10 @@ def sweep(pos, vel, radius, mass, size_m, cr_puck, cr_wall, dt, pucks=True, move
             o[a] = x - vel[a] * t_now
             out.walls += 1
             touched.add(a)
+            if pucks:  # a new path for a: its candidates again
+                keep = (ci != a) & (cj != a)
+                ni, nj = _near(o, vel, radius, np.array([a]), dt)
+                ci, cj = np.concatenate([ci[keep], ni]), np.concatenate([cj[keep], nj])
         elif hit is not None:
             t_now, a, b = hit
             if leave and _ends_overlapping_and_approaching(o, vel, radius, a, b, dt):
@@ -132,6 +152,10 @@ def sweep(pos, vel, radius, mass, size_m, cr_puck, cr_wall, dt, pucks=True, move
             _collide(o, vel, mass, a, b, t_now, cr_puck, out)
             touched.update((a, b))
             movers = np.union1d(movers, [a, b])
+            # New paths for a and b: their candidates again.
+            keep = (ci != a) & (ci != b) & (cj != a) & (cj != b)
+            ni, nj = _near(o, vel, radius, np.array([a, b]), dt)
+            ci, cj = np.concatenate([ci[keep], ni]), np.concatenate([cj[keep], nj])
         else:
             break
     rows = np.fromiter(touched, dtype=np.intp, count=len(touched))
