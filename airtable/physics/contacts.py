@@ -8,8 +8,10 @@ time never lets support travel up a stack, so they get a stage of their own,
 after the collisions, in which walls and puck pairs take part together.
 
 Which contacts: pairs and puck-wall contacts that touch or nearly touch
-(gap under MARGIN_M) and approach slower than the rest speed (faster ones
-are collisions: they keep the course's model). Each contact k has a normal
+(gap under a margin: MARGIN_M plus as far as the stage may move a puck)
+and approach slower than the rest speed (faster ones are collisions: they
+keep the course's model), and pairs that pressed on each other in the last
+step, whatever their speed. Each contact k has a normal
 n (from body b to body a; a wall is a body that never moves) and asks:
 
 * velocity: the relative normal velocity vn after the stage is at least
@@ -47,7 +49,9 @@ ITERATIONS = 10
 SOLVER = "gs"
 OMEGA = 1.0
 CONVERGED_MPS = 1e-7
-# Contacts are the pairs closer than their reach plus this (m).
+# Contacts are the pairs closer than their reach plus this (m), plus as far
+# as this stage may move a puck in the step: a contact left out here is one
+# the stage can push a puck into (it is speculative: a gap may close, not more).
 MARGIN_M = 1e-3
 # Overlap left alone (m), so contacts stay touching from step to step.
 SLOP_M = 2e-5
@@ -71,10 +75,10 @@ class _Contacts:
     keys: np.ndarray  # one integer per contact, the same from step to step
 
 
-def _pair_contacts(pos, vel, ci, cj, reach, rest, held) -> _Contacts:
-    """The candidate pairs that touch (within MARGIN_M) and approach slower than their rest speed."""
+def _pair_contacts(pos, vel, ci, cj, reach, rest, held, margin) -> _Contacts:
+    """The candidate pairs that touch (within margin) and approach slower than their rest speed."""
     d = vectors.take(pos, ci) - vectors.take(pos, cj)
-    lim = reach + MARGIN_M
+    lim = reach + margin
     near = np.flatnonzero(vectors.squared_lengths(d) < lim * lim)
     i, j = ci.take(near), cj.take(near)
     n, dist = vectors.unit_vectors(vectors.take(d, near), i + j)
@@ -87,15 +91,15 @@ def _pair_contacts(pos, vel, ci, cj, reach, rest, held) -> _Contacts:
     return _Contacts(i, j, nc, dist.take(slow) - reach.take(near).take(slow), vn.take(slow), keys)
 
 
-def _wall_contacts(pos, vel, radius, size_m, rest) -> _Contacts:
-    """The pucks within MARGIN_M of a wall, moving into it slower than their rest speed (rest: (N, 2), per axis)."""
+def _wall_contacts(pos, vel, radius, size_m, rest, margin) -> _Contacts:
+    """The pucks within margin of a wall, moving into it slower than their rest speed (rest: (N, 2), per axis)."""
     x, y, vx, vy = pos[:, 0], pos[:, 1], vel[:, 0], vel[:, 1]
     width, height = size_m
     gaps = (x - radius, y - radius, width - x - radius, height - y - radius)
     speeds = (vx, vy, -vx, -vy)
     rows, walls, gap, vn = [], [], [], []
     for w in range(4):
-        k = np.flatnonzero((gaps[w] < MARGIN_M) & (speeds[w] >= -rest[:, w % 2]))
+        k = np.flatnonzero((gaps[w] < margin) & (speeds[w] >= -rest[:, w % 2]))
         rows.append(k)
         walls.append(np.full(len(k), w))
         gap.append(gaps[w].take(k))
@@ -195,8 +199,9 @@ class ContactSolver:
             self.forget()
             self._rows = len(pos)
         ci, cj, reach = candidates
-        pc = _pair_contacts(pos, vel, ci, cj, reach, rest, self.held)
-        wc = _wall_contacts(pos, vel, radius, size_m, self.wall_rest(rest))
+        margin = MARGIN_M + (2.0 * float(np.abs(vel).max()) + MAX_PUSH_MPS) * dt
+        pc = _pair_contacts(pos, vel, ci, cj, reach, rest, self.held, margin)
+        wc = _wall_contacts(pos, vel, radius, size_m, self.wall_rest(rest), margin)
         c = _Contacts(*(np.concatenate([getattr(pc, f), getattr(wc, f)]) for f in _Contacts.__dataclass_fields__))
         self.count = len(c.a)
         if self.count == 0:
