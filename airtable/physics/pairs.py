@@ -133,16 +133,24 @@ def order_by_contact_time(pos, vel, radius, i, j, dt_s: float) -> tuple[np.ndarr
     A pair whose overlap this step's motion does not explain counts as
     touching at the start of the step.
     """
-    if len(i) < 2 or np.bincount(np.concatenate([i, j])).max() < 2:
+    if len(i) < 2:
         return i, j
-    d = vectors.take(pos, i) - vectors.take(pos, j)
-    w = vectors.take(vel, i) - vectors.take(vel, j)
-    reach = radius.take(i) + radius.take(j)
+    uses = np.bincount(np.concatenate([i, j]))
+    shared = np.flatnonzero((uses.take(i) > 1) | (uses.take(j) > 1))
+    if len(shared) == 0:
+        return i, j
+    si, sj = i.take(shared), j.take(shared)
+    d = vectors.take(pos, si) - vectors.take(pos, sj)
+    w = vectors.take(vel, si) - vectors.take(vel, sj)
+    reach = radius.take(si) + radius.take(sj)
     ww, dw = vectors.squared_lengths(w), vectors.dot_rows(d, w)
     disc = np.maximum(dw * dw - ww * (vectors.squared_lengths(d) - reach * reach), 0.0)
     back = (dw + np.sqrt(disc)) / np.where(ww > 0.0, ww, 1.0)  # how long ago they touched
     back = np.where((ww > 0.0) & (back >= 0.0) & (back <= dt_s), back, dt_s)
-    order = np.argsort(-back, kind="stable")
+    alone = np.ones(len(i), dtype=bool)
+    alone[shared] = False
+    # Pairs that share no puck go in the first round wherever they are (disjoint_rounds).
+    order = np.concatenate([np.flatnonzero(alone), shared.take(np.argsort(-back, kind="stable"))])
     return i.take(order), j.take(order)
 
 
