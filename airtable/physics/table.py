@@ -437,9 +437,9 @@ class AirTable:
             self._resolve_walls(rest=None if rest is None else self._contacts.wall_rest(rest))  # 3. walls
             moved = self._resolve_pairs(dt, rest) if self.puck_collisions else np.empty(0, dtype=np.intp)  # 4. pairs
             if rest is not None and self._resolve_contacts(rest, dt):  # 5. resting contacts
-                moved = None  # every puck may have moved
-            if moved is None or len(moved):
-                self._resolve_walls(only=moved)  # 6. walls again, for the pucks the last stages moved
+                self._resolve_walls(rest=self._contacts.wall_rest(rest), hold=True)  # 6. walls again
+            elif len(moved):
+                self._resolve_walls(only=moved)  # 6. walls again, for the pucks the pairs moved
         self.time_s += dt
         self.steps += 1
 
@@ -526,10 +526,11 @@ class AirTable:
             self.pos_m, self.vel_mps, self.radius_m, self.mass_kg, self.size_m, candidates, rest, dt
         )
 
-    def _resolve_walls(self, only: np.ndarray | None = None, rest: np.ndarray | None = None) -> None:
+    def _resolve_walls(self, only: np.ndarray | None = None, rest: np.ndarray | None = None, hold=False) -> None:
         """Push pucks back inside the walls and bounce them (only the rows `only`, if given).
 
-        With `rest`, slow pucks are left to the contact stage (walls.resolve_walls).
+        With `rest`, slow pucks are left to the contact stage, or with `hold`
+        put on the surface without a bounce (walls.resolve_walls).
         """
         self.wall_collision_count += walls.resolve_walls(
             self.pos_m,
@@ -540,6 +541,7 @@ class AirTable:
             self.wall_correction,
             only=only,
             rest=rest,
+            hold_slow=hold,
         )
 
     def _resolve_pairs(self, dt: float, rest: np.ndarray | None = None) -> np.ndarray:

@@ -16,6 +16,7 @@ def resolve_walls(
     correction: bool,
     only: np.ndarray | None = None,
     rest: np.ndarray | None = None,
+    hold_slow: bool = False,
 ) -> int:
     """Keep every puck inside the box [0, size_m], in place; return how many bounced.
 
@@ -27,7 +28,9 @@ def resolve_walls(
 
     `rest`, if given, is each puck's rest speed (m/s; (N,) or (N, 2) per axis): a puck past a wall that
     moves into it no faster than that is left alone, for the contact stage
-    (contacts.py) to hold it up without a bounce.
+    (contacts.py) to hold it up without a bounce; with `hold_slow` (the last
+    pass, after that stage) it is put on the surface and stopped there
+    instead: a resting contact never bounces.
     """
     if len(pos) == 0:
         return 0
@@ -43,7 +46,10 @@ def resolve_walls(
     if only is not None:
         out = only.take(out)
     if rest is not None:
-        out = _fast_ones(pos, vel, radius, size_m, rest, out)
+        fast = _fast_ones(pos, vel, radius, size_m, rest, out)
+        if hold_slow:
+            _hold(pos, vel, radius, size_m, np.setdiff1d(out, fast))
+        out = fast
     p, v = vectors.take(pos, out), vectors.take(vel, out)
     lo = radius.take(out)[:, None]
     hi = size_m - lo
@@ -67,3 +73,16 @@ def _fast_ones(pos, vel, radius, size_m, rest, out: np.ndarray) -> np.ndarray:
     r = r[:, None] if r.ndim == 1 else r
     fast = ((p < lo) & (v < -r)) | ((p > size_m - lo) & (v > r))
     return out.take(np.flatnonzero(fast[:, 0] | fast[:, 1]))
+
+
+def _hold(pos, vel, radius, size_m, rows: np.ndarray) -> None:
+    """Put the rows on the surface of the walls they are past and stop their motion into them."""
+    if len(rows) == 0:
+        return
+    p, v = vectors.take(pos, rows), vectors.take(vel, rows)
+    lo = radius.take(rows)[:, None]
+    hi = size_m - lo
+    into = ((p < lo) & (v < 0.0)) | ((p > hi) & (v > 0.0))
+    vectors.put(vel, rows, np.where(into, 0.0, v))
+    half = 0.5 * size_m
+    vectors.put(pos, rows, np.minimum(np.maximum(p, np.minimum(lo, half)), np.maximum(hi, half)))
