@@ -91,7 +91,7 @@ def _pair_contacts(pos, vel, ci, cj, reach, rest, held, margin) -> _Contacts:
     vn = vectors.dot_rows(vectors.take(vel, i) - vectors.take(vel, j), n)
     slow = np.flatnonzero((vn >= -np.maximum(rest.take(i), rest.take(j))) | held(i, j))
     i, j = i.take(slow), j.take(slow)
-    nc = n.take(slow, axis=0) @ np.array([1.0, 1j])
+    nc = _as_complex(vectors.take(n, slow))
     count = len(pos)
     keys = i.astype(np.int64) * (count + 4) + j
     return _Contacts(i, j, nc, dist.take(slow) - reach.take(near).take(slow), vn.take(slow), keys)
@@ -115,6 +115,11 @@ def _wall_contacts(pos, vel, radius, size_m, rest, margin) -> _Contacts:
     keys = a.astype(np.int64) * (count + 4) + count + w
     b = np.full(len(a), count)
     return _Contacts(a, b, WALL_NORMALS.take(w), np.concatenate(gap), np.concatenate(vn), keys)
+
+
+def _as_complex(rows: np.ndarray) -> np.ndarray:
+    """(N, 2) float rows as N complex numbers x + iy (a matrix product with (1, i) is many times slower)."""
+    return np.ascontiguousarray(rows, dtype=np.float64).view(np.complex128).reshape(-1)
 
 
 def colour_rounds(a: np.ndarray, b: np.ndarray, n_bodies: int, prio: np.ndarray | None = None) -> list[np.ndarray]:
@@ -217,7 +222,7 @@ class ContactSolver:
         self._y, self._r_mean = pos[:, 1], float(radius.mean())
         rounds = self._gather(c, mass, len(pc.a), dt)
         w = np.zeros((len(pos) + 1, 2), dtype=complex)  # velocities and pseudo-velocities; the last row: walls
-        w[:-1, 0] = vel @ np.array([1.0, 1j])
+        w[:-1, 0] = _as_complex(vel)
         v0 = w[:-1, 0].copy()
         for g in rounds:  # warm start: last step's velocity impulses first
             _apply(w.reshape(-1), g, g.impulse * np.array([1.0, 0.0]))
