@@ -96,12 +96,15 @@ class Collisions:
         return Collisions(*(getattr(self, f).take(k, axis=0) for f in self.__dataclass_fields__))
 
 
-def disjoint_rounds(i: np.ndarray, j: np.ndarray, n: int) -> list[np.ndarray]:
+def disjoint_rounds(i: np.ndarray, j: np.ndarray, n: int, since=None) -> list[np.ndarray]:
     """Split pairs into rounds in which no puck appears twice.
 
     Keeps the pairs' order: a pair goes into the first round after every
     earlier pair that shares a puck with it. Resolving the rounds in turn is
     therefore the same as resolving the pairs one by one in the given order.
+    since(k), if given, says how long ago the pairs k met: then the pairs
+    that share a puck are taken in the order they met (events in time order)
+    instead of the given one.
     """
     m = len(i)
     if m == 0:
@@ -113,6 +116,8 @@ def disjoint_rounds(i: np.ndarray, j: np.ndarray, n: int) -> list[np.ndarray]:
     # For the others, level[k] = how many earlier pairs form a chain into
     # pair k. One pass in Python over just those, a handful per step.
     shared = np.flatnonzero((uses.take(i) > 1) | (uses.take(j) > 1))
+    if since is not None:
+        shared = shared.take(np.argsort(-since(shared), kind="stable"))  # the earliest contact first
     busy_until: dict[int, int] = {}  # per puck: first level at which it is free again
     levels = []
     for a, b in zip(i.take(shared).tolist(), j.take(shared).tolist(), strict=True):
@@ -126,32 +131,15 @@ def disjoint_rounds(i: np.ndarray, j: np.ndarray, n: int) -> list[np.ndarray]:
     return [order[bounds[r] : bounds[r + 1]] for r in range(len(bounds) - 1)]
 
 
-def order_by_contact_time(pos, vel, radius, i, j, dt_s: float) -> tuple[np.ndarray, np.ndarray]:
-    """The pairs (i, j) sorted by when they first touched during the step, earliest first.
-
-    Only matters where pairs share a puck; elsewhere the order is left as is.
-    A pair whose overlap this step's motion does not explain counts as
-    touching at the start of the step.
-    """
-    if len(i) < 2:
-        return i, j
-    uses = np.bincount(np.concatenate([i, j]))
-    shared = np.flatnonzero((uses.take(i) > 1) | (uses.take(j) > 1))
-    if len(shared) == 0:
-        return i, j
-    si, sj = i.take(shared), j.take(shared)
-    d = vectors.take(pos, si) - vectors.take(pos, sj)
-    w = vectors.take(vel, si) - vectors.take(vel, sj)
-    reach = radius.take(si) + radius.take(sj)
+def since_contact(pos, vel, radius, i, j, dt_s: float) -> np.ndarray:
+    """How long ago each pair (i, j) first touched during the step (dt_s if its motion does not explain it)."""
+    d = vectors.take(pos, i) - vectors.take(pos, j)
+    w = vectors.take(vel, i) - vectors.take(vel, j)
+    reach = radius.take(i) + radius.take(j)
     ww, dw = vectors.squared_lengths(w), vectors.dot_rows(d, w)
     disc = np.maximum(dw * dw - ww * (vectors.squared_lengths(d) - reach * reach), 0.0)
-    back = (dw + np.sqrt(disc)) / np.where(ww > 0.0, ww, 1.0)  # how long ago they touched
-    back = np.where((ww > 0.0) & (back >= 0.0) & (back <= dt_s), back, dt_s)
-    alone = np.ones(len(i), dtype=bool)
-    alone[shared] = False
-    # Pairs that share no puck go in the first round wherever they are (disjoint_rounds).
-    order = np.concatenate([np.flatnonzero(alone), shared.take(np.argsort(-back, kind="stable"))])
-    return i.take(order), j.take(order)
+    back = (dw + np.sqrt(disc)) / np.where(ww > 0.0, ww, 1.0)
+    return np.where((ww > 0.0) & (back >= 0.0) & (back <= dt_s), back, dt_s)
 
 
 def resolve_pairs(
@@ -164,16 +152,22 @@ def resolve_pairs(
     cr_puck: float,
     mode: str,
     dt_s: float,
+    in_time_order: bool = False,
 ) -> list[Collisions]:
     """Collide the overlapping pairs (i, j) in order, in place (see the module docstring).
 
-    Returns one record per round that collided anything; `Collisions.concatenate`
-    joins them, which is left to whoever reads them.
+    in_time_order: pairs that share a puck go in the order they met during
+    the step, not the given one. Returns one record per round that collided
+    anything; `Collisions.concatenate` joins them, which is left to whoever reads them.
     """
     if mode not in CORRECTION_MODES:
         raise ValueError(f"puck_correction must be one of {CORRECTION_MODES}, not {mode!r}")
+
+    def since(k):
+        return since_contact(pos, vel, radius, i.take(k), j.take(k), dt_s)
+
     records = []
-    for r in disjoint_rounds(i, j, len(pos)):
+    for r in disjoint_rounds(i, j, len(pos), since if in_time_order else None):
         c = _resolve_round(pos, vel, radius, mass, i.take(r), j.take(r), cr_puck, mode, dt_s)
         if c is not None:
             records.append(c)

@@ -52,8 +52,13 @@ class Swept:
 
 def fast_rows(vel: np.ndarray, radius: np.ndarray, dt: float) -> np.ndarray:
     """Rows that move more than FAST_FRACTION of their radius this step."""
-    lim = FAST_FRACTION * radius / dt if dt > 0.0 else np.full(len(radius), np.inf)
-    return np.flatnonzero(vectors.squared_lengths(vel) > lim * lim)
+    if dt <= 0.0 or len(vel) == 0:
+        return np.empty(0, dtype=np.intp)
+    v2 = vectors.squared_lengths(vel)
+    if v2.max() * dt * dt <= (FAST_FRACTION * float(radius.min())) ** 2:
+        return np.empty(0, dtype=np.intp)  # the usual case: nobody is that fast
+    lim = FAST_FRACTION * radius / dt
+    return np.flatnonzero(v2 > lim * lim)
 
 
 def _near(o, vel, radius, rows, dt) -> tuple[np.ndarray, np.ndarray]:

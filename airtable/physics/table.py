@@ -557,8 +557,9 @@ class AirTable:
             if len(i) == 0:
                 break
             if attempt < EXTRA_PASSES:
-                i, j = pairs.order_by_contact_time(pos, vel, radius, i, j, dt)  # events in time order
-                records += pairs.resolve_pairs(pos, vel, radius, mass, i, j, self.cr_puck, self.puck_correction, dt)
+                records += pairs.resolve_pairs(
+                    pos, vel, radius, mass, i, j, self.cr_puck, self.puck_correction, dt, in_time_order=True
+                )
             else:
                 pairs.push_apart(pos, radius, mass, i, j)
             moved += [i, j]
