@@ -28,6 +28,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from airtable import bench_hard
 from airtable.bench_cpu import cpu_section
 from airtable.bench_frames import window_section
 from airtable.bench_net_sections import link_section, snapshot_section
@@ -479,6 +480,7 @@ SECTIONS: dict[str, Callable[[argparse.Namespace], bool]] = {
     "window": window_section,
     "snapshots": snapshot_section,
     "link": link_section,
+    "hard": bench_hard.hard_section,
 }
 
 

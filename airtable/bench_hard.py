@@ -283,48 +283,57 @@ def fast_shot_case(speed_mps: float, dt_s: float, mode: str, engine_name: str = 
     return f"{passed} of {SHOTS} passed through"
 
 
-def pi_case(n: int, engine_name: str = "ours", max_steps: int = 2_000_000) -> str:
+def pi_case(n: int, engine_name: str = "ours", max_steps: int = 20_000) -> str:
+    """Count the collisions (pucks and walls) of the pi setup at mass ratio 100^n, against the exact count."""
     table = AirTable(width_m=10.0, height_m=4.0)
-    table.puck_correction = "perfect-kiss"
     pi_scene(table, n)
-    engine = table if engine_name == "ours" else PymunkMirror(table)
-    light_vx_prev = 0.0
-    walls = 0
+    light, heavy = table.pucks
     for _ in range(max_steps):
-        engine.step(DT_S)
-        vel = engine.vel_mps
-        if light_vx_prev < 0.0 <= vel[0, 0] and engine.pos_m[0, 0] < 0.5:
-            walls += 1
-        light_vx_prev = float(vel[0, 0])
-        if vel[0, 0] >= 0.0 and vel[1, 0] >= vel[0, 0] and engine.pos_m[1, 0] > 8.0:
+        table.step(DT_S)
+        if 0.0 <= light.vel_mps[0] <= heavy.vel_mps[0]:  # both going right, the heavy one faster: done
             break
-    pairs = table.collision_count if engine_name == "ours" else None
-    due, _, _ = pi_exact(100.0**n)
-    got = "?" if pairs is None else pairs + walls
-    passed = "; the light puck passed through" if engine.pos_m[0, 0] > engine.pos_m[1, 0] else ""
-    return f"n={n}: {got} collisions (due {due}){passed}"
+    due, v_light, v_heavy = pi_exact(100.0**n)
+    got = table.collision_count + table.wall_collision_count
+    err = max(abs(light.vel_mps[0] - v_light), abs(heavy.vel_mps[0] - v_heavy))
+    passed = "; the light puck passed through" if light.pos_m[0] > heavy.pos_m[0] else ""
+    return f"n={n}: {got} (due {due}), final velocities off by {err:.1g} m/s{passed}"
+
+
+def _row(case: str, ours: str, pymunk: str = "") -> None:
+    print(f"{case:<34} | {ours:<64} | {pymunk}", flush=True)
 
 
 def hard_section(args) -> bool:
-    """Print each hard case, ours beside pymunk where it applies. Always True: these are reports."""
-    engines = ["ours", "pymunk"] if _has_pymunk() and not getattr(args, "no_pymunk", False) else ["ours"]
+    """Print each hard case as a table row, ours beside pymunk where it applies. Always True: these are reports.
+
+    Before the engine work of issue 14 (main at the physics split, dt 1/240):
+    column of 20, e=0: v_rms 3.2 m/s, sunk 1.15 m, overlap 298 mm (pymunk: at rest, 8 mm, 0.9 mm);
+    e=0.9: v_rms 0.33 m/s, sunk 86 mm; pile of 800: KE 3.9 J after 10 s, overlap 93 mm, 10.5 ms a
+    step (pymunk 3e-6 J, 1.1 mm, 0.88 ms); fast shots passing through, of 40, at 10/50/200 m/s:
+    two-step 16/35/39 (dt 1/60) and 0/23/35 (1/240), perfect kiss 0/31/38 and 0/4/31; pi counts:
+    3 and 31 right, n=2 failed.
+    """
+    use_pymunk = _has_pymunk() and not getattr(args, "no_pymunk", False)
     print("\n== hard cases (dt 1/240 s unless said) ==")
+    _row("case", "ours", "pymunk" if use_pymunk else "")
     for e in (0.0, 0.9):
-        for name in engines:
-            print(f"column of {COLUMN_COUNT}, restitution {e:g}, {name}: {column_case(e, name)}", flush=True)
-    for name in engines:
-        print(f"pile of {PILE_COUNT}, {name}: {pile_case(name, 3.0 if args.quick else 10.0)}", flush=True)
+        _row(f"column of {COLUMN_COUNT}, restitution {e:g}", column_case(e, "ours"),
+             column_case(e, "pymunk") if use_pymunk else "")  # fmt: skip
+    seconds = 3.0 if args.quick else 10.0
+    _row(f"pile of {PILE_COUNT}", pile_case("ours", seconds), pile_case("pymunk", seconds) if use_pymunk else "")
     for label, build in (
         ("jelly 5x5", jelly_scene),
         ("hub on 6 spokes", hub_scene),
         ("12-spoke wheel", lambda t: hub_scene(t, 12, rim=True, k_Npm=2000.0)),
     ):
-        for name in engines:
-            print(f"{label}, {name}: {springs_case(build, name)}", flush=True)
+        _row(label, springs_case(build, "ours"), springs_case(build, "pymunk") if use_pymunk else "")
     for dt in (1 / 60, 1 / 240):
         for v in (10.0, 50.0, 200.0):
-            for mode in ("two-step", "perfect-kiss"):
-                print(f"fast shot {v:g} m/s, dt 1/{round(1 / dt)}, {mode}: {fast_shot_case(v, dt, mode)}", flush=True)
-    for n in range(3 if args.quick else 4):
-        print(f"pi from collisions, {pi_case(n)}", flush=True)
+            ours = ", ".join(
+                f"{mode} {fast_shot_case(v, dt, mode).split(' of')[0]}" for mode in ("two-step", "perfect-kiss", "off")
+            )
+            theirs = fast_shot_case(v, dt, "perfect-kiss", "pymunk") if use_pymunk else ""
+            _row(f"fast shot {v:g} m/s, dt 1/{round(1 / dt)}: through", f"{ours} of {SHOTS}", theirs)
+    for n in range(4 if args.quick else 5):
+        _row("pi from collisions", pi_case(n), "(no count)" if use_pymunk else "")
     return True

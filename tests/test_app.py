@@ -158,7 +158,10 @@ def test_help_screen_toggles_and_lists_every_key(app):
     assert app.show_help
     after = pygame.surfarray.array3d(app.window.surface)
     assert np.mean(np.any(before != after, axis=2)) > 0.3
-    press(app, pygame.K_F1)
+    for _ in range(3):  # F1 turns the pages of a help that needs more than one, then closes it
+        press(app, pygame.K_F1)
+        if not app.show_help:
+            break
     assert not app.show_help
 
 

@@ -72,7 +72,7 @@ def mechanical_energy(table: AirTable) -> float:
 
 def test_the_keys_are_exactly_the_builtin_set_and_all_load():
     assert ERRORS == []
-    assert list(DEMOS) == ["1", "2", "3", "4", "5", "6", "7", "8", "9", "0", "1p", "2p", "3p", "6p"]
+    assert list(DEMOS) == ["1", "2", "3", "4", "5", "6", "7", "8", "9", "0", "1p", "2p", "3p", "6p", "t"]
 
 
 @pytest.mark.parametrize("key", list(DEMOS))

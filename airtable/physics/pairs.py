@@ -16,7 +16,9 @@ overlaps).
 * "off": velocities only; the pucks stay overlapping ("stickiness").
 * "two-step": back both pucks up along their normal velocities for the
   penetration time t_p = overlap / |vn|, then forward t_p with the
-  restitution-1 normal velocities: the pair ends as far apart as it overlapped.
+  post-collision normal velocities: the pair parts by (1 + e) times the
+  overlap, so it ends e times the overlap apart (as far apart as it
+  overlapped at e = 1, touching at e = 0).
 * "perfect-kiss": back the pair up along its full relative motion to the
   moment of first contact, take the normal there, collide, and go forward
   again by the same time.
@@ -94,12 +96,15 @@ class Collisions:
         return Collisions(*(getattr(self, f).take(k, axis=0) for f in self.__dataclass_fields__))
 
 
-def disjoint_rounds(i: np.ndarray, j: np.ndarray, n: int) -> list[np.ndarray]:
+def disjoint_rounds(i: np.ndarray, j: np.ndarray, n: int, since=None) -> list[np.ndarray]:
     """Split pairs into rounds in which no puck appears twice.
 
     Keeps the pairs' order: a pair goes into the first round after every
     earlier pair that shares a puck with it. Resolving the rounds in turn is
     therefore the same as resolving the pairs one by one in the given order.
+    since(k), if given, says how long ago the pairs k met: then the pairs
+    that share a puck are taken in the order they met (events in time order)
+    instead of the given one.
     """
     m = len(i)
     if m == 0:
@@ -111,6 +116,8 @@ def disjoint_rounds(i: np.ndarray, j: np.ndarray, n: int) -> list[np.ndarray]:
     # For the others, level[k] = how many earlier pairs form a chain into
     # pair k. One pass in Python over just those, a handful per step.
     shared = np.flatnonzero((uses.take(i) > 1) | (uses.take(j) > 1))
+    if since is not None:
+        shared = shared.take(np.argsort(-since(shared), kind="stable"))  # the earliest contact first
     busy_until: dict[int, int] = {}  # per puck: first level at which it is free again
     levels = []
     for a, b in zip(i.take(shared).tolist(), j.take(shared).tolist(), strict=True):
@@ -124,6 +131,17 @@ def disjoint_rounds(i: np.ndarray, j: np.ndarray, n: int) -> list[np.ndarray]:
     return [order[bounds[r] : bounds[r + 1]] for r in range(len(bounds) - 1)]
 
 
+def since_contact(pos, vel, radius, i, j, dt_s: float) -> np.ndarray:
+    """How long ago each pair (i, j) first touched during the step (dt_s if its motion does not explain it)."""
+    d = vectors.take(pos, i) - vectors.take(pos, j)
+    w = vectors.take(vel, i) - vectors.take(vel, j)
+    reach = radius.take(i) + radius.take(j)
+    ww, dw = vectors.squared_lengths(w), vectors.dot_rows(d, w)
+    disc = np.maximum(dw * dw - ww * (vectors.squared_lengths(d) - reach * reach), 0.0)
+    back = (dw + np.sqrt(disc)) / np.where(ww > 0.0, ww, 1.0)
+    return np.where((ww > 0.0) & (back >= 0.0) & (back <= dt_s), back, dt_s)
+
+
 def resolve_pairs(
     pos: np.ndarray,
     vel: np.ndarray,
@@ -134,16 +152,22 @@ def resolve_pairs(
     cr_puck: float,
     mode: str,
     dt_s: float,
+    in_time_order: bool = False,
 ) -> list[Collisions]:
     """Collide the overlapping pairs (i, j) in order, in place (see the module docstring).
 
-    Returns one record per round that collided anything; `Collisions.concatenate`
-    joins them, which is left to whoever reads them.
+    in_time_order: pairs that share a puck go in the order they met during
+    the step, not the given one. Returns one record per round that collided
+    anything; `Collisions.concatenate` joins them, which is left to whoever reads them.
     """
     if mode not in CORRECTION_MODES:
         raise ValueError(f"puck_correction must be one of {CORRECTION_MODES}, not {mode!r}")
+
+    def since(k):
+        return since_contact(pos, vel, radius, i.take(k), j.take(k), dt_s)
+
     records = []
-    for r in disjoint_rounds(i, j, len(pos)):
+    for r in disjoint_rounds(i, j, len(pos), since if in_time_order else None):
         c = _resolve_round(pos, vel, radius, mass, i.take(r), j.take(r), cr_puck, mode, dt_s)
         if c is not None:
             records.append(c)
@@ -158,7 +182,7 @@ def push_apart(pos: np.ndarray, radius: np.ndarray, mass: np.ndarray, i: np.ndar
     a puck add their pushes. Used for the small overlaps a correction leaves
     behind; velocities (and so energy and momentum) are untouched.
     """
-    n, dist = vectors.unit_vectors(vectors.take(pos, i) - vectors.take(pos, j))
+    n, dist = vectors.unit_vectors(vectors.take(pos, i) - vectors.take(pos, j), i + j)
     left = np.maximum(radius.take(i) + radius.take(j) - dist, 0.0)
     m_i, m_j = mass.take(i), mass.take(j)
     push = (left / (m_i + m_j))[:, None] * n
@@ -207,7 +231,7 @@ def _gather(pos, vel, radius, mass, a, b) -> _Round | None:
     x1, x2 = vectors.take(pos, a), vectors.take(pos, b)
     r2 = radius.take(b)
     reach = radius.take(a) + r2
-    n, dist = vectors.unit_vectors(x1 - x2)
+    n, dist = vectors.unit_vectors(x1 - x2, a + b)
     overlap = reach - dist
     if np.count_nonzero(overlap > 0.0) < len(overlap):
         keep = np.flatnonzero(overlap > 0.0)
@@ -248,7 +272,7 @@ def separate(g: _Round, n: np.ndarray, move: np.ndarray, approach: np.ndarray):
     x2 = g.x2 - (move * g.share2)[:, None] * n
     d = x1 - x2
     if np.count_nonzero(vectors.squared_lengths(d) < g.reach * g.reach):
-        n_now, dist_now = vectors.unit_vectors(d)
+        n_now, dist_now = vectors.unit_vectors(d, g.a + g.b)
         left = np.maximum(g.reach - dist_now, 0.0)
         x1 = x1 + (left * g.share1)[:, None] * n_now
         x2 = x2 - (left * g.share2)[:, None] * n_now
@@ -262,21 +286,22 @@ def _round_off(g: _Round, cr: float, dt_s: float) -> _Outcome:
     return _Outcome(g.n, g.x2, approach, v1, v2, g.x1, g.x2)
 
 
-def _two_step_move(g: _Round, dt_s: float) -> np.ndarray:
+def _two_step_move(g: _Round, cr: float, dt_s: float) -> np.ndarray:
     """How far the two-step correction parts each pair along the normal.
 
-    Back up t_p = overlap / |vn|, then forward t_p with the restitution-1
-    normal velocities: the pair parts by 2 |vn| t_p = twice the overlap. An
+    Back up t_p = overlap / |vn| (the pair parts by |vn| t_p, the overlap),
+    then forward t_p with the normal velocities after the collision (it
+    parts by another e |vn| t_p): (1 + e) times the overlap in all. An
     overlap deeper than one step of approach can explain is capped there;
     `separate` pushes the rest apart.
     """
-    return 2.0 * np.minimum(g.overlap, -g.vn * dt_s)
+    return (1.0 + cr) * np.minimum(g.overlap, -g.vn * dt_s)
 
 
 def _round_two_step(g: _Round, cr: float, dt_s: float) -> _Outcome:
     approach = g.vn < -REST_SPEED_MPS
     v1, v2 = collide_along_normal(g, g.n, g.vn, approach, cr)
-    x1, x2 = separate(g, g.n, _two_step_move(g, dt_s), approach)
+    x1, x2 = separate(g, g.n, _two_step_move(g, cr, dt_s), approach)
     return _Outcome(g.n, g.x2, approach, v1, v2, x1, x2)
 
 
@@ -302,7 +327,7 @@ def _round_perfect_kiss(g: _Round, cr: float, dt_s: float) -> _Outcome:
         return _round_two_step(g, cr, dt_s)
     t_b = np.where(kiss, t_back, 0.0)[:, None]
     c2 = g.x2 - g.v2 * t_b  # both centres at first contact
-    n_kiss, _ = vectors.unit_vectors(g.x1 - g.v1 * t_b - c2)
+    n_kiss, _ = vectors.unit_vectors(g.x1 - g.v1 * t_b - c2, g.a + g.b)
     vn_kiss = vectors.dot_rows(g.vrel, n_kiss)
     kiss2 = kiss[:, None]
     n = np.where(kiss2, n_kiss, g.n)
@@ -311,7 +336,7 @@ def _round_perfect_kiss(g: _Round, cr: float, dt_s: float) -> _Outcome:
     # after its closest approach. Going forward t_b with the new velocities
     # parts the pair by (1 + cr) |vn| t_b.
     approach = np.where(kiss, vn_kiss < 0.0, g.vn < -REST_SPEED_MPS)
-    move = np.where(kiss, -(1.0 + cr) * vn_kiss * t_b[:, 0], _two_step_move(g, dt_s))
+    move = np.where(kiss, -(1.0 + cr) * vn_kiss * t_b[:, 0], _two_step_move(g, cr, dt_s))
     v1, v2 = collide_along_normal(g, n, vn, approach, cr)
     x1, x2 = separate(g, n, move, approach)
     return _Outcome(n, np.where(kiss2, c2, g.x2), approach, v1, v2, x1, x2)

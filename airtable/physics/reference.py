@@ -44,10 +44,14 @@ def _dot(a: Vec, b: Vec) -> float:
     return a[0] * b[0] + a[1] * b[1]
 
 
-def _unit(d: Vec) -> tuple[Vec, float]:
-    """d / |d| and |d|; two pucks exactly on top of each other get the normal (1, 0)."""
+def _unit(d: Vec, key: int = 0) -> tuple[Vec, float]:
+    """d / |d| and |d|; two pucks exactly on top of each other get the
+    direction key * the golden angle (key: the pair's i + j)."""
     dist = math.sqrt(d[0] * d[0] + d[1] * d[1])
-    return ((d[0] / dist, d[1] / dist) if dist > 0.0 else (1.0, 0.0)), dist
+    if dist > 0.0:
+        return (d[0] / dist, d[1] / dist), dist
+    angle = key * math.pi * (3.0 - math.sqrt(5.0))
+    return (math.cos(angle), math.sin(angle)), dist
 
 
 def collide_1d(u1: float, u2: float, m1: float, m2: float, cr: float) -> tuple[float, float]:
@@ -67,9 +71,9 @@ def collide_along(n: Vec, v1: Vec, v2: Vec, m1: float, m2: float, cr: float) -> 
     return _add(v1, _scale(w1 - u1, n)), _add(v2, _scale(w2 - u2, n))
 
 
-def _push_apart(x1: Vec, x2: Vec, p1: Disc, p2: Disc) -> tuple[Vec, Vec]:
+def _push_apart(x1: Vec, x2: Vec, p1: Disc, p2: Disc, key: int) -> tuple[Vec, Vec]:
     """Part a pair that still overlaps along its line of centres; the lighter puck moves more."""
-    n, dist = _unit(_sub(x1, x2))
+    n, dist = _unit(_sub(x1, x2), key)
     left = max(p1.r + p2.r - dist, 0.0)
     m_sum = p1.m + p2.m
     return _add(x1, _scale(left * p2.m / m_sum, n)), _sub(x2, _scale(left * p1.m / m_sum, n))
@@ -91,13 +95,15 @@ def _time_since_contact(p1: Disc, p2: Disc, dt_s: float) -> float | None:
     return t if 0.0 <= t <= dt_s * (1.0 + 1e-9) + 1e-15 else None
 
 
-def collide_pair(p1: Disc, p2: Disc, cr: float, mode: str, dt_s: float) -> tuple[Disc, Disc]:
+def collide_pair(p1: Disc, p2: Disc, cr: float, mode: str, dt_s: float, key: int = 0) -> tuple[Disc, Disc]:
     """The two pucks after their collision, with the position correction `mode`.
 
     mode is "off", "two-step" or "perfect-kiss"; dt_s is the step that
-    brought them into overlap. A pair that does not overlap is returned as is.
+    brought them into overlap; key (the pair's i + j) picks the direction
+    in which two pucks exactly on top of each other part. A pair that does
+    not overlap is returned as is.
     """
-    n, dist = _unit(_sub(p1.pos, p2.pos))
+    n, dist = _unit(_sub(p1.pos, p2.pos), key)
     overlap = p1.r + p2.r - dist
     if not overlap > 0.0:
         return p1, p2
@@ -111,21 +117,22 @@ def collide_pair(p1: Disc, p2: Disc, cr: float, mode: str, dt_s: float) -> tuple
         # contact, collide there along the normal at contact, and move forward
         # t with the new velocities. Approaching is judged at contact.
         c1, c2 = _sub(x1, _scale(t_kiss, v1)), _sub(x2, _scale(t_kiss, v2))
-        n, _ = _unit(_sub(c1, c2))
+        n, _ = _unit(_sub(c1, c2), key)
         if _dot(_sub(v1, v2), n) < 0.0:
             v1, v2 = collide_along(n, v1, v2, m1, m2, cr)
             x1, x2 = _add(c1, _scale(t_kiss, v1)), _add(c2, _scale(t_kiss, v2))
     elif vn < -REST_SPEED_MPS:
-        w1, w2 = collide_along(n, v1, v2, m1, m2, 1.0)  # restitution 1: for the correction only
         v1, v2 = collide_along(n, v1, v2, m1, m2, cr)
         if mode != "off":
             # Two-step: back up the penetration time t_p = overlap / |vn| along
-            # the normal velocities, then go forward t_p with the restitution-1
-            # normal velocities, so the pair ends as far apart as it overlapped.
-            # An overlap deeper than this step's approach is capped at dt.
+            # the normal velocities (the pair parts by the overlap), then go
+            # forward t_p with the normal velocities after the collision (it
+            # parts by e times the overlap more), so it ends e times the
+            # overlap apart: touching at e = 0. An overlap deeper than this
+            # step's approach is capped at dt.
             t_p = min(overlap / -vn, dt_s)
-            x1 = _add(x1, _scale(t_p * (_dot(w1, n) - _dot(p1.vel, n)), n))
-            x2 = _add(x2, _scale(t_p * (_dot(w2, n) - _dot(p2.vel, n)), n))
+            x1 = _add(x1, _scale(t_p * (_dot(v1, n) - _dot(p1.vel, n)), n))
+            x2 = _add(x2, _scale(t_p * (_dot(v2, n) - _dot(p2.vel, n)), n))
     if mode != "off":
-        x1, x2 = _push_apart(x1, x2, p1, p2)  # whatever still overlaps
+        x1, x2 = _push_apart(x1, x2, p1, p2, key)  # whatever still overlaps
     return Disc(x1, v1, p1.r, m1), Disc(x2, v2, p2.r, m2)

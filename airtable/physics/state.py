@@ -56,6 +56,7 @@ HANDLED = frozenset(
         "_events",
         "_event_seq",
         "_neighbours",
+        "_contacts",
         "notices",
         "_noticed",
         "_collision_records",
@@ -83,6 +84,7 @@ class TableState:
     neighbours: tuple[np.ndarray, np.ndarray] | None  # positions and radii of the neighbour list's build
     notices: tuple[str, ...]
     noticed: frozenset
+    contacts: tuple[np.ndarray, np.ndarray, int]  # the contact stage's warm start (ContactSolver.warm_start)
 
     @property
     def time_s(self) -> float:
@@ -94,7 +96,7 @@ class TableState:
 
     def parts(self) -> Iterator[tuple[object, int]]:
         """(object, bytes) of every sizeable part: the arrays and the handle tuples (some may be shared)."""
-        for a in (*self.pucks.values(), *self.springs.values(), *(self.neighbours or ())):
+        for a in (*self.pucks.values(), *self.springs.values(), *(self.neighbours or ()), *self.contacts[:2]):
             yield a, a.nbytes
         for t in (self.puck_handles, self.spring_handles):
             yield t, sys.getsizeof(t)
@@ -212,6 +214,7 @@ def capture(table: AirTable, like: TableState | None = None) -> TableState:
         neighbours=_neighbour_build(table, pucks, like),
         notices=_shared(tuple(table.notices), like.notices if like is not None else None),
         noticed=frozenset(table._noticed),
+        contacts=table._contacts.warm_start(),
     )
 
 
@@ -252,6 +255,7 @@ def restore(table: AirTable, state: TableState) -> None:
     table._noticed = set(state.noticed)
     table._collision_records, table._last_collisions = [], None
     _restore_neighbours(table, state.neighbours)
+    table._contacts.set_warm_start(*state.contacts)
 
 
 def _restore_neighbours(table: AirTable, build) -> None:

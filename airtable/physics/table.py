@@ -11,12 +11,20 @@ and the numpy work of each is in a module of its own:
    springs have beyond what an explicit step can hold is marked implicit;
 2. integrate, semi-implicit Euler: v += (F/m + g) dt, then x += v dt; the
    pulls' drag and the stiff springs' implicit parts are solved for
-   (implicit.py), so springs hold at any stiffness;
+   (implicit.py), so springs hold at any stiffness; then the fast pucks
+   (moving a good part of their radius) are swept over the step, their hits
+   resolved exactly at first contact, in time order (sweep.py), so they
+   never pass through;
 3. walls: push pucks back inside and bounce them (walls.py);
 4. puck pairs: the candidates from a neighbour list (broadphase.py), then
-   collision + position correction one pair at a time (pairs.py), then a
+   collision + position correction one pair at a time, in the order the
+   pairs met during the step (pairs.py), then a
    second look at the pairs the corrections pushed into overlap;
-5. walls again, since pushing pairs apart can push a puck into a wall.
+5. resting contacts: pucks pressing on each other or on a wall, approaching
+   slower than the rest speed, held up together by impulses (contacts.py);
+   stages 3 and 4 leave those to this one. Only when something presses:
+   gravity, springs, pulls or a rest speed set by hand;
+6. walls again, since pushing pairs apart can push a puck into a wall.
 """
 
 from __future__ import annotations
@@ -29,7 +37,7 @@ from collections.abc import Callable, Sequence
 import numpy as np
 
 from airtable.colors import rgb
-from airtable.physics import broadphase, forces, pairs, vectors, walls
+from airtable.physics import broadphase, contacts, forces, pairs, sweep, vectors, walls
 from airtable.physics import implicit as implicit_solve
 from airtable.physics.bodies import Puck, Spring, as_vector
 from airtable.physics.forces import GRAVITY_MPS2, Pull
@@ -71,6 +79,18 @@ def _non_negative(value, what: str) -> float:
     if not (math.isfinite(v) and v >= 0.0):
         raise ValueError(f"{what} must be zero or a positive number, not {value!r}")
     return v
+
+
+def _swept_record(s: sweep.Swept, radius: np.ndarray) -> pairs.Collisions:
+    """The sweep's puck hits as a collision record: the pucks where they touched, overlap 0."""
+    i, j = np.array(s.i), np.array(s.j)
+    xi, xj = (np.array([x[k] for x in s.x]) for k in (0, 1))
+    vi0, vj0 = (np.array([v[k] for v in s.v_before]) for k in (0, 1))
+    vi1, vj1 = (np.array([v[k] for v in s.v_after]) for k in (0, 1))
+    n = np.array(s.normal)
+    reach = radius.take(i) + radius.take(j)
+    contact = xj + n * radius.take(j)[:, None]
+    return pairs.Collisions(i, j, n, contact, np.zeros(len(i)), reach, xi, xj, xi, xj, vi0, vj0, vi1, vj1)
 
 
 class _Columns:
@@ -146,6 +166,7 @@ class AirTable:
         )
         self._puck_handles: list[Puck] = []
         self._neighbours = broadphase.NeighbourList()
+        self._contacts = contacts.ContactSolver()
         self._spring_handles: list[Spring] = []
         self._events: list[tuple[float, int, Callable[[AirTable], None]]] = []
         self._event_seq = itertools.count()
@@ -161,8 +182,12 @@ class AirTable:
         self.cr_puck = 1.0
         self.cr_wall = 1.0
         self.wall_correction = True
-        self.puck_correction = "two-step"
+        self.puck_correction = "perfect-kiss"  # the accurate mode; two-step is taught in demo 2p
         self.puck_collisions = True
+        # Contacts approaching slower than this (m/s), or than twice what the
+        # step's forces add to a puck's speed (2 g dt under gravity), are
+        # resting: held up by the contact stage, with no bounce.
+        self.rest_speed_mps = 0.0
 
     @property
     def puck_correction(self) -> str:
@@ -249,8 +274,13 @@ class AirTable:
         vel_mps: Sequence[float] = (0.0, 0.0),
         color="white",
     ) -> Puck:
-        """Add a puck; its mass is density * pi * r^2 (kg)."""
-        pos = as_vector(pos_m, "pos_m")
+        """Add a puck; its mass is density * pi * r^2 (kg).
+
+        A puck asked for outside the walls (or partly through one) is placed
+        at the nearest point inside: its edge on the wall it was beyond (at
+        the centre of the table along an axis the puck is too big for).
+        """
+        pos = self._nearest_inside(as_vector(pos_m, "pos_m"), _positive(radius_m, "radius_m"))
         vel = as_vector(vel_mps, "vel_mps")
         r = _positive(radius_m, "radius_m")
         rho = _positive(density_kgpm2, "density_kgpm2")
@@ -258,6 +288,12 @@ class AirTable:
         handle = Puck(self, row)
         self._puck_handles.append(handle)
         return handle
+
+    def _nearest_inside(self, pos: np.ndarray, r: float) -> np.ndarray:
+        """The point nearest pos where a puck of radius r is inside the walls."""
+        half = 0.5 * self.size_m
+        lo, hi = np.minimum(r, half), np.maximum(self.size_m - r, half)
+        return np.minimum(np.maximum(pos, lo), hi)
 
     def add_spring(
         self,
@@ -329,9 +365,11 @@ class AirTable:
         self.notices: list[str] = []  # sentences for the user, appended once each (see _notice)
         self._noticed: set = set()
         self._spring_dt_s = 1 / 240  # the dt the springs' effective stiffness was last worked out for
+        self._contacts.forget()
         self.time_s = 0.0
         self.steps = 0
-        self.collision_count = 0
+        self.collision_count = 0  # puck-puck collisions since the start
+        self.wall_collision_count = 0  # bounces off a wall since the start
         self._collision_records: list[pairs.Collisions] = []
         self._last_collisions: pairs.Collisions | None = None
 
@@ -408,15 +446,19 @@ class AirTable:
         self._run_due_events()
         self._collision_records, self._last_collisions = [], None
         if self._pucks.n:
+            kick = None
             if dt > 0.0:
                 implicit = self._add_forces(pulls, dt)  # 1. forces
-                self._integrate(implicit, dt)  # 2. semi-implicit Euler
+                kick = self._integrate(implicit, dt)  # 2. semi-implicit Euler
+                self._sweep_fast(dt)  # 2b. fast pucks: their hits in time order, exactly
             self.force_N[:] = 0.0  # the accumulators hold one step's forces
-            self._resolve_walls()  # 3. walls
-            if self.puck_collisions:
-                moved = self._resolve_pairs(dt)  # 4. puck pairs
-                if len(moved):
-                    self._resolve_walls(only=moved)  # 5. walls again, for the pucks pairs moved
+            rest = self._rest_speeds(kick, dt)  # below these speeds contacts rest, not bounce
+            self._resolve_walls(rest=None if rest is None else self._contacts.wall_rest(rest))  # 3. walls
+            moved = self._resolve_pairs(dt, rest) if self.puck_collisions else np.empty(0, dtype=np.intp)  # 4. pairs
+            if rest is not None and self._resolve_contacts(rest, dt):  # 5. resting contacts
+                self._resolve_walls(rest=self._contacts.wall_rest(rest), hold=True)  # 6. walls again
+            elif len(moved):
+                self._resolve_walls(only=moved)  # 6. walls again, for the pucks the pairs moved
         self.time_s += dt
         self.steps += 1
 
@@ -437,25 +479,38 @@ class AirTable:
             forces.add_spring_forces(force, a, b, f1)
         return implicit
 
-    def _integrate(self, implicit: forces.Implicit, dt: float) -> None:
-        """Semi-implicit Euler: v += (F/m + g) dt (the implicit parts solved for), then x += v dt."""
+    def _integrate(self, implicit: forces.Implicit, dt: float) -> np.ndarray | float | None:
+        """Semi-implicit Euler: v += (F/m + g) dt (the implicit parts solved for), then x += v dt.
+
+        Returns the speed the forces and gravity added to each puck (a number
+        if the same for all), or None if nothing pushed: the contact stage's
+        rest speeds come from it.
+        """
         pos, vel, force, mass = self.pos_m, self.vel_mps, self.force_N, self.mass_kg
+        kick = None
         if implicit.any:
             rhs = dt * (force + implicit.lag)
             if self.gravity_on:
                 rhs[:, 1] -= self.gravity_mps2 * dt * mass
-            vel += self._implicit_velocity_change(implicit, rhs, dt)
-        else:
-            if np.count_nonzero(force):  # usually nothing pushes: skip the (N, 2) update
-                vel += force * (dt / mass)[:, None]
+            dv = self._implicit_velocity_change(implicit, rhs, dt)
+            vel += dv
+            kick = vectors.lengths(dv)
+        elif np.count_nonzero(force):  # usually nothing pushes: skip the (N, 2) update
+            dv = force * (dt / mass)[:, None]
             if self.gravity_on:
-                vel[:, 1] -= self.gravity_mps2 * dt
+                dv[:, 1] -= self.gravity_mps2 * dt
+            vel += dv
+            kick = vectors.lengths(dv)
+        elif self.gravity_on:
+            vel[:, 1] -= self.gravity_mps2 * dt
+            kick = self.gravity_mps2 * dt
         # A last guard against runaway values; a cheap bound first: a speed
         # over the limit has a component over limit / sqrt(2).
         if np.abs(vel).max() > MAX_SPEED_MPS / math.sqrt(2.0):
             speed = np.hypot(vel[:, 0], vel[:, 1])  # not lengths(): v^2 may overflow here
             vel *= np.minimum(1.0, MAX_SPEED_MPS / np.maximum(speed, 1e-300))[:, None]
         pos += vel * dt
+        return kick
 
     def _implicit_velocity_change(self, implicit: forces.Implicit, rhs: np.ndarray, dt: float) -> np.ndarray:
         """dv from the implicit solve (implicit.py), with walls braced and the springs' turning taken in."""
@@ -481,23 +536,76 @@ class AirTable:
         walls = (self.size_m, self.cr_wall)
         return implicit_solve.brace_walls(self.pos_m, self.vel_mps, dv, self.radius_m, walls, implicit, released, dt)
 
-    def _resolve_walls(self, only: np.ndarray | None = None) -> None:
-        """Push pucks back inside the walls and bounce them (only the rows `only`, if given)."""
-        walls.resolve_walls(
-            self.pos_m, self.vel_mps, self.radius_m, self.size_m, self.cr_wall, self.wall_correction, only=only
+    def _sweep_fast(self, dt: float) -> None:
+        """Sweep the pucks that move a good part of their radius this step (sweep.py)."""
+        movers = sweep.fast_rows(self.vel_mps, self.radius_m, dt)
+        if len(movers) == 0:
+            return
+        s = sweep.sweep(
+            self.pos_m, self.vel_mps, self.radius_m, self.mass_kg, self.size_m,
+            self.cr_puck, self.cr_wall, dt, pucks=self.puck_collisions, movers=movers,
+            leave=self.puck_correction != "perfect-kiss",
+        )  # fmt: skip
+        self.wall_collision_count += s.walls
+        if s.i:
+            self._collision_records.append(_swept_record(s, self.radius_m))
+            self.collision_count += len(s.i)
+
+    def _rest_speeds(self, kick: np.ndarray | float | None, dt: float) -> np.ndarray | None:
+        """Each puck's rest speed: rest_speed_mps or twice its kick from this step's forces; None: all zero."""
+        floor = _non_negative(self.rest_speed_mps, "rest_speed_mps")
+        if kick is None and floor == 0.0:
+            return None  # nothing presses: every contact is a collision, as in the course's model
+        rest = np.full(self._pucks.n, floor)
+        if kick is not None:
+            np.maximum(rest, 2.0 * np.asarray(kick), out=rest)
+        return rest
+
+    def _resolve_contacts(self, rest: np.ndarray, dt: float) -> bool:
+        """Hold resting contacts (contacts.py); return whether there were any."""
+        if self.puck_collisions:
+            candidates = self._neighbours.pairs(self.pos_m, self.radius_m)
+        else:
+            none = np.empty(0, dtype=np.intp)
+            candidates = (none, none, np.empty(0))
+        return self._contacts.solve(
+            self.pos_m, self.vel_mps, self.radius_m, self.mass_kg, self.size_m, candidates, rest, dt
         )
 
-    def _resolve_pairs(self, dt: float) -> np.ndarray:
-        """Collide and part the overlapping pairs; return the rows they moved (a row may repeat)."""
+    def _resolve_walls(self, only: np.ndarray | None = None, rest: np.ndarray | None = None, hold=False) -> None:
+        """Push pucks back inside the walls and bounce them (only the rows `only`, if given).
+
+        With `rest`, slow pucks are left to the contact stage, or with `hold`
+        put on the surface without a bounce (walls.resolve_walls).
+        """
+        self.wall_collision_count += walls.resolve_walls(
+            self.pos_m,
+            self.vel_mps,
+            self.radius_m,
+            self.size_m,
+            self.cr_wall,
+            self.wall_correction,
+            only=only,
+            rest=rest,
+            hold_slow=hold,
+        )
+
+    def _resolve_pairs(self, dt: float, rest: np.ndarray | None = None) -> np.ndarray:
+        """Collide and part the overlapping pairs; return the rows they moved (a row may repeat).
+
+        With `rest`, pairs approaching slower than their rest speed are left to the contact stage.
+        """
         pos, vel, radius, mass = self.pos_m, self.vel_mps, self.radius_m, self.mass_kg
         ci, cj, reach = self._neighbours.pairs(pos, radius)
-        i, j = broadphase.overlapping_pairs(pos, ci, cj, reach)
+        i, j = self._colliding(rest, *broadphase.overlapping_pairs(pos, ci, cj, reach))
         records, moved = [], []
         for attempt in range(1 + EXTRA_PASSES):
             if len(i) == 0:
                 break
             if attempt < EXTRA_PASSES:
-                records += pairs.resolve_pairs(pos, vel, radius, mass, i, j, self.cr_puck, self.puck_correction, dt)
+                records += pairs.resolve_pairs(
+                    pos, vel, radius, mass, i, j, self.cr_puck, self.puck_correction, dt, in_time_order=True
+                )
             else:
                 pairs.push_apart(pos, radius, mass, i, j)
             moved += [i, j]
@@ -506,12 +614,23 @@ class AirTable:
             # Parting a pair can push one of its pucks into a third one that
             # was already handled: look again among the same candidates,
             # collide those pairs too, and at last just push apart what is left.
-            i, j = broadphase.overlapping_pairs(pos, ci, cj, reach - OVERLAP_SLOP_M)
+            i, j = self._colliding(rest, *broadphase.overlapping_pairs(pos, ci, cj, reach - OVERLAP_SLOP_M))
         if not moved:
             return np.empty(0, dtype=np.intp)
-        self._collision_records = records
+        self._collision_records += records
         self.collision_count += sum(len(r) for r in records)
         return np.concatenate(moved)
+
+    def _colliding(self, rest: np.ndarray | None, i: np.ndarray, j: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """The pairs (i, j) that collide: all of them if rest is None, else those that approach
+        faster than their rest speed and did not press on each other in the last step."""
+        if rest is None or len(i) == 0:
+            return i, j
+        pos, vel = self.pos_m, self.vel_mps
+        n, _ = vectors.unit_vectors(vectors.take(pos, i) - vectors.take(pos, j), i + j)
+        vn = vectors.dot_rows(vectors.take(vel, i) - vectors.take(vel, j), n)
+        fast = np.flatnonzero((vn < -np.maximum(rest.take(i), rest.take(j))) & ~self._contacts.held(i, j))
+        return i.take(fast), j.take(fast)
 
     def _spring_forces(
         self, dt: float, implicit: forces.Implicit | None = None

@@ -18,8 +18,16 @@ from __future__ import annotations
 
 import numpy as np
 
-# The direction given to a zero-length row (two pucks exactly on top of each other).
-FALLBACK_NORMAL = np.array([1.0, 0.0])
+# Two pucks exactly on top of each other have no line of centres. Each such
+# pair gets a direction of its own, turned by the golden angle per key, so
+# that a heap of pucks created at one point spreads in 2D, not along a line.
+GOLDEN_ANGLE_RAD = np.pi * (3.0 - np.sqrt(5.0))
+
+
+def fallback_directions(keys: np.ndarray) -> np.ndarray:
+    """(len(keys), 2) unit vectors at keys * the golden angle: deterministic, evenly spread."""
+    angle = GOLDEN_ANGLE_RAD * np.asarray(keys, dtype=float)
+    return np.column_stack([np.cos(angle), np.sin(angle)])
 
 
 def squared_lengths(d: np.ndarray) -> np.ndarray:
@@ -33,15 +41,21 @@ def lengths(d: np.ndarray) -> np.ndarray:
     return np.sqrt(squared_lengths(d))
 
 
-def unit_vectors(d: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Unit vectors along the rows of d and their lengths; zero rows get FALLBACK_NORMAL."""
+def unit_vectors(d: np.ndarray, keys: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """Unit vectors along the rows of d and their lengths.
+
+    A zero row gets `fallback_directions` of its key (keys: one integer per
+    row, e.g. a pair's i + j; the row number if not given).
+    """
     dist = lengths(d)
     # np.count_nonzero, here and in the step, costs a quarter of .all() or
     # .any(), whose Python-level wrappers dominate on a few dozen pairs.
     if np.count_nonzero(dist) == len(dist):
         return d / dist[:, None], dist
     safe = dist > 0.0
-    n = np.where(safe[:, None], d / np.where(safe, dist, 1.0)[:, None], FALLBACK_NORMAL)
+    zero = np.flatnonzero(~safe)
+    n = d / np.where(safe, dist, 1.0)[:, None]
+    n[zero] = fallback_directions(zero if keys is None else np.asarray(keys).take(zero))
     return n, dist
 
 

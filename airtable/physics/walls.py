@@ -15,6 +15,8 @@ def resolve_walls(
     cr_wall: float,
     correction: bool,
     only: np.ndarray | None = None,
+    rest: np.ndarray | None = None,
+    hold_slow: bool = False,
 ) -> int:
     """Keep every puck inside the box [0, size_m], in place; return how many bounced.
 
@@ -23,6 +25,12 @@ def resolve_walls(
     `correction` is on (where it would be had it bounced at the surface), else
     just placed on the surface. Its normal velocity reverses, times `cr_wall`,
     only if it was moving into that wall.
+
+    `rest`, if given, is each puck's rest speed (m/s; (N,) or (N, 2) per axis): a puck past a wall that
+    moves into it no faster than that is left alone, for the contact stage
+    (contacts.py) to hold it up without a bounce; with `hold_slow` (the last
+    pass, after that stage) it is put on the surface and stopped there
+    instead: a resting contact never bounces.
     """
     if len(pos) == 0:
         return 0
@@ -37,6 +45,11 @@ def resolve_walls(
     out = np.flatnonzero(~(room >= 0.0))  # NaN counts as outside
     if only is not None:
         out = only.take(out)
+    if rest is not None:
+        fast = _fast_ones(pos, vel, radius, size_m, rest, out)
+        if hold_slow:
+            _hold(pos, vel, radius, size_m, np.setdiff1d(out, fast))
+        out = fast
     p, v = vectors.take(pos, out), vectors.take(vel, out)
     lo = radius.take(out)[:, None]
     hi = size_m - lo
@@ -50,3 +63,26 @@ def resolve_walls(
     half = 0.5 * size_m
     vectors.put(pos, out, np.minimum(np.maximum(target, np.minimum(lo, half)), np.maximum(hi, half)))
     return int(np.count_nonzero(into))
+
+
+def _fast_ones(pos, vel, radius, size_m, rest, out: np.ndarray) -> np.ndarray:
+    """The rows `out` (past a wall) that move into a wall they are past faster than their rest speed."""
+    p, v = vectors.take(pos, out), vectors.take(vel, out)
+    lo = radius.take(out)[:, None]
+    r = rest.take(out, axis=0)
+    r = r[:, None] if r.ndim == 1 else r
+    fast = ((p < lo) & (v < -r)) | ((p > size_m - lo) & (v > r))
+    return out.take(np.flatnonzero(fast[:, 0] | fast[:, 1]))
+
+
+def _hold(pos, vel, radius, size_m, rows: np.ndarray) -> None:
+    """Put the rows on the surface of the walls they are past and stop their motion into them."""
+    if len(rows) == 0:
+        return
+    p, v = vectors.take(pos, rows), vectors.take(vel, rows)
+    lo = radius.take(rows)[:, None]
+    hi = size_m - lo
+    into = ((p < lo) & (v < 0.0)) | ((p > hi) & (v > 0.0))
+    vectors.put(vel, rows, np.where(into, 0.0, v))
+    half = 0.5 * size_m
+    vectors.put(pos, rows, np.minimum(np.maximum(p, np.minimum(lo, half)), np.maximum(hi, half)))

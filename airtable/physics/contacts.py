@@ -1,0 +1,329 @@
+"""Resting contact: pucks that press on each other or on a wall, solved together.
+
+A collision is an event: two pucks meet fast, bounce, and part (pairs.py).
+A resting contact is a state: a puck in a pile presses on its neighbours and
+on the floor step after step, approaching them each step only by what the
+step's forces added (g dt under gravity). Bouncing those contacts one at a
+time never lets support travel up a stack, so they get a stage of their own,
+after the collisions, in which walls and puck pairs take part together.
+
+Which contacts: pairs and puck-wall contacts that touch or nearly touch
+(gap under a margin: MARGIN_M plus as far as the stage may move a puck)
+and approach slower than the rest speed (faster ones are collisions: they
+keep the course's model), and pairs that pressed on each other in the last
+step, whatever their speed. Each contact k has a normal
+n (from body b to body a; a wall is a body that never moves) and asks:
+
+* velocity: the relative normal velocity vn after the stage is at least
+  `bound` (0 for pucks already touching: no bounce; for a pair still a gap
+  s apart, -s / dt: it may close the gap, not more);
+* position: a separate pseudo-velocity (a "split impulse") pushes out a
+  fraction POSITION_FRACTION of the overlap beyond SLOP_M per step. It moves
+  positions only and never enters the velocities, so correcting overlap
+  feeds no energy into the motion.
+
+Both are solved by sequential impulses (Erin Catto's; Box2D and Chipmunk
+solve contacts this way): each contact's impulse is accumulated over the
+iterations and clamped at zero (contacts push, never pull); a contact's
+impulse from the last step is applied first ("warm starting"), so a pile at
+rest starts from the answer. The contacts are coloured into rounds in which
+no puck appears twice, so each round is one numpy operation and still the
+exact sequential result.
+
+Order of the step: positions have already moved with the velocities when
+this stage runs, so a velocity change dv also moves the puck by dv dt: the
+stage gives the same result as solving contacts before the position update.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from airtable.physics import vectors
+
+# Iterations over all contacts per step (Box2D and pymunk use about ten);
+# the loop stops early once an iteration changes no velocity by CONVERGED_MPS.
+ITERATIONS = 10
+SOLVER = "gs"
+OMEGA = 1.0
+CONVERGED_MPS = 1e-7
+# Rounds go bottom-up by horizontal bands this many radii high (random inside
+# a band): support from the floor then travels up a pile within one
+# iteration. Bands of one contact each would be exact Gauss-Seidel from the
+# bottom but need a round per contact of the tallest stack; random order
+# alone is as cheap as these bands, and a 300-puck pile then keeps 3x the jitter.
+BAND_RADII = 8.0
+# Contacts are the pairs closer than their reach plus this (m), plus as far
+# as this stage may move a puck in the step: a contact left out here is one
+# the stage can push a puck into (it is speculative: a gap may close, not more).
+MARGIN_M = 1e-3
+# Overlap left alone (m), so contacts stay touching from step to step.
+SLOP_M = 2e-5
+# Share of the overlap beyond the slop pushed out per step.
+POSITION_FRACTION = 0.4
+MAX_PUSH_MPS = 0.5
+# The four walls as unit normals pointing into the table (complex x + iy):
+# left, bottom, right, top.
+WALL_NORMALS = np.array([1.0, 1j, -1.0, -1j])
+
+
+@dataclass
+class _Contacts:
+    """The contacts of one step: body a, body b (the row count for a wall), normal n from b to a."""
+
+    a: np.ndarray
+    b: np.ndarray
+    n: np.ndarray  # complex unit normals
+    gap: np.ndarray  # m, negative: overlap
+    vn: np.ndarray  # relative normal velocity, negative: approaching
+    keys: np.ndarray  # one integer per contact, the same from step to step
+
+
+def _pair_contacts(pos, vel, ci, cj, reach, rest, held, margin) -> _Contacts:
+    """The candidate pairs that touch (within margin) and approach slower than their rest speed."""
+    d = vectors.take(pos, ci) - vectors.take(pos, cj)
+    lim = reach + margin
+    near = np.flatnonzero(vectors.squared_lengths(d) < lim * lim)
+    i, j = ci.take(near), cj.take(near)
+    n, dist = vectors.unit_vectors(vectors.take(d, near), i + j)
+    vn = vectors.dot_rows(vectors.take(vel, i) - vectors.take(vel, j), n)
+    slow = np.flatnonzero((vn >= -np.maximum(rest.take(i), rest.take(j))) | held(i, j))
+    i, j = i.take(slow), j.take(slow)
+    nc = _as_complex(vectors.take(n, slow))
+    count = len(pos)
+    keys = i.astype(np.int64) * (count + 4) + j
+    return _Contacts(i, j, nc, dist.take(slow) - reach.take(near).take(slow), vn.take(slow), keys)
+
+
+def _wall_contacts(pos, vel, radius, size_m, rest, margin) -> _Contacts:
+    """The pucks within margin of a wall, moving into it slower than their rest speed (rest: (N, 2), per axis)."""
+    x, y, vx, vy = pos[:, 0], pos[:, 1], vel[:, 0], vel[:, 1]
+    width, height = size_m
+    gaps = (x - radius, y - radius, width - x - radius, height - y - radius)
+    speeds = (vx, vy, -vx, -vy)
+    rows, walls, gap, vn = [], [], [], []
+    for w in range(4):
+        k = np.flatnonzero((gaps[w] < margin) & (speeds[w] >= -rest[:, w % 2]))
+        rows.append(k)
+        walls.append(np.full(len(k), w))
+        gap.append(gaps[w].take(k))
+        vn.append(speeds[w].take(k))
+    a, w = np.concatenate(rows), np.concatenate(walls)
+    count = len(pos)
+    keys = a.astype(np.int64) * (count + 4) + count + w
+    b = np.full(len(a), count)
+    return _Contacts(a, b, WALL_NORMALS.take(w), np.concatenate(gap), np.concatenate(vn), keys)
+
+
+def _as_complex(rows: np.ndarray) -> np.ndarray:
+    """(N, 2) float rows as N complex numbers x + iy (a matrix product with (1, i) is many times slower)."""
+    return np.ascontiguousarray(rows, dtype=np.float64).view(np.complex128).reshape(-1)
+
+
+def colour_rounds(a: np.ndarray, b: np.ndarray, n_bodies: int, prio: np.ndarray | None = None) -> list[np.ndarray]:
+    """Split contacts (a, b) into rounds in which no body appears twice.
+
+    Vectorised: in each pass, a contact joins the round if it has the
+    highest priority (the lowest number in `prio`) among the remaining
+    contacts of both its bodies. By default the priorities are a fixed
+    scramble of the contact numbers, so that a row of contacts in index
+    order does not go one per round.
+    """
+    m = len(a)
+    if prio is None:
+        prio = (np.arange(m, dtype=np.uint64) * np.uint64(0x9E3779B1)) % np.uint64(1 << 32)
+    remaining = np.arange(m)
+    rounds = []
+    while len(remaining):
+        p, ra, rb = prio.take(remaining), a.take(remaining), b.take(remaining)
+        best = np.full(n_bodies, np.iinfo(np.uint64).max, dtype=np.uint64)
+        np.minimum.at(best, ra, p)
+        np.minimum.at(best, rb, p)
+        pick = (best.take(ra) == p) & (best.take(rb) == p)
+        rounds.append(remaining[pick])
+        remaining = remaining[~pick]
+    return rounds
+
+
+@dataclass
+class _Round:
+    """One round's contacts, gathered once per step: targets and impulses as (m, 2) [velocity, position]."""
+
+    fa: np.ndarray  # flat indices of body a's velocity and pseudo-velocity: 2 a, 2 a + 1
+    fb: np.ndarray
+    n: np.ndarray  # (m, 1) complex
+    wa: np.ndarray  # (2 m,) inverse masses, each twice
+    wb: np.ndarray
+    k: np.ndarray  # (m, 1) effective mass 1 / (wa + wb)
+    w_max: float  # the largest wa + wb, to turn an impulse into a speed
+    target: np.ndarray  # (m, 2): least relative normal velocity, and pseudo-velocity
+    impulse: np.ndarray  # (m, 2) accumulated, >= 0
+
+
+class ContactSolver:
+    """The contact stage, with the impulses it keeps from step to step for warm starting."""
+
+    def __init__(self) -> None:
+        self._keys = np.empty(0, dtype=np.int64)  # sorted
+        self._impulses = np.empty((0, 2))
+        self._rows = -1
+        self._round_keys: np.ndarray | None = None
+        self._rounds: list[np.ndarray] = []
+        self.count = 0  # contacts in the last step
+        self.iterations = 0  # iterations the last step needed
+
+    def held(self, i: np.ndarray, j: np.ndarray) -> np.ndarray:
+        """Which pairs (i, j) pressed on each other in the last step (a non-zero impulse).
+
+        Such a pair is a resting contact whatever its approach speed: a pile
+        whose contacts have not quite converged must not start to bounce.
+        """
+        if len(self._keys) == 0 or len(i) == 0:
+            return np.zeros(len(i), dtype=bool)
+        keys = i.astype(np.int64) * (self._rows + 4) + j
+        found = np.searchsorted(self._keys, keys).clip(0, len(self._keys) - 1)
+        return (self._keys.take(found) == keys) & (self._impulses[found, 0] > 0.0)
+
+    def wall_rest(self, rest: np.ndarray) -> np.ndarray:
+        """(N, 2) rest speeds towards the walls along x and y: infinite where the puck pressed
+        on a wall across that axis in the last step (it rests there whatever its speed)."""
+        out = np.repeat(rest[:, None], 2, axis=1)
+        if len(self._keys) == 0 or self._rows != len(rest):
+            return out
+        row, other = np.divmod(self._keys, self._rows + 4)
+        held = np.flatnonzero((other >= self._rows) & (self._impulses[:, 0] > 0.0))
+        out[row.take(held), (other.take(held) - self._rows) % 2] = np.inf
+        return out
+
+    def forget(self) -> None:
+        """Drop the kept impulses (pucks were added, removed or moved by hand)."""
+        self.__init__()
+
+    def warm_start(self) -> tuple[np.ndarray, np.ndarray, int]:
+        """What the next step starts from: the contacts' keys, their impulses and the row count they were made for."""
+        return self._keys.copy(), self._impulses.copy(), self._rows
+
+    def set_warm_start(self, keys: np.ndarray, impulses: np.ndarray, rows: int) -> None:
+        """Start the next step from `warm_start()`'s values (a rewound table); the round caches are rebuilt."""
+        self.__init__()
+        self._keys, self._impulses, self._rows = keys.copy(), impulses.copy(), rows
+
+    def solve(self, pos, vel, radius, mass, size_m, candidates, rest, dt) -> bool:
+        """Solve the resting contacts in place; return whether there were any.
+
+        candidates: (i, j, reach) pairs that may touch; rest: each puck's rest
+        speed (m/s): contacts approaching slower than it are resting.
+        """
+        if len(pos) != self._rows:
+            self.forget()
+            self._rows = len(pos)
+        ci, cj, reach = candidates
+        margin = MARGIN_M + (2.0 * float(np.abs(vel).max()) + MAX_PUSH_MPS) * dt
+        pc = _pair_contacts(pos, vel, ci, cj, reach, rest, self.held, margin)
+        wc = _wall_contacts(pos, vel, radius, size_m, self.wall_rest(rest), margin)
+        c = _Contacts(*(np.concatenate([getattr(pc, f), getattr(wc, f)]) for f in _Contacts.__dataclass_fields__))
+        self.count = len(c.a)
+        if self.count == 0:
+            self._keys, self._impulses = np.empty(0, dtype=np.int64), np.empty((0, 2))
+            return False
+        self._y, self._r_mean = pos[:, 1], float(radius.mean())
+        rounds = self._gather(c, mass, len(pc.a), dt)
+        w = np.zeros((len(pos) + 1, 2), dtype=complex)  # velocities and pseudo-velocities; the last row: walls
+        w[:-1, 0] = _as_complex(vel)
+        v0 = w[:-1, 0].copy()
+        for g in rounds:  # warm start: last step's velocity impulses first
+            _apply(w.reshape(-1), g, g.impulse * np.array([1.0, 0.0]))
+        self.iterations = _iterate(w, rounds)
+        self._keep(c, rounds)
+        moved = (w[:-1, 0] - v0 + w[:-1, 1]) * dt
+        pos += np.column_stack([moved.real, moved.imag])
+        vel[:, 0], vel[:, 1] = w[:-1, 0].real, w[:-1, 0].imag
+        return True
+
+    def _gather(self, c: _Contacts, mass, n_pairs: int, dt: float) -> list[_Round]:
+        """Per round: the bodies, inverse masses, targets and the warm-start impulses."""
+        rows = len(mass)
+        inv = np.append(1.0 / mass, 0.0)  # the walls never move
+        # Where the pair was at the start of the step, if it approached: the
+        # velocity bound keeps it from closing more than that gap.
+        s0 = c.gap - np.minimum(c.vn, 0.0) * dt
+        target = np.column_stack(
+            [
+                -np.maximum(s0, 0.0) / dt,
+                np.minimum(POSITION_FRACTION * np.maximum(-s0 - SLOP_M, 0.0) / dt, MAX_PUSH_MPS),
+            ]
+        )
+        impulse = np.zeros((len(c.keys), 2))  # pseudo-velocities start from nothing each step
+        if len(self._keys):
+            found = np.searchsorted(self._keys, c.keys).clip(0, len(self._keys) - 1)
+            hit = np.flatnonzero(self._keys.take(found) == c.keys)
+            impulse[hit, 0] = self._impulses[found.take(hit), 0]
+        if self._round_keys is None or not np.array_equal(self._round_keys, c.keys):
+            virtual = c.b.copy()
+            virtual[n_pairs:] = rows + 1 + np.arange(len(c.b) - n_pairs)  # each wall contact its own body
+            self._rounds = colour_rounds(c.a, virtual, rows + 1 + len(c.b) - n_pairs, self._bands(c))
+            self._round_keys = c.keys.copy()
+        wa, wb = inv.take(c.a), inv.take(c.b)
+        k = 1.0 / (wa + wb)
+        out = []
+        both = np.arange(2)
+        for r in self._rounds:
+            twice = np.repeat(r, 2)
+            out.append(
+                _Round(
+                    (2 * c.a.take(r)[:, None] + both).ravel(), (2 * c.b.take(r)[:, None] + both).ravel(),
+                    c.n.take(r[:, None]), wa.take(twice), wb.take(twice), k.take(r[:, None]),
+                    float((wa.take(r) + wb.take(r)).max()), target.take(r, axis=0), impulse.take(r, axis=0),
+                )
+            )  # fmt: skip
+        return out
+
+    def _bands(self, c: _Contacts) -> np.ndarray | None:
+        """Priorities bottom-up by bands of height (BAND_RADII radii), scrambled within a band."""
+        if BAND_RADII <= 0:
+            return None
+        y = self._y.take(c.a)
+        band = ((y - y.min()) / (BAND_RADII * self._r_mean)).astype(np.uint64)
+        m = len(y)
+        scramble = (np.arange(m, dtype=np.uint64) * np.uint64(0x9E3779B1)) % np.uint64(1 << 32)
+        return band * np.uint64(1 << 32) + scramble
+
+    def _keep(self, c: _Contacts, rounds: list[_Round]) -> None:
+        """Keep this step's impulses by contact key, for the next step's warm start."""
+        impulses = np.empty((len(c.keys), 2))
+        for r, g in zip(self._rounds, rounds, strict=True):
+            impulses[r] = g.impulse
+        order = np.argsort(c.keys)
+        self._keys, self._impulses = c.keys.take(order), impulses.take(order, axis=0)
+
+
+def _apply(flat: np.ndarray, g: _Round, impulse: np.ndarray) -> None:
+    """Add impulse (m, 2) along each contact's normal to body a, minus it to body b.
+
+    flat: the (rows + 1, 2) velocities seen as one row of numbers (1-D fancy
+    indexing is several times cheaper than 2-D). The walls' row takes many
+    writes in one round, all of them zero (wb = 0).
+    """
+    push = (impulse * g.n).reshape(-1)
+    flat[g.fa] += push * g.wa
+    flat[g.fb] -= push * g.wb
+
+
+def _iterate(w: np.ndarray, rounds: list[_Round]) -> int:
+    """Sequential impulses, round by round, until converged or ITERATIONS; return the iterations used."""
+    flat = w.reshape(-1)
+    for it in range(1, ITERATIONS + 1):
+        worst = 0.0
+        for g in rounds:
+            dv = (flat.take(g.fa) - flat.take(g.fb)).reshape(-1, 2)
+            vn = (g.n.conjugate() * dv).real
+            new = np.maximum(g.impulse + g.k * (g.target - vn), 0.0)
+            change = new - g.impulse
+            g.impulse = new
+            _apply(flat, g, change)
+            worst = max(worst, float(np.abs(change).max() * g.w_max))
+        if worst < CONVERGED_MPS:
+            return it
+    return ITERATIONS

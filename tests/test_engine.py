@@ -1,0 +1,205 @@
+"""The engine under real use (issue 14): the small ones, resting contact, fast shots, pi.
+
+Every expected number is worked out by hand here; every loop is bounded in steps.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from airtable import AirTable
+from airtable.physics.reference import Disc, collide_pair
+
+# ---------------------------------------------------------------- the small ones
+
+
+def test_two_step_at_restitution_0_leaves_the_pair_touching() -> None:
+    # Head on, equal masses (1 kg), 0.04 m of overlap closing at 2 m/s, e = 0:
+    # both end at 0 m/s; back up t_p = 0.02 s (each moves 0.02 m back), then
+    # forward 0.02 s at 0 m/s: centres 1.0 apart, exactly touching.
+    p1 = Disc((1.0, 0.0), (1.0, 0.0), 0.5, 1.0)
+    p2 = Disc((1.96, 0.0), (-1.0, 0.0), 0.5, 1.0)
+    q1, q2 = collide_pair(p1, p2, cr=0.0, mode="two-step", dt_s=1 / 20)
+    assert q1.vel == pytest.approx((0.0, 0.0)) and q2.vel == pytest.approx((0.0, 0.0))
+    assert q1.pos == pytest.approx((0.98, 0.0)) and q2.pos == pytest.approx((1.98, 0.0))
+
+
+def test_pucks_created_at_one_point_spread_in_2d() -> None:
+    table = AirTable()
+    for _ in range(50):
+        table.add_puck(pos_m=(5.0, 4.0), radius_m=0.1)
+    for _ in range(240):
+        table.step(1 / 240)
+    spread = table.pos_m - table.pos_m.mean(axis=0)
+    # Along a line, one of the two spreads would be zero.
+    assert spread[:, 0].std() > 0.2 and spread[:, 1].std() > 0.2
+    d = table.pos_m[:, None, :] - table.pos_m[None, :, :]
+    gap = np.hypot(d[..., 0], d[..., 1]) + 0.21 * np.eye(50)
+    assert gap.min() > 0.2 - 1e-3  # nobody overlaps by more than a millimetre
+
+
+@pytest.mark.parametrize(
+    ("asked", "placed"),
+    [((-100.0, -100.0), (0.25, 0.25)), ((3.0, 50.0), (3.0, 8.7556 - 0.25)), ((10.1, 4.0), (9.75, 4.0))],
+)
+def test_a_puck_created_outside_the_walls_is_placed_at_the_nearest_point_inside(asked, placed) -> None:
+    table = AirTable()
+    p = table.add_puck(pos_m=asked, radius_m=0.25)
+    np.testing.assert_allclose(p.pos_m, placed, rtol=0, atol=1e-12)
+
+
+def test_the_default_correction_is_the_accurate_one() -> None:
+    assert AirTable().puck_correction == "perfect-kiss"
+
+
+# ---------------------------------------------------------------- resting contact
+
+
+@pytest.mark.parametrize("restitution", [0.0, 0.9])
+def test_a_column_of_20_comes_to_rest_on_the_floor(restitution: float) -> None:
+    # 20 pucks of r = 0.2 m stacked on the floor, each touching the next: at
+    # rest the centres are at 0.2 + 0.4 k m. Under gravity each step adds
+    # g dt = 4 cm/s, which the contacts must take out again without a bounce.
+    table = AirTable()
+    table.gravity_on = True
+    table.cr_puck = table.cr_wall = restitution
+    for k in range(20):
+        table.add_puck(pos_m=(5.0, 0.2 + 0.4 * k), radius_m=0.2)
+    for _ in range(3 * 240):  # 3 s
+        table.step(1 / 240)
+    assert np.abs(table.vel_mps).max() < 1e-3  # every speed under 1 mm/s
+    heights = table.pos_m[:, 1]
+    np.testing.assert_allclose(heights, 0.2 + 0.4 * np.arange(20), rtol=0, atol=1e-3)
+    assert 7.8 - heights.max() < 0.02  # the top sunk less than 20 mm
+    np.testing.assert_allclose(table.pos_m[:, 0], 5.0, rtol=0, atol=1e-12)  # not thrown sideways
+    assert table.collision_count == 0  # resting contacts, never collisions
+
+
+@pytest.mark.parametrize("k_Npm", [10.0, 100.0])
+def test_a_spring_pressing_two_touching_pucks_together_gains_no_energy(k_Npm: float) -> None:
+    # Two pucks of r = 0.25 m touching (centres 0.5 m apart) on a spring of
+    # rest length 0.3 m: it presses them together with k * 0.2 N, and the
+    # contact holds them where they are. Energy: k 0.2^2 / 2, all in the spring.
+    table = AirTable()
+    a = table.add_puck(pos_m=(4.75, 4.0), radius_m=0.25)
+    b = table.add_puck(pos_m=(5.25, 4.0), radius_m=0.25)
+    table.add_spring(a, b, length_m=0.3, k_Npm=k_Npm, damper_Nspm=0.0)
+    e0 = 0.5 * k_Npm * 0.2**2
+    for _ in range(20 * 240):  # 20 s
+        table.step(1 / 240)
+    e1 = table.kinetic_energy_J() + table.spring_energy_J()
+    assert abs(e1 - e0) / e0 < 0.01
+
+
+def test_fast_collisions_under_gravity_keep_the_course_model() -> None:
+    # Gravity on, a 3 m/s head-on hit of equal pucks (far above the rest
+    # speed 2 g dt = 8 cm/s): the velocities swap exactly, as without gravity.
+    table = AirTable()
+    table.gravity_on = True
+    a = table.add_puck(pos_m=(3.0, 6.0), radius_m=0.25, vel_mps=(3.0, 0.0))
+    b = table.add_puck(pos_m=(4.0, 6.0), radius_m=0.25)
+    for _ in range(60):
+        table.step(1 / 240)
+        if table.collision_count:
+            break
+    assert table.collision_count == 1
+    assert a.vel_mps[0] == pytest.approx(0.0, abs=1e-12) and b.vel_mps[0] == pytest.approx(3.0, rel=1e-12)
+    assert a.vel_mps[1] == pytest.approx(b.vel_mps[1], rel=1e-12)  # both fell alike
+
+
+# ---------------------------------------------------------------- fast pucks
+
+
+@pytest.mark.parametrize("dt_s", [1 / 60, 1 / 240])
+@pytest.mark.parametrize("mode", ["off", "two-step", "perfect-kiss"])
+@pytest.mark.parametrize("speed", [10.0, 50.0, 200.0])
+def test_a_fast_shot_hits_the_puck_in_its_path(speed: float, mode: str, dt_s: float) -> None:
+    # A 5 cm puck aimed dead centre at an equal still one 2 m away: the hit
+    # is head on, so the shooter stops and the target leaves at `speed`,
+    # however far the shooter moves in one step (up to 3.3 m: 33 diameters).
+    table = AirTable(width_m=60.0, height_m=10.0)
+    table.puck_correction = mode
+    shooter = table.add_puck(pos_m=(27.0 + 0.37 * speed * dt_s, 5.0), radius_m=0.05, vel_mps=(speed, 0.0))
+    target = table.add_puck(pos_m=(30.0, 5.0), radius_m=0.05)
+    for _ in range(int(3.0 / (speed * dt_s)) + 2):  # 3 m of travel
+        table.step(dt_s)
+    assert table.collision_count == 1
+    np.testing.assert_allclose(shooter.vel_mps, (0.0, 0.0), atol=1e-9 * speed)
+    np.testing.assert_allclose(target.vel_mps, (speed, 0.0), rtol=1e-12)
+    assert shooter.pos_m[0] < target.pos_m[0]
+
+
+def test_reverse_time_retraces_three_pucks_that_meet_in_one_step() -> None:
+    # dt = 0.1 s. A (1 kg-ish) at x = 1.0 moves at 2 m/s; B (twice as dense)
+    # at 1.35 and C at 1.58 are still; all r = 0.1. A hits B at t = 0.075 s,
+    # then B hits C at t = 0.075 + 0.03 / vB, still inside the step. Negating
+    # every velocity and stepping again must bring all three back.
+    table = AirTable()
+    a = table.add_puck(pos_m=(1.0, 4.0), radius_m=0.1, vel_mps=(2.0, 0.0))
+    b = table.add_puck(pos_m=(1.35, 4.0), radius_m=0.1, density_kgpm2=0.6)
+    c = table.add_puck(pos_m=(1.58, 4.0), radius_m=0.1)
+    start_pos, start_vel = table.pos_m.copy(), table.vel_mps.copy()
+    table.step(0.1)
+    assert table.collision_count == 2
+    table.vel_mps[:] *= -1.0
+    table.step(0.1)
+    assert table.collision_count == 4
+    np.testing.assert_allclose(table.pos_m, start_pos, rtol=0, atol=1e-12)
+    np.testing.assert_allclose(table.vel_mps, -start_vel, rtol=0, atol=1e-12)
+    del a, b, c
+
+
+# ---------------------------------------------------------------- pi from collisions
+
+
+@pytest.mark.parametrize(("n", "due"), [(0, 3), (1, 31), (2, 314), (3, 3141), (4, 31415)])
+def test_pi_from_collisions(n: int, due: int) -> None:
+    # A light puck at rest between the left wall and a puck 100^n times
+    # heavier coming at 1 m/s: floor(pi 10^n) collisions in all (Galperin),
+    # and the final velocities of the exact event-by-event 1D solution.
+    from airtable.bench_hard import pi_exact, pi_scene
+
+    table = AirTable(width_m=10.0, height_m=4.0)
+    light, heavy = pi_scene(table, n)
+    count, v_light, v_heavy = pi_exact(100.0**n)
+    assert count == due
+    for _ in range(4000):  # the heavy puck is back at x = 8 m by 2256 steps
+        table.step(1 / 240)
+        v1, v2 = light.vel_mps[0], heavy.vel_mps[0]
+        if 0.0 <= v1 <= v2:  # both going right, the heavy one faster: nothing more can happen
+            break
+    assert table.collision_count + table.wall_collision_count == due
+    # Round-off grows with the count; the light puck reaches 100^n / 10^n times its final speed.
+    assert light.vel_mps[0] == pytest.approx(v_light, rel=1e-10 * 10**n)
+    assert heavy.vel_mps[0] == pytest.approx(v_heavy, rel=1e-11)
+    np.testing.assert_allclose(table.vel_mps[:, 1], 0.0, atol=1e-12)
+
+
+def test_the_pi_demo_counts_the_digits_of_pi_and_stops_the_pucks(demos) -> None:
+    demo = demos["t"]
+    assert len(demo.variations) == 5
+    for n, due in enumerate((3, 31, 314, 3141)):
+        table = AirTable()
+        demo.build(table, n)
+        for _ in range(20 * 240):  # 20 s: done within 10
+            table.step(demo.dt_s)
+        assert table.collision_count + table.wall_collision_count == due
+        np.testing.assert_allclose(table.vel_mps, 0.0)  # stopped before the far wall
+
+
+def test_a_pile_dropped_into_a_box_comes_to_rest_without_sinking() -> None:
+    # 120 pucks of r = 0.1 m dropped into a 2.5 m wide box at up to 1 m/s,
+    # restitution 0.5: after 6 s nothing moves (a puck at 1 mm/s has
+    # 5e-9 J) and no two pucks overlap by more than 2 mm.
+    from airtable.bench_hard import pile_scene
+
+    table = AirTable(width_m=2.5, height_m=4.0)
+    pile_scene(table, n=120)
+    for _ in range(6 * 240):
+        table.step(1 / 240)
+    assert table.kinetic_energy_J() < 1e-4
+    d = table.pos_m[:, None, :] - table.pos_m[None, :, :]
+    gap = np.hypot(d[..., 0], d[..., 1]) + np.eye(120)
+    assert gap.min() > 0.2 - 2e-3
+    assert np.all(table.pos_m >= 0.1) and np.all(table.pos_m <= table.size_m - 0.1)
