@@ -21,6 +21,7 @@ from airtable.app.saved_demo import DEFAULT_FOLDER as SAVED_DEMOS_DIR
 from airtable.app.saved_demo import check_save_demo_path
 from airtable.assets import ASSETS_DIR
 from airtable.memory import keep_freed_memory
+from airtable.net.server import validate_server_options
 
 HEADLESS_FRAME_S = 1 / 60  # a headless run with no server: simulated frames of this length
 
@@ -237,6 +238,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     os.environ.setdefault("PYGAME_HIDE_SUPPORT_PROMPT", "1")
     parser = build_parser()
     args = parser.parse_args(argv)
+    if not args.no_server:  # refuse what the server would, in the server's own words
+        validate_server_options(args.port, args.max_clients, args.snapshot_hz, error=parser.error)
     keep_freed_memory()  # the step's big temporary arrays are reused, not re-faulted (35 % at 10000 pucks)
     if args.new_demo:
         try:
