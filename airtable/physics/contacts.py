@@ -201,15 +201,6 @@ class ContactSolver:
         """Drop the kept impulses (pucks were added, removed or moved by hand)."""
         self.__init__()
 
-    def warm_start(self) -> tuple[np.ndarray, np.ndarray, int]:
-        """What the next step starts from: the contacts' keys, their impulses and the row count they were made for."""
-        return self._keys.copy(), self._impulses.copy(), self._rows
-
-    def set_warm_start(self, keys: np.ndarray, impulses: np.ndarray, rows: int) -> None:
-        """Start the next step from `warm_start()`'s values (a rewound table); the round caches are rebuilt."""
-        self.__init__()
-        self._keys, self._impulses, self._rows = keys.copy(), impulses.copy(), rows
-
     def solve(self, pos, vel, radius, mass, size_m, candidates, rest, dt) -> bool:
         """Solve the resting contacts in place; return whether there were any.
 

@@ -22,6 +22,8 @@ What a state holds, and why each part is needed:
   where the pucks were when the list was built, and a stale list can miss a
   pair a correction pushed into overlap where a fresh one would see it;
   rebuilding from the same positions gives the same list again;
+- the contact stage's warm start (last step's impulses, by contact) and the
+  rounds it solves in, when the table has that stage (CONTACT_KEPT);
 - the notices already given (so each is still said once).
 
 Not kept: what the last step's collisions were (`last_collisions`, for the
@@ -64,6 +66,13 @@ HANDLED = frozenset(
     }
 )
 PLAIN_TYPES = (bool, int, float, str, type(None))
+# What the contact stage keeps from step to step: its impulses by contact (the warm start), and
+# the rounds it solves in, kept while the contacts stay the same (their order depends on where
+# the pucks were when they were formed, so they change results). The stage replaces these
+# arrays each step and never changes them in place, so a state keeps references.
+CONTACT_KEPT = ("_keys", "_impulses", "_rows", "_round_keys", "_rounds", "count", "iterations")
+# Worked out afresh at the start of every contact stage: nothing to keep.
+CONTACT_SCRATCH = frozenset({"_y", "_r_mean"})
 # The Python objects of one state beside its arrays' data (the state, its dicts and tuples,
 # the arrays' headers): tracemalloc measures 1.0 to 1.2 kB, with or without springs.
 STATE_OVERHEAD_BYTES = 1600
@@ -82,9 +91,9 @@ class TableState:
     events: tuple  # the scheduled (t_s, seq, fn), in heap order
     next_event_seq: int
     neighbours: tuple[np.ndarray, np.ndarray] | None  # positions and radii of the neighbour list's build
+    contacts: tuple | None  # the contact stage's CONTACT_KEPT values
     notices: tuple[str, ...]
     noticed: frozenset
-    contacts: tuple[np.ndarray, np.ndarray, int]  # the contact stage's warm start (ContactSolver.warm_start)
 
     @property
     def time_s(self) -> float:
@@ -96,7 +105,7 @@ class TableState:
 
     def parts(self) -> Iterator[tuple[object, int]]:
         """(object, bytes) of every sizeable part: the arrays and the handle tuples (some may be shared)."""
-        for a in (*self.pucks.values(), *self.springs.values(), *(self.neighbours or ()), *self.contacts[:2]):
+        for a in (*self.pucks.values(), *self.springs.values(), *(self.neighbours or ()), *_contact_arrays(self)):
             yield a, a.nbytes
         for t in (self.puck_handles, self.spring_handles):
             yield t, sys.getsizeof(t)
@@ -129,6 +138,7 @@ def unchanged(new: TableState, old: TableState) -> bool:
         and new.events == old.events
         and new.next_event_seq == old.next_event_seq
         and new.neighbours is old.neighbours
+        and new.contacts is old.contacts
         and new.notices == old.notices
     )
 
@@ -198,6 +208,54 @@ def _neighbour_build(table: AirTable, pucks: dict[str, np.ndarray], like: TableS
     return _frozen(built, None if old is None else old[0]), radius
 
 
+def _contact_state(table: AirTable, like: TableState | None) -> tuple | None:
+    """The contact stage's warm start and rounds (references: see CONTACT_KEPT); like's tuple if the same."""
+    solver = getattr(table, "_contacts", None)
+    if solver is None:
+        return None
+    unknown = set(vars(solver)) - set(CONTACT_KEPT) - CONTACT_SCRATCH
+    if unknown:
+        raise TypeError(
+            f"the contact stage keeps {sorted(unknown)}: airtable/physics/state.py must learn to capture it"
+        )
+    kept = [getattr(solver, name) for name in CONTACT_KEPT]
+    kept[4] = tuple(kept[4])  # the list of rounds, as it is now
+    old = like.contacts if like is not None else None
+    if old is None:
+        return tuple(kept)
+    same = [_same_part(a, b) for a, b in zip(kept, old, strict=True)]
+    if all(same):
+        return old
+    if same[4]:
+        kept[4] = old[4]  # the same rounds: one tuple for both
+    return tuple(kept)
+
+
+def _same_part(a, b) -> bool:
+    """Arrays and tuples of arrays are the same only if they are the same objects; plain values if equal."""
+    if isinstance(a, np.ndarray) or isinstance(b, np.ndarray):
+        return a is b
+    if isinstance(a, tuple):
+        return isinstance(b, tuple) and len(a) == len(b) and all(x is y for x, y in zip(a, b, strict=True))
+    return a == b
+
+
+def _contact_arrays(state: TableState) -> tuple:
+    """The contact stage's arrays in `state` (for counting bytes)."""
+    if state.contacts is None:
+        return ()
+    keys, impulses, _, round_keys, rounds = state.contacts[:5]
+    return (keys, impulses, *(() if round_keys is None else (round_keys,)), *rounds)
+
+
+def _restore_contacts(table: AirTable, kept: tuple | None) -> None:
+    solver = getattr(table, "_contacts", None)
+    if solver is None or kept is None:
+        return
+    for name, value in zip(CONTACT_KEPT, kept, strict=True):
+        setattr(solver, name, list(value) if name == "_rounds" else value)
+
+
 def capture(table: AirTable, like: TableState | None = None) -> TableState:
     """Everything the next step of `table` depends on, copied out; parts equal to `like`'s are shared with it."""
     pucks = _columns(table._pucks, like.pucks if like is not None else None)
@@ -212,9 +270,9 @@ def capture(table: AirTable, like: TableState | None = None) -> TableState:
         events=tuple(table._events),
         next_event_seq=_next_event_seq(table),
         neighbours=_neighbour_build(table, pucks, like),
+        contacts=_contact_state(table, like),
         notices=_shared(tuple(table.notices), like.notices if like is not None else None),
         noticed=frozenset(table._noticed),
-        contacts=table._contacts.warm_start(),
     )
 
 
@@ -255,7 +313,7 @@ def restore(table: AirTable, state: TableState) -> None:
     table._noticed = set(state.noticed)
     table._collision_records, table._last_collisions = [], None
     _restore_neighbours(table, state.neighbours)
-    table._contacts.set_warm_start(*state.contacts)
+    _restore_contacts(table, state.contacts)
 
 
 def _restore_neighbours(table: AirTable, build) -> None:
