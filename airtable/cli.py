@@ -238,6 +238,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     os.environ.setdefault("PYGAME_HIDE_SUPPORT_PROMPT", "1")
     parser = build_parser()
     args = parser.parse_args(argv)
+    if args.headless:
+        os.environ.setdefault("SDL_VIDEODRIVER", "dummy")  # no screen: pygame's events still need a driver
     if not args.no_server:  # refuse what the server would, in the server's own words
         validate_server_options(args.port, args.max_clients, args.snapshot_hz, error=parser.error)
     keep_freed_memory()  # the step's big temporary arrays are reused, not re-faulted (35 % at 10000 pucks)

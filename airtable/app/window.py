@@ -106,8 +106,8 @@ class GameWindow:
         size_px: Sequence[int] | None = None,
         fullscreen: bool = False,
     ) -> None:
-        if headless:  # no screen needed, so none is asked for (pygame's events still need a driver)
-            os.environ.setdefault("SDL_VIDEODRIVER", "dummy")
+        # A headless window draws on a plain Surface; its entry point chose the
+        # dummy video driver (cli.main, the player's main, tests/conftest.py).
         pygame.display.init()
         pygame.font.init()
         self.env = env

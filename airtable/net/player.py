@@ -18,6 +18,7 @@ import argparse
 import dataclasses
 import enum
 import math
+import os
 import socket
 import sys
 import threading
@@ -739,7 +740,9 @@ def main(argv: Sequence[str] | None = None) -> int:
         print(f"airtable-client: {net.waiting_because}; waiting for a place (Esc quits)")
     else:
         print(f"airtable-client: connected to {net.address}; you are {welcome.label}")
-    if not args.headless:
+    if args.headless:
+        os.environ.setdefault("SDL_VIDEODRIVER", "dummy")  # no screen: pygame's events still need a driver
+    else:
         from airtable.app.window import prefer_plain_framebuffer
 
         prefer_plain_framebuffer()  # software OpenGL behind the window costs 11-35 ms a flip at 1920x1080
