@@ -125,7 +125,7 @@ def test_player_joins_sees_the_table_and_drags_a_puck(cleanup):
     server, loop = start_table(cleanup)
     net = player(cleanup, server.port, name="Ann")
     welcome = net.connect()
-    assert welcome.client == "C1 Ann" and net.state == net.CONNECTED
+    assert welcome.label == "C1 Ann" and net.state == net.CONNECTED
     scene = wait_until(net.latest, what="a snapshot")
     assert len(scene.pos_m) == 30
     start = scene.pos_m[0].copy()

@@ -111,7 +111,7 @@ class Honest:
 
     def __init__(self, port: int, centre_m: tuple[float, float]) -> None:
         self.client = RawClient(port)
-        self.name = self.client.hello("honest").client
+        self.name = self.client.hello("honest").label
         self.centre_m = centre_m
         self.snapshots = 0
         self.scene: Scene | None = None
@@ -239,9 +239,11 @@ def test_hello_gets_welcome_then_a_snapshot(make_server, make_loop, clients):
     message = json.loads(payload)
     assert message == {
         "protocol": 1,
-        "client": "C1 Ann",
+        "client": "C1",
+        "name": "Ann",
         "color": list(rgb("maroon1")),
         "table": {"width_m": loop.table.width_m, "height_m": loop.table.height_m},
+        "token": message["token"],
     }
     scene = proto.decode_snapshot(c.next_of(proto.SNAPSHOT))
     assert len(scene.pos_m) == 30 and scene.title == "headless table"
@@ -272,7 +274,7 @@ def test_input_drags_the_puck_and_disconnect_lets_go(make_server, make_loop, cli
     table = one_puck_table()
     loop = make_loop(server, table)
     c = clients(server.port)
-    name = c.hello().client
+    name = c.hello().label
     c.send(proto.encode_input((5.1, 4.0), 1))
 
     def holder() -> Client | None:
@@ -375,7 +377,7 @@ def test_joins_leaves_and_cursors_are_applied_every_frame_even_without_steps(mak
     server = make_server()
     game = GameLoop(server, one_puck_table())
     c = clients(server.port)
-    name = c.hello("Ann").client
+    name = c.hello("Ann").label
     c.send(proto.encode_input((2.0, 3.0), 0))
     player = wait_until(lambda: (p := game.update()) and p[0].active and p[0], what="the join and first input")
     assert player.name == name and tuple(player.cursor_m) == (2.0, 3.0)
@@ -559,7 +561,7 @@ def test_password(make_server, clients):
         got = c.next_frame()
         return got is not None and got[0] == proto.WELCOME and proto.parse_welcome(got[1])
 
-    assert wait_until(joined, what="the wait after a wrong password to end").client == "C1 Ann"
+    assert wait_until(joined, what="the wait after a wrong password to end").label == "C1 Ann"
 
 
 def test_wrong_passwords_earn_a_growing_wait_then_a_lockout_and_few_log_lines(make_server, clients, caplog):

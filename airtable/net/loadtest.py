@@ -66,7 +66,7 @@ class _Sim:
         # Reader thread: only appends (list.append is atomic), the numbers are worked out afterwards.
         self.snapshot_times.append(t)
         self.fps.append((t, scene.fps))
-        me = self.net.welcome.client if self.net.welcome else None
+        me = self.net.welcome.label if self.net.welcome else None
         for cursor in scene.cursors:
             if cursor.name == me:
                 self.seen.append((t, cursor.cursor_m))

@@ -26,6 +26,7 @@ from collections.abc import Callable, Iterable, Sequence
 
 import numpy as np
 
+from airtable.app.room import student_banner
 from airtable.app.scene import CursorView, Scene
 from airtable.net import protocol as proto
 
@@ -248,7 +249,9 @@ class NetPlayer:
         reader = proto.FrameReader(proto.MAX_SERVER_FRAME, sender="the server")
         deadline = time.monotonic() + self.timeout_s
         try:
-            sock.sendall(proto.encode_hello(self.name, self.password, self.protocol_version))
+            # After a first WELCOME, its token asks for the same seat (number, name, colour) again.
+            token = self.welcome.token if self.welcome is not None else None
+            sock.sendall(proto.encode_hello(self.name, self.password, self.protocol_version, token))
             while True:
                 sock.settimeout(max(0.01, deadline - time.monotonic()))
                 data = sock.recv(65536)
@@ -526,7 +529,7 @@ class PlayerApp:
         return self.env
 
     def _caption(self) -> str:
-        return f"Air Table - {self._welcome.client}" if self._welcome else "Air Table - waiting for a place"
+        return f"Air Table - {self._welcome.label}" if self._welcome else "Air Table - waiting for a place"
 
     def _handle_events(self, events) -> bool:
         """Mouse buttons and keys; False when the user quits (window closed or Esc)."""
@@ -581,13 +584,13 @@ class PlayerApp:
 
     def _draw(self, scene: Scene, cursor_m: np.ndarray, focused: bool) -> None:
         net, win, welcome = self.net, self.window, self._welcome
-        me = welcome.client if welcome else ""
+        me = welcome.label if welcome else ""
         color = welcome.color if welcome else (200, 200, 200)
         cursors, extra = own_cursor_live(scene.cursors, me, cursor_m, self.button, focused)
         win.draw(
             dataclasses.replace(scene, cursors=cursors),
             hud=(f"You are {me}" if me else "Not at the table yet", net.status_text),
-            banner=net.banner_text,
+            banner=net.banner_text or student_banner(scene, me),
             hud_color=color,
         )
         if extra and me:  # not in the snapshots yet: the arrow alone
@@ -728,7 +731,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     if welcome is None:
         print(f"airtable-client: {net.waiting_because}; waiting for a place (Esc quits)")
     else:
-        print(f"airtable-client: connected to {net.address}; you are {welcome.client}")
+        print(f"airtable-client: connected to {net.address}; you are {welcome.label}")
     if not args.headless:
         from airtable.app.window import prefer_plain_framebuffer
 

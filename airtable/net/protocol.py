@@ -52,6 +52,7 @@ MAX_PASSWORD_CHARS = 100
 MAX_KEYS = 16
 MAX_KEY_CHARS = 16
 MAX_ERROR_CHARS = 500
+MAX_TOKEN_CHARS = 48  # a seat token, "<number>-<32 hex digits>" (see identity.py)
 # A cursor may wander off the table (the view can be zoomed out), but not
 # further than this many table sizes from it; the player clamps to the same box.
 CURSOR_MARGIN_TABLES = 5.0
@@ -312,18 +313,23 @@ class Hello:
     protocol: int
     name: str | None = None
     password: str | None = None
+    token: str | None = None  # from an earlier WELCOME: asks for the same seat again
 
 
 HELLO_EXAMPLE = '{"protocol": 1, "name": "Ann"}'
 
 
-def encode_hello(name: str | None = None, password: str | None = None, protocol: int = PROTOCOL_VERSION) -> bytes:
+def encode_hello(
+    name: str | None = None, password: str | None = None, protocol: int = PROTOCOL_VERSION, token: str | None = None
+) -> bytes:
     """A HELLO frame."""
     message: dict = {"protocol": protocol}
     if name is not None:
         message["name"] = name
     if password is not None:
         message["password"] = password
+    if token is not None:
+        message["token"] = token
     return encode_json(HELLO, message)
 
 
@@ -357,14 +363,17 @@ def _validate_hello(message: dict) -> Hello:
         raise ProtocolError(f'HELLO "protocol" must be a whole number like {PROTOCOL_VERSION}, not {_short(protocol)}')
     if protocol != PROTOCOL_VERSION:
         raise ProtocolError(version_mismatch(protocol))
-    _check_fields(message, "HELLO", ("protocol",), ("name", "password"))
+    _check_fields(message, "HELLO", ("protocol",), ("name", "password", "token"))
     name = message.get("name")
     if name is not None:
         name = check_name(name)
     password = message.get("password")
     if password is not None:
         password = _text(password, "the password", MAX_PASSWORD_CHARS)
-    return Hello(protocol, name, password)
+    token = message.get("token")
+    if token is not None:
+        token = _text(token, "the seat token", MAX_TOKEN_CHARS)
+    return Hello(protocol, name, password, token)
 
 
 def parse_hello(payload: bytes) -> Hello:
@@ -470,26 +479,38 @@ def parse_input(payload: bytes, table_size_m: Sequence[float] = DEFAULT_TABLE_SI
 
 @dataclass(frozen=True)
 class Welcome:
-    """A validated WELCOME: the player's name and colour and the table size (m)."""
+    """A validated WELCOME: the player's id ("C3"), name, colour, the table size (m)
+    and the seat token to send in HELLO when reconnecting."""
 
     client: str
     color: tuple[int, int, int]
     width_m: float
     height_m: float
     protocol: int = PROTOCOL_VERSION
+    name: str = ""
+    token: str | None = None
+
+    @property
+    def label(self) -> str:
+        """How the table labels this player's cursor: "C3 Ann", or "C3" without a name."""
+        return f"{self.client} {self.name}" if self.name else self.client
 
 
-def encode_welcome(client: str, color: Sequence[int], width_m: float, height_m: float) -> bytes:
-    """A WELCOME frame."""
-    return encode_json(
-        WELCOME,
-        {
-            "protocol": PROTOCOL_VERSION,
-            "client": client,
-            "color": [int(c) for c in color],
-            "table": {"width_m": float(width_m), "height_m": float(height_m)},
-        },
-    )
+def encode_welcome(
+    client: str, color: Sequence[int], width_m: float, height_m: float, name: str = "", token: str | None = None
+) -> bytes:
+    """A WELCOME frame: `client` is the id alone ("C3"), `name` the player's name (left out when "")."""
+    message: dict = {
+        "protocol": PROTOCOL_VERSION,
+        "client": client,
+        "color": [int(c) for c in color],
+        "table": {"width_m": float(width_m), "height_m": float(height_m)},
+    }
+    if name:
+        message["name"] = name
+    if token is not None:
+        message["token"] = token
+    return encode_json(WELCOME, message)
 
 
 def parse_welcome(payload: bytes) -> Welcome:
@@ -501,10 +522,16 @@ def parse_welcome(payload: bytes) -> Welcome:
             f"the server speaks airtable protocol {_short(protocol)} but this client speaks protocol "
             f"{PROTOCOL_VERSION}; install the same airtable version as the teacher's"
         )
-    _check_fields(message, "the server's WELCOME", ("protocol", "client", "color", "table"))
+    _check_fields(message, "the server's WELCOME", ("protocol", "client", "color", "table"), ("name", "token"))
     client = message["client"]
     if not (isinstance(client, str) and 1 <= len(client) <= 2 * MAX_NAME_CHARS and client.isprintable()):
         raise ProtocolError(f"the server's WELCOME has a bad client name {_short(client)}")
+    name = message.get("name", "")
+    if not (isinstance(name, str) and len(name) <= MAX_NAME_CHARS and name.isprintable()):
+        raise ProtocolError(f"the server's WELCOME has a bad name {_short(name)}")
+    token = message.get("token")
+    if token is not None and not (isinstance(token, str) and len(token) <= MAX_TOKEN_CHARS and token.isprintable()):
+        raise ProtocolError("the server's WELCOME has a bad seat token")
     color = _color(message["color"], "the server's WELCOME colour")
     table = message["table"]
     if not isinstance(table, dict):
@@ -515,7 +542,7 @@ def parse_welcome(payload: bytes) -> Welcome:
     problem = table_size_problem(w, h)
     if problem:
         raise ProtocolError(f"the server's WELCOME has {problem}")
-    return Welcome(client, color, w, h, protocol)
+    return Welcome(client, color, w, h, protocol, name, token)
 
 
 def encode_error(sentence: str, retry: bool = False) -> bytes:
