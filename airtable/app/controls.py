@@ -252,17 +252,19 @@ BINDINGS: tuple[Binding, ...] = (
         "export the recording as CSV; save the moment as a new demo (s1, s2, ...)",
         {pygame.K_x: lessons.export_recording, (pygame.KMOD_CTRL, pygame.K_s): lessons.save_moment},
     ),
+    # F2-F5 share F1's row: the help must fit one page on a 900 x 788 window; the roster panel
+    # (F2) and the HUD's "3 students (F2: roster)" name them in full.
     Binding(
-        "F2-F5",
-        "students: roster (Up / Down, Delete twice removes) / hands off / floor to the next / hide names",
+        "F1",
+        "this help screen (again: next page); F2-F5: the room",
         {
+            pygame.K_F1: toggle_help,
             pygame.K_F2: room.toggle_roster,
             pygame.K_F3: room.toggle_hands_off,
             pygame.K_F4: room.next_floor,
             pygame.K_F5: room.toggle_anonymous,
         },
     ),
-    Binding("F1", "this help screen (again: next page)", {pygame.K_F1: toggle_help}),
     Binding("F11", "fullscreen on / off", {pygame.K_F11: toggle_fullscreen}),
     Binding("F12", "save a screenshot PNG", {pygame.K_F12: screenshot}),
     Binding("Esc", "close what is open; else quit (twice if students are connected)", {pygame.K_ESCAPE: escape}),

@@ -22,6 +22,11 @@ if TYPE_CHECKING:
 ALERT_COLOR = (255, 90, 70)
 SELECTED_COLOR = (60, 60, 110)
 WARN_COLOR = (255, 170, 90)
+HINTS = (
+    "Up / Down or click: select    Delete twice: remove    F2 or Esc: close",
+    "F3: hands off    F4: the floor to the next student    F5: hide names",
+)
+HEADINGS = ("seat", "", "rate", "lag", "warnings")
 # Columns, in font heights from the left: swatch, seat, name, rate, lag, flags.
 COLUMNS_EM = (0.0, 1.2, 3.0, 11.5, 15.0, 18.0)
 
@@ -45,10 +50,15 @@ def draw_roster(app: App) -> None:
     surf.blit(
         w.big_font.render(panel_view.shorten(w.big_font, title, rect.w - 2 * pad), True, panel_view.ACCENT), (pad, pad)
     )
-    hint = "Up / Down or click: select    Delete twice: remove    F2 or Esc: close"
     y = pad + w.big_font.get_linesize()
-    surf.blit(font.render(panel_view.shorten(font, hint, rect.w - 2 * pad), True, panel_view.DIM_TEXT), (pad, y))
-    y += font.get_linesize() * 3 // 2
+    for hint in HINTS:
+        surf.blit(font.render(panel_view.shorten(font, hint, rect.w - 2 * pad), True, panel_view.DIM_TEXT), (pad, y))
+        y += font.get_linesize()
+    y += font.get_linesize() // 2
+    em = font.get_height()
+    for k, heading in enumerate(HEADINGS):
+        surf.blit(font.render(heading, True, panel_view.DIM_TEXT), (pad + int(COLUMNS_EM[k + 1] * em), y))
+    y += font.get_linesize()
     line_h = font.get_linesize()
     fits = max(1, (rect.h - y - pad) // line_h)
     first = max(0, min(r.selected - fits + 1, n - fits))
