@@ -271,3 +271,27 @@ def test_the_anonymous_projector_hides_names_but_not_colours(served, monkeypatch
     monkeypatch.setattr(roster_view, "_row_texts", lambda seat, label: rows.append(row_texts(seat, label)) or rows[-1])
     app.frame(FRAME_S)
     assert rows and rows[-1][:2] == ["C1", ""], rows
+
+
+def test_a_students_window_says_hands_off(served, monkeypatch):
+    from airtable.app.window import GameWindow
+    from airtable.net.player import PlayerApp
+
+    app, server, _ = served
+    banners: list[str] = []
+    draw_banner = GameWindow.draw_banner
+    monkeypatch.setattr(GameWindow, "draw_banner", lambda self, text: (banners.append(text), draw_banner(self, text)))
+    net = NetPlayer("127.0.0.1", server.port, name="Ann")
+    try:
+        net.connect()
+        press(app, pygame.K_F3)
+
+        def seen() -> bool:
+            app.frame(FRAME_S)  # the teacher's frames publish the snapshots the student draws
+            return room.HANDS_OFF_BANNER in banners
+
+        deadline = time.monotonic() + WAIT_S
+        PlayerApp(net, headless=True).run(until=lambda: seen() or time.monotonic() > deadline)
+        assert room.HANDS_OFF_BANNER in banners
+    finally:
+        net.close()
