@@ -30,6 +30,7 @@ import numpy as np
 
 from airtable.bench_cpu import cpu_section
 from airtable.bench_frames import window_section
+from airtable.bench_net_sections import link_section, snapshot_section
 from airtable.memory import keep_freed_memory
 from airtable.physics import broadphase, vectors
 from airtable.physics.table import AirTable, kinetic_energy_J
@@ -476,6 +477,8 @@ SECTIONS: dict[str, Callable[[argparse.Namespace], bool]] = {
     "frames": frames_section,
     "cpu": cpu_section,
     "window": window_section,
+    "snapshots": snapshot_section,
+    "link": link_section,
 }
 
 

@@ -34,12 +34,33 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--demo", default="1", metavar="KEY", help="demo to start with (see --list-demos); default 1")
     p.add_argument("--variation", type=_non_negative_int, default=0, metavar="N", help="variation of that demo")
     p.add_argument("--list-demos", action="store_true", help="list the demos and exit")
+    _server_options(p)
+    _run_options(p)
+    _output_options(p)
+    p.add_argument(
+        "--demos",
+        action="append",
+        default=[],
+        metavar="DIR",
+        help="also load every demo file in DIR (a key already taken is replaced); may be repeated; Ctrl+S saves"
+        " demos in the last DIR (without --demos: in ./my_demos, loaded when it exists)",
+    )
+    p.add_argument(
+        "--new-demo", default=None, metavar="FILE.py", help="write a commented starter demo to FILE.py and exit"
+    )
+    return p
+
+
+def _server_options(p: argparse.ArgumentParser) -> None:
     p.add_argument("--port", type=_port, default=8888, help="port students join on (default 8888)")
     p.add_argument("--host", default="0.0.0.0", help="address to listen on (default 0.0.0.0: every network)")
     p.add_argument("--password", default=None, help="students must give this password to join")
     p.add_argument("--max-clients", type=_positive_int, default=30, metavar="N", help="most students at once")
     p.add_argument("--snapshot-hz", type=_positive_float, default=30.0, metavar="HZ", help="snapshots per second")
     p.add_argument("--no-server", action="store_true", help="do not accept students over the network")
+
+
+def _run_options(p: argparse.ArgumentParser) -> None:
     p.add_argument("--headless", action="store_true", help="run the same loop without a window")
     p.add_argument(
         "--seconds",
@@ -56,6 +77,10 @@ def build_parser() -> argparse.ArgumentParser:
         help="save the last frame to FILE.png at exit (.png is added if the name lacks it)",
     )
     p.add_argument("--fullscreen", action="store_true", help="open on the whole screen (F11 switches)")
+
+
+def _output_options(p: argparse.ArgumentParser) -> None:
+    """What a run leaves behind at exit."""
     p.add_argument(
         "--stats",
         action="store_true",
@@ -75,18 +100,6 @@ def build_parser() -> argparse.ArgumentParser:
         metavar="FILE.py",
         help="at exit, write the table as it is then as a new demo file FILE.py (load it with --demos FOLDER)",
     )
-    p.add_argument(
-        "--demos",
-        action="append",
-        default=[],
-        metavar="DIR",
-        help="also load every demo file in DIR (a key already taken is replaced); may be repeated; Ctrl+S saves"
-        " demos in the last DIR (without --demos: in ./my_demos, loaded when it exists)",
-    )
-    p.add_argument(
-        "--new-demo", default=None, metavar="FILE.py", help="write a commented starter demo to FILE.py and exit"
-    )
-    return p
 
 
 def _number(kind, text: str, check, what: str):

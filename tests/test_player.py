@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import os
 import socket
 import struct
@@ -19,6 +20,7 @@ from test_server import RawClient
 from airtable.app.scene import CursorView, Scene
 from airtable.app.window import background_for
 from airtable.net import protocol as proto
+from airtable.net.codec import SnapshotEncoder, Viewer, encode_layout, layout_of
 from airtable.net.loadtest import TableLoop, grid_table
 from airtable.net.player import InputThrottle, NetPlayer, PlayerApp, PlayerError, main, own_cursor_live
 from airtable.net.server import GameServer
@@ -232,14 +234,14 @@ def test_wrong_and_missing_password(capsys, cleanup):
 
 def test_protocol_version_mismatch_both_ways(capsys, cleanup):
     server, _ = start_table(cleanup)
-    net = player(cleanup, server.port, protocol_version=2)
+    net = player(cleanup, server.port, protocol_version=1)  # a client of the last version
     with pytest.raises(PlayerError) as err:
         net.connect()
-    assert "protocol 2" in str(err.value) and "same airtable version" in str(err.value)
-    fake = FakeServer(proto.encode_json(proto.WELCOME, {"protocol": 2, "client": "C1"}))
+    assert "protocol 1" in str(err.value) and "same airtable version" in str(err.value)
+    fake = FakeServer(proto.encode_json(proto.WELCOME, {"protocol": 1, "client": "C1"}))  # a server of the last
     cleanup(fake.close)
     line = one_line_error(capsys, [f"127.0.0.1:{fake.port}"])
-    assert "server speaks airtable protocol 2" in line
+    assert "server speaks airtable protocol 1" in line and "\n" not in line.strip()
 
 
 def test_something_else_on_the_port(capsys, cleanup):
@@ -395,7 +397,7 @@ class ScriptedServer:
 
 def welcome_frame(width_m: float = 10.0, height_m: float = 8.7556) -> bytes:
     message = {
-        "protocol": 1,
+        "protocol": proto.PROTOCOL_VERSION,
         "client": "C1",
         "color": [255, 52, 179],
         "table": {"width_m": width_m, "height_m": height_m},
@@ -403,20 +405,21 @@ def welcome_frame(width_m: float = 10.0, height_m: float = 8.7556) -> bytes:
     return proto.encode_json(proto.WELCOME, message)
 
 
-def snapshot_frame(scene: Scene, **header: float) -> bytes:
-    """A SNAPSHOT of `scene`, with header fields (zoom, origin_x_m, ...) overwritten after encoding."""
-    payload = bytearray(proto.encode_snapshot(scene))
-    fields = ["width_m", "height_m", "time_s", "fps", "zoom", "origin_x_m", "origin_y_m"]
-    for name, value in header.items():
-        struct.pack_into("<d", payload, 20 + 8 * fields.index(name), value)
-    return proto.encode_frame(proto.SNAPSHOT, bytes(payload))
+def snapshot_frame(scene: Scene, **view: float) -> bytes:
+    """The LAYOUT and SNAPSHOT frames (format 2) a new player gets for `scene`, with the
+    view (zoom, origin_x_m, origin_y_m) changed first."""
+    origin = (view.get("origin_x_m", scene.origin_m[0]), view.get("origin_y_m", scene.origin_m[1]))
+    scene = dataclasses.replace(scene, zoom=view.get("zoom", scene.zoom), origin_m=origin)
+    encoder = SnapshotEncoder()
+    encoder.add(scene)
+    return encoder.frames_for(Viewer())
 
 
 def counts_frame(pucks: int = 0, springs: int = 0, cursors: int = 0, padding: int = 0) -> bytes:
-    """A SNAPSHOT that claims huge counts, with `padding` zero bytes of body after the header."""
-    payload = bytearray(proto.encode_snapshot(_one_puck_scene()))
+    """A LAYOUT that claims huge counts, with `padding` zero bytes of body after its header."""
+    payload = bytearray(encode_layout(layout_of(_one_puck_scene())))
     struct.pack_into("<III", payload, 8, pucks, springs, cursors)
-    return proto.encode_frame(proto.SNAPSHOT, bytes(payload) + b"\0" * padding)
+    return proto.encode_frame(proto.LAYOUT, bytes(payload) + b"\0" * padding)
 
 
 def _one_puck_scene(radius_m: float = 0.3) -> Scene:
@@ -563,7 +566,11 @@ def test_extreme_but_valid_snapshots_never_crash_hang_or_bloat_the_client(cleanu
         net = NetPlayer("127.0.0.1", fake.port, max_backoff_s=0.3)
         try:
             net.connect()
-            fake.send(b"".join(proto.encode_frame(proto.SNAPSHOT, proto.encode_snapshot(sc)) for sc in scenes))
+            encoder, viewer, frames = SnapshotEncoder(), Viewer(), []
+            for sc in scenes:
+                encoder.add(sc)
+                frames.append(encoder.frames_for(viewer))
+            fake.send(b"".join(frames))
             app = PlayerApp(net, headless=True)
             drawn = lambda: net.snapshots == len(scenes) and app.frames > 1  # noqa: E731
             start = time.monotonic()

@@ -90,9 +90,9 @@ def test_a_huge_length_is_refused_before_its_payload_arrives():
 def test_hello_round_trip():
     (t, payload), *_ = proto.FrameReader().feed(proto.encode_hello("  Ann  ", "pw"))
     assert t == proto.HELLO
-    assert json.loads(payload) == {"protocol": 1, "name": "  Ann  ", "password": "pw"}
-    assert proto.parse_hello(payload) == proto.Hello(1, "Ann", "pw")
-    assert proto.parse_hello(b'{"protocol": 1}') == proto.Hello(1)
+    assert json.loads(payload) == {"protocol": 2, "name": "  Ann  ", "password": "pw"}
+    assert proto.parse_hello(payload) == proto.Hello(2, "Ann", "pw")
+    assert proto.parse_hello(b'{"protocol": 2}') == proto.Hello(2)
 
 
 @pytest.mark.parametrize(
@@ -102,16 +102,16 @@ def test_hello_round_trip():
         (b"{nope", ["not valid JSON", "protocol"]),
         (b"[1, 2]", ["JSON object"]),
         (b"{}", ["missing", "protocol"]),
-        (b'{"protocol": 2}', ["protocol 1", "protocol 2", "same airtable version"]),
-        (b'{"protocol": 2, "shiny": true}', ["protocol 2"]),  # the version is checked first
+        (b'{"protocol": 1}', ["protocol 1", "protocol 2", "same airtable version"]),
+        (b'{"protocol": 3, "shiny": true}', ["protocol 3"]),  # the version is checked first
         (b'{"protocol": "1"}', ["whole number"]),
         (b'{"protocol": true}', ["whole number"]),
-        (b'{"protocol": 1, "name": "' + b"x" * 21 + b'"}', ["name", "20"]),
-        (b'{"protocol": 1, "name": "   "}', ["name"]),
-        (b'{"protocol": 1, "name": "a\\u0007b"}', ["printable"]),
-        (b'{"protocol": 1, "name": 7}', ["name must be text"]),
-        (b'{"protocol": 1, "password": 1234}', ["password must be text"]),
-        (b'{"protocol": 1, "colour": "red"}', ["unknown field", "protocol, name, password"]),
+        (b'{"protocol": 2, "name": "' + b"x" * 21 + b'"}', ["name", "20"]),
+        (b'{"protocol": 2, "name": "   "}', ["name"]),
+        (b'{"protocol": 2, "name": "a\\u0007b"}', ["printable"]),
+        (b'{"protocol": 2, "name": 7}', ["name must be text"]),
+        (b'{"protocol": 2, "password": 1234}', ["password must be text"]),
+        (b'{"protocol": 2, "colour": "red"}', ["unknown field", "protocol, name, password"]),
         (b"[" * 100000, ["not valid JSON"]),
         (b'{"protocol": ' + b"9" * 5000 + b"}", []),
     ],
@@ -236,7 +236,7 @@ def test_welcome_has_the_fields_of_the_design():
     (t, payload), *_ = proto.FrameReader().feed(proto.encode_welcome("C3", (0, 255, 255), 10.0, 8.7556))
     assert t == proto.WELCOME
     assert json.loads(payload) == {
-        "protocol": 1,
+        "protocol": 2,
         "client": "C3",
         "color": [0, 255, 255],
         "table": {"width_m": 10.0, "height_m": 8.7556},
@@ -245,10 +245,10 @@ def test_welcome_has_the_fields_of_the_design():
 
 
 def test_welcome_from_a_newer_server_names_the_versions():
-    payload = json.dumps({"protocol": 2, "client": "C1"}).encode()
+    payload = json.dumps({"protocol": 3, "client": "C1"}).encode()
     with pytest.raises(proto.ProtocolError) as err:
         proto.parse_welcome(payload)
-    assert_sentence(str(err.value), "protocol 2", "same airtable version")
+    assert_sentence(str(err.value), "protocol 3", "same airtable version")
 
 
 def test_error_sentences_come_back_printable():

@@ -15,6 +15,7 @@ from conftest import FRAME_S, WAIT_S, press, wait_until
 from airtable.app import room, roster_view
 from airtable.app.app import App
 from airtable.net import protocol as proto
+from airtable.net.codec import SnapshotDecoder
 from airtable.net.identity import SeatTokens, load_key
 from airtable.net.player import NetPlayer, PlayerState
 from airtable.net.server import GameServer, client_color
@@ -27,6 +28,7 @@ class Student:
         self.sock = socket.create_connection(("127.0.0.1", port), timeout=WAIT_S)
         self.reader = proto.FrameReader(proto.MAX_SERVER_FRAME, sender="the server")
         self.pending: list[tuple[int, bytes]] = []
+        self.decoder = SnapshotDecoder()
         self.sock.sendall(proto.encode_hello(name, token=token))
         kind, payload = self.next_frame()
         assert kind == proto.WELCOME, proto.parse_error(payload)
@@ -41,6 +43,15 @@ class Student:
                 raise ConnectionError("the server closed the connection")
             self.pending += self.reader.feed(data)
         return self.pending.pop(0)
+
+    def next_scene(self):
+        """The next Scene (snapshot format 2: a LAYOUT, then SNAPSHOTs coded against it)."""
+        while True:
+            kind, payload = self.next_frame()
+            if kind == proto.LAYOUT:
+                self.decoder.feed_layout(payload)
+            elif kind == proto.SNAPSHOT:
+                return self.decoder.feed_tick(payload).scene
 
     def drag(self, cursor_m, button: int = 1) -> None:
         self.sock.sendall(proto.encode_input(cursor_m, button))
@@ -170,8 +181,8 @@ def test_hands_off_lets_go_ignores_input_and_tells_every_student(served):
     assert app.clients[1].held is None and np.array_equal(app.table.pos_m, before)
 
     def banner():
-        kind, payload = ann.next_frame()
-        return kind == proto.SNAPSHOT and room.student_banner(proto.decode_snapshot(payload))
+        scene = ann.next_scene()
+        return room.student_banner(scene)
 
     assert wait_until(banner, what="the hands-off banner") == room.HANDS_OFF_BANNER
     press(app, pygame.K_F3)

@@ -22,6 +22,7 @@ from airtable.app.client import LOCAL_COLOR, cursor_pulls
 from airtable.app.scene import Scene
 from airtable.colors import rgb
 from airtable.net import protocol as proto
+from airtable.net.codec import SnapshotDecoder
 from airtable.net.events import MAX_QUEUED_INPUTS, EventQueue, PlayerInput, PlayerJoined, PlayerLeft
 from airtable.net.loadtest import TableLoop, grid_table, run_load
 from airtable.net.server import (
@@ -51,6 +52,7 @@ class RawClient:
         self.reader = proto.FrameReader(proto.MAX_SERVER_FRAME, sender="the server")
         self.pending: list[tuple[int, bytes]] = []
         self.welcome: proto.Welcome | None = None
+        self.decoder = SnapshotDecoder()
 
     def send(self, data: bytes) -> bool:
         try:
@@ -83,6 +85,20 @@ class RawClient:
             if got[0] == frame_type:
                 return got[1]
 
+    def take_scene(self, frame_type: int, payload: bytes) -> Scene | None:
+        """Decode a LAYOUT (None) or SNAPSHOT (its Scene) of snapshot format 2."""
+        if frame_type == proto.LAYOUT:
+            self.decoder.feed_layout(payload)
+            return None
+        return self.decoder.feed_tick(payload).scene
+
+    def next_scene(self) -> Scene:
+        while True:
+            got = self.next_frame()
+            assert got is not None, "connection closed while waiting for a SNAPSHOT"
+            if got[0] in (proto.LAYOUT, proto.SNAPSHOT) and (scene := self.take_scene(*got)) is not None:
+                return scene
+
     def hello(self, name: str | None = None, password: str | None = None) -> proto.Welcome:
         self.send(proto.encode_hello(name, password))
         t, payload = self.next_frame()
@@ -98,7 +114,7 @@ class RawClient:
             if got[0] == proto.ERROR:
                 sentence = proto.parse_error(got[1])
                 break
-            assert got[0] in (proto.WELCOME, proto.SNAPSHOT), got
+            assert got[0] in (proto.WELCOME, proto.LAYOUT, proto.SNAPSHOT), got
         assert self.next_frame() is None, "the connection stayed open after ERROR"
         return sentence
 
@@ -136,8 +152,10 @@ class Honest:
                 continue
             if got is None:
                 return
-            if got[0] == proto.SNAPSHOT:
-                self.scene = proto.decode_snapshot(got[1])
+            if got[0] == proto.LAYOUT:
+                self.client.take_scene(*got)
+            elif got[0] == proto.SNAPSHOT:
+                self.scene = self.client.take_scene(*got)
                 self.snapshots += 1
 
     def me(self, scene: Scene):
@@ -238,14 +256,14 @@ def test_hello_gets_welcome_then_a_snapshot(make_server, make_loop, clients):
     assert t == proto.WELCOME
     message = json.loads(payload)
     assert message == {
-        "protocol": 1,
+        "protocol": 2,
         "client": "C1",
         "name": "Ann",
         "color": list(rgb("maroon1")),
         "table": {"width_m": loop.table.width_m, "height_m": loop.table.height_m},
         "token": message["token"],
     }
-    scene = proto.decode_snapshot(c.next_of(proto.SNAPSHOT))
+    scene = c.next_scene()
     assert len(scene.pos_m) == 30 and scene.title == "headless table"
     assert server.player_names() == ["C1 Ann"]
 
@@ -443,11 +461,11 @@ BAD_CLIENTS = {
     "a web browser": ([b"GET / HTTP/1.1\r\nHost: teacher\r\n\r\n"], ["web browser", "airtable-client"]),
     "a frame over 1 KiB": ([struct.pack(">IB", 1024 + 1, 1) + b"x" * 1000], ["1024 byte limit"]),
     "an empty frame": ([b"\0\0\0\0"], ["empty"]),
-    "invalid UTF-8": ([frame(proto.HELLO, b'{"protocol": 1, "name": "\xff"}')], ["UTF-8"]),
-    "invalid JSON": ([frame(proto.HELLO, b'{"protocol": 1,')], ["not valid JSON", '{"protocol": 1']),
+    "invalid UTF-8": ([frame(proto.HELLO, b'{"protocol": 2, "name": "\xff"}')], ["UTF-8"]),
+    "invalid JSON": ([frame(proto.HELLO, b'{"protocol": 2,')], ["not valid JSON", '{"protocol": 2']),
     "HELLO without protocol": ([frame(proto.HELLO, b'{"name": "Ann"}')], ["missing", "protocol"]),
-    "wrong protocol version": ([proto.encode_hello(protocol=2)], ["protocol 1", "protocol 2", "same airtable"]),
-    "unknown HELLO field": ([frame(proto.HELLO, b'{"protocol": 1, "admin": true}')], ["unknown field"]),
+    "wrong protocol version": ([proto.encode_hello(protocol=1)], ["protocol 1", "protocol 2", "same airtable"]),
+    "unknown HELLO field": ([frame(proto.HELLO, b'{"protocol": 2, "admin": true}')], ["unknown field"]),
     "a 21 character name": ([proto.encode_hello("x" * 21)], ["name", "20"]),
     "a name with a bell": ([proto.encode_hello("a\x07")], ["printable"]),
     "a blank-looking name": ([proto.encode_hello("\u3164")], ["no visible letter or digit"]),
@@ -734,7 +752,7 @@ def test_a_failing_network_thread_is_logged_shown_and_stops_cleanly(make_server,
     assert not server.running
     assert any(r.exc_info and r.exc_info[0] is ValueError for r in caplog.records), "logged with its traceback"
     while (got := c.next_frame()) is not None:  # the player is let go, not left hanging
-        assert got[0] in (proto.SNAPSHOT, proto.BYE)
+        assert got[0] in (proto.LAYOUT, proto.SNAPSHOT, proto.BYE)
     server.stop()
 
 

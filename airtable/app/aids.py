@@ -184,6 +184,12 @@ class EnergyChart:
         self._next = (self._next + 1) % len(self._data)
         self._count = min(self._count + 1, len(self._data))
 
+    def drop_after(self, t_s: float) -> None:
+        """Forget the samples later than `t_s` (the table was rewound to it and runs on)."""
+        while self._count and self._data[(self._next - 1) % len(self._data), 0] > t_s:
+            self._next = (self._next - 1) % len(self._data)
+            self._count -= 1
+
     def series(self, window_s: float = CHART_WINDOW_S) -> dict[str, np.ndarray]:
         """The samples of the last `window_s` seconds of simulation, oldest first."""
         if self._count == 0:

@@ -21,6 +21,10 @@ COM_COLOR = (255, 255, 255)
 FORCE_COLORS = {"cursor strings": (255, 120, 80), "springs": (255, 215, 0), "gravity": (90, 160, 255)}
 
 
+# A puck in a jelly can have a dozen springs; the inspector lists the first few.
+MAX_INSPECTED_SPRINGS = 4
+
+
 def draw_aids(app: App) -> None:
     t, paint = app.table, app.painter
     if app.show_chart:  # first: the labels below then find their places around it
@@ -35,17 +39,25 @@ def draw_aids(app: App) -> None:
     if app.inspecting:
         puck = t.puck_at(app.env.to_world(app.mouse_px))
         if puck is not None:
-            v = puck.vel_mps
-            speed = float(np.hypot(*v))
-            paint.inspector(
-                puck.pos_m,
-                [
-                    f"mass {puck.mass_kg:.4g} kg   radius {puck.radius_m:.4g} m",
-                    f"speed {speed:.4g} m/s",
-                    f"velocity ({v[0]:.3f}, {v[1]:.3f}) m/s",
-                    f"kinetic energy {0.5 * puck.mass_kg * speed**2:.4g} J",
-                ],
-            )
+            paint.inspector(puck.pos_m, inspector_lines(t, puck))
+
+
+def inspector_lines(table, puck) -> list[str]:
+    """What `i` tells about a puck: mass, speed, energy, and each spring on it with the stiffness it acts with."""
+    v = puck.vel_mps
+    speed = float(np.hypot(*v))
+    lines = [
+        f"mass {puck.mass_kg:.4g} kg   radius {puck.radius_m:.4g} m",
+        f"speed {speed:.4g} m/s",
+        f"velocity ({v[0]:.3f}, {v[1]:.3f}) m/s",
+        f"kinetic energy {0.5 * puck.mass_kg * speed**2:.4g} J",
+    ]
+    for spring in table.springs_on(puck)[:MAX_INSPECTED_SPRINGS]:
+        line = f"spring k {spring.k_Npm:.4g} N/m"
+        if spring.k_effective_Npm != spring.k_Npm:
+            line += f", acts with {spring.k_effective_Npm:.4g} N/m (softened)"
+        lines.append(line)
+    return lines
 
 
 def _draw_vectors(app: App) -> None:

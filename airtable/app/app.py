@@ -17,11 +17,12 @@ from pathlib import Path
 import numpy as np
 import pygame
 
-from airtable.app import aids, controls, room, world
+from airtable.app import aids, controls, rewind, room, world
 from airtable.app.aids_view import draw_aids
 from airtable.app.client import LOCAL_COLOR, Client, cursor_pulls
 from airtable.app.demo_loader import Demo, DemoError, DemoShelf, error_from_exception, key_label
 from airtable.app.environment import Environment
+from airtable.app.history import History
 from airtable.app.lessons import Lessons
 from airtable.app.lessons_view import draw_lessons
 from airtable.app.loop import FixedStep, FpsCounter, FrameLoop
@@ -29,7 +30,7 @@ from airtable.app.menu import DemoMenu
 from airtable.app.roster_view import draw_alert, draw_roster
 from airtable.app.scene import STATUS_SEPARATOR, Scene
 from airtable.app.stats import RunStats
-from airtable.app.window import AidsPainter, GameWindow
+from airtable.app.window import AidsPainter, GameWindow, TimelinePainter
 from airtable.physics.table import TABLE_HEIGHT_M, TABLE_WIDTH_M, AirTable
 
 MESSAGE_S = 4.0
@@ -94,6 +95,7 @@ class App:
         self.clients: list[Client] = [self.local]
         self.window = GameWindow(self.env, headless=headless, size_px=window_size_px, fullscreen=fullscreen)
         self.painter = AidsPainter(self.window)
+        self.timeline_painter = TimelinePainter(self.window)
         if not headless:
             pygame.mouse.set_visible(False)  # the local client's arrow is the pointer
         self.server = server
@@ -117,12 +119,14 @@ class App:
         self.show_chart = False
         self.vectors = 0  # 0 off, 1 velocity, 2 momentum
         self.inspecting = False
+        self._notices_seen = 0  # how many of table.notices were said
         self.menu: DemoMenu | None = None
         self.quit_armed_until = -1.0  # clock_s until which a second Esc quits
         self.collision_log = aids.CollisionLog()
         self.chart = aids.EnergyChart()
         self.lessons = Lessons()  # recording, momenta, saving the moment (lessons.py)
         self.room = room.Room()  # the roster, hands off, the floor, anonymous names (room.py)
+        self.history = History()  # the table's recent moments, for rewinding (history.py, rewind.py)
         self.keys_down: set[int] = set()
         self.mouse_px = (self.env.size_px[0] / 2, self.env.size_px[1] / 2)
         self.mouse_button = 0
@@ -188,6 +192,8 @@ class App:
         self.trails = demo.trails if demo else False
         self.chart.sample(self.table)
         self.lessons.start(self.table)
+        self.history.clear()
+        self.history.record(self.table)
         self.window.set_caption(f"Air Table - {self.caption()}")
 
     def _clear_table(self) -> None:
@@ -349,17 +355,37 @@ class App:
         # Recomputed every frame: zooming moves the world under a still mouse.
         self.local.set_input(self.table, self.env.to_world(self.mouse_px), self.mouse_button)
         if self.server is not None:
-            self.server.apply_inputs(self.clients, self.table)  # joins, leaves and inputs, even while paused
+            self.server.update_clients(self.clients, self.table)  # joins, leaves and inputs, even while paused
         if not self.paused:
-            for _ in range(self.stepper.steps(frame_dt_s, self.speed)):
-                if not self.physics_step():
-                    break
+            self._run_physics(frame_dt_s)
+        self._say_new_notices()
         self.fps = self._fps_counter.tick(self.clock_s)
         scene = self.scene()
         if self.server is not None:
             self.server.publish(scene)
         self.draw(scene)
         self.stats.frame()
+
+    def _say_new_notices(self) -> None:
+        """Each sentence the table adds to its notices (a softened spring, say) is said once, here and on stderr."""
+        notices = self.table.notices
+        if len(notices) < self._notices_seen:  # a new scene started the list again
+            self._notices_seen = 0
+        for sentence in notices[self._notices_seen :]:
+            self.say(sentence)
+            print(f"airtable: {sentence}", file=sys.stderr)
+        self._notices_seen = len(notices)
+
+    def _run_physics(self, frame_dt_s: float) -> None:
+        """The frame's physics steps; the table as they left it joins the history."""
+        if self.history.in_past:
+            rewind.run_on(self)  # running again from a moment in the past: its future is dropped
+        steps = self.table.steps
+        for _ in range(self.stepper.steps(frame_dt_s, self.speed)):
+            if not self.physics_step():
+                break
+        if self.table.steps != steps:
+            self.history.record(self.table)
 
     def scene(self) -> Scene:
         return Scene.from_table(
@@ -377,6 +403,9 @@ class App:
         t = self.table
         parts = ["PAUSED"] if self.paused else []
         parts.extend(room.status_parts(self))  # hands off, the floor
+        timeline = self.history.timeline() if self.history.in_past else None
+        if timeline is not None:
+            parts.append(f"rewound {timeline.newest_s - timeline.view_s:.2f} s")
         if self.speed != 1.0:
             parts.append(f"slow motion x1/{round(1 / self.speed)}")
         parts.append(f"t = {t.time_s:.2f} s")
@@ -410,9 +439,16 @@ class App:
         self.window.draw(projected, trails=self.trails, hud=self.hud_lines())
         draw_alert(self)  # the network thread failed: students can no longer join
         draw_lessons(self)  # first: the aids' labels then place themselves around its panels
+        self._draw_timeline()
         draw_aids(self)
         self._draw_panel()
         self.window.present()
+
+    def _draw_timeline(self) -> None:
+        """While paused (or in the past), where the view is in the history."""
+        timeline = self.history.timeline()
+        if (self.paused or self.history.in_past) and timeline is not None and timeline.frames > 1:
+            self.timeline_painter.timeline(timeline)
 
     def _draw_panel(self) -> None:
         panel, w = self.panel(), self.window
@@ -430,7 +466,11 @@ class App:
         elif panel == "error":
             error = self.build_error
             title = ERROR_TITLES[error.stage].format(key=key_label(self.demo_key))
-            w.draw_panel(title, [str(error), "Fix the file and press the demo's key again (Esc hides this)."])
+            label = key_label(self.demo_key)  # "7", "Shift+1"; keys like "t1" have no key of their own
+            again = (
+                f"press {label} again" if len(self.demo_key) == 1 or label != self.demo_key else "pick it in Tab's menu"
+            )
+            w.draw_panel(title, [str(error), f"Fix the file, then {again}. Esc hides this."])
         elif panel == "notice":
             w.draw_panel("Some demo files could not be loaded", [*self.notice, "Press any key to go on."])
         elif panel == "help":

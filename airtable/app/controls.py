@@ -17,7 +17,7 @@ from typing import TYPE_CHECKING
 
 import pygame
 
-from airtable.app import aids, lessons, room, world
+from airtable.app import aids, lessons, rewind, room, world
 
 if TYPE_CHECKING:
     from airtable.app.app import App
@@ -53,13 +53,6 @@ KEYPAD_KEYS = (*(getattr(pygame, f"K_KP_{d}") for d in "1234567890"),)
 
 def toggle_pause(app: App) -> None:
     app.paused = not app.paused
-
-
-def single_step(app: App) -> None:
-    if app.paused:
-        app.physics_step()
-    else:
-        app.say("'.' steps once while paused (Space pauses)")
 
 
 def freeze(app: App) -> None:
@@ -193,7 +186,16 @@ BINDINGS: tuple[Binding, ...] = (
         "PageUp / PageDown", "previous / next demo", {pygame.K_PAGEUP: previous_demo, pygame.K_PAGEDOWN: next_demo}
     ),
     Binding("Space", "pause / resume", {pygame.K_SPACE: toggle_pause}),
-    Binding(".", "one step while paused", {pygame.K_PERIOD: single_step}),
+    Binding(
+        ", / .",
+        "rewind / on a frame (Shift: 1 s)",
+        {
+            pygame.K_COMMA: rewind.step_back,
+            pygame.K_PERIOD: rewind.step_forward,
+            (pygame.KMOD_SHIFT, pygame.K_COMMA): rewind.jump_back,
+            (pygame.KMOD_SHIFT, pygame.K_PERIOD): rewind.jump_forward,
+        },
+    ),
     Binding("f", "freeze: all velocities to zero", {pygame.K_f: freeze}),
     Binding("g", "gravity on/off (restitution 0.9 with gravity, 1.0 without)", {pygame.K_g: toggle_gravity}),
     Binding("p", "puck penetration correction off / two-step", {pygame.K_p: toggle_correction}),

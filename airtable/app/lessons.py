@@ -42,6 +42,12 @@ class Lessons:
         if self.painter is not None:
             self.painter.new_demo()
 
+    def drop_after(self, t_s: float) -> None:
+        """The table was rewound to `t_s` and runs on: what the recording and the diagram saw later did not happen."""
+        self.recorder.drop_after(t_s)
+        if self.momenta.latest is not None and self.momenta.latest.t_s > t_s:
+            self.momenta.clear()
+
     def after_step(self, table: AirTable) -> None:
         self.recorder.sample(table)
         if self.show_momenta:  # only then: most steps nobody asks what the collisions did

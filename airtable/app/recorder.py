@@ -90,6 +90,14 @@ class Recorder:
         self.samples.append(s)
         self.nbytes += s.nbytes
 
+    def drop_after(self, t_s: float) -> int:
+        """Forget the samples later than `t_s` (the table was rewound to it and runs on); returns how many."""
+        gone = 0
+        while self.samples and self.samples[-1].t_s > t_s:
+            self.nbytes -= self.samples.pop().nbytes
+            gone += 1
+        return gone
+
     @property
     def span_s(self) -> float:
         """Simulated time from the oldest sample kept to the newest."""

@@ -27,6 +27,7 @@ from airtable.app.environment import Environment, fitting_size_px
 from airtable.app.lessons_paint import LessonsPainter  # noqa: F401  (imported from here by lessons_view)
 from airtable.app.pucks_view import COLORKEY, MIN_PUCK_RADIUS_PX, PuckSprites, draw_pucks
 from airtable.app.scene import STATUS_SEPARATOR, Scene
+from airtable.app.timeline_paint import TimelinePainter  # noqa: F401  (imported from here by the app)
 from airtable.assets import ASSETS_DIR
 
 BACKGROUND = (0, 0, 0)

@@ -2,8 +2,10 @@
 
 Owned by the server's network thread. A `Connection` reads frames (at most a
 message and byte budget a second, see `RateLimit`), and sends in this order:
-control frames (WELCOME, ERROR, BYE) first, then only the newest snapshot,
-so a slow reader misses snapshots instead of piling them up. After an ERROR
+control frames (WELCOME, ERROR, BYE) first, then the newest snapshot tick,
+coded for this player (codec.py) only when it can go: once the previous one
+is acknowledged (pacing.py), so a slow reader misses snapshots instead of
+piling them up, and on a tight link every player's rate drops evenly. After an ERROR
 it shuts its side and waits for the client to hang up (`closing`).
 """
 
@@ -15,7 +17,9 @@ import socket
 import time
 from collections import deque
 
+from airtable.net import pacing
 from airtable.net import protocol as proto
+from airtable.net.codec import SnapshotEncoder, Viewer
 
 RATE_PER_S = 240.0  # sustained messages a second per client (a player sends <= 61)
 RATE_BURST = 480.0
@@ -80,7 +84,11 @@ class Connection:
         self.lag_s = 0.0  # smoothed time a snapshot waited here before it was sent
         self._out_cur: memoryview | None = None  # the frame being sent
         self._out_ctrl: deque[bytes] = deque()  # WELCOME / ERROR / BYE, before any snapshot
-        self._out_snap: bytes | None = None  # the newest snapshot not yet started
+        self.viewer = Viewer()  # the snapshot ticks this player holds
+        self._encoder: SnapshotEncoder | None = None
+        self._tick_due = False  # a newer tick than the player holds is waiting to be coded and sent
+        self._last_snap_bytes = 0
+        self.held_back = False  # the tick waits for the previous one to be acknowledged
         self._snap_offered = now
         self._sending_snap = False
         self._shut = False  # our side is shut down after an ERROR
@@ -98,7 +106,7 @@ class Connection:
         return self._out_cur is not None
 
     def has_output(self) -> bool:
-        return self._out_cur is not None or bool(self._out_ctrl) or self._out_snap is not None
+        return self._out_cur is not None or bool(self._out_ctrl) or self._tick_due
 
     # ------------------------------------------------------------ receiving
 
@@ -135,19 +143,20 @@ class Connection:
         self._out_ctrl.append(frame)
         self.flush()
 
-    def offer_snapshot(self, frame: bytes | None, now: float) -> None:
-        """The newest snapshot replaces one that never started going out."""
-        if frame is None or self.state != State.PLAYING:
+    def offer_tick(self, encoder: SnapshotEncoder, now: float) -> None:
+        """A new snapshot tick is out: it replaces one that never started going out,
+        and is coded against what this player holds when its turn comes."""
+        if encoder.newest is None or self.state != State.PLAYING:
             return
-        if self._out_snap is None:
+        if not self._tick_due:
             self._snap_offered = now
-        self._out_snap = frame
+        self._encoder, self._tick_due = encoder, True
         self.flush()
 
     def fail(self, sentence: str, now: float, retry: bool = False) -> None:
         """Send ERROR `sentence`; close once it is out (the server closes it after LINGER_S)."""
         self.state = State.CLOSING
-        self._out_snap = None
+        self._tick_due = False
         self._out_ctrl.append(proto.encode_error(sentence, retry=retry))
         self.deadline = now + LINGER_S
         self.flush()
@@ -171,7 +180,8 @@ class Connection:
         if self.state == State.CLOSING and not self._shut and not self.has_output():
             self._shut_down()
         events = selectors.EVENT_READ
-        if self.has_output() and not self._shut:
+        # A held-back tick waits for acknowledgements, not for room: the server looks again.
+        if (self._out_cur is not None or self._out_ctrl) and not self._shut:
             events |= selectors.EVENT_WRITE
         if events != self._events and not self.closed:
             self._events = events
@@ -186,10 +196,22 @@ class Connection:
             return True
         if self._out_ctrl:
             self._out_cur, self._sending_snap = memoryview(self._out_ctrl.popleft()), False
-        elif self._out_snap is not None:
-            self._out_cur, self._out_snap, self._sending_snap = memoryview(self._out_snap), None, True
+        elif self._tick_due:
+            return self._start_tick()
         else:
             return False
+        return True
+
+    def _start_tick(self) -> bool:
+        self.held_back = not pacing.may_send(self.sock, self._last_snap_bytes)
+        if self.held_back:
+            return False
+        self._tick_due = False
+        data = self._encoder.frames_for(self.viewer)
+        if not data:
+            return False
+        self._last_snap_bytes = len(data)
+        self._out_cur, self._sending_snap = memoryview(data), True
         return True
 
     def _frame_done(self) -> None:

@@ -29,6 +29,7 @@ import numpy as np
 from airtable.app.room import student_banner
 from airtable.app.scene import CursorView, Scene
 from airtable.net import protocol as proto
+from airtable.net.playout import SnapshotFeed
 
 CONNECT_TIMEOUT_S = 5.0
 SILENCE_S = 10.0  # no snapshot for this long: the server is gone (snapshots come 30 times a second)
@@ -149,6 +150,7 @@ class NetPlayer:
         self.reconnects = 0
         self.snapshots = 0
         self._scene: Scene | None = None
+        self._feed = SnapshotFeed()
         self._sock: socket.socket | None = None
         self._send_lock = threading.Lock()
         self._closed = threading.Event()
@@ -289,6 +291,7 @@ class NetPlayer:
         with self._send_lock:
             self._sock = sock
             self.welcome = welcome
+            self._feed = SnapshotFeed()  # a new connection starts from a keyframe
             self._throttle.reset()
             self.state = PlayerState.CONNECTED
             self.waiting_because = None
@@ -353,11 +356,13 @@ class NetPlayer:
 
     def _take(self, frames: list, now: float) -> None:
         for frame_type, payload in frames:
-            if frame_type == proto.SNAPSHOT:
+            if frame_type in (proto.SNAPSHOT, proto.LAYOUT):
                 try:
-                    scene = proto.decode_snapshot(payload)
+                    scene = self._feed.feed(frame_type, payload, now)
                 except proto.ProtocolError as e:
                     raise _ConnectionEndedError(str(e)) from None
+                if scene is None:
+                    continue  # a LAYOUT: what the next snapshots need
                 self._scene = scene  # one reference swap: readers see the old or the new scene
                 self.snapshots += 1
                 if self.on_snapshot is not None:
@@ -395,6 +400,11 @@ class NetPlayer:
     def latest(self) -> Scene | None:
         """The newest scene received (None before the first snapshot)."""
         return self._scene
+
+    def smooth(self, now_s: float | None = None) -> Scene | None:
+        """The scene to draw at `now_s` (default: now): interpolated between snapshots a
+        small adaptive delay ago, so motion stays even when snapshots arrive unevenly."""
+        return self._feed.scene(time.monotonic() if now_s is None else now_s)
 
     def send_input(self, cursor_m: Sequence[float], button: int = 0, keys: Iterable[str] = ()) -> bool:
         """Send one INPUT now (no throttle); False when not connected. Never raises."""
@@ -567,7 +577,7 @@ class PlayerApp:
 
         net, env = self.net, self.env
         self._follow_welcome()
-        scene = net.latest() or _empty_scene(*self._table_size())
+        scene = net.smooth() or _empty_scene(*self._table_size())
         # The teacher's view: the student sees what the projector shows.
         env.zoom = min(max(scene.zoom, MIN_ZOOM), MAX_ZOOM)
         env.origin_m = np.array(scene.origin_m, dtype=float)

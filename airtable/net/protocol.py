@@ -1,8 +1,9 @@
-"""The airtable wire protocol, version 1 (no pygame, no sockets).
+"""The airtable wire protocol, version 2 (no pygame, no sockets).
 
 Every message is a frame: ``[u32 big-endian length L][u8 type][L-1 payload bytes]``.
-HELLO, WELCOME, ERROR and INPUT carry a JSON object; SNAPSHOT carries a binary
-Scene (layout in `encode_snapshot`); BYE is empty. See DESIGN.md section 5.
+HELLO, WELCOME, ERROR and INPUT carry a JSON object; SNAPSHOT and LAYOUT carry
+snapshot format 2 (codec.py: what moves, coded against what each player holds,
+and what rarely changes); BYE is empty. README documents every byte.
 
 Everything that comes off the network is checked here and turned into small
 immutable values (`Hello`, `InputRecord`, `Welcome`, a `Scene`); a bad message
@@ -26,7 +27,7 @@ import numpy as np
 from airtable.app.scene import CursorView, Scene
 from airtable.physics.table import TABLE_HEIGHT_M, TABLE_WIDTH_M
 
-PROTOCOL_VERSION = 1
+PROTOCOL_VERSION = 2
 DEFAULT_PORT = 8888
 DEFAULT_TABLE_SIZE_M = (TABLE_WIDTH_M, TABLE_HEIGHT_M)  # until the game loop (or a WELCOME) says otherwise
 
@@ -36,7 +37,16 @@ ERROR = 3
 INPUT = 4
 SNAPSHOT = 5
 BYE = 6
-FRAME_NAMES = {HELLO: "HELLO", WELCOME: "WELCOME", ERROR: "ERROR", INPUT: "INPUT", SNAPSHOT: "SNAPSHOT", BYE: "BYE"}
+LAYOUT = 7  # what rarely changes in a snapshot (codec.py), sent when it changes
+FRAME_NAMES = {
+    HELLO: "HELLO",
+    WELCOME: "WELCOME",
+    ERROR: "ERROR",
+    INPUT: "INPUT",
+    SNAPSHOT: "SNAPSHOT",
+    BYE: "BYE",
+    LAYOUT: "LAYOUT",
+}
 CLIENT_FRAMES = frozenset({HELLO, INPUT, BYE})
 
 # Bytes of L (type + payload) a client may send. A real INPUT is under 400
@@ -316,7 +326,7 @@ class Hello:
     token: str | None = None  # from an earlier WELCOME: asks for the same seat again
 
 
-HELLO_EXAMPLE = '{"protocol": 1, "name": "Ann"}'
+HELLO_EXAMPLE = f'{{"protocol": {PROTOCOL_VERSION}, "name": "Ann"}}'
 
 
 def encode_hello(
@@ -479,7 +489,7 @@ def parse_input(payload: bytes, table_size_m: Sequence[float] = DEFAULT_TABLE_SI
 
 @dataclass(frozen=True)
 class Welcome:
-    """A validated WELCOME: the player's id ("C3"), name, colour, the table size (m)
+    """A validated WELCOME: the player's id ("C3") and name, colour, the table size (m),
     and the seat token to send in HELLO when reconnecting."""
 
     client: str
@@ -487,7 +497,7 @@ class Welcome:
     width_m: float
     height_m: float
     protocol: int = PROTOCOL_VERSION
-    name: str = ""
+    name: str | None = None
     token: str | None = None
 
     @property
@@ -497,10 +507,16 @@ class Welcome:
 
 
 def encode_welcome(
-    client: str, color: Sequence[int], width_m: float, height_m: float, name: str = "", token: str | None = None
+    client: str,
+    color: Sequence[int],
+    width_m: float,
+    height_m: float,
+    name: str | None = None,
+    token: str | None = None,
 ) -> bytes:
-    """A WELCOME frame: `client` is the id alone ("C3"), `name` the player's name (left out when "")."""
-    message: dict = {
+    """A WELCOME frame; `client` is the id alone ("C3"), `name` the name the player gave,
+    `token` the seat token a reconnecting client sends back in HELLO."""
+    message = {
         "protocol": PROTOCOL_VERSION,
         "client": client,
         "color": [int(c) for c in color],
@@ -515,7 +531,7 @@ def encode_welcome(
 
 def parse_welcome(payload: bytes) -> Welcome:
     """Check a WELCOME from the server (the player trusts no bytes either)."""
-    message = parse_json(payload, "the server's WELCOME", '{"protocol": 1, ...}')
+    message = parse_json(payload, "the server's WELCOME", f'{{"protocol": {PROTOCOL_VERSION}, ...}}')
     protocol = message.get("protocol")
     if protocol != PROTOCOL_VERSION or isinstance(protocol, bool):
         raise ProtocolError(
@@ -524,11 +540,11 @@ def parse_welcome(payload: bytes) -> Welcome:
         )
     _check_fields(message, "the server's WELCOME", ("protocol", "client", "color", "table"), ("name", "token"))
     client = message["client"]
-    if not (isinstance(client, str) and 1 <= len(client) <= 2 * MAX_NAME_CHARS and client.isprintable()):
-        raise ProtocolError(f"the server's WELCOME has a bad client name {_short(client)}")
-    name = message.get("name", "")
-    if not (isinstance(name, str) and len(name) <= MAX_NAME_CHARS and name.isprintable()):
-        raise ProtocolError(f"the server's WELCOME has a bad name {_short(name)}")
+    if not (isinstance(client, str) and re.fullmatch(r"C[1-9][0-9]{0,5}", client)):
+        raise ProtocolError(f"the server's WELCOME has a bad client id {_short(client)} (it should be like C3)")
+    name = message.get("name")
+    if name is not None:
+        name = check_name(name)
     token = message.get("token")
     if token is not None and not (isinstance(token, str) and len(token) <= MAX_TOKEN_CHARS and token.isprintable()):
         raise ProtocolError("the server's WELCOME has a bad seat token")

@@ -7,9 +7,11 @@ touches the table or the loop's clients. The game loop calls, every frame:
     server.update_clients(clients, table)  # joins, leaves, newest inputs (even while paused)
     server.publish(scene)                  # after the physics steps: at most snapshot_hz a second
 
-and neither call ever waits on a socket. A snapshot is encoded once and the
-same bytes go to every player; a player whose connection is slow keeps only
-the newest snapshot waiting, so it misses frames instead of slowing anyone.
+and neither call ever waits on a socket. Each snapshot tick is coded against
+what each player holds (snapshot format 2, codec.py), once per distinct base
+and shared; players are served in turn and paced (pacing.py), so a slow
+connection misses ticks instead of slowing anyone, and on a tight link every
+player's rate drops evenly.
 
 Joining is guarded (see gate.py): handshakes have their own cap and a short
 deadline, one computer may hold only a few handshakes and seats, and wrong
@@ -35,7 +37,9 @@ from dataclasses import dataclass
 from airtable.app.client import Client
 from airtable.app.scene import Scene
 from airtable.colors import rgb
+from airtable.net import pacing
 from airtable.net import protocol as proto
+from airtable.net.codec import SnapshotEncoder
 from airtable.net.connection import Connection, State
 from airtable.net.events import EventQueue, PlayerInput, PlayerJoined, PlayerLeft
 from airtable.net.gate import FIRST_PASSWORD_WAIT_S, HANDSHAKES_PER_ADDRESS, PLAYERS_PER_ADDRESS, Gate, QuietLog
@@ -215,7 +219,7 @@ class GameServer:
         # Shared between the network thread and the game loop.
         self._events = EventQueue()
         self._lock = threading.Lock()  # guards the fields below
-        self._snapshot: bytes | None = None  # newest SNAPSHOT frame
+        self._encoder = SnapshotEncoder()  # has its own lock
         self._snapshot_seq = 0
         self._names: dict[int, str] = {}  # player number -> name, for player_names()
         self._roster: tuple[Seat, ...] = ()
@@ -233,13 +237,13 @@ class GameServer:
         self._gate = Gate(handshakes_per_address, players_per_address, limit_loopback, password_wait_s)
         self._quiet = QuietLog(log)
         self._sent_seq = 0
+        self._turns = pacing.RoundRobin()
         self._next_cid = 1
         self._accept_paused_until = 0.0
 
         self._listener: socket.socket | None = None
         self._selector: selectors.BaseSelector | None = None
-        self._wake_r: socket.socket | None = None
-        self._wake_w: socket.socket | None = None
+        self._wake_r, self._wake_w = None, None  # a socketpair that wakes the network thread (made in start)
         self._thread: threading.Thread | None = None
         self._stopping = threading.Event()
         self._join_lines: tuple[int, list[str]] | None = None
@@ -470,9 +474,8 @@ class GameServer:
         self._table_size_m = (float(scene.width_m), float(scene.height_m))
         if not self._names:
             return  # nobody to send to; encoding would be wasted work
-        frame = proto.encode_frame(proto.SNAPSHOT, proto.encode_snapshot(scene))
+        self._encoder.add(scene)
         with self._lock:
-            self._snapshot = frame
             self._snapshot_seq += 1
         self._wake()
 
@@ -508,14 +511,16 @@ class GameServer:
         assert sel is not None
         next_check = 0.0
         while not self._stopping.is_set():
+            held = [conn for conn in self._conns.values() if conn.held_back]
             try:
-                ready = sel.select(timeout=0.1)
+                ready = sel.select(timeout=pacing.RECHECK_S if held else 0.1)
             except OSError:  # the selector was closed under us during stop
                 if self._stopping.is_set():
                     break
                 raise
             for key, mask in ready:
                 self._on_ready(key, mask)
+            self._retry_held(held)
             now = time.monotonic()
             if now >= next_check:
                 next_check = now + 0.1
@@ -605,14 +610,21 @@ class GameServer:
 
     def _distribute_snapshot(self) -> None:
         with self._lock:
-            frame, seq = self._snapshot, self._snapshot_seq
-        if frame is None or seq == self._sent_seq:
+            seq = self._snapshot_seq
+        if seq == self._sent_seq:
             return
         self._sent_seq = seq
         now = time.monotonic()
-        for conn in list(self._conns.values()):
-            conn.offer_snapshot(frame, now)
+        for conn in self._turns.order(list(self._conns.values())):
+            conn.offer_tick(self._encoder, now)
             self._settle(conn)
+
+    def _retry_held(self, held: list[Connection]) -> None:
+        """Players whose tick waited for acknowledgements: send it if it may go now."""
+        for conn in held:
+            if not conn.closed and conn.held_back:
+                conn.flush()
+                self._settle(conn)
 
     def _on_readable(self, conn: Connection) -> None:
         now = time.monotonic()
@@ -668,19 +680,19 @@ class GameServer:
             number = 1
             while number in self._numbers:  # the lowest free number, so names get reused
                 number += 1
-        name = f"C{number}" + (f" {hello.name}" if hello.name else "")
+        client = f"C{number}"
+        name = client + (f" {hello.name}" if hello.name else "")  # the cursor's label
         color = client_color(number)
         self._gate.handshake_ended(conn.host, seated=True)
         conn.number, conn.name, conn.state = number, name, State.PLAYING
         self._numbers[number] = conn.cid
         with self._lock:
             self._names[number] = name
-            snapshot = self._snapshot
         self._events.join(conn.cid, name, color, number)
         width_m, height_m = self._table_size_m
         token = self._tokens.make(number, hello.name or "")
-        conn.send_control(proto.encode_welcome(f"C{number}", color, width_m, height_m, hello.name or "", token))
-        conn.offer_snapshot(snapshot, now)  # the newest picture straight away, if there is one
+        conn.send_control(proto.encode_welcome(client, color, width_m, height_m, hello.name, token))
+        conn.offer_tick(self._encoder, now)  # the newest picture straight away, if there is one
         self._log_seat(conn, "%s joined from %s", name, conn.peer)
 
     def _log_seat(self, conn: Connection, line: str, *args) -> None:
@@ -744,7 +756,7 @@ class GameServer:
                 if not self._names:
                     # publish() stops encoding when nobody plays: do not greet the
                     # next player with a picture from long ago.
-                    self._snapshot = None
+                    self._encoder.forget()
             self._events.leave(conn.cid)
         conn.number = 0
 

@@ -1,0 +1,243 @@
+"""Per-student snapshot rates on a link of limited bandwidth (Linux network namespaces).
+
+    python -m airtable.net.fairness [--mbit 5 10 20] [--clients 30] [--seconds 5]
+
+creates a private network namespace, brings up its loopback and holds it to
+the given rate with a token bucket (`tc qdisc add dev lo root tbf rate
+10mbit burst 32kbit latency 50ms`), runs a headless demo 4 table with a
+server in it and N load-tool players that drag pucks round, and prints the
+snapshots per second each student received. A fair server lets every
+student's rate drop evenly when the link cannot carry everything.
+
+Needs root (or CAP_NET_ADMIN) and the `ip` and `tc` tools; `available()` says
+why not where they are missing. Only loopback addresses are used, every wait
+is bounded, and the namespace is deleted in a `finally`.
+
+The two halves that run inside the namespace are subcommands of this module:
+`serve` (the table and its server) and `measure` (the players; prints JSON).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import selectors
+import shutil
+import statistics
+import subprocess
+import sys
+import time
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+PORT = 8888
+READY = "fairness-server-ready"
+BENCH_MBIT = (5, 10, 20)
+START_TIMEOUT_S = 30.0
+
+
+def _ip(*args: str, check: bool = True) -> subprocess.CompletedProcess:
+    return subprocess.run(["ip", *args], capture_output=True, text=True, timeout=20, check=check)
+
+
+def available() -> str | None:
+    """None when namespaces and tc work here, else the reason they do not."""
+    if sys.platform != "linux":
+        return "network namespaces need Linux"
+    for tool in ("ip", "tc"):
+        if shutil.which(tool) is None:
+            return f"the {tool!r} tool is not installed (iproute2)"
+    name = f"airtable-probe-{os.getpid()}"
+    try:
+        made = _ip("netns", "add", name, check=False)
+        if made.returncode != 0:
+            return f"cannot create a network namespace ({made.stderr.strip() or 'permission denied'}); run as root"
+        shaped = _ip("netns", "exec", name, "tc", "qdisc", "add", "dev", "lo", "root", "tbf", "rate", "10mbit",
+                     "burst", "32kbit", "latency", "50ms", check=False)  # fmt: skip
+        if shaped.returncode != 0:
+            return f"tc cannot shape the namespace's loopback ({shaped.stderr.strip()})"
+    finally:
+        _ip("netns", "del", name, check=False)
+    return None
+
+
+class Namespace:
+    """A private network namespace whose loopback is held to `mbit` Mbit/s."""
+
+    def __init__(self, mbit: float) -> None:
+        self.name = f"airtable-net-{os.getpid()}-{int(mbit * 1000)}"
+        self.mbit = mbit
+
+    def __enter__(self) -> Namespace:
+        _ip("netns", "add", self.name)
+        try:
+            _ip("-n", self.name, "link", "set", "lo", "up")
+            self.run("tc", "qdisc", "add", "dev", "lo", "root", "tbf", "rate", f"{self.mbit:g}mbit",
+                     "burst", "32kbit", "latency", "50ms")  # fmt: skip
+        except BaseException:
+            self.__exit__()
+            raise
+        return self
+
+    def __exit__(self, *exc) -> None:
+        _ip("netns", "del", self.name, check=False)
+
+    def command(self, *args: str) -> list[str]:
+        return ["ip", "netns", "exec", self.name, *args]
+
+    def run(self, *args: str, timeout_s: float = 20.0) -> subprocess.CompletedProcess:
+        return subprocess.run(self.command(*args), capture_output=True, text=True, timeout=timeout_s, check=True)
+
+
+@dataclass
+class Rates:
+    """What the students got on one link."""
+
+    mbit: float
+    rates: list[float]
+    mean_bytes: float
+    mbit_used: float
+    server_fps: float
+
+    @property
+    def median(self) -> float:
+        return statistics.median(self.rates) if self.rates else 0.0
+
+    def line(self) -> str:
+        r = sorted(self.rates)
+        if not r:
+            return f"{self.mbit:5g} Mbit/s: no student got any snapshot"
+        return (
+            f"{self.mbit:5g} Mbit/s: {len(r)} students, snapshots/s min {r[0]:.1f}, median {self.median:.1f}, "
+            f"max {r[-1]:.1f}; {self.mean_bytes:.0f} B per snapshot, {self.mbit_used:.2f} Mbit/s used, "
+            f"server {self.server_fps:.0f} fps"
+        )
+
+
+def _wait_ready(proc: subprocess.Popen, timeout_s: float) -> None:
+    """Wait (bounded) for the server's ready line."""
+    sel = selectors.DefaultSelector()
+    sel.register(proc.stdout, selectors.EVENT_READ)
+    deadline = time.monotonic() + timeout_s
+    try:
+        while (left := deadline - time.monotonic()) > 0:
+            if not sel.select(left):
+                break
+            line = proc.stdout.readline()
+            if not line:
+                break
+            if line.strip() == READY:
+                return
+    finally:
+        sel.close()
+    raise RuntimeError("the table server in the namespace did not start")
+
+
+def measure_rates(mbit: float, clients: int = 30, seconds: float = 5.0, demo: str = "4") -> Rates:
+    """Run a demo table and `clients` players in a namespace held to `mbit` Mbit/s."""
+    py = sys.executable
+    with Namespace(mbit) as ns:
+        server = subprocess.Popen(
+            ns.command(py, "-m", "airtable.net.fairness", "serve", "--demo", demo, "--seconds", str(seconds + 60)),
+            stdout=subprocess.PIPE,
+            stderr=subprocess.DEVNULL,
+            text=True,
+        )
+        try:
+            _wait_ready(server, START_TIMEOUT_S)
+            args = ("measure", "--clients", str(clients), "--seconds", str(seconds))
+            done = ns.run(py, "-m", "airtable.net.fairness", *args, timeout_s=seconds + 90)
+        finally:
+            server.terminate()
+            try:
+                server.wait(timeout=10)
+            except subprocess.TimeoutExpired:
+                server.kill()
+                server.wait(timeout=10)
+            server.stdout.close()
+    result = json.loads(done.stdout.strip().splitlines()[-1])
+    return Rates(mbit, result["rates"], result["mean_bytes"], result["mbit"], result["fps"])
+
+
+# ---------------------------------------------------------------- the halves inside the namespace
+
+
+def serve(demo_key: str, seconds: float) -> int:
+    """A headless demo table with a server on 127.0.0.1:PORT, for `seconds` at most."""
+    from airtable.net.loadtest import TableLoop, table_for
+    from airtable.net.server import GameServer
+
+    table, dt_s, title = table_for(demo_key)
+    server = GameServer(host="127.0.0.1", port=PORT, max_clients=200)
+    server.start()
+    loop = TableLoop(server, table, fps=60, dt_s=dt_s, title=title).start()
+    print(READY, flush=True)
+    try:
+        time.sleep(seconds)
+    except KeyboardInterrupt:
+        pass
+    finally:
+        loop.stop()
+        server.stop()
+    return 0
+
+
+def measure(clients: int, seconds: float) -> int:
+    """Players from the load tool; prints one JSON line with each one's rate."""
+    from airtable.net.loadtest import run_load
+
+    result = run_load("127.0.0.1", PORT, clients=clients, seconds=seconds)
+    fps = statistics.median(result.loaded_fps) if result.loaded_fps else 0.0
+    print(
+        json.dumps(
+            {
+                "rates": result.snapshot_rates,
+                "mean_bytes": result.mean_snapshot_bytes,
+                "mbit": result.mbit_per_s,
+                "fps": fps,
+                "errors": result.errors[:5],
+            }
+        )
+    )
+    return 0
+
+
+def bench(mbits: Sequence[float] = BENCH_MBIT, clients: int = 30, seconds: float = 5.0) -> list[Rates]:
+    """Print per-student rates at each link rate (the `make bench` section); [] where not possible."""
+    why = available()
+    if why:
+        print(f"fairness: skipped: {why}")
+        return []
+    print(f"fairness: {clients} students on demo 4, loopback held to each rate with a tc token bucket")
+    results = []
+    for mbit in mbits:
+        rates = measure_rates(mbit, clients, seconds)
+        print(rates.line(), flush=True)
+        results.append(rates)
+    return results
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(prog="python -m airtable.net.fairness", description=__doc__.splitlines()[0])
+    sub = parser.add_subparsers(dest="command")
+    s = sub.add_parser("serve")
+    s.add_argument("--demo", default="4")
+    s.add_argument("--seconds", type=float, default=60.0)
+    m = sub.add_parser("measure")
+    m.add_argument("--clients", type=int, default=30)
+    m.add_argument("--seconds", type=float, default=5.0)
+    parser.add_argument("--mbit", type=float, nargs="+", default=list(BENCH_MBIT))
+    parser.add_argument("--clients", type=int, default=30)
+    parser.add_argument("--seconds", type=float, default=5.0)
+    args = parser.parse_args(argv)
+    if args.command == "serve":
+        return serve(args.demo, min(args.seconds, 3600.0))
+    if args.command == "measure":
+        return measure(args.clients, args.seconds)
+    bench(args.mbit, args.clients, args.seconds)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

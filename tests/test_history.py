@@ -1,0 +1,150 @@
+"""The rewind history: moving through it restores exact moments; its memory is bounded by bytes at any size."""
+
+from __future__ import annotations
+
+import gc
+import tracemalloc
+
+import numpy as np
+import pytest
+
+from airtable.app.history import BUDGET_BYTES, History
+from airtable.bench import gas_scene
+from airtable.physics.state import same_bits
+from airtable.physics.table import AirTable
+
+
+def frames(table: AirTable, history: History, n: int, steps: int = 4, dt_s: float = 1 / 240) -> list:
+    """Run `n` frames of `steps` steps, recording each; the positions after each frame."""
+    out = []
+    for _ in range(n):
+        for _ in range(steps):
+            table.step(dt_s)
+        history.record(table)
+        out.append(table.pos_m.copy())
+    return out
+
+
+def test_back_and_forward_show_the_recorded_moments_exactly():
+    table = gas_scene(60, seed=2)
+    table.gravity_on, table.cr_puck, table.cr_wall = True, 0.5, 0.8
+    h = History()
+    h.record(table)
+    seen = frames(table, h, 50)
+    assert len(h) == 51 and not h.in_past
+    assert h.back(table, 10)
+    assert h.in_past and h.index == 40 and same_bits(table.pos_m, seen[39])
+    assert h.forward(table) and same_bits(table.pos_m, seen[40])
+    assert h.forward(table, 100)  # past the newest: stops there, live again
+    assert not h.in_past and same_bits(table.pos_m, seen[-1])
+    assert not h.forward(table)  # nothing newer: the app steps instead
+
+
+def test_jumps_by_seconds_land_on_the_moments_a_second_apart():
+    table = gas_scene(30, seed=2)
+    h = History()
+    h.record(table)
+    frames(table, h, 180)  # 3 s of 1/60 s frames
+    assert h.back_seconds(table, 1.0)
+    assert table.time_s == pytest.approx(2.0)
+    assert h.back_seconds(table, 1.0) and table.time_s == pytest.approx(1.0)
+    assert h.back_seconds(table, 5.0) and table.time_s == 0.0 and h.index == 0
+    assert not h.back_seconds(table, 1.0)  # the oldest moment
+    assert h.forward_seconds(table, 1.0) and table.time_s == pytest.approx(1.0)
+    assert h.forward_seconds(table, 10.0) and not h.in_past and table.time_s == pytest.approx(3.0)
+
+
+def test_running_on_from_the_past_drops_the_future_and_replays_it_bit_for_bit():
+    table = gas_scene(200, seed=4)
+    table.gravity_on, table.cr_puck = True, 0.3
+    h = History()
+    h.record(table)
+    first = frames(table, h, 40)
+    end_vel = table.vel_mps.copy()
+    h.back(table, 25)
+    nbytes = h.nbytes
+    assert h.drop_future() == 25
+    assert len(h) == 16 and not h.in_past and h.nbytes < nbytes
+    again = frames(table, h, 25)
+    for a, b in zip(first[15:], again, strict=True):
+        assert same_bits(a, b)
+    assert same_bits(table.vel_mps, end_vel) and len(h) == 41
+
+
+def test_a_change_made_while_paused_at_the_newest_moment_is_kept():
+    table = gas_scene(20, seed=1)
+    h = History()
+    h.record(table)
+    frames(table, h, 5)
+    table.vel_mps[:] = 0.0  # "freeze", while paused
+    moved = table.pos_m.copy()
+    assert h.back(table) and len(h) == 7  # the frozen table became a moment of its own
+    assert h.forward(table) and not np.any(table.vel_mps) and same_bits(table.pos_m, moved)
+
+
+def test_an_unchanged_table_is_not_kept_twice():
+    table = gas_scene(20, seed=1)
+    h = History()
+    assert h.record(table)
+    assert not h.record(table)
+    assert len(h) == 1
+
+
+def measured_bytes(build) -> tuple[int, int, int]:
+    """A history filled by `build(history)`: the bytes tracemalloc sees it hold, its own count, moments dropped."""
+    gc.collect()
+    tracemalloc.start()
+    try:
+        h = History()
+        build(h)
+        gc.collect()
+        held = tracemalloc.get_traced_memory()[0]
+        counted, dropped = h.nbytes, h.dropped
+        h.clear()
+        gc.collect()
+        freed = held - tracemalloc.get_traced_memory()[0]
+    finally:
+        tracemalloc.stop()
+    return freed, counted, dropped
+
+
+@pytest.mark.parametrize("n_pucks", [10, 1000, 10000])
+def test_the_history_never_holds_more_than_64_MB(n_pucks):
+    table = gas_scene(n_pucks, seed=5)
+    table.gravity_on = True
+    table.step(1 / 240)  # a neighbour list too, for the big ones
+    per_frame = 32 * n_pucks + 2000
+    total_frames = int(1.3 * BUDGET_BYTES / per_frame) if n_pucks > 10 else 3000
+
+    def fill(h: History) -> None:
+        for _ in range(total_frames):
+            # A new moment each frame (cheaper than stepping, the same bytes): positions and velocities change.
+            table.pos_m[:, 0] += 1e-7
+            table.vel_mps[:, 1] -= 1e-7
+            table.time_s += 1 / 60
+            table.steps += 4
+            h.record(table)
+
+    held, counted, dropped = measured_bytes(fill)
+    assert held <= BUDGET_BYTES and counted <= BUDGET_BYTES
+    if n_pucks > 10:
+        assert dropped > 0 and counted > 0.95 * BUDGET_BYTES  # full, and the oldest went
+        assert held == pytest.approx(counted, rel=0.1)  # its own count is close to the truth
+
+
+def test_thirty_seconds_of_a_99_puck_gas_under_gravity_fit():
+    table = gas_scene(99, seed=6)
+    table.gravity_on = True  # the list of neighbours is rebuilt almost every frame: a state's worst size
+    h = History()
+    h.record(table)
+    frames(table, h, 30 * 60, steps=1, dt_s=1 / 60)
+    assert h.dropped == 0 and h.span_s == pytest.approx(30.0)
+    assert h.nbytes < BUDGET_BYTES / 4
+
+
+def test_a_table_too_big_for_the_budget_keeps_no_moment():
+    table = gas_scene(1000, seed=1)
+    h = History(budget_bytes=20_000)
+    assert h.record(table)
+    assert len(h) == 0 and h.nbytes == 0
+    assert not h.back(table) and h.timeline() is None

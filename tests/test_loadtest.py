@@ -1,0 +1,73 @@
+"""The load tool: players in worker processes, bytes and Mbit/s, and its own bottleneck."""
+
+from __future__ import annotations
+
+import pytest
+
+from airtable.net.loadtest import LoadResult, TableLoop, default_processes, grid_table, run_load
+from airtable.net.server import GameServer
+
+
+@pytest.fixture
+def table_server():
+    server = GameServer(host="127.0.0.1", port=0)
+    server.start()
+    loop = TableLoop(server, grid_table(), fps=60).start()
+    yield server
+    loop.stop()
+    server.stop()
+
+
+def test_players_spread_over_two_processes_are_all_measured(table_server):
+    result = run_load("127.0.0.1", table_server.port, clients=4, seconds=1.0, processes=2)
+    assert result.connected == 4 and result.processes == 2
+    assert len(result.snapshot_rates) == 4 and min(result.snapshot_rates) > 0
+    assert result.snapshots == pytest.approx(sum(result.snapshot_rates) * 1.0)
+    assert result.mean_snapshot_bytes > 50 and result.mbit_per_s > 0
+    assert len(result.tool_cpu) == 2 and all(0 <= c < 2 for c in result.tool_cpu)
+    assert result.latencies_s and result.baseline_fps > 0
+    report = result.report()
+    assert "B per snapshot" in report and "Mbit/s" in report and "the tool:" in report
+
+
+def _result(**changes) -> LoadResult:
+    values = dict(
+        address="127.0.0.1:8888",
+        clients=30,
+        connected=30,
+        seconds=10.0,
+        snapshot_rates=[30.0] * 30,
+        baseline_fps=60.0,
+        loaded_fps=[60.0],
+        latencies_s=[0.01] * 100,
+        errors=[],
+        processes=1,
+        snapshot_bytes=30 * 300 * 600,
+        snapshots=30 * 300,
+        tool_cpu=[0.3],
+        tool_lag_s=[0.002],
+    )
+    values.update(changes)
+    return LoadResult(**values)
+
+
+def test_a_calm_run_holds_the_class_and_counts_the_bandwidth():
+    result = _result()
+    assert result.verdict() == "OK, this server holds 30 players"
+    assert result.mean_snapshot_bytes == 600
+    assert result.mbit_per_s == pytest.approx(30 * 30 * 600 * 8 / 1e6)  # 4.32
+
+
+def test_a_busy_tool_says_it_was_the_bottleneck():
+    busy = _result(tool_cpu=[0.95, 0.4], snapshot_rates=[10.0] + [30.0] * 29)
+    assert "the load tool itself was the bottleneck (a worker used 95 % of a core)" in busy.verdict()
+    assert "bottleneck" not in _result(tool_lag_s=[0.03]).verdict()  # a frame or two late is normal
+    late = _result(tool_lag_s=[0.2])
+    assert "loop ran 200 ms late" in late.verdict()
+
+
+def test_about_fifty_players_per_process():
+    assert default_processes(1) == 1
+    assert default_processes(100) >= 1
+    with pytest.raises(ValueError, match="--processes"):
+        run_load("127.0.0.1", 1, clients=2, seconds=1.0, processes=3)

@@ -1,0 +1,53 @@
+"""A spring too stiff for the step is softened, and the teacher is told: once, and by `i`."""
+
+from __future__ import annotations
+
+import pygame
+from conftest import FRAME_S
+
+from airtable.app.aids_view import inspector_lines
+from airtable.app.app import App
+from airtable.physics.table import AirTable
+
+# Two 9 g pucks 1 m apart: k dt^2 / mu passes the softening limit (1e6) near 2.6e8 N/m at 1/240 s.
+LIGHT_DENSITY = 0.009 / (3.141592653589793 * 0.1**2)
+TOO_STIFF_NPM = 1e12
+
+
+def _stiff_pair(table: AirTable):
+    a = table.add_puck(pos_m=(4.0, 4.0), radius_m=0.1, density_kgpm2=LIGHT_DENSITY)
+    b = table.add_puck(pos_m=(5.0, 4.0), radius_m=0.1, density_kgpm2=LIGHT_DENSITY)
+    return a, table.add_spring(a, b, length_m=1.0, k_Npm=TOO_STIFF_NPM, damper_Nspm=0.0)
+
+
+def test_the_inspector_shows_the_stiffness_a_softened_spring_acts_with() -> None:
+    table = AirTable()
+    a, spring = _stiff_pair(table)
+    table.step(1 / 240)
+    assert spring.k_effective_Npm < spring.k_Npm
+    lines = inspector_lines(table, a)
+    assert f"spring k {TOO_STIFF_NPM:.4g} N/m, acts with {spring.k_effective_Npm:.4g} N/m (softened)" in lines
+
+
+def test_an_ordinary_spring_is_listed_without_softening() -> None:
+    table = AirTable()
+    a = table.add_puck(pos_m=(4.0, 4.0))
+    b = table.add_puck(pos_m=(5.5, 4.0))
+    table.add_spring(a, b, k_Npm=20.0)
+    table.step(1 / 240)
+    assert inspector_lines(table, a)[-1] == "spring k 20 N/m"
+
+
+def test_the_app_says_each_notice_once(demos, capsys) -> None:
+    app = App(demos, demo_key="5", headless=True)
+    app.table.clear()
+    _stiff_pair(app.table)
+    app.frame(FRAME_S)
+    assert app.table.notices, "softening a spring must leave a notice"
+    said = app.message
+    assert said in app.table.notices
+    assert capsys.readouterr().err.count(said) == 1
+    for _ in range(30):
+        app.frame(FRAME_S)
+    assert capsys.readouterr().err == ""  # not again while the scene lasts
+    pygame.event.clear()
