@@ -306,3 +306,15 @@ def test_a_students_window_says_hands_off(served, monkeypatch):
         assert room.HANDS_OFF_BANNER in banners
     finally:
         net.close()
+
+
+def test_when_the_student_with_the_floor_leaves_everyone_acts_again(served):
+    app, server, join = served
+    ann, _ = join("Ann"), join("Bo")
+    frames_until(app, lambda: len(server.roster()) == 2, "two seats")
+    press(app, pygame.K_F4)
+    assert server.floor == 1
+    ann.close()
+    frames_until(app, lambda: server.floor is None, "the floor to come back")
+    assert app.message == "the student with the floor left: everyone's cursor acts again"
+    assert not any(p.startswith(room.FLOOR_PREFIX) for p in app.scene().status_parts)
