@@ -261,6 +261,7 @@ def test_hello_gets_welcome_then_a_snapshot(make_server, make_loop, clients):
         "name": "Ann",
         "color": list(rgb("maroon1")),
         "table": {"width_m": loop.table.width_m, "height_m": loop.table.height_m},
+        "token": message["token"],
     }
     scene = c.next_scene()
     assert len(scene.pos_m) == 30 and scene.title == "headless table"
@@ -291,7 +292,7 @@ def test_input_drags_the_puck_and_disconnect_lets_go(make_server, make_loop, cli
     table = one_puck_table()
     loop = make_loop(server, table)
     c = clients(server.port)
-    name = c.hello().client
+    name = c.hello().label
     c.send(proto.encode_input((5.1, 4.0), 1))
 
     def holder() -> Client | None:

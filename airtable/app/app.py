@@ -17,7 +17,7 @@ from pathlib import Path
 import numpy as np
 import pygame
 
-from airtable.app import aids, controls, rewind, world
+from airtable.app import aids, controls, rewind, room, world
 from airtable.app.aids_view import draw_aids
 from airtable.app.client import LOCAL_COLOR, Client, cursor_pulls
 from airtable.app.demo_loader import Demo, DemoError, DemoShelf, error_from_exception, key_label
@@ -27,6 +27,7 @@ from airtable.app.lessons import Lessons
 from airtable.app.lessons_view import draw_lessons
 from airtable.app.loop import FixedStep, FpsCounter, FrameLoop
 from airtable.app.menu import DemoMenu
+from airtable.app.roster_view import draw_alert, draw_roster
 from airtable.app.scene import STATUS_SEPARATOR, Scene
 from airtable.app.stats import RunStats
 from airtable.app.window import AidsPainter, GameWindow, TimelinePainter
@@ -124,6 +125,7 @@ class App:
         self.collision_log = aids.CollisionLog()
         self.chart = aids.EnergyChart()
         self.lessons = Lessons()  # recording, momenta, saving the moment (lessons.py)
+        self.room = room.Room()  # the roster, hands off, the floor, anonymous names (room.py)
         self.history = History()  # the table's recent moments, for rewinding (history.py, rewind.py)
         self.keys_down: set[int] = set()
         self.mouse_px = (self.env.size_px[0] / 2, self.env.size_px[1] / 2)
@@ -251,6 +253,8 @@ class App:
             return "help"
         if self.show_notes:
             return "notes"
+        if self.room.show_roster:
+            return "roster"
         return None
 
     def close_panel(self) -> bool:
@@ -268,6 +272,8 @@ class App:
             self.show_help = False
         elif closing == "notes":
             self.show_notes = False
+        elif closing == "roster":
+            self.room.show_roster = False
         return closing is not None
 
     def take_key_for_overlay(self, event: pygame.event.Event) -> bool:
@@ -396,6 +402,7 @@ class App:
         """The status line in parts, most important first (a narrow window drops the last)."""
         t = self.table
         parts = ["PAUSED"] if self.paused else []
+        parts.extend(room.status_parts(self))  # hands off, the floor
         timeline = self.history.timeline() if self.history.in_past else None
         if timeline is not None:
             parts.append(f"rewound {timeline.newest_s - timeline.view_s:.2f} s")
@@ -421,13 +428,16 @@ class App:
         lines = []
         if self.server is not None:
             lines.extend(self.server.join_lines())
+            lines.extend(room.hud_lines(self))
         if self.message and self.clock_s < self.message_until:
             lines.append(self.message)
         return lines
 
     def draw(self, scene: Scene | None = None) -> None:
         """Draw `scene` (by default the table as it is now), the aids and the panel on top."""
-        self.window.draw(scene or self.scene(), trails=self.trails, hud=self.hud_lines())
+        projected = self.room.projected(scene or self.scene())  # names hidden if anonymous
+        self.window.draw(projected, trails=self.trails, hud=self.hud_lines())
+        draw_alert(self)  # the network thread failed: students can no longer join
         draw_lessons(self)  # first: the aids' labels then place themselves around its panels
         self._draw_timeline()
         draw_aids(self)
@@ -470,6 +480,8 @@ class App:
             )
         elif panel == "notes":
             w.draw_panel(self.demo.label(self.variation), [self.demo.notes or "(no notes)"], large=True)
+        elif panel == "roster":
+            draw_roster(self)
 
     def still(self) -> bool:
         """Nothing to show that changes quickly: paused or motionless, and no input

@@ -17,7 +17,7 @@ from typing import TYPE_CHECKING
 
 import pygame
 
-from airtable.app import aids, lessons, rewind, world
+from airtable.app import aids, lessons, rewind, room, world
 
 if TYPE_CHECKING:
     from airtable.app.app import App
@@ -254,7 +254,19 @@ BINDINGS: tuple[Binding, ...] = (
         "export the recording as CSV; save the moment as a new demo (s1, s2, ...)",
         {pygame.K_x: lessons.export_recording, (pygame.KMOD_CTRL, pygame.K_s): lessons.save_moment},
     ),
-    Binding("F1", "this help screen (again: next page)", {pygame.K_F1: toggle_help}),
+    # F2-F5 share F1's row: the help must fit one page on a 900 x 788 window; the roster panel
+    # (F2) and the HUD's "3 students (F2: roster)" name them in full.
+    Binding(
+        "F1",
+        "this help screen (again: next page); F2-F5: the room",
+        {
+            pygame.K_F1: toggle_help,
+            pygame.K_F2: room.toggle_roster,
+            pygame.K_F3: room.toggle_hands_off,
+            pygame.K_F4: room.next_floor,
+            pygame.K_F5: room.toggle_anonymous,
+        },
+    ),
     Binding("F11", "fullscreen on / off", {pygame.K_F11: toggle_fullscreen}),
     Binding("F12", "save a screenshot PNG", {pygame.K_F12: screenshot}),
     Binding("Esc", "close what is open; else quit (twice if students are connected)", {pygame.K_ESCAPE: escape}),
@@ -267,6 +279,13 @@ MODIFIED_ACTIONS: dict[tuple[int, int], Action] = {
     k: a for b in BINDINGS for k, a in b.actions.items() if isinstance(k, tuple)
 }
 HELD_ACTIONS: dict[int, Action] = {k: a for b in BINDINGS if b.held for k, a in b.actions.items()}
+# Keys the roster panel takes while it is open (documented in BINDINGS above).
+ROSTER_KEYS: dict[int, Action] = {
+    pygame.K_UP: lambda app: room.move_selection(app, -1),
+    pygame.K_DOWN: lambda app: room.move_selection(app, +1),
+    pygame.K_DELETE: room.remove_selected,
+    pygame.K_BACKSPACE: room.remove_selected,
+}
 
 
 def demo_key_for(event: pygame.event.Event) -> str | None:
@@ -294,6 +313,10 @@ def handle_key(app: App, event: pygame.event.Event) -> None:
     """A KEYDOWN: an open panel takes it first, then the key table, then the demo keys."""
     app.keys_down.add(event.key)
     if app.take_key_for_overlay(event):
+        return
+    roster_action = ROSTER_KEYS.get(event.key) if app.panel() == "roster" else None
+    if roster_action is not None:
+        roster_action(app)
         return
     action = modified_action(event) or PRESS_ACTIONS.get(event.key)
     if action is not None:
@@ -323,6 +346,8 @@ def handle_mouse(app: App, event: pygame.event.Event) -> None:
         app.zoom(WHEEL_ZOOM**event.y)
     elif event.button in (1, 2, 3):
         app.mouse_px = event.pos
+        if event.type == pygame.MOUSEBUTTONDOWN and app.panel() == "roster" and room.click(app, event.pos):
+            return  # a row of the roster was picked, not a puck
         if event.type == pygame.MOUSEBUTTONDOWN:
             # Ctrl comes from the key events the app saw, never from a global read.
             if app.keys_down & {pygame.K_LCTRL, pygame.K_RCTRL}:

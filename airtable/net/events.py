@@ -29,6 +29,7 @@ class PlayerJoined:
     cid: int
     name: str
     color: tuple[int, int, int]
+    number: int = 0  # n of "Cn" (the teacher's floor and hands-off rules go by it)
 
 
 @dataclass(frozen=True)
@@ -66,9 +67,9 @@ class EventQueue:
         with self._lock:
             return len(self._members) + sum(len(q) for q in self._inputs.values())
 
-    def join(self, cid: int, name: str, color: tuple[int, int, int]) -> None:
+    def join(self, cid: int, name: str, color: tuple[int, int, int], number: int = 0) -> None:
         with self._lock:
-            self._members.append(PlayerJoined(cid, name, color))
+            self._members.append(PlayerJoined(cid, name, color, number))
 
     def leave(self, cid: int) -> None:
         """Queue a leave; a join the loop has not seen yet is simply withdrawn."""

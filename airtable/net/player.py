@@ -27,6 +27,7 @@ from collections.abc import Callable, Iterable, Sequence
 
 import numpy as np
 
+from airtable.app.room import student_banner
 from airtable.app.scene import CursorView, Scene
 from airtable.net import protocol as proto
 from airtable.net.playout import SnapshotFeed
@@ -251,7 +252,9 @@ class NetPlayer:
         reader = proto.FrameReader(proto.MAX_SERVER_FRAME, sender="the server")
         deadline = time.monotonic() + self.timeout_s
         try:
-            sock.sendall(proto.encode_hello(self.name, self.password, self.protocol_version))
+            # After a first WELCOME, its token asks for the same seat (number, name, colour) again.
+            token = self.welcome.token if self.welcome is not None else None
+            sock.sendall(proto.encode_hello(self.name, self.password, self.protocol_version, token))
             while True:
                 sock.settimeout(max(0.01, deadline - time.monotonic()))
                 data = sock.recv(65536)
@@ -598,7 +601,7 @@ class PlayerApp:
         win.draw(
             dataclasses.replace(scene, cursors=cursors),
             hud=(f"You are {me}" if me else "Not at the table yet", net.status_text),
-            banner=net.banner_text,
+            banner=net.banner_text or student_banner(scene, me),
             hud_color=color,
         )
         if extra and me:  # not in the snapshots yet: the arrow alone

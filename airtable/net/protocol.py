@@ -62,6 +62,7 @@ MAX_PASSWORD_CHARS = 100
 MAX_KEYS = 16
 MAX_KEY_CHARS = 16
 MAX_ERROR_CHARS = 500
+MAX_TOKEN_CHARS = 48  # a seat token, "<number>-<32 hex digits>" (see identity.py)
 # A cursor may wander off the table (the view can be zoomed out), but not
 # further than this many table sizes from it; the player clamps to the same box.
 CURSOR_MARGIN_TABLES = 5.0
@@ -322,18 +323,23 @@ class Hello:
     protocol: int
     name: str | None = None
     password: str | None = None
+    token: str | None = None  # from an earlier WELCOME: asks for the same seat again
 
 
 HELLO_EXAMPLE = f'{{"protocol": {PROTOCOL_VERSION}, "name": "Ann"}}'
 
 
-def encode_hello(name: str | None = None, password: str | None = None, protocol: int = PROTOCOL_VERSION) -> bytes:
+def encode_hello(
+    name: str | None = None, password: str | None = None, protocol: int = PROTOCOL_VERSION, token: str | None = None
+) -> bytes:
     """A HELLO frame."""
     message: dict = {"protocol": protocol}
     if name is not None:
         message["name"] = name
     if password is not None:
         message["password"] = password
+    if token is not None:
+        message["token"] = token
     return encode_json(HELLO, message)
 
 
@@ -367,14 +373,17 @@ def _validate_hello(message: dict) -> Hello:
         raise ProtocolError(f'HELLO "protocol" must be a whole number like {PROTOCOL_VERSION}, not {_short(protocol)}')
     if protocol != PROTOCOL_VERSION:
         raise ProtocolError(version_mismatch(protocol))
-    _check_fields(message, "HELLO", ("protocol",), ("name", "password"))
+    _check_fields(message, "HELLO", ("protocol",), ("name", "password", "token"))
     name = message.get("name")
     if name is not None:
         name = check_name(name)
     password = message.get("password")
     if password is not None:
         password = _text(password, "the password", MAX_PASSWORD_CHARS)
-    return Hello(protocol, name, password)
+    token = message.get("token")
+    if token is not None:
+        token = _text(token, "the seat token", MAX_TOKEN_CHARS)
+    return Hello(protocol, name, password, token)
 
 
 def parse_hello(payload: bytes) -> Hello:
@@ -480,7 +489,8 @@ def parse_input(payload: bytes, table_size_m: Sequence[float] = DEFAULT_TABLE_SI
 
 @dataclass(frozen=True)
 class Welcome:
-    """A validated WELCOME: the player's id ("C3") and name, colour and the table size (m)."""
+    """A validated WELCOME: the player's id ("C3") and name, colour, the table size (m),
+    and the seat token to send in HELLO when reconnecting."""
 
     client: str
     color: tuple[int, int, int]
@@ -488,6 +498,7 @@ class Welcome:
     height_m: float
     protocol: int = PROTOCOL_VERSION
     name: str | None = None
+    token: str | None = None
 
     @property
     def label(self) -> str:
@@ -496,9 +507,15 @@ class Welcome:
 
 
 def encode_welcome(
-    client: str, color: Sequence[int], width_m: float, height_m: float, name: str | None = None
+    client: str,
+    color: Sequence[int],
+    width_m: float,
+    height_m: float,
+    name: str | None = None,
+    token: str | None = None,
 ) -> bytes:
-    """A WELCOME frame; `client` is the id alone ("C3"), `name` the name the player gave."""
+    """A WELCOME frame; `client` is the id alone ("C3"), `name` the name the player gave,
+    `token` the seat token a reconnecting client sends back in HELLO."""
     message = {
         "protocol": PROTOCOL_VERSION,
         "client": client,
@@ -507,6 +524,8 @@ def encode_welcome(
     }
     if name:
         message["name"] = name
+    if token is not None:
+        message["token"] = token
     return encode_json(WELCOME, message)
 
 
@@ -519,13 +538,16 @@ def parse_welcome(payload: bytes) -> Welcome:
             f"the server speaks airtable protocol {_short(protocol)} but this client speaks protocol "
             f"{PROTOCOL_VERSION}; install the same airtable version as the teacher's"
         )
-    _check_fields(message, "the server's WELCOME", ("protocol", "client", "color", "table"), ("name",))
+    _check_fields(message, "the server's WELCOME", ("protocol", "client", "color", "table"), ("name", "token"))
     client = message["client"]
     if not (isinstance(client, str) and re.fullmatch(r"C[1-9][0-9]{0,5}", client)):
         raise ProtocolError(f"the server's WELCOME has a bad client id {_short(client)} (it should be like C3)")
     name = message.get("name")
     if name is not None:
         name = check_name(name)
+    token = message.get("token")
+    if token is not None and not (isinstance(token, str) and len(token) <= MAX_TOKEN_CHARS and token.isprintable()):
+        raise ProtocolError("the server's WELCOME has a bad seat token")
     color = _color(message["color"], "the server's WELCOME colour")
     table = message["table"]
     if not isinstance(table, dict):
@@ -536,7 +558,7 @@ def parse_welcome(payload: bytes) -> Welcome:
     problem = table_size_problem(w, h)
     if problem:
         raise ProtocolError(f"the server's WELCOME has {problem}")
-    return Welcome(client, color, w, h, protocol, name)
+    return Welcome(client, color, w, h, protocol, name, token)
 
 
 def encode_error(sentence: str, retry: bool = False) -> bytes:

@@ -43,6 +43,7 @@ from airtable.net.codec import SnapshotEncoder
 from airtable.net.connection import Connection, State
 from airtable.net.events import EventQueue, PlayerInput, PlayerJoined, PlayerLeft
 from airtable.net.gate import FIRST_PASSWORD_WAIT_S, HANDSHAKES_PER_ADDRESS, PLAYERS_PER_ADDRESS, Gate, QuietLog
+from airtable.net.identity import SeatTokens
 
 log = logging.getLogger("airtable.net")
 
@@ -200,6 +201,7 @@ class GameServer:
         players_per_address: int = PLAYERS_PER_ADDRESS,
         limit_loopback: bool = False,
         password_wait_s: float = FIRST_PASSWORD_WAIT_S,
+        token_key: bytes | None = None,
     ) -> None:
         validate_server_options(port, max_clients, snapshot_hz, timeout_s)
         self.host = host
@@ -211,7 +213,9 @@ class GameServer:
         self.hello_timeout_s = float(hello_timeout_s)
         self.max_handshakes = int(max_handshakes)
         self.failure: str | None = None  # set when the network thread died: a sentence for the teacher
-
+        self.hands_off = False  # game loop: every student's string lets go, their input is ignored
+        self.floor: int | None = None  # game loop: only player C<floor> acts (None: everyone); see may_act
+        self._tokens = SeatTokens(token_key)  # the same key after a restart: the same seats
         # Shared between the network thread and the game loop.
         self._events = EventQueue()
         self._lock = threading.Lock()  # guards the fields below
@@ -224,6 +228,7 @@ class GameServer:
 
         # Game loop only.
         self._clients: dict[int, Client] = {}
+        self._seat_of: dict[int, int] = {}  # cid -> player number
         self._next_publish = 0.0
 
         # Network thread only.
@@ -238,8 +243,7 @@ class GameServer:
 
         self._listener: socket.socket | None = None
         self._selector: selectors.BaseSelector | None = None
-        self._wake_r: socket.socket | None = None
-        self._wake_w: socket.socket | None = None
+        self._wake_r, self._wake_w = None, None  # a socketpair that wakes the network thread (made in start)
         self._thread: threading.Thread | None = None
         self._stopping = threading.Event()
         self._join_lines: tuple[int, list[str]] | None = None
@@ -418,11 +422,13 @@ class GameServer:
         self._table_size_m = (float(table.width_m), float(table.height_m))
         for event in self._events.take():
             match event:
-                case PlayerJoined(cid, name, color):
+                case PlayerJoined(cid, name, color, number):
                     client = Client(name=name, color=color, active=False)
                     self._clients[cid] = client
+                    self._seat_of[cid] = number
                     clients.append(client)
                 case PlayerLeft(cid):
+                    self._seat_of.pop(cid, None)
                     client = self._clients.pop(cid, None)
                     if client is not None:
                         client.release()
@@ -432,8 +438,22 @@ class GameServer:
                 case PlayerInput(cid, record):
                     client = self._clients.get(cid)
                     if client is not None:
-                        client.set_input(table, record.cursor_m, record.button)  # INPUT's keys are not used
+                        button = record.button if self.may_act(self._seat_of.get(cid, 0)) else 0
+                        client.set_input(table, record.cursor_m, button)  # INPUT's keys are not used
                         client.active = True
+        self._hold_back()
+
+    def may_act(self, number: int) -> bool:
+        """Whether player C<number>'s cursor may pull pucks now (hands off, or another has the floor)."""
+        return not self.hands_off and (self.floor is None or self.floor == number)
+
+    def _hold_back(self) -> None:
+        """Players who may not act let go at once, even before their next input."""
+        if not self.hands_off and self.floor is None:
+            return
+        for cid, client in self._clients.items():
+            if client.button and not self.may_act(self._seat_of.get(cid, 0)):
+                client.release()
 
     def apply_inputs(self, clients: list[Client], table) -> None:
         """The old name of update_clients, for game loops not yet moved over."""
@@ -655,9 +675,11 @@ class GameServer:
         if len(self._numbers) >= self.max_clients:
             self._fail(conn, self._full_sentence(), retry=True)
             return
-        number = 1
-        while number in self._numbers:  # the lowest free number, so names get reused
-            number += 1
+        number = self._tokens.seat(hello.token, hello.name or "")  # their old seat, if it is free
+        if number is None or number in self._numbers or number > MAX_PLAYERS:
+            number = 1
+            while number in self._numbers:  # the lowest free number, so names get reused
+                number += 1
         client = f"C{number}"
         name = client + (f" {hello.name}" if hello.name else "")  # the cursor's label
         color = client_color(number)
@@ -666,9 +688,10 @@ class GameServer:
         self._numbers[number] = conn.cid
         with self._lock:
             self._names[number] = name
-        self._events.join(conn.cid, name, color)
+        self._events.join(conn.cid, name, color, number)
         width_m, height_m = self._table_size_m
-        conn.send_control(proto.encode_welcome(client, color, width_m, height_m, hello.name))
+        token = self._tokens.make(number, hello.name or "")
+        conn.send_control(proto.encode_welcome(client, color, width_m, height_m, hello.name, token))
         conn.offer_tick(self._encoder, now)  # the newest picture straight away, if there is one
         self._log_seat(conn, "%s joined from %s", name, conn.peer)
 
