@@ -297,3 +297,16 @@ def test_f1_opens_the_students_help_panel(classroom):
         assert student.show_help and rect.width > 100
     finally:
         net2.close()
+
+
+def test_with_the_teachers_aids_off_a_student_draws_arrows_from_the_snapshots(classroom):
+    teacher, net = classroom
+    teacher.trails = False  # every aid off: no AIDS frames at all
+    student = _run_student(
+        teacher, net, lambda s: net.aids.velocities(2) is not None and net.aids.shows("v"), keys=(pygame.K_v,)
+    )
+    assert net.aids.frame is None and net.aids.teacher == 0
+    v = net.aids.velocities(2)
+    assert np.hypot(*v[0]) == pytest.approx(np.hypot(*teacher.table.vel_mps[0]), rel=0.05)
+    pixels = pygame.surfarray.array3d(student.window.surface).reshape(-1, 3)
+    assert (pixels == VELOCITY_COLOR).all(axis=1).any()

@@ -83,10 +83,11 @@ def shared_aids(app: App) -> SharedAids | None:
         c, cv = t.center_of_mass_m(), t.center_of_mass_vel_mps()
         com = (float(c[0]), float(c[1]), float(cv[0]), float(cv[1]))
     live = tuple(app.collision_log.live(app.clock_s)) if app.show_annotations else ()
-    chart = None
+    chart, corner = None, 0
     if app.show_chart:
         latest = app.chart.latest()
         chart = tuple(latest[f] for f in aids.EnergyChart.FIELDS)
+        corner = (paint.chart_corner or 0) + (4 if paint.chart_small else 0)
     return SharedAids(
         trails=app.trails,
         vectors=app.vectors,
@@ -98,6 +99,7 @@ def shared_aids(app: App) -> SharedAids | None:
         annotation_records=tuple(record_of(a, app.clock_s) for a in live),
         annotations_on=app.show_annotations,
         chart=chart,
+        chart_corner=corner,
         notes=notes,
     )
 
@@ -121,6 +123,7 @@ class StudentAids:
         self._got = False
         self._seen: tuple[float, np.ndarray] | None = None  # the previous snapshot's time and positions
         self._derived: np.ndarray | None = None
+        self.restarts = 0  # counts demo starts and restarts (time going back, pucks coming or going)
 
     def snapshot(self, scene) -> None:
         """A SNAPSHOT came in: if the one before had no AIDS after it, the teacher's aids are off."""
@@ -133,7 +136,9 @@ class StudentAids:
             if seen is not None and seen[1].shape == pos.shape and scene.time_s > seen[0]:
                 self._derived = (pos - seen[1]) / (scene.time_s - seen[0])
             elif seen is not None and scene.time_s != seen[0]:
-                self._derived = None  # a restart or another demo
+                self._derived = None
+            if seen is not None and (seen[1].shape != pos.shape or scene.time_s < seen[0]):
+                self.restarts += 1  # a restart or another demo: trails and arrow scales start afresh
 
     def velocities(self, n: int) -> np.ndarray | None:
         """(n, 2) puck velocities: the teacher's when it sends them, else from the last two snapshots."""

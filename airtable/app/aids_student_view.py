@@ -14,14 +14,15 @@ from airtable.app.aids_paint import AidsPainter
 from airtable.app.aids_share import StudentAids
 from airtable.app.aids_view import COM_COLOR
 from airtable.app.scene import Scene
+from airtable.net import aids_wire
 
 VELOCITY_COLOR = (120, 220, 255)
 MOMENTUM_COLOR = (230, 120, 230)
 # The keys of a student's window, as its F1 panel lists them.
 STUDENT_KEYS = (
     ("mouse buttons 1 / 2 / 3", "grab a puck with the medium / soft / stiff cursor string"),
-    ("v", "vectors on your window: the teacher's velocity or momentum arrows, on or off"),
-    ("c", "the energy and momentum chart on your window, on or off (while the teacher sends it)"),
+    ("v", "arrows on your window: the teacher's, or velocities from the snapshots when the teacher has none"),
+    ("c", "hide or show the teacher's energy and momentum chart on your window"),
     ("i", "inspect the puck under your cursor, on or off"),
     ("e", "trails on your window, on or off"),
     ("F1", "this help (again: close it)"),
@@ -32,9 +33,13 @@ STUDENT_KEYS = (
 def draw_student_aids(paint: AidsPainter, scene: Scene, state: StudentAids, now_s: float, mouse_m) -> None:
     """The aids over a student's frame: chart, vectors, annotations, inspector (in the teacher's order)."""
     env = paint.w.env
-    series = state.chart.series() if state.shows("c") else None
+    # The chart needs the teacher's samples: the student can hide it, not make it up.
+    series = state.chart.series() if state.shows("c") and state.teacher & aids_wire.CHART else None
     if series is not None and len(series["time_s"]):
-        if len(scene.pos_m):
+        frame = state.frame
+        if frame is not None and frame.chart is not None:  # where the teacher has it
+            paint.chart_corner, paint.chart_small = frame.chart_corner % 4, frame.chart_corner >= 4
+        elif len(scene.pos_m):
             paint.choose_chart_corner(env.to_screen(scene.pos_m))
         paint.energy_chart(series, state.chart.latest(), state.chart.euler_wiggle_note(scene))
     if state.shows("v") and len(scene.pos_m):

@@ -59,7 +59,7 @@ _ANN_HEAD = struct.Struct("<IBB")  # newest serial, live count, new count
 _ANN = struct.Struct("<HB16f")  # age ms, has (1 angle, 2 target), 16 numbers
 _ANGLE = struct.Struct("<f")
 _TARGET = struct.Struct("<8f")
-_CHART = struct.Struct("<6f")
+_CHART = struct.Struct("<6fB")  # the sample, then the teacher's corner (0-3) + 4 if the chart is small
 _NOTES = struct.Struct("<HH")  # notes version, text size (then deflated text)
 
 
@@ -86,6 +86,7 @@ class SharedAids:
     annotations: tuple = ()  # live annotations (objects; the encoder gives each a serial), oldest first
     annotation_records: tuple[AnnotationRecord, ...] = ()
     chart: tuple[float, ...] | None = None  # the newest sample: time, kinetic, spring, gravity, total, |p|
+    chart_corner: int = 0  # where the teacher's chart is (aids_paint.CHART_CORNERS), + 4 if small
     notes: str | None = None  # the lecture notes, while their panel is open
 
     annotations_on: bool = False
@@ -229,7 +230,7 @@ def encode_aids(p: _Prepared, base: np.ndarray | None, fresh: int, send_notes: b
         parts.append(_ANN_HEAD.pack(newest & 0xFFFFFFFF, len(p.serials), len(new)))
         parts.extend(_annotation_bytes(r) for r in new)
     if flags & CHART:
-        parts.append(_CHART.pack(*_f32(p.aids.chart)))
+        parts.append(_CHART.pack(*_f32(p.aids.chart), p.aids.chart_corner & 7))
     if send_notes:
         raw = (notes or "").encode("utf-8")[:MAX_NOTES_BYTES]
         parts.append(_NOTES.pack(p.notes_version, len(raw)))
@@ -266,6 +267,7 @@ class AidsFrame:
     live: int = 0
     new_annotations: list[AnnotationRecord] = field(default_factory=list)
     chart: tuple[float, ...] | None = None
+    chart_corner: int = 0
     notes: str | None = None  # only when its text came in this frame
 
     @property
@@ -301,7 +303,10 @@ class AidsDecoder:
         if flags & ANNOTATIONS:
             _annotations(r, out)
         if flags & CHART:
-            out.chart = _finite(_CHART.unpack(r.take(_CHART.size)), "chart sample")
+            *sample, corner = _CHART.unpack(r.take(_CHART.size))
+            if corner > 7:
+                raise _bad(f"a chart in corner {corner}")
+            out.chart, out.chart_corner = _finite(sample, "chart sample"), corner
         if flags & NOTES_TEXT:
             if not flags & NOTES:
                 raise _bad("notes text while the notes are off")

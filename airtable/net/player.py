@@ -500,6 +500,7 @@ class PlayerApp:
         self.keys: set[str] = set()
         self.show_help = False  # F1: the keys of this window
         self.painter = None  # the AidsPainter, once the window is open
+        self._drawn_from: tuple = ()  # the restarts and view the trails were drawn in
         self._welcome: proto.Welcome | None = None
 
     def run(
@@ -597,6 +598,15 @@ class PlayerApp:
             return False
         return True
 
+    def _follow_restarts(self, scene: Scene) -> None:
+        """A demo (re)start or another view: trails and arrow scales start afresh, as on the teacher's window."""
+        drawn_from = (self.net.aids.restarts, scene.zoom, scene.origin_m)
+        if drawn_from != self._drawn_from:
+            if self._drawn_from and drawn_from[0] != self._drawn_from[0]:
+                self.painter.new_demo()
+            self._drawn_from = drawn_from
+            self.window.clear_trails()
+
     def _follow_welcome(self) -> None:
         """After a (re)connect: the new name in the caption, the new table size in the view."""
         welcome = self.net.welcome
@@ -637,6 +647,7 @@ class PlayerApp:
         me = welcome.label if welcome else ""
         color = welcome.color if welcome else (200, 200, 200)
         cursors, extra = own_cursor_live(scene.cursors, me, cursor_m, self.button, focused)
+        self._follow_restarts(scene)
         win.draw(
             dataclasses.replace(scene, cursors=cursors),
             trails=net.aids.shows("e"),
