@@ -8,12 +8,13 @@ What it carries, and how compactly:
 - which aids are on (one flag byte);
 - vectors: the arrows' round scale (the teacher's, fixed per demo), the centre
   of mass and its velocity, and per puck the drawn quantity (velocity or
-  momentum) in thousandths (1 mm/s), coded against the values the same
-  student got last (they change little between ticks), zigzag byte planes,
-  deflated when that is shorter;
+  momentum) in steps of a thousandth of that scale (an arrow 1 m long is
+  1000 steps: arrows are exact to a millimetre of table, and 1 mm/s for a
+  1 m/s scale), coded against the values the same student got last (they
+  change little between ticks), zigzag byte planes, deflated when shorter;
 - annotations: the serial of the newest collision and how many are live; the
   full record (16-26 float32) only of those this student has not had yet;
-- the chart: the newest sample (6 float32); the student keeps the history;
+- the chart: the newest sample (5 float32; its time is the snapshot's); the student keeps the history;
 - the notes: their text only when this student does not hold it yet.
 
 `AidsEncoder` (server) caches one encoding per (tick, what the student
@@ -45,8 +46,8 @@ NOTES = 32
 NOTES_TEXT = 64  # the notes' text is in this frame
 VECTOR_KEY = 128  # the vector values are not a delta (no base)
 
-UNITS = 1000  # vector values travel as thousandths: 1 mm/s, 1 mN s
-MAX_VALUE = 1 << 30  # |value| <= about a million m/s; residuals then fit 32 bits
+ARROW_STEPS = 1000  # vector values travel in thousandths of the arrow scale
+MAX_VALUE = 1 << 20  # steps: an arrow of at most a kilometre (the scale keeps real ones under 1 m)
 MAX_ANNOTATIONS = 8
 MAX_AGE_MS = 60_000
 MAX_NOTES_BYTES = 16_384
@@ -54,12 +55,13 @@ MAX_VECTOR_HISTORY = 8  # ticks of vector values kept as bases
 MAX_COORD_M = 1e6  # a position or length beyond this is not a picture of a table
 
 _HEAD = struct.Struct("<4sBBI")  # magic, version, flags, tick seq
-_VEC = struct.Struct("<I6fBBI")  # N, amount, velocity amount, com x, y, vx, vy, width, deflated, block size
+_VEC = struct.Struct("<H6fBBI")  # N, amount, velocity amount, com x, y, vx, vy, width, deflated, block size
 _ANN_HEAD = struct.Struct("<IBB")  # newest serial, live count, new count
 _ANN = struct.Struct("<HB16f")  # age ms, has (1 angle, 2 target), 16 numbers
 _ANGLE = struct.Struct("<f")
 _TARGET = struct.Struct("<8f")
-_CHART = struct.Struct("<6fB")  # the sample, then the teacher's corner (0-3) + 4 if the chart is small
+# The sample without its time (the snapshot's), then the teacher's corner (0-3) + 4 if the chart is small.
+_CHART = struct.Struct("<5fB")
 _NOTES = struct.Struct("<HH")  # notes version, text size (then deflated text)
 
 
@@ -119,6 +121,11 @@ class _Prepared:
     serials: tuple[int, ...]  # of the live annotations, oldest first
     notes_version: int
 
+    @property
+    def base_key(self) -> tuple:
+        """Values are deltas only on values of the same quantity at the same scale."""
+        return (self.flags & (VELOCITY | MOMENTUM), _scale32(self.aids.amount), self.values)
+
 
 class AidsEncoder:
     """Server side: `add(aids, seq)` per tick (game loop), `frame_for(viewer)` per student (network thread)."""
@@ -126,7 +133,8 @@ class AidsEncoder:
     def __init__(self) -> None:
         self._lock = threading.Lock()
         self._newest: _Prepared | None = None
-        self._history: dict[int, np.ndarray] = {}  # rebuilt on each publish: readers keep their copy
+        # seq -> (flags, scale, values); rebuilt on each publish: readers keep their copy
+        self._history: dict[int, tuple] = {}
         self._serials: dict[int, tuple[object, int]] = {}  # id(annotation) -> (annotation, serial)
         self._next_serial = 1
         self._notes: str | None = None
@@ -144,7 +152,7 @@ class AidsEncoder:
             self._cache = {}
             if prepared is not None and prepared.values is not None:
                 kept = sorted(self._history)[-(MAX_VECTOR_HISTORY - 1) :]
-                self._history = {**{s: self._history[s] for s in kept}, prepared.seq: prepared.values}
+                self._history = {**{s: self._history[s] for s in kept}, prepared.seq: prepared.base_key}
 
     def state(self) -> tuple:
         """What frame_for needs, read at one moment (with the snapshot tick it goes with)."""
@@ -155,7 +163,8 @@ class AidsEncoder:
         values = None
         if aids.vectors and aids.values is not None:
             v = np.nan_to_num(np.asarray(aids.values, dtype=float).reshape(-1, 2), posinf=0.0, neginf=0.0)
-            q = np.clip(np.rint(v * UNITS), -MAX_VALUE, MAX_VALUE).astype(np.int64)
+            q = np.rint(v * (ARROW_STEPS / _scale32(aids.amount)))
+            q = np.clip(np.nan_to_num(q), -MAX_VALUE, MAX_VALUE).astype(np.int64)
             values = np.concatenate([q[:, 0], q[:, 1]])
         serials = []
         known = {}
@@ -177,9 +186,8 @@ class AidsEncoder:
         p, history, cache, notes = self.state() if state is None else state
         if p is None:
             return b""
-        base = history.get(viewer.vector_seq) if p.values is not None else None
-        if base is not None and base.shape != p.values.shape:
-            base = None
+        held = history.get(viewer.vector_seq) if p.values is not None else None
+        base = held[2] if held is not None and held[:2] == p.base_key[:2] and held[2].shape == p.values.shape else None
         fresh = [s for s in p.serials if s > viewer.annotation_serial]
         send_notes = bool(p.flags & NOTES) and viewer.notes_version != p.notes_version
         key = (p.seq, viewer.vector_seq if base is not None else 0, len(fresh), send_notes)
@@ -193,6 +201,12 @@ class AidsEncoder:
         if send_notes:
             viewer.notes_version = p.notes_version
         return data
+
+
+def _scale32(amount: float) -> float:
+    """The arrow scale as it travels (float32), never 0 or beyond."""
+    a = float(amount)
+    return float(np.float32(min(max(a, 1e-29), 1e29))) if math.isfinite(a) else 1.0
 
 
 def _f32(values) -> list[float]:
@@ -216,7 +230,9 @@ def encode_aids(p: _Prepared, base: np.ndarray | None, fresh: int, send_notes: b
         parts.append(
             _VEC.pack(
                 len(p.values) // 2,
-                *_f32((a.amount, a.velocity_amount, *a.com)),
+                _scale32(a.amount),
+                _scale32(a.velocity_amount),
+                *_f32(a.com),
                 width,
                 int(deflated),
                 len(block),
@@ -230,7 +246,7 @@ def encode_aids(p: _Prepared, base: np.ndarray | None, fresh: int, send_notes: b
         parts.append(_ANN_HEAD.pack(newest & 0xFFFFFFFF, len(p.serials), len(new)))
         parts.extend(_annotation_bytes(r) for r in new)
     if flags & CHART:
-        parts.append(_CHART.pack(*_f32(p.aids.chart), p.aids.chart_corner & 7))
+        parts.append(_CHART.pack(*_f32(p.aids.chart[1:]), p.aids.chart_corner & 7))
     if send_notes:
         raw = (notes or "").encode("utf-8")[:MAX_NOTES_BYTES]
         parts.append(_NOTES.pack(p.notes_version, len(raw)))
@@ -280,11 +296,12 @@ class AidsDecoder:
     """Feed it AIDS payloads in order, each right after the SNAPSHOT of the same tick."""
 
     values: np.ndarray | None = None  # int64, the last vector values (the next delta's base)
+    values_key: tuple = ()  # their quantity flag and scale
     values_seq: int = 0
     notes: str | None = None
 
-    def feed(self, payload: bytes, seq: int, pucks: int) -> AidsFrame:
-        """Check and decode; `seq` and `pucks` are those of the snapshot just decoded."""
+    def feed(self, payload: bytes, seq: int, pucks: int, time_s: float = 0.0) -> AidsFrame:
+        """Check and decode; `seq`, `pucks` and `time_s` are those of the snapshot just decoded."""
         payload = bytes(payload)
         if len(payload) < _HEAD.size:
             raise ProtocolError(f"the aids frame is only {len(payload)} bytes, less than its {_HEAD.size} byte header")
@@ -306,7 +323,7 @@ class AidsDecoder:
             *sample, corner = _CHART.unpack(r.take(_CHART.size))
             if corner > 7:
                 raise _bad(f"a chart in corner {corner}")
-            out.chart, out.chart_corner = _finite(sample, "chart sample"), corner
+            out.chart, out.chart_corner = (float(time_s), *_finite(sample, "chart sample")), corner
         if flags & NOTES_TEXT:
             if not flags & NOTES:
                 raise _bad("notes text while the notes are off")
@@ -316,6 +333,7 @@ class AidsDecoder:
 
     def _vectors(self, r: _Reader, out: AidsFrame, pucks: int) -> None:
         n, amount, vel_amount, cx, cy, cvx, cvy, width, deflated, size = _VEC.unpack(r.take(_VEC.size))
+        kind = out.flags & (VELOCITY | MOMENTUM)
         if n != pucks or n > MAX_DRAWN_PUCKS:
             raise _bad(f"arrows for {n} pucks on a table of {pucks}")
         for value in (amount, vel_amount):
@@ -327,14 +345,14 @@ class AidsDecoder:
         residuals = unpack_residuals(r.take(size), width, 2 * n, bool(deflated))
         if out.flags & VECTOR_KEY:
             values = residuals
-        elif self.values is None or len(self.values) != 2 * n:
+        elif self.values is None or len(self.values) != 2 * n or self.values_key != (kind, amount):
             raise _bad("vector values coded against values this client does not hold")
         else:
             values = self.values + residuals
         if len(values) and np.abs(values).max() > MAX_VALUE:
             raise _bad("an arrow longer than any table")
-        self.values, self.values_seq = values, out.seq
-        out.values = np.column_stack([values[:n], values[n:]]) / UNITS
+        self.values, self.values_seq, self.values_key = values, out.seq, (kind, amount)
+        out.values = np.column_stack([values[:n], values[n:]]) * (amount / ARROW_STEPS)
         out.amount, out.velocity_amount = amount, vel_amount
 
 

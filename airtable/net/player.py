@@ -388,7 +388,7 @@ class NetPlayer:
         if last is None:
             raise _ConnectionEndedError(f"{self.address} sent aids before any snapshot")
         try:
-            frame = self._aids.feed(payload, last.seq, last.layout.sizes[0])
+            frame = self._aids.feed(payload, last.seq, last.layout.sizes[0], last.time_us / 1e6)
         except proto.ProtocolError as e:
             raise _ConnectionEndedError(str(e)) from None
         self.aids.take(frame, now)
