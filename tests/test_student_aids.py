@@ -155,6 +155,22 @@ def test_chart_samples_append_and_notes_come_once():
     assert series["total_J"][-1] == pytest.approx(1.5)
 
 
+def test_a_student_gets_the_charts_last_seconds_once_and_again_after_it_was_off():
+    enc, viewer, student = AidsEncoder(), AidsViewer(), _Student()
+    past = np.array([[t, 1.0, 0.5, 0.0, 1.5, 0.25] for t in (0.1, 0.2, 0.3)])
+    got = []
+    for seq, on in enumerate((True, True, False, True), start=1):
+        shared = (
+            SharedAids(chart=(seq, 1.0, 0.5, 0.0, 1.5, 0.25), chart_history=past) if on else SharedAids(trails=True)
+        )
+        enc.publish(enc.prepare(shared, seq))
+        frame = student.aids.feed(_payload(enc, viewer), seq, 3, float(seq))
+        student.state.take(frame, 0.0)
+        got.append(None if frame.chart_history is None else len(frame.chart_history))
+    assert got == [3, None, None, 3]
+    assert list(student.state.chart.series()["time_s"]) == pytest.approx([0.1, 0.2, 0.3, 4.0])
+
+
 def _valid_payload() -> bytes:
     enc = AidsEncoder()
     shared = SharedAids(
@@ -164,6 +180,7 @@ def _valid_payload() -> bytes:
         amount=5.0,
         com=(1.0, 1.0, 0.1, 0.0),
         chart=(1.0, 2.0, 3.0, 0.0, 5.0, 1.0),
+        chart_history=np.array([[0.5, 2.0, 3.0, 0.0, 5.0, 1.0], [0.75, 2.0, 3.0, 0.0, 5.0, 1.0]]),
         notes="notes",
     )
     enc.publish(enc.prepare(shared, 7))

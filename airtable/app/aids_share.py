@@ -83,10 +83,11 @@ def shared_aids(app: App) -> SharedAids | None:
         c, cv = t.center_of_mass_m(), t.center_of_mass_vel_mps()
         com = (float(c[0]), float(c[1]), float(cv[0]), float(cv[1]))
     live = tuple(app.collision_log.live(app.clock_s)) if app.show_annotations else ()
-    chart, corner = None, 0
+    chart, corner, history = None, 0, None
     if app.show_chart:
         latest = app.chart.latest()
         chart = tuple(latest[f] for f in aids.EnergyChart.FIELDS)
+        history = _chart_history(app.chart)
         corner = (paint.chart_corner or 0) + (4 if paint.chart_small else 0)
     return SharedAids(
         trails=app.trails,
@@ -100,8 +101,18 @@ def shared_aids(app: App) -> SharedAids | None:
         annotations_on=app.show_annotations,
         chart=chart,
         chart_corner=corner,
+        chart_history=history,
         notes=notes,
     )
+
+
+def _chart_history(chart: aids.EnergyChart) -> np.ndarray:
+    """The chart's window before its newest sample, thinned to at most MAX_CHART_HISTORY samples."""
+    series = chart.series()
+    rows = np.column_stack([series[f] for f in aids.EnergyChart.FIELDS])[:-1]
+    if len(rows) > aids_wire.MAX_CHART_HISTORY:
+        rows = rows[np.linspace(0, len(rows) - 1, aids_wire.MAX_CHART_HISTORY).astype(int)]
+    return rows
 
 
 class StudentAids:
@@ -158,6 +169,10 @@ class StudentAids:
                     self.annotations.append((serial + k + 1, annotation_of(r, now_s - r.age_s)))
                 first = frame.annotation_serial - frame.live
                 self.annotations = [(s, a) for s, a in self.annotations if first < s <= frame.annotation_serial]
+            if frame.chart_history is not None:  # the teacher's last seconds, once
+                self.chart.clear()
+                for row in frame.chart_history:
+                    self.chart.append(row)
             if frame.chart is not None:
                 self.chart.append(frame.chart)
             if frame.notes is not None:

@@ -14,7 +14,9 @@ What it carries, and how compactly:
   change little between ticks), zigzag byte planes, deflated when shorter;
 - annotations: the serial of the newest collision and how many are live; the
   full record (16-26 float32) only of those this student has not had yet;
-- the chart: the newest sample (5 float32; its time is the snapshot's); the student keeps the history;
+- the chart: the newest sample (5 float32; its time is the snapshot's); the student keeps the
+  history, and gets the teacher's last seconds (at most MAX_CHART_HISTORY samples) once, when
+  the chart first reaches it;
 - the notes: their text only when this student does not hold it yet.
 
 `AidsEncoder` (server) caches one encoding per (tick, what the student
@@ -52,6 +54,7 @@ MAX_ANNOTATIONS = 8
 MAX_AGE_MS = 60_000
 MAX_NOTES_BYTES = 16_384
 MAX_VECTOR_HISTORY = 8  # ticks of vector values kept as bases
+MAX_CHART_HISTORY = 600  # samples of the teacher's chart sent once to a student who lacks them
 MAX_COORD_M = 1e6  # a position or length beyond this is not a picture of a table
 
 _HEAD = struct.Struct("<4sBBI")  # magic, version, flags, tick seq
@@ -60,8 +63,10 @@ _ANN_HEAD = struct.Struct("<IBB")  # newest serial, live count, new count
 _ANN = struct.Struct("<HB16f")  # age ms, has (1 angle, 2 target), 16 numbers
 _ANGLE = struct.Struct("<f")
 _TARGET = struct.Struct("<8f")
-# The sample without its time (the snapshot's), then the teacher's corner (0-3) + 4 if the chart is small.
+# The sample without its time (the snapshot's), then the teacher's corner (0-3) + 4 if the chart is small
+# + 128 if the history follows: u16 H, then H samples of 6 f4 (time first), oldest first.
 _CHART = struct.Struct("<5fB")
+HISTORY_FOLLOWS = 128
 _NOTES = struct.Struct("<HH")  # notes version, text size (then deflated text)
 
 
@@ -89,6 +94,7 @@ class SharedAids:
     annotation_records: tuple[AnnotationRecord, ...] = ()
     chart: tuple[float, ...] | None = None  # the newest sample: time, kinetic, spring, gravity, total, |p|
     chart_corner: int = 0  # where the teacher's chart is (aids_paint.CHART_CORNERS), + 4 if small
+    chart_history: np.ndarray | None = None  # (H, 6) the samples before `chart`, oldest first
     notes: str | None = None  # the lecture notes, while their panel is open
 
     annotations_on: bool = False
@@ -110,6 +116,7 @@ class AidsViewer:
     vector_seq: int = 0
     annotation_serial: int = 0
     notes_version: int = -1
+    chart_synced: bool = False  # has the chart's history (and every sample since)
 
 
 @dataclass
@@ -185,15 +192,18 @@ class AidsEncoder:
         Updates `viewer`."""
         p, history, cache, notes = self.state() if state is None else state
         if p is None:
+            viewer.chart_synced = False
             return b""
         held = history.get(viewer.vector_seq) if p.values is not None else None
         base = held[2] if held is not None and held[:2] == p.base_key[:2] and held[2].shape == p.values.shape else None
         fresh = [s for s in p.serials if s > viewer.annotation_serial]
         send_notes = bool(p.flags & NOTES) and viewer.notes_version != p.notes_version
-        key = (p.seq, viewer.vector_seq if base is not None else 0, len(fresh), send_notes)
+        sync = bool(p.flags & CHART) and not viewer.chart_synced and p.aids.chart_history is not None
+        key = (p.seq, viewer.vector_seq if base is not None else 0, len(fresh), send_notes, sync)
         data = cache.get(key)
         if data is None:
-            data = cache[key] = encode_frame(AIDS, encode_aids(p, base, len(fresh), send_notes, notes))
+            data = cache[key] = encode_frame(AIDS, encode_aids(p, base, len(fresh), send_notes, notes, sync))
+        viewer.chart_synced = bool(p.flags & CHART)
         if p.values is not None:
             viewer.vector_seq = p.seq
         if p.serials:
@@ -217,7 +227,9 @@ def _f32(values) -> list[float]:
     return out
 
 
-def encode_aids(p: _Prepared, base: np.ndarray | None, fresh: int, send_notes: bool, notes: str | None) -> bytes:
+def encode_aids(
+    p: _Prepared, base: np.ndarray | None, fresh: int, send_notes: bool, notes: str | None, history: bool = False
+) -> bytes:
     """The AIDS payload for one tick and one footing (see the module's docstring)."""
     flags = p.flags | (NOTES_TEXT if send_notes else 0)
     parts = []
@@ -246,13 +258,22 @@ def encode_aids(p: _Prepared, base: np.ndarray | None, fresh: int, send_notes: b
         parts.append(_ANN_HEAD.pack(newest & 0xFFFFFFFF, len(p.serials), len(new)))
         parts.extend(_annotation_bytes(r) for r in new)
     if flags & CHART:
-        parts.append(_CHART.pack(*_f32(p.aids.chart[1:]), p.aids.chart_corner & 7))
+        parts.append(_chart_bytes(p.aids, history))
     if send_notes:
         raw = (notes or "").encode("utf-8")[:MAX_NOTES_BYTES]
         parts.append(_NOTES.pack(p.notes_version, len(raw)))
         packed = _deflate(raw)
         parts.append(len(packed).to_bytes(2, "little") + packed)
     return _HEAD.pack(AIDS_MAGIC, AIDS_VERSION, flags, p.seq & 0xFFFFFFFF) + b"".join(parts)
+
+
+def _chart_bytes(a: SharedAids, history: bool) -> bytes:
+    out = _CHART.pack(*_f32(a.chart[1:]), (a.chart_corner & 7) | (HISTORY_FOLLOWS if history else 0))
+    if not history:
+        return out
+    rows = np.asarray(a.chart_history, dtype=float).reshape(-1, 6)[-MAX_CHART_HISTORY:]
+    rows = np.clip(np.nan_to_num(rows, posinf=0.0, neginf=0.0), -1e30, 1e30)
+    return out + len(rows).to_bytes(2, "little") + rows.astype("<f4").tobytes()
 
 
 def _annotation_bytes(r: AnnotationRecord) -> bytes:
@@ -284,6 +305,7 @@ class AidsFrame:
     new_annotations: list[AnnotationRecord] = field(default_factory=list)
     chart: tuple[float, ...] | None = None
     chart_corner: int = 0
+    chart_history: np.ndarray | None = None  # (H, 6), only when it came in this frame
     notes: str | None = None  # only when its text came in this frame
 
     @property
@@ -320,10 +342,7 @@ class AidsDecoder:
         if flags & ANNOTATIONS:
             _annotations(r, out)
         if flags & CHART:
-            *sample, corner = _CHART.unpack(r.take(_CHART.size))
-            if corner > 7:
-                raise _bad(f"a chart in corner {corner}")
-            out.chart, out.chart_corner = (float(time_s), *_finite(sample, "chart sample")), corner
+            _chart(r, out, time_s)
         if flags & NOTES_TEXT:
             if not flags & NOTES:
                 raise _bad("notes text while the notes are off")
@@ -360,6 +379,21 @@ def _finite(values, what: str) -> tuple[float, ...]:
     if not all(math.isfinite(v) and abs(v) <= 1e30 for v in values):
         raise _bad(f"a {what} that is not a finite number")
     return tuple(float(v) for v in values)
+
+
+def _chart(r: _Reader, out: AidsFrame, time_s: float) -> None:
+    *sample, corner = _CHART.unpack(r.take(_CHART.size))
+    if corner & ~HISTORY_FOLLOWS > 7:
+        raise _bad(f"a chart in corner {corner}")
+    out.chart, out.chart_corner = (float(time_s), *_finite(sample, "chart sample")), corner & 7
+    if corner & HISTORY_FOLLOWS:
+        count = int.from_bytes(r.take(2), "little")
+        if count > MAX_CHART_HISTORY:
+            raise _bad(f"a chart history of {count} samples (at most {MAX_CHART_HISTORY})")
+        rows = r.array("<f4", (count, 6)).astype(float)
+        if not (np.isfinite(rows).all() and (np.abs(rows) <= 1e30).all()):
+            raise _bad("a chart history that is not finite numbers")
+        out.chart_history = rows
 
 
 def _annotations(r: _Reader, out: AidsFrame) -> None:
