@@ -188,6 +188,11 @@ class StudentAids:
         flag = {"v": aids_wire.VELOCITY | aids_wire.MOMENTUM, "c": aids_wire.CHART, "e": aids_wire.TRAILS}.get(key, 0)
         return self.local.get(key, bool(self.teacher & flag))
 
+    def chart_view(self, scene) -> tuple[dict, dict, str | None]:
+        """(series, latest, note) of the chart, read while the network thread is not appending."""
+        with self._lock:
+            return self.chart.series(), self.chart.latest(), self.chart.euler_wiggle_note(scene)
+
     def live_annotations(self, now_s: float) -> list[aids.Annotation]:
         with self._lock:
             if not self.teacher & aids_wire.ANNOTATIONS:

@@ -34,14 +34,15 @@ def draw_student_aids(paint: AidsPainter, scene: Scene, state: StudentAids, now_
     """The aids over a student's frame: chart, vectors, annotations, inspector (in the teacher's order)."""
     env = paint.w.env
     # The chart needs the teacher's samples: the student can hide it, not make it up.
-    series = state.chart.series() if state.shows("c") and state.teacher & aids_wire.CHART else None
+    chart = state.chart_view(scene) if state.shows("c") and state.teacher & aids_wire.CHART else None
+    series = chart[0] if chart else None
     if series is not None and len(series["time_s"]):
         frame = state.frame
         if frame is not None and frame.chart is not None:  # where the teacher has it
             paint.chart_corner, paint.chart_small = frame.chart_corner % 4, frame.chart_corner >= 4
         elif len(scene.pos_m):
             paint.choose_chart_corner(env.to_screen(scene.pos_m))
-        paint.energy_chart(series, state.chart.latest(), state.chart.euler_wiggle_note(scene))
+        paint.energy_chart(*chart)
     if state.shows("v") and len(scene.pos_m):
         _vectors(paint, scene, state)
     for annotation in state.live_annotations(now_s):
