@@ -271,6 +271,7 @@ def _run_student(teacher, net, until, keys=()):
         return student.frames > 8 and until(student)
 
     assert student.run(seconds=20, until=step) == 0
+    assert until(student), "the condition came true before the time ran out"
     return student
 
 
@@ -328,3 +329,19 @@ def test_with_the_teachers_aids_off_a_student_draws_arrows_from_the_snapshots(cl
     assert np.hypot(*v[0]) == pytest.approx(np.hypot(*teacher.table.vel_mps[0]), rel=0.05)
     pixels = pygame.surfarray.array3d(student.window.surface).reshape(-1, 3)
     assert (pixels == VELOCITY_COLOR).all(axis=1).any()
+
+
+def test_a_student_sees_the_teachers_lecture_notes_panel(classroom):
+    teacher, net = classroom
+    teacher.trails, teacher.show_notes = False, True
+    seen = []
+
+    def notes_then_none(student):
+        if not seen and net.aids.teacher & aids_wire.NOTES and net.aids.notes is not None:
+            seen.append(net.aids.notes)
+            teacher.show_notes = False  # the teacher closes them
+        return seen and net.aids.frame is None
+
+    _run_student(teacher, net, notes_then_none)
+    assert seen == [teacher.demo.notes] and len(seen[0]) > 20
+    assert net.aids.teacher == 0, "notes closed and every other aid off: no AIDS frames"
