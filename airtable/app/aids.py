@@ -184,6 +184,14 @@ class EnergyChart:
         self._next = (self._next + 1) % len(self._data)
         self._count = min(self._count + 1, len(self._data))
 
+    def append(self, row) -> None:
+        """One sample made elsewhere (a student's window gets the teacher's): the values of FIELDS."""
+        if self._count and row[0] < self._data[(self._next - 1) % len(self._data), 0]:
+            self.clear()  # time went back: a restart or a rewind
+        self._data[self._next] = row
+        self._next = (self._next + 1) % len(self._data)
+        self._count = min(self._count + 1, len(self._data))
+
     def drop_after(self, t_s: float) -> None:
         """Forget the samples later than `t_s` (the table was rewound to it and runs on)."""
         while self._count and self._data[(self._next - 1) % len(self._data), 0] > t_s:

@@ -18,6 +18,7 @@ import numpy as np
 import pygame
 
 from airtable.app import aids, controls, rewind, room, world
+from airtable.app.aids_share import shared_aids
 from airtable.app.aids_view import draw_aids
 from airtable.app.client import LOCAL_COLOR, Client, cursor_pulls
 from airtable.app.demo_loader import Demo, DemoError, DemoShelf, error_from_exception, key_label
@@ -362,6 +363,7 @@ class App:
         self.fps = self._fps_counter.tick(self.clock_s)
         scene = self.scene()
         if self.server is not None:
+            scene.aids = shared_aids(self)  # the students see the teacher's aids too
             self.server.publish(scene)
         self.draw(scene)
         self.stats.frame()

@@ -46,6 +46,7 @@ class Scene:
     fps: float = 0.0
     zoom: float = 1.0
     origin_m: tuple[float, float] = (0.0, 0.0)
+    aids: object = None  # the teacher's aids for the students (aids_wire.SharedAids), set while serving
 
     @property
     def status_parts(self) -> list[str]:

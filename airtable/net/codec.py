@@ -31,7 +31,7 @@ import struct
 import threading
 import time
 import zlib
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -505,6 +505,9 @@ def encode_tick(tick: Tick, b1: Tick | None = None, b2: Tick | None = None) -> t
 
 # ---------------------------------------------------------------- the server side
 
+# Here, not at the top: aids_wire reuses the packing helpers above.
+from airtable.net import aids_wire  # noqa: E402
+
 
 @dataclass
 class Viewer:
@@ -513,6 +516,7 @@ class Viewer:
     layout_version: int | None = None
     last: Tick | None = None
     prev: Tick | None = None
+    aids: aids_wire.AidsViewer = field(default_factory=lambda: aids_wire.AidsViewer())
 
 
 class SnapshotEncoder:
@@ -533,6 +537,8 @@ class SnapshotEncoder:
         self._cache: dict[tuple, bytes] = {}
         self._layout_frame = b""
         self.encodings = 0  # distinct encodings made (for tests and the bench)
+        self.aids = aids_wire.AidsEncoder()  # the teacher's aids: an AIDS frame after each SNAPSHOT while any is on
+        self._aids_state: tuple = (None, {}, {}, None)
 
     @property
     def newest(self) -> Tick | None:
@@ -567,7 +573,10 @@ class SnapshotEncoder:
             status=_clean_text(scene.status, MAX_STATUS_BYTES),
             values=tick_values(scene),
         )
+        prepared = self.aids.prepare(scene.aids, tick.seq)
         with self._lock:
+            self.aids.publish(prepared)
+            self._aids_state = self.aids.state()
             if layout is not old:
                 self._layout_frame = encode_frame(LAYOUT, encode_layout(layout))
             self._layout = layout
@@ -585,7 +594,7 @@ class SnapshotEncoder:
     def frames_for(self, viewer: Viewer) -> bytes:
         """The bytes that bring `viewer` to the newest tick (b"" if it has it); updates `viewer`."""
         with self._lock:
-            tick, layout_frame, cache = self._newest, self._layout_frame, self._cache
+            tick, layout_frame, cache, aids = self._newest, self._layout_frame, self._cache, self._aids_state
         if tick is None or viewer.last is tick:
             return b""
         out = b""
@@ -605,7 +614,7 @@ class SnapshotEncoder:
         data, keyframe = cached
         viewer.layout_version = tick.layout.version
         viewer.prev, viewer.last = (None if keyframe else b1), tick
-        return out + data
+        return out + data + self.aids.frame_for(viewer.aids, aids)
 
 
 # ---------------------------------------------------------------- the player side

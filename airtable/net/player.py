@@ -27,9 +27,11 @@ from collections.abc import Callable, Iterable, Sequence
 
 import numpy as np
 
+from airtable.app.aids_share import LOCAL_KEYS, StudentAids
 from airtable.app.room import student_banner
 from airtable.app.scene import CursorView, Scene
 from airtable.net import protocol as proto
+from airtable.net.aids_wire import NOTES, AidsDecoder
 from airtable.net.playout import SnapshotFeed
 
 CONNECT_TIMEOUT_S = 5.0
@@ -152,6 +154,8 @@ class NetPlayer:
         self.snapshots = 0
         self._scene: Scene | None = None
         self._feed = SnapshotFeed()
+        self.aids = StudentAids()  # the teacher's aids as the AIDS frames tell them, and our own toggles
+        self._aids = AidsDecoder()
         self._sock: socket.socket | None = None
         self._send_lock = threading.Lock()
         self._closed = threading.Event()
@@ -293,6 +297,7 @@ class NetPlayer:
             self._sock = sock
             self.welcome = welcome
             self._feed = SnapshotFeed()  # a new connection starts from a keyframe
+            self._aids = AidsDecoder()
             self._throttle.reset()
             self.state = PlayerState.CONNECTED
             self.waiting_because = None
@@ -365,9 +370,12 @@ class NetPlayer:
                 if scene is None:
                     continue  # a LAYOUT: what the next snapshots need
                 self._scene = scene  # one reference swap: readers see the old or the new scene
+                self.aids.snapshot(scene)
                 self.snapshots += 1
                 if self.on_snapshot is not None:
                     self.on_snapshot(scene, now)
+            elif frame_type == proto.AIDS:
+                self._take_aids(payload, now)
             elif frame_type == proto.ERROR:
                 sentence, retry = proto.parse_error_message(payload)
                 raise _ConnectionEndedError(None if retry else sentence)
@@ -377,6 +385,17 @@ class NetPlayer:
                 raise _ConnectionEndedError(
                     f"{self.address} sent an unexpected {proto.FRAME_NAMES[frame_type]} message"
                 )
+
+    def _take_aids(self, payload: bytes, now: float) -> None:
+        """An AIDS frame: the teacher's aids at the tick just decoded."""
+        last = self._feed.decoder.last
+        if last is None:
+            raise _ConnectionEndedError(f"{self.address} sent aids before any snapshot")
+        try:
+            frame = self._aids.feed(payload, last.seq, last.layout.sizes[0], last.time_us / 1e6)
+        except proto.ProtocolError as e:
+            raise _ConnectionEndedError(str(e)) from None
+        self.aids.take(frame, now)
 
     def _reconnect(self) -> tuple | None:
         """Try again with backoff until connected (the tuple of _open), failed or closed (None)."""
@@ -483,6 +502,9 @@ class PlayerApp:
         self.draw_error: str | None = None  # the first drawing error, reported once
         self.button = 0
         self.keys: set[str] = set()
+        self.show_help = False  # F1: the keys of this window
+        self.painter = None  # the AidsPainter, once the window is open
+        self._drawn_from: tuple = ()  # the restarts and view the trails were drawn in
         self._welcome: proto.Welcome | None = None
 
     def run(
@@ -525,7 +547,10 @@ class PlayerApp:
         from airtable.app.window import GameWindow
 
         self._welcome = self.net.welcome
+        from airtable.app.aids_paint import AidsPainter
+
         self.window = GameWindow(self._new_env(), caption=self._caption(), headless=self.headless)
+        self.painter = AidsPainter(self.window)
         if not self.headless:
             pygame.mouse.set_visible(False)  # our arrow, drawn each frame, is the pointer
 
@@ -547,8 +572,13 @@ class PlayerApp:
         import pygame
 
         for event in events:
+            if event.type == pygame.KEYDOWN and event.key == pygame.K_ESCAPE and self.show_help:
+                self.show_help = False
+                continue
             if event.type == pygame.QUIT or (event.type == pygame.KEYDOWN and event.key == pygame.K_ESCAPE):
                 return False
+            if event.type == pygame.KEYDOWN and self._local_key(pygame.key.name(event.key)):
+                continue  # this window's own toggles: the server never hears of them
             if event.type == pygame.KEYDOWN:
                 self.keys.add(pygame.key.name(event.key))
             elif event.type == pygame.KEYUP:
@@ -559,6 +589,27 @@ class PlayerApp:
                 held = pygame.mouse.get_pressed(3)
                 self.button = next((b for b in (1, 2, 3) if held[b - 1]), 0)
         return True
+
+    def _local_key(self, name: str) -> bool:
+        """F1 and the aids a student turns on or off for their own window; True if `name` was one."""
+        if name == "f1":
+            self.show_help = not self.show_help
+        elif name in LOCAL_KEYS:
+            self.net.aids.toggle(name)
+            if name == "e":
+                self.window.clear_trails()
+        else:
+            return False
+        return True
+
+    def _follow_restarts(self, scene: Scene) -> None:
+        """A demo (re)start or another view: trails and arrow scales start afresh, as on the teacher's window."""
+        drawn_from = (self.net.aids.restarts, scene.zoom, scene.origin_m)
+        if drawn_from != self._drawn_from:
+            if self._drawn_from and drawn_from[0] != self._drawn_from[0]:
+                self.painter.new_demo()
+            self._drawn_from = drawn_from
+            self.window.clear_trails()
 
     def _follow_welcome(self) -> None:
         """After a (re)connect: the new name in the caption, the new table size in the view."""
@@ -594,18 +645,27 @@ class PlayerApp:
                 print(f"airtable-client: could not draw a frame ({self.draw_error}); carrying on", file=sys.stderr)
 
     def _draw(self, scene: Scene, cursor_m: np.ndarray, focused: bool) -> None:
+        from airtable.app.aids_student_view import STUDENT_KEYS, draw_student_aids
+
         net, win, welcome = self.net, self.window, self._welcome
         me = welcome.label if welcome else ""
         color = welcome.color if welcome else (200, 200, 200)
         cursors, extra = own_cursor_live(scene.cursors, me, cursor_m, self.button, focused)
+        self._follow_restarts(scene)
         win.draw(
             dataclasses.replace(scene, cursors=cursors),
+            trails=net.aids.shows("e"),
             hud=(f"You are {me}" if me else "Not at the table yet", net.status_text),
             banner=net.banner_text or student_banner(scene, me),
             hud_color=color,
         )
+        draw_student_aids(self.painter, scene, net.aids, time.monotonic(), cursor_m)
         if extra and me:  # not in the snapshots yet: the arrow alone
             win.draw_cursor(me, color, cursor_m)
+        if self.show_help:
+            win.draw_panel("Keys", list(STUDENT_KEYS))
+        elif net.aids.teacher & NOTES and net.aids.notes is not None:
+            win.draw_panel(scene.title, [net.aids.notes], large=True)
         win.present()
 
 

@@ -38,6 +38,7 @@ INPUT = 4
 SNAPSHOT = 5
 BYE = 6
 LAYOUT = 7  # what rarely changes in a snapshot (codec.py), sent when it changes
+AIDS = 10  # the teacher's teaching aids at a tick (aids_wire.py), after its SNAPSHOT while any aid is on
 FRAME_NAMES = {
     HELLO: "HELLO",
     WELCOME: "WELCOME",
@@ -46,6 +47,7 @@ FRAME_NAMES = {
     SNAPSHOT: "SNAPSHOT",
     BYE: "BYE",
     LAYOUT: "LAYOUT",
+    AIDS: "AIDS",
 }
 CLIENT_FRAMES = frozenset({HELLO, INPUT, BYE})
 

@@ -1,0 +1,429 @@
+"""The teacher's teaching aids on the wire: the AIDS frame (type 10, server -> client). No pygame, no sockets.
+
+When the teacher turns an aid on (trails, collision annotations, vectors,
+the energy chart, the lecture notes), each SNAPSHOT is followed by one AIDS
+frame for the same tick. With every aid off nothing is sent: not one byte.
+What it carries, and how compactly:
+
+- which aids are on (one flag byte);
+- vectors: the arrows' round scale (the teacher's, fixed per demo), the centre
+  of mass and its velocity, and per puck the drawn quantity (velocity or
+  momentum) in steps of a thousandth of that scale (an arrow 1 m long is
+  1000 steps: arrows are exact to a millimetre of table, and 1 mm/s for a
+  1 m/s scale), coded against the values the same student got last (they
+  change little between ticks), zigzag byte planes, deflated when shorter;
+- annotations: the serial of the newest collision and how many are live; the
+  full record (16-26 float32) only of those this student has not had yet;
+- the chart: the newest sample (5 float32; its time is the snapshot's); the student keeps the
+  history, and gets the teacher's last seconds (at most MAX_CHART_HISTORY samples) once, when
+  the chart first reaches it;
+- the notes: their text only when this student does not hold it yet.
+
+`AidsEncoder` (server) caches one encoding per (tick, what the student
+holds), so students on the same footing share it. `AidsDecoder` (player)
+checks every count, index and value before use and raises ProtocolError.
+"""
+
+from __future__ import annotations
+
+import math
+import struct
+import threading
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from airtable.net.codec import _bad, _deflate, _inflate, _Reader, pack_residuals, unpack_residuals
+from airtable.net.protocol import AIDS, MAX_DRAWN_PUCKS, ProtocolError, encode_frame
+
+AIDS_MAGIC = b"ATAD"
+AIDS_VERSION = 1
+
+TRAILS = 1
+ANNOTATIONS = 2
+VELOCITY = 4
+MOMENTUM = 8
+CHART = 16
+NOTES = 32
+NOTES_TEXT = 64  # the notes' text is in this frame
+VECTOR_KEY = 128  # the vector values are not a delta (no base)
+
+ARROW_STEPS = 1000  # vector values travel in thousandths of the arrow scale
+MAX_VALUE = 1 << 20  # steps: an arrow of at most a kilometre (the scale keeps real ones under 1 m)
+MAX_ANNOTATIONS = 8
+MAX_AGE_MS = 60_000
+MAX_NOTES_BYTES = 16_384
+MAX_VECTOR_HISTORY = 8  # ticks of vector values kept as bases
+MAX_CHART_HISTORY = 600  # samples of the teacher's chart sent once to a student who lacks them
+MAX_COORD_M = 1e6  # a position or length beyond this is not a picture of a table
+
+_HEAD = struct.Struct("<4sBBI")  # magic, version, flags, tick seq
+_VEC = struct.Struct("<H6fBBI")  # N, amount, velocity amount, com x, y, vx, vy, width, deflated, block size
+_ANN_HEAD = struct.Struct("<IBB")  # newest serial, live count, new count
+_ANN = struct.Struct("<HB16f")  # age ms, has (1 angle, 2 target), 16 numbers
+_ANGLE = struct.Struct("<f")
+_TARGET = struct.Struct("<8f")
+# The sample without its time (the snapshot's), then the teacher's corner (0-3) + 4 if the chart is small
+# + 128 if the history follows: u16 H, then H samples of 6 f4 (time first), oldest first.
+_CHART = struct.Struct("<5fB")
+HISTORY_FOLLOWS = 128
+_NOTES = struct.Struct("<HH")  # notes version, text size (then deflated text)
+
+
+@dataclass(frozen=True, eq=False)
+class AnnotationRecord:
+    """The numbers a collision annotation is drawn from (aids.Annotation without its clock)."""
+
+    age_s: float  # how old it was when sent
+    numbers: tuple[float, ...]  # contact 2, normal 2, overlap, separation, 4 positions x 2, radius i, radius j
+    angle_deg: float | None = None
+    target: tuple[float, ...] | None = None  # actual, ideal deg, pos 2, push dir 2, ideal dir 2
+
+
+@dataclass(frozen=True, eq=False)
+class SharedAids:
+    """What the teacher's aids show at one tick, as the app hands it to the server."""
+
+    trails: bool = False
+    vectors: int = 0  # 0 off, 1 velocity, 2 momentum
+    values: np.ndarray | None = None  # (N, 2) the drawn quantity per puck
+    amount: float = 1.0  # the round value an arrow 1 m long stands for
+    velocity_amount: float = 1.0  # the same for velocities (the centre of mass arrow)
+    com: tuple[float, float, float, float] = (0.0, 0.0, 0.0, 0.0)  # x, y, vx, vy
+    annotations: tuple = ()  # live annotations (objects; the encoder gives each a serial), oldest first
+    annotation_records: tuple[AnnotationRecord, ...] = ()
+    chart: tuple[float, ...] | None = None  # the newest sample: time, kinetic, spring, gravity, total, |p|
+    chart_corner: int = 0  # where the teacher's chart is (aids_paint.CHART_CORNERS), + 4 if small
+    chart_history: np.ndarray | None = None  # (H, 6) the samples before `chart`, oldest first
+    notes: str | None = None  # the lecture notes, while their panel is open
+
+    annotations_on: bool = False
+
+    @property
+    def flags(self) -> int:
+        f = TRAILS if self.trails else 0
+        f |= {1: VELOCITY, 2: MOMENTUM}.get(self.vectors, 0)
+        f |= ANNOTATIONS if self.annotations_on else 0
+        f |= CHART if self.chart is not None else 0
+        f |= NOTES if self.notes is not None else 0
+        return f
+
+
+@dataclass
+class AidsViewer:
+    """What one student holds of the aids: vector values of a tick, annotations up to a serial, notes."""
+
+    vector_seq: int = 0
+    annotation_serial: int = 0
+    notes_version: int = -1
+    chart_synced: bool = False  # has the chart's history (and every sample since)
+
+
+@dataclass
+class _Prepared:
+    seq: int
+    flags: int
+    aids: SharedAids
+    values: np.ndarray | None  # int64 (2N,): x of N then y of N
+    serials: tuple[int, ...]  # of the live annotations, oldest first
+    notes_version: int
+
+    @property
+    def base_key(self) -> tuple:
+        """Values are deltas only on values of the same quantity at the same scale."""
+        return (self.flags & (VELOCITY | MOMENTUM), _scale32(self.aids.amount), self.values)
+
+
+class AidsEncoder:
+    """Server side: `add(aids, seq)` per tick (game loop), `frame_for(viewer)` per student (network thread)."""
+
+    def __init__(self) -> None:
+        self._lock = threading.Lock()
+        self._newest: _Prepared | None = None
+        # seq -> (flags, scale, values); rebuilt on each publish: readers keep their copy
+        self._history: dict[int, tuple] = {}
+        self._serials: dict[int, tuple[object, int]] = {}  # id(annotation) -> (annotation, serial)
+        self._next_serial = 1
+        self._notes: str | None = None
+        self._notes_version = 0
+        self._cache: dict[tuple, bytes] = {}
+
+    def prepare(self, aids: SharedAids | None, seq: int) -> _Prepared | None:
+        """The aids of tick `seq`, made ready (O(N), outside any lock); None, or every aid off: nothing to send."""
+        return None if aids is None or not aids.flags else self._prepare(aids, seq)
+
+    def publish(self, prepared: _Prepared | None) -> None:
+        """Make `prepared` the newest (the snapshot encoder calls this with its tick, under its lock)."""
+        with self._lock:
+            self._newest = prepared
+            self._cache = {}
+            if prepared is not None and prepared.values is not None:
+                kept = sorted(self._history)[-(MAX_VECTOR_HISTORY - 1) :]
+                self._history = {**{s: self._history[s] for s in kept}, prepared.seq: prepared.base_key}
+
+    def state(self) -> tuple:
+        """What frame_for needs, read at one moment (with the snapshot tick it goes with)."""
+        with self._lock:
+            return self._newest, self._history, self._cache, self._notes
+
+    def _prepare(self, aids: SharedAids, seq: int) -> _Prepared:
+        values = None
+        if aids.vectors and aids.values is not None:
+            v = np.nan_to_num(np.asarray(aids.values, dtype=float).reshape(-1, 2), posinf=0.0, neginf=0.0)
+            q = np.rint(v * (ARROW_STEPS / _scale32(aids.amount)))
+            q = np.clip(np.nan_to_num(q), -MAX_VALUE, MAX_VALUE).astype(np.int64)
+            values = np.concatenate([q[:, 0], q[:, 1]])
+        serials = []
+        known = {}
+        for a in aids.annotations[-MAX_ANNOTATIONS:]:
+            old = self._serials.get(id(a))
+            if old is None or old[0] is not a:
+                old = (a, self._next_serial)
+                self._next_serial += 1
+            known[id(a)] = old
+            serials.append(old[1])
+        self._serials = known  # forget the faded ones (and ids that could be reused)
+        if aids.notes is not None and aids.notes != self._notes:
+            self._notes, self._notes_version = aids.notes, (self._notes_version + 1) & 0xFFFF
+        return _Prepared(seq, aids.flags, aids, values, tuple(serials), self._notes_version)
+
+    def frame_for(self, viewer: AidsViewer, state: tuple | None = None) -> bytes:
+        """The AIDS frame for `viewer` at the tick of `state` (default: the newest); b"" with every aid off.
+        Updates `viewer`."""
+        p, history, cache, notes = self.state() if state is None else state
+        if p is None:
+            viewer.chart_synced = False
+            return b""
+        held = history.get(viewer.vector_seq) if p.values is not None else None
+        base = held[2] if held is not None and held[:2] == p.base_key[:2] and held[2].shape == p.values.shape else None
+        fresh = [s for s in p.serials if s > viewer.annotation_serial]
+        send_notes = bool(p.flags & NOTES) and viewer.notes_version != p.notes_version
+        sync = bool(p.flags & CHART) and not viewer.chart_synced and p.aids.chart_history is not None
+        key = (p.seq, viewer.vector_seq if base is not None else 0, len(fresh), send_notes, sync)
+        data = cache.get(key)
+        if data is None:
+            data = cache[key] = encode_frame(AIDS, encode_aids(p, base, len(fresh), send_notes, notes, sync))
+        viewer.chart_synced = bool(p.flags & CHART)
+        if p.values is not None:
+            viewer.vector_seq = p.seq
+        if p.serials:
+            viewer.annotation_serial = max(viewer.annotation_serial, p.serials[-1])
+        if send_notes:
+            viewer.notes_version = p.notes_version
+        return data
+
+
+def _scale32(amount: float) -> float:
+    """The arrow scale as it travels (float32), never 0 or beyond."""
+    a = float(amount)
+    return float(np.float32(min(max(a, 1e-29), 1e29))) if math.isfinite(a) else 1.0
+
+
+def _f32(values) -> list[float]:
+    out = []
+    for v in values:
+        v = float(v)
+        out.append(min(max(v, -3e38), 3e38) if math.isfinite(v) else 0.0)
+    return out
+
+
+def encode_aids(
+    p: _Prepared, base: np.ndarray | None, fresh: int, send_notes: bool, notes: str | None, history: bool = False
+) -> bytes:
+    """The AIDS payload for one tick and one footing (see the module's docstring)."""
+    flags = p.flags | (NOTES_TEXT if send_notes else 0)
+    parts = []
+    if p.values is not None:
+        if base is None:
+            flags |= VECTOR_KEY
+        residuals = p.values - (0 if base is None else base)
+        width, block, deflated = pack_residuals(residuals)
+        a = p.aids
+        parts.append(
+            _VEC.pack(
+                len(p.values) // 2,
+                _scale32(a.amount),
+                _scale32(a.velocity_amount),
+                *_f32(a.com),
+                width,
+                int(deflated),
+                len(block),
+            )
+        )
+        parts.append(block)
+    if flags & ANNOTATIONS:
+        records = p.aids.annotation_records[-len(p.serials) :] if p.serials else ()
+        newest = p.serials[-1] if p.serials else 0
+        new = records[len(records) - fresh :] if fresh else ()
+        parts.append(_ANN_HEAD.pack(newest & 0xFFFFFFFF, len(p.serials), len(new)))
+        parts.extend(_annotation_bytes(r) for r in new)
+    if flags & CHART:
+        parts.append(_chart_bytes(p.aids, history))
+    if send_notes:
+        raw = (notes or "").encode("utf-8")[:MAX_NOTES_BYTES]
+        parts.append(_NOTES.pack(p.notes_version, len(raw)))
+        packed = _deflate(raw)
+        parts.append(len(packed).to_bytes(2, "little") + packed)
+    return _HEAD.pack(AIDS_MAGIC, AIDS_VERSION, flags, p.seq & 0xFFFFFFFF) + b"".join(parts)
+
+
+def _chart_bytes(a: SharedAids, history: bool) -> bytes:
+    out = _CHART.pack(*_f32(a.chart[1:]), (a.chart_corner & 7) | (HISTORY_FOLLOWS if history else 0))
+    if not history:
+        return out
+    rows = np.asarray(a.chart_history, dtype=float).reshape(-1, 6)[-MAX_CHART_HISTORY:]
+    rows = np.clip(np.nan_to_num(rows, posinf=0.0, neginf=0.0), -1e30, 1e30)
+    return out + len(rows).to_bytes(2, "little") + rows.astype("<f4").tobytes()
+
+
+def _annotation_bytes(r: AnnotationRecord) -> bytes:
+    has = (1 if r.angle_deg is not None else 0) | (2 if r.target is not None else 0)
+    age = min(max(int(round(r.age_s * 1000)), 0), MAX_AGE_MS)
+    out = _ANN.pack(age, has, *_f32(r.numbers))
+    if r.angle_deg is not None:
+        out += _ANGLE.pack(*_f32((r.angle_deg,)))
+    if r.target is not None:
+        out += _TARGET.pack(*_f32(r.target))
+    return out
+
+
+# ---------------------------------------------------------------- the player side
+
+
+@dataclass
+class AidsFrame:
+    """One decoded AIDS frame."""
+
+    seq: int
+    flags: int
+    values: np.ndarray | None = None  # (N, 2) float, the drawn quantity
+    amount: float = 1.0
+    velocity_amount: float = 1.0
+    com: tuple[float, float, float, float] = (0.0, 0.0, 0.0, 0.0)
+    annotation_serial: int = 0
+    live: int = 0
+    new_annotations: list[AnnotationRecord] = field(default_factory=list)
+    chart: tuple[float, ...] | None = None
+    chart_corner: int = 0
+    chart_history: np.ndarray | None = None  # (H, 6), only when it came in this frame
+    notes: str | None = None  # only when its text came in this frame
+
+    @property
+    def vectors(self) -> int:
+        return 1 if self.flags & VELOCITY else 2 if self.flags & MOMENTUM else 0
+
+
+@dataclass
+class AidsDecoder:
+    """Feed it AIDS payloads in order, each right after the SNAPSHOT of the same tick."""
+
+    values: np.ndarray | None = None  # int64, the last vector values (the next delta's base)
+    values_key: tuple = ()  # their quantity flag and scale
+    values_seq: int = 0
+    notes: str | None = None
+
+    def feed(self, payload: bytes, seq: int, pucks: int, time_s: float = 0.0) -> AidsFrame:
+        """Check and decode; `seq`, `pucks` and `time_s` are those of the snapshot just decoded."""
+        payload = bytes(payload)
+        if len(payload) < _HEAD.size:
+            raise ProtocolError(f"the aids frame is only {len(payload)} bytes, less than its {_HEAD.size} byte header")
+        magic, version, flags, aseq = _HEAD.unpack_from(payload)
+        if magic != AIDS_MAGIC or version != AIDS_VERSION:
+            raise _bad("an aids frame of another version")
+        if aseq != seq & 0xFFFFFFFF:
+            raise _bad(f"aids for tick {aseq} right after tick {seq}")
+        if flags & VELOCITY and flags & MOMENTUM:
+            raise _bad("aids asking for velocity and momentum arrows at once")
+        r = _Reader(payload, "aids frame")
+        r.take(_HEAD.size)
+        out = AidsFrame(seq=aseq, flags=flags)
+        if flags & (VELOCITY | MOMENTUM):
+            self._vectors(r, out, pucks)
+        if flags & ANNOTATIONS:
+            _annotations(r, out)
+        if flags & CHART:
+            _chart(r, out, time_s)
+        if flags & NOTES_TEXT:
+            if not flags & NOTES:
+                raise _bad("notes text while the notes are off")
+            out.notes = self.notes = _notes(r)
+        r.done()
+        return out
+
+    def _vectors(self, r: _Reader, out: AidsFrame, pucks: int) -> None:
+        n, amount, vel_amount, cx, cy, cvx, cvy, width, deflated, size = _VEC.unpack(r.take(_VEC.size))
+        kind = out.flags & (VELOCITY | MOMENTUM)
+        if n != pucks or n > MAX_DRAWN_PUCKS:
+            raise _bad(f"arrows for {n} pucks on a table of {pucks}")
+        for value in (amount, vel_amount):
+            if not (math.isfinite(value) and 1e-30 < value < 1e30):
+                raise _bad("an arrow scale that is not a positive number")
+        if deflated > 1:
+            raise _bad("a vector block with a bad flag")
+        out.com = _finite((cx, cy, cvx, cvy), "centre of mass")
+        residuals = unpack_residuals(r.take(size), width, 2 * n, bool(deflated))
+        if out.flags & VECTOR_KEY:
+            values = residuals
+        elif self.values is None or len(self.values) != 2 * n or self.values_key != (kind, amount):
+            raise _bad("vector values coded against values this client does not hold")
+        else:
+            values = self.values + residuals
+        if len(values) and np.abs(values).max() > MAX_VALUE:
+            raise _bad("an arrow longer than any table")
+        self.values, self.values_seq, self.values_key = values, out.seq, (kind, amount)
+        out.values = np.column_stack([values[:n], values[n:]]) * (amount / ARROW_STEPS)
+        out.amount, out.velocity_amount = amount, vel_amount
+
+
+def _finite(values, what: str) -> tuple[float, ...]:
+    if not all(math.isfinite(v) and abs(v) <= 1e30 for v in values):
+        raise _bad(f"a {what} that is not a finite number")
+    return tuple(float(v) for v in values)
+
+
+def _chart(r: _Reader, out: AidsFrame, time_s: float) -> None:
+    *sample, corner = _CHART.unpack(r.take(_CHART.size))
+    if corner & ~HISTORY_FOLLOWS > 7:
+        raise _bad(f"a chart in corner {corner}")
+    out.chart, out.chart_corner = (float(time_s), *_finite(sample, "chart sample")), corner & 7
+    if corner & HISTORY_FOLLOWS:
+        count = int.from_bytes(r.take(2), "little")
+        if count > MAX_CHART_HISTORY:
+            raise _bad(f"a chart history of {count} samples (at most {MAX_CHART_HISTORY})")
+        rows = r.array("<f4", (count, 6)).astype(float)
+        if not (np.isfinite(rows).all() and (np.abs(rows) <= 1e30).all()):
+            raise _bad("a chart history that is not finite numbers")
+        out.chart_history = rows
+
+
+def _annotations(r: _Reader, out: AidsFrame) -> None:
+    newest, live, new = _ANN_HEAD.unpack(r.take(_ANN_HEAD.size))
+    if live > MAX_ANNOTATIONS or new > live or live > newest:
+        raise _bad(f"{new} new of {live} live collision annotations (at most {MAX_ANNOTATIONS})")
+    out.annotation_serial, out.live = newest, live
+    for _ in range(new):
+        age_ms, has, *numbers = _ANN.unpack(r.take(_ANN.size))
+        if has > 3 or age_ms > MAX_AGE_MS:
+            raise _bad("a collision annotation with bad flags or age")
+        numbers = _finite(numbers, "collision annotation")
+        if any(abs(v) > MAX_COORD_M for v in numbers) or numbers[4] < 0 or min(numbers[14:16]) <= 0:
+            raise _bad("a collision annotation with impossible sizes")
+        angle = _finite(_ANGLE.unpack(r.take(_ANGLE.size)), "collision angle")[0] if has & 1 else None
+        target = _finite(_TARGET.unpack(r.take(_TARGET.size)), "collision target") if has & 2 else None
+        if target is not None and any(abs(v) > MAX_COORD_M for v in target):
+            raise _bad("a collision target far off the table")
+        out.new_annotations.append(AnnotationRecord(age_ms / 1000, numbers, angle, target))
+
+
+def _notes(r: _Reader) -> str:
+    _version, size = _NOTES.unpack(r.take(_NOTES.size))
+    if size > MAX_NOTES_BYTES:
+        raise _bad(f"notes of {size} bytes (at most {MAX_NOTES_BYTES})")
+    packed = r.take(int.from_bytes(r.take(2), "little"))
+    try:
+        text = _inflate(packed, size, "notes text").decode("utf-8")
+    except UnicodeDecodeError:
+        raise _bad("notes that are not UTF-8") from None
+    if not text.isprintable():
+        raise _bad("unprintable notes")
+    return text

@@ -1,0 +1,347 @@
+"""Students see the teacher's aids: the AIDS frame (type 10), its strict decoder, the student's window."""
+
+from __future__ import annotations
+
+import numpy as np
+import pygame
+import pytest
+from conftest import post_key
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+
+from airtable.app import aids
+from airtable.app.aids_share import StudentAids, annotation_of, record_of
+from airtable.app.aids_student_view import VELOCITY_COLOR
+from airtable.app.scene import Scene
+from airtable.net import aids_wire
+from airtable.net.aids_wire import AidsDecoder, AidsEncoder, AidsViewer, SharedAids
+from airtable.net.bench_aids import frame_sizes, measure
+from airtable.net.codec import SnapshotDecoder, SnapshotEncoder, Viewer
+from airtable.net.player import NetPlayer, PlayerApp
+from airtable.net.protocol import AIDS, LAYOUT, SNAPSHOT, ProtocolError
+from airtable.net.server import GameServer
+
+FRAME_S = 1 / 60
+
+
+def _scene(n: int = 3, aids_: SharedAids | None = None, t: float = 0.0) -> Scene:
+    pos = np.column_stack([np.linspace(1.0, 3.0, n), np.full(n, 2.0)])
+    return Scene(
+        width_m=10.0,
+        height_m=8.0,
+        pos_m=pos,
+        radius_m=np.full(n, 0.2),
+        color_rgb=np.full((n, 3), 200, np.uint8),
+        time_s=t,
+        aids=aids_,
+    )
+
+
+def _frames(data: bytes) -> list[tuple[int, bytes]]:
+    out, k = [], 0
+    while k < len(data):
+        size = int.from_bytes(data[k : k + 4], "big")
+        out.append((data[k + 4], data[k + 5 : k + 4 + size]))
+        k += 4 + size
+    return out
+
+
+class _Student:
+    """The decoding side without sockets: the snapshot decoder, then the aids decoder."""
+
+    def __init__(self) -> None:
+        self.snaps, self.aids, self.state = SnapshotDecoder(), AidsDecoder(), StudentAids()
+
+    def take(self, data: bytes, now_s: float = 0.0) -> list:
+        got = []
+        for kind, payload in _frames(data):
+            if kind == LAYOUT:
+                self.snaps.feed_layout(payload)
+            elif kind == SNAPSHOT:
+                self.state.snapshot(self.snaps.feed_tick(payload).scene)
+            else:
+                assert kind == AIDS
+                last = self.snaps.last
+                frame = self.aids.feed(payload, last.seq, last.layout.sizes[0], last.time_us / 1e6)
+                self.state.take(frame, now_s)
+                got.append(frame)
+        return got
+
+
+def test_aids_off_add_no_bytes_at_all():
+    with_field, without = SnapshotEncoder(), SnapshotEncoder()
+    v1, v2 = Viewer(), Viewer()
+    for k in range(5):
+        a = with_field.frames_for(v1) if with_field.add(_scene(aids_=SharedAids(), t=k / 30)) else b""
+        b = without.frames_for(v2) if without.add(_scene(t=k / 30)) else b""
+        assert len(a) == len(b) and AIDS not in frame_sizes(a)
+
+
+def test_vectors_round_trip_to_a_thousandth_of_the_arrow_scale_and_code_as_deltas():
+    enc, viewer, student = SnapshotEncoder(), Viewer(), _Student()
+    rng = np.random.default_rng(1)
+    v = rng.normal(0, 2, (3, 2))
+    sizes = []
+    for k in range(6):
+        v = v + rng.normal(0, 0.01, (3, 2))
+        shared = SharedAids(vectors=1, values=v, amount=2.0, velocity_amount=2.0, com=(1.0, 2.0, 0.5, 0.0))
+        enc.add(_scene(aids_=shared, t=k / 30))
+        data = enc.frames_for(viewer)
+        (frame,) = student.take(data)
+        sizes.append(frame_sizes(data)[AIDS])
+        assert np.allclose(frame.values, np.round(v / 2.0 * 1000) * 2.0 / 1000, atol=1e-12)
+        assert frame.amount == 2.0 and frame.com == (1.0, 2.0, 0.5, 0.0) and frame.vectors == 1
+    assert frame.flags & aids_wire.VECTOR_KEY == 0, "later ticks are deltas on what the student holds"
+    assert sizes[-1] < sizes[0]
+
+
+def test_annotations_are_sent_once_and_forgotten_as_the_teacher_forgets_them():
+    enc, viewer, student = AidsEncoder(), AidsViewer(), _Student()
+    made = [
+        aids.Annotation(
+            born_s=10.0,
+            contact_m=(1.0, 2.0),
+            normal=(1.0, 0.0),
+            overlap_m=0.004,
+            separation_m=0.004,
+            pos_i_before=(1.2, 2.0),
+            pos_j_before=(0.8, 2.0),
+            pos_i_after=(1.25, 2.0),
+            pos_j_after=(0.75, 2.0),
+            radius_i_m=0.2,
+            radius_j_m=0.2,
+            angle_deg=None if k else 90.0,
+            target=aids.TargetPush(29.4, 14.5, (1.3, 2.1), (0.8, 0.6), (0.9, 0.4)) if k == 0 else None,
+        )
+        for k in range(2)
+    ]
+    sent = []
+    for seq, live in ((1, made[:1]), (2, made[:1]), (3, made), (4, made[1:])):
+        records = tuple(record_of(a, 10.5) for a in live)
+        shared = SharedAids(annotations=tuple(live), annotation_records=records, annotations_on=True)
+        enc.publish(enc.prepare(shared, seq))
+        frame = student.aids.feed(_payload(enc, viewer), seq, 3)
+        student.state.take(frame, now_s=100.0)
+        sent.append(len(frame.new_annotations))
+    assert sent == [1, 0, 1, 0]
+    (kept,) = student.state.live_annotations(100.0)
+    assert kept.born_s == pytest.approx(99.5, abs=1e-3), "as old as it was on the teacher's side"
+    assert kept.pos_j_after == pytest.approx(made[1].pos_j_after) and kept.angle_deg is None
+    assert kept.overlap_m == pytest.approx(0.004) and kept.ratio == pytest.approx(1.0, abs=1e-6)
+    assert annotation_of(record_of(made[0], 10.0), 10.0).target.ideal_deg == pytest.approx(14.5)
+
+
+def _payload(enc: AidsEncoder, viewer: AidsViewer) -> bytes:
+    data = enc.frame_for(viewer)
+    ((kind, payload),) = _frames(data)
+    assert kind == AIDS
+    return payload
+
+
+def test_chart_samples_append_and_notes_come_once():
+    enc, viewer, student = AidsEncoder(), AidsViewer(), _Student()
+    notes_bytes = []
+    for seq in range(1, 5):
+        shared = SharedAids(chart=(seq / 30, 1.0, 0.5, 0.0, 1.5, 0.25), notes="Two pucks collide.")
+        enc.publish(enc.prepare(shared, seq))
+        payload = _payload(enc, viewer)
+        frame = student.aids.feed(payload, seq, 3, seq / 30)
+        student.state.take(frame, 0.0)
+        notes_bytes.append(frame.notes is not None)
+    assert notes_bytes == [True, False, False, False]
+    assert student.state.notes == "Two pucks collide."
+    series = student.state.chart.series()
+    assert list(series["time_s"]) == pytest.approx([1 / 30, 2 / 30, 3 / 30, 4 / 30])
+    assert series["total_J"][-1] == pytest.approx(1.5)
+
+
+def test_a_student_gets_the_charts_last_seconds_once_and_again_after_it_was_off():
+    enc, viewer, student = AidsEncoder(), AidsViewer(), _Student()
+    past = np.array([[t, 1.0, 0.5, 0.0, 1.5, 0.25] for t in (0.1, 0.2, 0.3)])
+    got = []
+    for seq, on in enumerate((True, True, False, True), start=1):
+        shared = (
+            SharedAids(chart=(seq, 1.0, 0.5, 0.0, 1.5, 0.25), chart_history=past) if on else SharedAids(trails=True)
+        )
+        enc.publish(enc.prepare(shared, seq))
+        frame = student.aids.feed(_payload(enc, viewer), seq, 3, float(seq))
+        student.state.take(frame, 0.0)
+        got.append(None if frame.chart_history is None else len(frame.chart_history))
+    assert got == [3, None, None, 3]
+    assert list(student.state.chart.series()["time_s"]) == pytest.approx([0.1, 0.2, 0.3, 4.0])
+
+
+def _valid_payload() -> bytes:
+    enc = AidsEncoder()
+    shared = SharedAids(
+        trails=True,
+        vectors=2,
+        values=np.array([[1.0, -2.0], [0.0, 0.5], [3.0, 0.0]]),
+        amount=5.0,
+        com=(1.0, 1.0, 0.1, 0.0),
+        chart=(1.0, 2.0, 3.0, 0.0, 5.0, 1.0),
+        chart_history=np.array([[0.5, 2.0, 3.0, 0.0, 5.0, 1.0], [0.75, 2.0, 3.0, 0.0, 5.0, 1.0]]),
+        notes="notes",
+    )
+    enc.publish(enc.prepare(shared, 7))
+    return _payload(enc, AidsViewer())
+
+
+@settings(max_examples=300, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(st.data())
+def test_fuzzed_aids_frames_raise_protocol_error_or_decode_within_bounds(data):
+    payload = bytearray(_valid_payload())
+    for _ in range(data.draw(st.integers(0, 6))):
+        k = data.draw(st.integers(0, len(payload) - 1))
+        payload[k] = data.draw(st.integers(0, 255))
+    cut = data.draw(st.integers(0, len(payload)))
+    payload = bytes(payload[:cut]) if data.draw(st.booleans()) else bytes(payload)
+    try:
+        frame = AidsDecoder().feed(payload, 7, 3)
+    except ProtocolError as e:
+        assert str(e)
+        return
+    if frame.values is not None:
+        assert frame.values.shape == (3, 2) and np.isfinite(frame.values).all()
+    assert 0 < frame.amount < 1e30
+    assert frame.chart is None or all(np.isfinite(frame.chart))
+
+
+@given(st.binary(max_size=200), st.integers(0, 2**32 - 1), st.integers(0, 50))
+def test_random_bytes_never_crash_the_aids_decoder(payload, seq, pucks):
+    try:
+        AidsDecoder().feed(payload, seq, pucks)
+    except ProtocolError:
+        pass
+
+
+def test_bad_frames_are_refused_in_a_sentence():
+    good = _valid_payload()
+    with pytest.raises(ProtocolError, match="right after tick"):
+        AidsDecoder().feed(good, 8, 3)
+    with pytest.raises(ProtocolError, match="arrows for 3 pucks on a table of 4"):
+        AidsDecoder().feed(good, 7, 4)
+    with pytest.raises(ProtocolError, match="too many"):
+        AidsDecoder().feed(good + b"x", 7, 3)
+
+
+def test_byte_figures_for_demo_4_and_shift_1_with_a_v_c_on():
+    off = measure("demo 4 off", "4", "", 30, ticks=30)
+    on = measure("demo 4 on", "4", "avc", 30, ticks=30)
+    shift1 = measure("Shift+1 on", "1p", "avc", 0, ticks=30)
+    rest = measure("rest off", "4", "", 0, ticks=30, rest=True)
+    rest_on = measure("rest on", "4", "avc", 0, ticks=30, rest=True)
+    assert off.aids_b == 0 and rest.aids_b == 0
+    assert on.snapshot_b == off.snapshot_b, "the aids never change the SNAPSHOT"
+    assert on.total_b <= 600  # 219 + 221 B when measured
+    assert shift1.total_b <= 130  # 47 + 76 B
+    assert rest_on.total_b <= 120  # 43 + 74 B: a table at rest stays under its target with the aids on
+
+
+# ---------------------------------------------------------------- the real player
+
+
+@pytest.fixture
+def classroom(demos):
+    from airtable.app.app import App
+
+    server = GameServer(host="127.0.0.1", port=0)
+    server.start()
+    teacher = App(demos, demo_key="1p", headless=True, server=server)
+    pygame.event.clear()
+    net = NetPlayer("127.0.0.1", server.port, name="Ann", max_backoff_s=0.3)
+    net.connect()
+    yield teacher, net
+    net.close()
+    server.stop()
+    pygame.event.clear()
+
+
+def _run_student(teacher, net, until, keys=()):
+    """The student's window, with the teacher's loop stepped once per student frame; `keys` are
+    pressed (for the student: posted after the teacher's frame) on the student's 5th frame."""
+    student = PlayerApp(net, headless=True)
+
+    def step():
+        teacher.frame(FRAME_S)
+        if student.frames == 5:
+            for key in keys:
+                post_key(key)
+                post_key(key, down=False)
+        return student.frames > 8 and until(student)
+
+    assert student.run(seconds=20, until=step) == 0
+    assert until(student), "the condition came true before the time ran out"
+    return student
+
+
+def test_a_student_sees_the_teachers_vectors_annotations_and_chart(classroom):
+    teacher, net = classroom
+    teacher.show_annotations, teacher.vectors, teacher.show_chart = True, 1, True
+    student = _run_student(teacher, net, lambda s: net.aids.annotations and len(net.aids.chart.series()["time_s"]) > 5)
+    frame = net.aids.frame
+    assert frame.vectors == 1 and frame.values.shape == (len(teacher.table.pos_m), 2)
+    moving = np.hypot(*frame.values.T) > 0
+    assert moving.any()
+    assert frame.amount == teacher.painter.vector_scale("velocity").update(np.zeros((0, 2)))[0]
+    # The arrows' colour and the chart panel are on the student's window.
+    pixels = pygame.surfarray.array3d(student.window.surface).reshape(-1, 3)
+    assert (pixels == VELOCITY_COLOR).all(axis=1).any()
+    box = student.painter.chart_rect()
+    assert box.width > 100 and (pygame.surfarray.array3d(student.window.surface.subsurface(box)) > 0).any()
+    a = net.aids.live_annotations(__import__("time").monotonic())
+    assert a and a[0].overlap_m > 0 and a[0].radius_i_m == pytest.approx(teacher.table.radius_m[0])
+
+
+def test_a_student_toggles_aids_on_their_own_window_only(classroom):
+    teacher, net = classroom
+    teacher.vectors, teacher.show_chart = 1, True
+    trails = teacher.trails  # Shift+1 starts with trails on
+    student = _run_student(teacher, net, lambda s: not net.aids.shows("v"), keys=(pygame.K_v, pygame.K_e))
+    assert teacher.vectors == 1 and teacher.show_chart and teacher.trails == trails, "the teacher's aids stay"
+    assert net.aids.teacher & aids_wire.VELOCITY, "and the teacher still sends them"
+    assert net.aids.shows("c") and net.aids.shows("e") != trails and not net.aids.shows("v")
+    assert not {"v", "e"} & student.keys, "the toggles are not sent in INPUT"
+
+
+def test_f1_opens_the_students_help_panel(classroom):
+    teacher, net = classroom
+    plain = _run_student(teacher, net, lambda s: True)
+    assert not plain.show_help
+    net2 = NetPlayer("127.0.0.1", net.port, name="Bo", max_backoff_s=0.3)
+    net2.connect()
+    try:
+        student = _run_student(teacher, net2, lambda s: s.show_help and s.frames > 8, keys=(pygame.K_F1,))
+        rect = student.window.panel_rect()
+        assert student.show_help and rect.width > 100
+    finally:
+        net2.close()
+
+
+def test_with_the_teachers_aids_off_a_student_draws_arrows_from_the_snapshots(classroom):
+    teacher, net = classroom
+    teacher.trails = False  # every aid off: no AIDS frames at all
+    student = _run_student(
+        teacher, net, lambda s: net.aids.velocities(2) is not None and net.aids.shows("v"), keys=(pygame.K_v,)
+    )
+    assert net.aids.frame is None and net.aids.teacher == 0
+    v = net.aids.velocities(2)
+    assert np.hypot(*v[0]) == pytest.approx(np.hypot(*teacher.table.vel_mps[0]), rel=0.05)
+    pixels = pygame.surfarray.array3d(student.window.surface).reshape(-1, 3)
+    assert (pixels == VELOCITY_COLOR).all(axis=1).any()
+
+
+def test_a_student_sees_the_teachers_lecture_notes_panel(classroom):
+    teacher, net = classroom
+    teacher.trails, teacher.show_notes = False, True
+    seen = []
+
+    def notes_then_none(student):
+        if not seen and net.aids.teacher & aids_wire.NOTES and net.aids.notes is not None:
+            seen.append(net.aids.notes)
+            teacher.show_notes = False  # the teacher closes them
+        return seen and net.aids.frame is None
+
+    _run_student(teacher, net, notes_then_none)
+    assert seen == [teacher.demo.notes] and len(seen[0]) > 20
+    assert net.aids.teacher == 0, "notes closed and every other aid off: no AIDS frames"
