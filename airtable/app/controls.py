@@ -17,7 +17,7 @@ from typing import TYPE_CHECKING
 
 import pygame
 
-from airtable.app import aids, lessons, rewind, world
+from airtable.app import aids, lessons, predict, rewind, world
 
 if TYPE_CHECKING:
     from airtable.app.app import App
@@ -254,6 +254,11 @@ BINDINGS: tuple[Binding, ...] = (
         "export the recording as CSV; save the moment as a new demo (s1, s2, ...)",
         {pygame.K_x: lessons.export_recording, (pygame.KMOD_CTRL, pygame.K_s): lessons.save_moment},
     ),
+    Binding(
+        "F6 / Shift+F6",
+        "predict, then reveal: open a round, reveal it, close it; names on the arrows on / off",
+        {pygame.K_F6: predict.predict_key, (pygame.KMOD_SHIFT, pygame.K_F6): predict.toggle_names},
+    ),
     Binding("F1", "this help screen (again: next page)", {pygame.K_F1: toggle_help}),
     Binding("F11", "fullscreen on / off", {pygame.K_F11: toggle_fullscreen}),
     Binding("F12", "save a screenshot PNG", {pygame.K_F12: screenshot}),
@@ -345,7 +350,7 @@ def handle_event(app: App, event: pygame.event.Event) -> None:
         handle_key(app, event)
     elif event.type == pygame.KEYUP:
         app.keys_down.discard(event.key)
-    elif event.type in MOUSE_EVENTS:
+    elif event.type in MOUSE_EVENTS and not predict.take_mouse(app, event):
         handle_mouse(app, event)
     elif event.type in (pygame.VIDEORESIZE, pygame.WINDOWSIZECHANGED):
         app.window.handle_event(event)  # the table and the type follow the new size
