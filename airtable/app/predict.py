@@ -271,3 +271,44 @@ def take_mouse(app: App, event) -> bool:
             r.dragging = None
             after_frame(app)
     return True
+
+
+# ---------------------------------------------------------------- a student's side
+
+
+class StudentGuesses:
+    """A student's own arrows in the round the server announced (the player window keeps one)."""
+
+    def __init__(self) -> None:
+        self.round_id = 0
+        self.guesses: dict[int, tuple[float, float]] = {}
+        self.dragging: int | None = None
+
+    def follow(self, info: RoundInfo | None) -> None:
+        """A new round starts with no arrows."""
+        if info is not None and info.round_id != self.round_id:
+            self.round_id, self.guesses, self.dragging = info.round_id, {}, None
+        if info is None or info.state != "open":
+            self.dragging = None
+
+    def press(self, info: RoundInfo | None, point_m: Sequence[float], radius_m: Sequence[float]) -> bool:
+        """Button 1 at `point_m`: start an arrow if it is on a predictable puck (True: taken)."""
+        self.follow(info)
+        if info is None or info.state != "open":
+            return False
+        for puck in range(min(len(info.from_m), len(radius_m)) - 1, -1, -1):  # the top one first
+            x, y = info.from_m[puck]
+            if math.hypot(point_m[0] - x, point_m[1] - y) <= radius_m[puck]:
+                self.dragging = puck
+                return True
+        return False
+
+    def drag(self, info: RoundInfo | None, point_m: Sequence[float]) -> tuple[int, tuple[float, float]] | None:
+        """The mouse moved (or let go) while dragging: (puck, velocity) now guessed, else None."""
+        self.follow(info)
+        if self.dragging is None or info is None:
+            return None
+        x, y = info.from_m[self.dragging]
+        vel = clamp_speed(((point_m[0] - x) / ARROW_S, (point_m[1] - y) / ARROW_S))
+        self.guesses[self.dragging] = vel
+        return self.dragging, vel
