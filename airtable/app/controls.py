@@ -255,8 +255,8 @@ BINDINGS: tuple[Binding, ...] = (
         {pygame.K_x: lessons.export_recording, (pygame.KMOD_CTRL, pygame.K_s): lessons.save_moment},
     ),
     Binding(
-        "F6 / Shift+F6",
-        "predict, then reveal: open a round, reveal it, close it; names on the arrows on / off",
+        "F6",
+        "predict, reveal, close (Shift: names)",
         {pygame.K_F6: predict.predict_key, (pygame.KMOD_SHIFT, pygame.K_F6): predict.toggle_names},
     ),
     Binding("F1", "this help screen (again: next page)", {pygame.K_F1: toggle_help}),
