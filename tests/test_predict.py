@@ -284,3 +284,20 @@ def test_the_local_mouse_predicts_on_the_teachers_window(tmp_path):
     frames_until(app, lambda: app.predict.settled, "the collision to be over")
     (line,) = app.predict.summary
     assert line == "puck 2: median 10 deg off; 0 of 1 within 5 deg; speeds within 20 %: 1 of 1"
+
+
+def test_nobody_s_string_touches_the_pucks_while_the_reveal_plays(server, tmp_path):
+    app = head_on_app(tmp_path, server)
+    student = RawClient(server.port)
+    try:
+        student.hello("Flo")
+        frames_until(app, lambda: app.student_count() == 1, "the student to join")
+        press(app, pygame.K_F6)
+        press(app, pygame.K_F6)  # reveal at once
+        x, y = app.table.pos_m[1]
+        student.send(proto.encode_input((x, y), 1))  # grab puck 2 ...
+        student.send(proto.encode_input((x, y + 3.0), 1))  # ... and pull it up hard
+        frames_until(app, lambda: app.predict.settled, "the collision to be over")
+        assert app.predict.truth[1] == pytest.approx((1.0, 0.0), abs=1e-6)  # as if nobody were there
+    finally:
+        student.close()

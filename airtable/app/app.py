@@ -352,6 +352,7 @@ class App:
         self.local.set_input(self.table, self.env.to_world(self.mouse_px), self.mouse_button)
         if self.server is not None:
             self.server.update_clients(self.clients, self.table)  # joins, leaves and inputs, even while paused
+        predict.hands_off(self)  # a reveal plays untouched
         if not self.paused:
             self._run_physics(frame_dt_s)
         predict.after_frame(self)  # a reveal freezes once its collision is over

@@ -176,7 +176,7 @@ def next_demo(app: App) -> None:
 
 
 BINDINGS: tuple[Binding, ...] = (
-    Binding("1-9, 0", "start that demo (press again to restart it, re-reading its file if it changed)"),
+    Binding("1-9, 0", "start (again: restart) that demo"),
     Binding("Shift+1/2/3", "correction comparison: off, two-step, perfect kiss"),
     Binding("Tab", "demo menu: every demo; arrows and Enter, or type its key", {pygame.K_TAB: open_menu}),
     Binding(
@@ -256,7 +256,7 @@ BINDINGS: tuple[Binding, ...] = (
     ),
     Binding(
         "F6",
-        "predict, reveal, close (Shift: names)",
+        "predict, then reveal",
         {pygame.K_F6: predict.predict_key, (pygame.KMOD_SHIFT, pygame.K_F6): predict.toggle_names},
     ),
     Binding("F1", "this help screen (again: next page)", {pygame.K_F1: toggle_help}),

@@ -217,9 +217,7 @@ def predict_key(app: App) -> None:
     elif r.state == "open":
         book = _book(app)
         r.reveal(book.arrows() if book is not None else (), app.table)
-        for client in app.clients:
-            client.release()  # the reveal plays the table as it was left, without anyone's string
-        app.paused = False
+        app.paused = False  # after_frame keeps everyone's strings off until the collision is over
     else:
         r.close()
         app.paused = True
@@ -239,6 +237,14 @@ def end_round(app: App) -> None:
     if app.predict.active:
         app.predict.close()
         publish(app)
+
+
+def hands_off(app: App) -> None:
+    """Before the physics steps: while the reveal plays nobody's string holds a puck,
+    so the truth is what the guesses were about."""
+    if app.predict.state == "revealed" and not app.predict.truth:
+        for client in app.clients:
+            client.release()
 
 
 def after_frame(app: App) -> None:

@@ -294,6 +294,7 @@ class NetPlayer:
             self.welcome = welcome
             self._feed = SnapshotFeed()  # a new connection starts from a keyframe
             self._throttle.reset()
+            self.round = None  # a round under way comes again after the WELCOME
             self.state = PlayerState.CONNECTED
             self.waiting_because = None
 
