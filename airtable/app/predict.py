@@ -213,7 +213,7 @@ def predict_key(app: App) -> None:
             return
         r.open(app.table.pos_m)
         app.paused = True
-        app.say("predict: drag an arrow from a puck (its velocity after the collision); the same key reveals")
+        app.say("prediction round open: F6 again reveals")
     elif r.state == "open":
         book = _book(app)
         r.reveal(book.arrows() if book is not None else (), app.table)

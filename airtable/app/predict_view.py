@@ -20,7 +20,7 @@ if TYPE_CHECKING:
 
 PROMPT_COLOR = (255, 220, 90)
 TRUTH_COLOR = (255, 255, 255)
-PROMPT = "predict: drag an arrow from a puck, its velocity once the collision is over"
+PROMPT = ("PREDICT: drag an arrow from a puck,", "its velocity once the collision is over")
 
 
 def paint_round(
@@ -34,7 +34,7 @@ def paint_round(
         for puck, vel in own.items():
             if puck < len(starts):
                 painter.arrow(starts[puck], (vel[0] * ARROW_S, vel[1] * ARROW_S), own_color, thin)
-        lines = [(PROMPT, PROMPT_COLOR)]
+        lines = [(text, PROMPT_COLOR) for text in PROMPT]
         if count:
             lines.append((count, PROMPT_COLOR))
         painter.legend(lines)
