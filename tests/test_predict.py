@@ -301,3 +301,17 @@ def test_nobody_s_string_touches_the_pucks_while_the_reveal_plays(server, tmp_pa
         assert app.predict.truth[1] == pytest.approx((1.0, 0.0), abs=1e-6)  # as if nobody were there
     finally:
         student.close()
+
+
+def test_a_student_who_joins_mid_round_is_told_at_once(server, tmp_path):
+    app = head_on_app(tmp_path, server)
+    press(app, pygame.K_F6)
+    late = RawClient(server.port)
+    try:
+        late.hello("Gus")
+        info = next_round(late, lambda i: True)  # the first ROUND, without waiting for a count change
+        assert (info.round_id, info.state, info.pucks) == (1, "open", 2)
+        late.send(encode_predict(info.round_id, 0, (0.0, 0.0)))
+        frames_until(app, lambda: "1 of 1 predicted" in app.status_line(), "the late guess counted")
+    finally:
+        late.close()
