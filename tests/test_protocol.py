@@ -67,7 +67,7 @@ def test_frame_header_is_big_endian_length_then_type():
         (b"\x00\x00\x00\x00", ["empty", "airtable-client"]),
         (struct.pack(">IB", proto.MAX_CLIENT_FRAME + 1, 1), ["1024 byte limit"]),
         (b"GET / HTTP/1.1\r\n", ["looks like text", "web browser"]),
-        (b"\x00\x00\x00\x02\x09x", ["unknown message type 9", "same airtable version"]),
+        (b"\x00\x00\x00\x02\x0cx", ["unknown message type 12", "same airtable version"]),
         (b"\x00\x00\x00\x02\x05x", ["may not send SNAPSHOT"]),
     ],
 )

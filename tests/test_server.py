@@ -472,7 +472,7 @@ BAD_CLIENTS = {
     "a name imitating players": ([proto.encode_hello("C7 C1")], ["looks like a player label"]),
     "INPUT before HELLO": ([proto.encode_input((1, 2), 1)], ["before HELLO", "HELLO"]),
     "HELLO twice": (_after_hello(proto.encode_hello()), ["twice"]),
-    "unknown frame type": (_after_hello(frame(9, b"{}")), ["unknown message type 9"]),
+    "unknown frame type": (_after_hello(frame(12, b"{}")), ["unknown message type 12"]),
     "a client sending SNAPSHOT": (_after_hello(frame(proto.SNAPSHOT, b"ATSN")), ["may not send SNAPSHOT"]),
     "NaN": (_after_hello(_input(cursor="[NaN, 1]")), ["NaN", "finite"]),
     "inf": (_after_hello(_input(cursor="[1, Infinity]")), ["finite"]),

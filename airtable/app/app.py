@@ -17,7 +17,7 @@ from pathlib import Path
 import numpy as np
 import pygame
 
-from airtable.app import aids, controls, rewind, room, world
+from airtable.app import aids, controls, predict, rewind, room, world
 from airtable.app.aids_share import shared_aids
 from airtable.app.aids_view import draw_aids
 from airtable.app.client import LOCAL_COLOR, Client, cursor_pulls
@@ -28,6 +28,7 @@ from airtable.app.lessons import Lessons
 from airtable.app.lessons_view import draw_lessons
 from airtable.app.loop import FixedStep, FpsCounter, FrameLoop
 from airtable.app.menu import DemoMenu
+from airtable.app.predict_view import draw_predict
 from airtable.app.roster_view import draw_alert, draw_roster
 from airtable.app.scene import STATUS_SEPARATOR, Scene
 from airtable.app.stats import RunStats
@@ -128,6 +129,7 @@ class App:
         self.lessons = Lessons()  # recording, momenta, saving the moment (lessons.py)
         self.room = room.Room()  # the roster, hands off, the floor, anonymous names (room.py)
         self.history = History()  # the table's recent moments, for rewinding (history.py, rewind.py)
+        self.predict = predict.PredictRound()  # predict, then reveal (predict.py)
         self.keys_down: set[int] = set()
         self.mouse_px = (self.env.size_px[0] / 2, self.env.size_px[1] / 2)
         self.mouse_button = 0
@@ -195,6 +197,7 @@ class App:
         self.lessons.start(self.table)
         self.history.clear()
         self.history.record(self.table)
+        predict.end_round(self)
         self.window.set_caption(f"Air Table - {self.caption()}")
 
     def _clear_table(self) -> None:
@@ -357,9 +360,11 @@ class App:
         self.local.set_input(self.table, self.env.to_world(self.mouse_px), self.mouse_button)
         if self.server is not None:
             self.server.update_clients(self.clients, self.table)  # joins, leaves and inputs, even while paused
+        predict.hands_off(self)  # a reveal plays untouched
         if not self.paused:
             self._run_physics(frame_dt_s)
         self._say_new_notices()
+        predict.after_frame(self)  # a reveal freezes once its collision is over
         self.fps = self._fps_counter.tick(self.clock_s)
         scene = self.scene()
         if self.server is not None:
@@ -405,6 +410,8 @@ class App:
         t = self.table
         parts = ["PAUSED"] if self.paused else []
         parts.extend(room.status_parts(self))  # hands off, the floor
+        if self.predict.active:
+            parts.append(predict.status_text(self))
         timeline = self.history.timeline() if self.history.in_past else None
         if timeline is not None:
             parts.append(f"rewound {timeline.newest_s - timeline.view_s:.2f} s")
@@ -443,6 +450,7 @@ class App:
         draw_lessons(self)  # first: the aids' labels then place themselves around its panels
         self._draw_timeline()
         draw_aids(self)
+        draw_predict(self)
         self._draw_panel()
         self.window.present()
 

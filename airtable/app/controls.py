@@ -17,7 +17,7 @@ from typing import TYPE_CHECKING
 
 import pygame
 
-from airtable.app import aids, lessons, rewind, room, world
+from airtable.app import aids, lessons, predict, rewind, room, world
 
 if TYPE_CHECKING:
     from airtable.app.app import App
@@ -176,7 +176,7 @@ def next_demo(app: App) -> None:
 
 
 BINDINGS: tuple[Binding, ...] = (
-    Binding("1-9, 0", "start that demo (press again to restart it, re-reading its file if it changed)"),
+    Binding("1-9, 0", "start (again: restart) that demo"),
     Binding("Shift+1/2/3", "correction comparison: off, two-step, perfect kiss"),
     Binding("Tab", "demo menu: every demo; arrows and Enter, or type its key", {pygame.K_TAB: open_menu}),
     Binding(
@@ -253,6 +253,11 @@ BINDINGS: tuple[Binding, ...] = (
         "x / Ctrl+S",
         "export the recording as CSV; save the moment as a new demo (s1, s2, ...)",
         {pygame.K_x: lessons.export_recording, (pygame.KMOD_CTRL, pygame.K_s): lessons.save_moment},
+    ),
+    Binding(
+        "F6",
+        "predict, then reveal",
+        {pygame.K_F6: predict.predict_key, (pygame.KMOD_SHIFT, pygame.K_F6): predict.toggle_names},
     ),
     # F2-F5 share F1's row: the help must fit one page on a 900 x 788 window; the roster panel
     # (F2) and the HUD's "3 students (F2: roster)" name them in full.
@@ -370,7 +375,7 @@ def handle_event(app: App, event: pygame.event.Event) -> None:
         handle_key(app, event)
     elif event.type == pygame.KEYUP:
         app.keys_down.discard(event.key)
-    elif event.type in MOUSE_EVENTS:
+    elif event.type in MOUSE_EVENTS and not predict.take_mouse(app, event):
         handle_mouse(app, event)
     elif event.type in (pygame.VIDEORESIZE, pygame.WINDOWSIZECHANGED):
         app.window.handle_event(event)  # the table and the type follow the new size

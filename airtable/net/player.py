@@ -28,11 +28,14 @@ from collections.abc import Callable, Iterable, Sequence
 import numpy as np
 
 from airtable.app.aids_share import LOCAL_KEYS, StudentAids
+from airtable.app.predict import StudentGuesses
+from airtable.app.predict_view import paint_round
 from airtable.app.room import student_banner
 from airtable.app.scene import CursorView, Scene
 from airtable.net import protocol as proto
 from airtable.net.aids_wire import NOTES, AidsDecoder
 from airtable.net.playout import SnapshotFeed
+from airtable.net.predictions import RoundInfo, clamp_speed, encode_predict, parse_round
 
 CONNECT_TIMEOUT_S = 5.0
 SILENCE_S = 10.0  # no snapshot for this long: the server is gone (snapshots come 30 times a second)
@@ -161,6 +164,7 @@ class NetPlayer:
         self._closed = threading.Event()
         self._thread: threading.Thread | None = None
         self._throttle = InputThrottle()
+        self.round: RoundInfo | None = None  # the newest prediction round the server announced
 
     @property
     def address(self) -> str:
@@ -299,6 +303,7 @@ class NetPlayer:
             self._feed = SnapshotFeed()  # a new connection starts from a keyframe
             self._aids = AidsDecoder()
             self._throttle.reset()
+            self.round = None  # a round under way comes again after the WELCOME
             self.state = PlayerState.CONNECTED
             self.waiting_because = None
 
@@ -376,6 +381,11 @@ class NetPlayer:
                     self.on_snapshot(scene, now)
             elif frame_type == proto.AIDS:
                 self._take_aids(payload, now)
+            elif frame_type == proto.ROUND:
+                try:
+                    self.round = parse_round(payload)
+                except proto.ProtocolError as e:
+                    raise _ConnectionEndedError(str(e)) from None
             elif frame_type == proto.ERROR:
                 sentence, retry = proto.parse_error_message(payload)
                 raise _ConnectionEndedError(None if retry else sentence)
@@ -440,6 +450,22 @@ class NetPlayer:
         if not self._throttle.due(record, now):
             return False
         return self._send(record, now)
+
+    def send_predict(self, puck: int, vel_mps: Sequence[float]) -> bool:
+        """Send this player's guess for `puck` in the open round; False when there is none or not connected."""
+        info = self.round
+        if info is None or info.state != "open":
+            return False
+        frame = encode_predict(info.round_id, puck, clamp_speed(vel_mps))
+        with self._send_lock:
+            sock = self._sock
+            if sock is None or self.state != PlayerState.CONNECTED:
+                return False
+            try:
+                sock.sendall(frame)
+            except OSError:
+                return False
+        return True
 
     def _record(self, cursor_m: Sequence[float], button: int, keys: Iterable[str]) -> proto.InputRecord:
         welcome = self.welcome
@@ -506,6 +532,8 @@ class PlayerApp:
         self.painter = None  # the AidsPainter, once the window is open
         self._drawn_from: tuple = ()  # the restarts and view the trails were drawn in
         self._welcome: proto.Welcome | None = None
+        self.predicting = StudentGuesses()  # our arrows in a prediction round
+        self._round_painter = None
 
     def run(
         self, seconds: float | None = None, screenshot: str | None = None, until: Callable[[], bool] | None = None
@@ -579,6 +607,8 @@ class PlayerApp:
                 return False
             if event.type == pygame.KEYDOWN and self._local_key(pygame.key.name(event.key)):
                 continue  # this window's own toggles: the server never hears of them
+            if self._predict_event(event):
+                continue
             if event.type == pygame.KEYDOWN:
                 self.keys.add(pygame.key.name(event.key))
             elif event.type == pygame.KEYUP:
@@ -610,6 +640,24 @@ class PlayerApp:
                 self.painter.new_demo()
             self._drawn_from = drawn_from
             self.window.clear_trails()
+
+    def _predict_event(self, event) -> bool:
+        """While a round is open, button 1 on a puck drags our arrow; letting go sends PREDICT."""
+        import pygame
+
+        if self.env is None or event.type not in (pygame.MOUSEBUTTONDOWN, pygame.MOUSEMOTION, pygame.MOUSEBUTTONUP):
+            return False
+        info, guesses = self.net.round, self.predicting
+        point = self.env.to_world(np.asarray(event.pos, dtype=float))
+        if event.type == pygame.MOUSEBUTTONDOWN:
+            scene = self.net.latest()
+            radius = scene.radius_m if scene is not None else ()
+            return event.button == 1 and guesses.press(info, point, radius)
+        guessed = guesses.drag(info, point)
+        if guessed is not None and event.type == pygame.MOUSEBUTTONUP:
+            guesses.dragging = None
+            self.net.send_predict(*guessed)
+        return guessed is not None
 
     def _follow_welcome(self) -> None:
         """After a (re)connect: the new name in the caption, the new table size in the view."""
@@ -662,11 +710,24 @@ class PlayerApp:
         draw_student_aids(self.painter, scene, net.aids, time.monotonic(), cursor_m)
         if extra and me:  # not in the snapshots yet: the arrow alone
             win.draw_cursor(me, color, cursor_m)
+        self._draw_round(color)
         if self.show_help:
             win.draw_panel("Keys", list(STUDENT_KEYS))
         elif net.aids.teacher & NOTES and net.aids.notes is not None:
             win.draw_panel(scene.title, [net.aids.notes], large=True)
         win.present()
+
+    def _draw_round(self, color) -> None:
+        info = self.net.round
+        self.predicting.follow(info)
+        if info is None or info.state == "closed":
+            return
+        if self._round_painter is None or self._round_painter.w is not self.window:
+            from airtable.app.window import AidsPainter
+
+            self._round_painter = AidsPainter(self.window)
+        count = f"{info.predicted} of {info.players} predicted"
+        paint_round(self._round_painter, info, self.predicting.guesses, color, count)
 
 
 def fit_drawing_budget(scene: Scene, env) -> Scene:

@@ -39,6 +39,8 @@ SNAPSHOT = 5
 BYE = 6
 LAYOUT = 7  # what rarely changes in a snapshot (codec.py), sent when it changes
 AIDS = 10  # the teacher's teaching aids at a tick (aids_wire.py), after its SNAPSHOT while any aid is on
+PREDICT = 8  # a student's guess in a predict-then-reveal round (predictions.py)
+ROUND = 9  # the round's state, counts and, once revealed, every guess (predictions.py)
 FRAME_NAMES = {
     HELLO: "HELLO",
     WELCOME: "WELCOME",
@@ -48,8 +50,10 @@ FRAME_NAMES = {
     BYE: "BYE",
     LAYOUT: "LAYOUT",
     AIDS: "AIDS",
+    PREDICT: "PREDICT",
+    ROUND: "ROUND",
 }
-CLIENT_FRAMES = frozenset({HELLO, INPUT, BYE})
+CLIENT_FRAMES = frozenset({HELLO, INPUT, BYE, PREDICT})
 
 # Bytes of L (type + payload) a client may send. A real INPUT is under 400
 # bytes and a HELLO with the longest name and password under 1000, so a

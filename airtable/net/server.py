@@ -44,6 +44,7 @@ from airtable.net.connection import Connection, State
 from airtable.net.events import EventQueue, PlayerInput, PlayerJoined, PlayerLeft
 from airtable.net.gate import FIRST_PASSWORD_WAIT_S, HANDSHAKES_PER_ADDRESS, PLAYERS_PER_ADDRESS, Gate, QuietLog
 from airtable.net.identity import SeatTokens
+from airtable.net.predictions import MAX_ROUND_PUCKS, PredictionBook, RoundInfo, encode_round, parse_predict
 
 log = logging.getLogger("airtable.net")
 
@@ -225,22 +226,26 @@ class GameServer:
         self._roster: tuple[Seat, ...] = ()
         self._commands: list[Callable[[], None]] = []  # from the game loop, run by the network thread
         self._table_size_m: tuple[float, float] = proto.DEFAULT_TABLE_SIZE_M  # plain tuple: replaced, never mutated
+        self.predictions = PredictionBook()  # the predict-then-reveal round's guesses (has its own lock)
+        self._round_frame: bytes | None = None  # the newest ROUND, for players who join during a round
 
         # Game loop only.
         self._clients: dict[int, Client] = {}
         self._seat_of: dict[int, int] = {}  # cid -> player number
         self._next_publish = 0.0
 
-        # Network thread only.
+        self._gate = Gate(handshakes_per_address, players_per_address, limit_loopback, password_wait_s)
+        self._init_network_thread_state()
+
+    def _init_network_thread_state(self) -> None:
+        """What only the network thread touches, and the sockets it will open in start()."""
         self._conns: dict[int, Connection] = {}
         self._numbers: dict[int, int] = {}  # player number -> cid
-        self._gate = Gate(handshakes_per_address, players_per_address, limit_loopback, password_wait_s)
         self._quiet = QuietLog(log)
         self._sent_seq = 0
         self._turns = pacing.RoundRobin()
         self._next_cid = 1
         self._accept_paused_until = 0.0
-
         self._listener: socket.socket | None = None
         self._selector: selectors.BaseSelector | None = None
         self._wake_r, self._wake_w = None, None  # a socketpair that wakes the network thread (made in start)
@@ -405,6 +410,19 @@ class GameServer:
         sentence = "the teacher removed you from the table" + (f": {reason}" if reason else "")
         self._command(lambda: self._remove(number, sentence))
         return True
+
+    def send_round(self, info: RoundInfo) -> None:
+        """Game loop: tell every player (and each who joins later) where the prediction round is."""
+        frame = encode_round(info)
+        with self._lock:
+            self._round_frame = frame if info.state != "closed" else None
+        self._command(lambda: self._send_to_players(frame))
+
+    def _send_to_players(self, frame: bytes) -> None:
+        for conn in list(self._conns.values()):
+            if conn.state == State.PLAYING:
+                conn.send_control(frame)
+                self._settle(conn)
 
     def _command(self, fn: Callable[[], None]) -> None:
         with self._lock:
@@ -658,6 +676,17 @@ class GameServer:
             record = proto.parse_input(payload, self._table_size_m)
             conn.note_input(record, now)
             self._events.input(conn.cid, record)
+        elif frame_type == proto.PREDICT:
+            self._predict(conn, payload)
+
+    def _predict(self, conn: Connection, payload: bytes) -> None:
+        """A guess in the prediction round: checked, then kept in the book (never the physics).
+
+        One for a round that has closed (it crossed the reveal on the wire) is ignored."""
+        if conn.state != State.PLAYING:
+            raise proto.ProtocolError("PREDICT came before HELLO; a client must first send HELLO and wait for WELCOME")
+        prediction = parse_predict(payload, MAX_ROUND_PUCKS)  # types, finite, speed; the book checks round and puck
+        self.predictions.add(conn.cid, conn.name, client_color(conn.number), prediction)
 
     def _full_sentence(self) -> str:
         return (
@@ -693,6 +722,10 @@ class GameServer:
         token = self._tokens.make(number, hello.name or "")
         conn.send_control(proto.encode_welcome(client, color, width_m, height_m, hello.name, token))
         conn.offer_tick(self._encoder, now)  # the newest picture straight away, if there is one
+        with self._lock:
+            round_frame = self._round_frame
+        if round_frame is not None:  # a prediction round is under way
+            conn.send_control(round_frame)
         self._log_seat(conn, "%s joined from %s", name, conn.peer)
 
     def _log_seat(self, conn: Connection, line: str, *args) -> None:
@@ -758,6 +791,7 @@ class GameServer:
                     # next player with a picture from long ago.
                     self._encoder.forget()
             self._events.leave(conn.cid)
+            self.predictions.forget(conn.cid)
         conn.number = 0
 
     def _settle(self, conn: Connection) -> None:

@@ -1,0 +1,320 @@
+"""Predict, then reveal: a round of peer instruction on the shared table.
+
+One key (`predict_key`) steps a round along:
+
+    none -> open      the table freezes; students (and the local mouse) drag
+                      arrows from pucks: the velocity each puck will have once
+                      the coming collision is over; the projector shows only a count
+    open -> revealed  every guess is drawn thin in its student's colour and the
+                      table plays; once the collision is over (no collision for
+                      SETTLE_S after at least one, or TIMEOUT_S) it freezes, the
+                      true velocities are drawn bold and a summary per puck printed
+    revealed -> none  the round closes; the table stays paused
+
+The guesses live in the server's PredictionBook (airtable/net/predictions.py)
+and in `local` here; nothing in them reaches the physics. `summarize` is the
+maths of the summary: angles between guess and truth, and speed ratios.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import replace
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from airtable.net.predictions import MAX_ROUND_PUCKS, Arrow, RoundInfo, clamp_speed
+
+if TYPE_CHECKING:
+    from airtable.app.app import App
+
+SETTLE_S = 0.3  # table time with no collision after which the collision is over
+TIMEOUT_S = 8.0  # table time after which the reveal freezes anyway
+WITHIN_DEG = 5.0  # "within 5 deg"
+WITHIN_SPEED = 0.2  # "speeds within 20 %"
+RESTING_MPS = 0.05  # a true speed below this: the puck stops, and direction means nothing
+ARROW_S = 1.0  # a prediction arrow is drawn as far as the puck would go in this time
+LOCAL_LABEL = "local"
+LOCAL_COLOR = (120, 255, 120)
+
+
+def angle_deg(a: Sequence[float], b: Sequence[float]) -> float:
+    """The angle between two vectors, 0 to 180 degrees (180 if either is zero)."""
+    na, nb = math.hypot(*a), math.hypot(*b)
+    if na == 0.0 or nb == 0.0:
+        return 180.0
+    cos = (a[0] * b[0] + a[1] * b[1]) / (na * nb)
+    return math.degrees(math.acos(min(1.0, max(-1.0, cos))))
+
+
+def puck_summary(puck: int, truth: Sequence[float], guesses: Sequence[Sequence[float]]) -> str:
+    """One line: how far the guesses for `puck` spread from its true velocity."""
+    n = len(guesses)
+    label = f"puck {puck + 1}"
+    speed = math.hypot(*truth)
+    if n == 0:
+        return f"{label}: no predictions"
+    if speed < RESTING_MPS:
+        still = sum(1 for g in guesses if math.hypot(*g) < RESTING_MPS)
+        return f"{label}: comes to rest; {still} of {n} predicted under {RESTING_MPS:g} m/s"
+    off = [angle_deg(g, truth) for g in guesses]
+    near = sum(1 for d in off if d <= WITHIN_DEG)
+    speeds = sum(1 for g in guesses if abs(math.hypot(*g) - speed) <= WITHIN_SPEED * speed)
+    return (
+        f"{label}: median {float(np.median(off)):.0f} deg off; {near} of {n} within {WITHIN_DEG:g} deg; "
+        f"speeds within {WITHIN_SPEED * 100:.0f} %: {speeds} of {n}"
+    )
+
+
+def summarize(truth: Sequence[Sequence[float]], arrows: Sequence[Arrow]) -> list[str]:
+    """A line per puck that someone predicted, in puck order."""
+    by_puck: dict[int, list[tuple[float, float]]] = {}
+    for a in arrows:
+        if a.puck < len(truth):
+            by_puck.setdefault(a.puck, []).append(a.vel_mps)
+    return [puck_summary(p, truth[p], by_puck[p]) for p in sorted(by_puck)]
+
+
+class PredictRound:
+    """The round's state on the teacher's side (`app.predict`)."""
+
+    def __init__(self) -> None:
+        self.round_id = 0
+        self.state = "closed"  # "open", "revealed", "closed" (no round)
+        self.pucks = 0
+        self.from_m: tuple[tuple[float, float], ...] = ()  # where the pucks stood when the round opened
+        self.show_names = False  # labels on the revealed arrows (Shift+F6)
+        self.local: dict[int, tuple[float, float]] = {}  # the local mouse's guesses
+        self.dragging: int | None = None  # the puck whose arrow the local mouse drags
+        self.arrows: tuple[Arrow, ...] = ()
+        self.truth: tuple[tuple[float, float], ...] = ()
+        self.summary: tuple[str, ...] = ()
+        self.players = 0
+        self.predicted = 0
+        self._hits = 0
+        self._last_hit_s = 0.0
+        self._started_s = 0.0
+        self._seen_collision = False
+
+    @property
+    def active(self) -> bool:
+        return self.state != "closed"
+
+    @property
+    def settled(self) -> bool:
+        """Revealed and the collision is over: the truth is known."""
+        return self.state == "revealed" and bool(self.truth)
+
+    def open(self, pos_m: np.ndarray) -> None:
+        self.round_id += 1
+        self.state, self.pucks = "open", min(len(pos_m), MAX_ROUND_PUCKS)
+        self.from_m = tuple((float(x), float(y)) for x, y in pos_m[: self.pucks])
+        self.local, self.dragging = {}, None
+        self.arrows, self.truth, self.summary = (), (), ()
+
+    def reveal(self, arrows: Sequence[Arrow], table) -> None:
+        local = [Arrow(p, v, LOCAL_COLOR, LOCAL_LABEL) for p, v in sorted(self.local.items())]
+        self.arrows = tuple(arrows) + tuple(local)
+        self.state, self.dragging = "revealed", None
+        self._hits, self._started_s = table.collision_count, table.time_s
+        self._last_hit_s, self._seen_collision = table.time_s, False
+
+    def close(self) -> None:
+        self.state, self.dragging = "closed", None
+
+    def collision_over(self, table) -> bool:
+        """Called while the revealed table plays: True once it should freeze."""
+        if table.collision_count != self._hits:
+            self._hits, self._last_hit_s, self._seen_collision = table.collision_count, table.time_s, True
+        quiet = table.time_s - self._last_hit_s >= SETTLE_S
+        return (self._seen_collision and quiet) or table.time_s - self._started_s >= TIMEOUT_S
+
+    def settle(self, table) -> None:
+        """Freeze on the truth: every predictable puck's velocity now, and the summary."""
+        n = min(self.pucks, len(table.vel_mps))
+        self.truth = tuple((float(v[0]), float(v[1])) for v in table.vel_mps[:n])
+        self.summary = tuple(summarize(self.truth, self.arrows))
+
+    def info(self, predicted: int, players: int) -> RoundInfo:
+        """What the ROUND message says now (arrows only after the reveal)."""
+        shown = self.state == "revealed"
+        return RoundInfo(
+            self.round_id,
+            self.state,
+            self.pucks,
+            predicted,
+            players,
+            tuple(a if self.show_names else replace(a, label="") for a in self.arrows) if shown else (),
+            self.truth if shown else (),
+            self.summary if shown else (),
+            self.from_m,
+        )
+
+    def guess_from_drag(self, puck_pos_m: Sequence[float], mouse_m: Sequence[float]) -> tuple[float, float]:
+        """The velocity an arrow dragged from the puck to the mouse stands for."""
+        return clamp_speed(((mouse_m[0] - puck_pos_m[0]) / ARROW_S, (mouse_m[1] - puck_pos_m[1]) / ARROW_S))
+
+
+# ---------------------------------------------------------------- the app side
+
+
+def _book(app: App):
+    return getattr(app.server, "predictions", None) if app.server is not None else None
+
+
+def _counts(app: App) -> tuple[int, int]:
+    """(who predicted, of how many): the students, plus the local mouse once it predicted."""
+    book = _book(app)
+    students = app.student_count()
+    predicted = book.count() if book is not None else 0
+    if app.predict.local:
+        return predicted + 1, students + 1
+    return predicted, students
+
+
+def count_text(app: App) -> str:
+    predicted, players = _counts(app)
+    return f"{predicted} of {players} predicted"
+
+
+def status_text(app: App) -> str:
+    """The round in the status line."""
+    r = app.predict
+    if r.state == "open":
+        return f"PREDICT: {count_text(app)} (F6 reveals)"
+    if r.settled:
+        return "REVEALED (F6 closes the round)"
+    return "REVEALED: playing until the collision is over"
+
+
+def publish(app: App) -> None:
+    """Tell the students where the round is (a ROUND message to each)."""
+    book = _book(app)
+    if book is None:
+        return
+    r = app.predict
+    r.predicted, r.players = _counts(app)
+    info = r.info(r.predicted, r.players)
+    if info.state == "open" and book.accepts() != (info.round_id, info.pucks):
+        book.open(info.round_id, info.pucks)
+    elif info.state != "open":
+        book.set_state(info.state)
+    app.server.send_round(info)
+
+
+def predict_key(app: App) -> None:
+    """The round key: open a round, reveal it, close it."""
+    r = app.predict
+    if r.state == "closed":
+        if not len(app.table.pos_m):
+            app.say("no pucks on the table to predict")
+            return
+        r.open(app.table.pos_m)
+        app.paused = True
+        app.say("prediction round open: F6 again reveals")
+    elif r.state == "open":
+        book = _book(app)
+        r.reveal(book.arrows() if book is not None else (), app.table)
+        app.paused = False  # after_frame keeps everyone's strings off until the collision is over
+    else:
+        r.close()
+        app.paused = True
+    publish(app)
+
+
+def toggle_names(app: App) -> None:
+    """Shift+F6: names on the revealed arrows, here and on the students' windows."""
+    app.predict.show_names = not app.predict.show_names
+    app.say(f"prediction names {'shown' if app.predict.show_names else 'hidden'}")
+    if app.predict.active:
+        publish(app)
+
+
+def end_round(app: App) -> None:
+    """A new demo: a round under way ends with it."""
+    if app.predict.active:
+        app.predict.close()
+        publish(app)
+
+
+def hands_off(app: App) -> None:
+    """Before the physics steps: while the reveal plays nobody's string holds a puck,
+    so the truth is what the guesses were about."""
+    if app.predict.state == "revealed" and not app.predict.truth:
+        for client in app.clients:
+            client.release()
+
+
+def after_frame(app: App) -> None:
+    """Every frame: freeze the reveal once the collision is over; keep the students' count fresh."""
+    r = app.predict
+    if r.state == "revealed" and not r.truth and not app.paused and r.collision_over(app.table):
+        app.paused = True
+        r.settle(app.table)
+        publish(app)
+    elif r.state == "open" and _counts(app) != (r.predicted, r.players):
+        publish(app)
+
+
+def take_mouse(app: App, event) -> bool:
+    """While a round is open the local mouse drags prediction arrows, not pucks; True if it took `event`."""
+    import pygame
+
+    r = app.predict
+    if r.state != "open" or event.type not in (pygame.MOUSEBUTTONDOWN, pygame.MOUSEMOTION, pygame.MOUSEBUTTONUP):
+        return False
+    app.mouse_px = event.pos
+    where = app.env.to_world(np.asarray(event.pos, dtype=float))
+    if event.type == pygame.MOUSEBUTTONDOWN and event.button == 1:
+        puck = app.table.puck_at(where)
+        if puck is not None and puck.index < r.pucks:
+            r.dragging = puck.index
+    elif r.dragging is not None and event.type != pygame.MOUSEBUTTONDOWN:
+        r.local[r.dragging] = r.guess_from_drag(app.table.pos_m[r.dragging], where)
+        if event.type == pygame.MOUSEBUTTONUP:
+            r.dragging = None
+            after_frame(app)
+    return True
+
+
+# ---------------------------------------------------------------- a student's side
+
+
+class StudentGuesses:
+    """A student's own arrows in the round the server announced (the player window keeps one)."""
+
+    def __init__(self) -> None:
+        self.round_id = 0
+        self.guesses: dict[int, tuple[float, float]] = {}
+        self.dragging: int | None = None
+
+    def follow(self, info: RoundInfo | None) -> None:
+        """A new round starts with no arrows."""
+        if info is not None and info.round_id != self.round_id:
+            self.round_id, self.guesses, self.dragging = info.round_id, {}, None
+        if info is None or info.state != "open":
+            self.dragging = None
+
+    def press(self, info: RoundInfo | None, point_m: Sequence[float], radius_m: Sequence[float]) -> bool:
+        """Button 1 at `point_m`: start an arrow if it is on a predictable puck (True: taken)."""
+        self.follow(info)
+        if info is None or info.state != "open":
+            return False
+        for puck in range(min(len(info.from_m), len(radius_m)) - 1, -1, -1):  # the top one first
+            x, y = info.from_m[puck]
+            if math.hypot(point_m[0] - x, point_m[1] - y) <= radius_m[puck]:
+                self.dragging = puck
+                return True
+        return False
+
+    def drag(self, info: RoundInfo | None, point_m: Sequence[float]) -> tuple[int, tuple[float, float]] | None:
+        """The mouse moved (or let go) while dragging: (puck, velocity) now guessed, else None."""
+        self.follow(info)
+        if self.dragging is None or info is None:
+            return None
+        x, y = info.from_m[self.dragging]
+        vel = clamp_speed(((point_m[0] - x) / ARROW_S, (point_m[1] - y) / ARROW_S))
+        self.guesses[self.dragging] = vel
+        return self.dragging, vel

@@ -1,0 +1,317 @@
+"""Predict, then reveal: the round's maths against hand-worked numbers, PREDICT and ROUND on
+real sockets with three scripted students, strict refusal of bad guesses, and the local mouse."""
+
+from __future__ import annotations
+
+import json
+import math
+from pathlib import Path
+
+import numpy as np
+import pygame
+import pytest
+from conftest import FRAME_S, WAIT_S, press, wait_until
+from test_server import RawClient, frame
+
+from airtable.app.app import App
+from airtable.app.demo_loader import BUILTIN_DIR, DemoShelf
+from airtable.app.environment import DEFAULT_SIZE_PX, Environment
+from airtable.app.predict import StudentGuesses, angle_deg, puck_summary, summarize
+from airtable.net import protocol as proto
+from airtable.net.player import NetPlayer, PlayerApp, PlayerState
+from airtable.net.predictions import (
+    MAX_PREDICT_SPEED_MPS,
+    Arrow,
+    RoundInfo,
+    encode_predict,
+    encode_round,
+    parse_predict,
+    parse_round,
+)
+from airtable.net.server import GameServer
+
+# Puck 1 at rest at (5, 4); puck 0 comes at it head-on at 1 m/s. Equal masses, restitution 1:
+# afterwards puck 0 stops and puck 1 leaves at (1, 0) m/s.
+HEAD_ON = (
+    "KEY = '5'\nTITLE = 'Head-on'\nNOTES = ''\n\n"
+    "def build(table, variation=0):\n"
+    "    table.add_puck((3.0, 4.0), 0.25, vel_mps=(1.0, 0.0))\n"
+    "    table.add_puck((5.0, 4.0), 0.25)\n"
+)
+# Three guesses for puck 1: 0, 10 and 30 degrees off (1, 0), at speeds 1.0, 1.1 and 1.5 m/s.
+GUESSES = [(1.0, 0.0), (1.1, 10.0), (1.5, 30.0)]
+# By hand: angles 0, 10, 30 -> median 10, one within 5 deg; speeds 1.0 and 1.1 within 20 % of 1.0, 1.5 not.
+EXPECTED = "puck 2: median 10 deg off; 1 of 3 within 5 deg; speeds within 20 %: 2 of 3"
+
+
+def polar(speed: float, deg: float) -> tuple[float, float]:
+    return (speed * math.cos(math.radians(deg)), speed * math.sin(math.radians(deg)))
+
+
+# ---------------------------------------------------------------- maths
+
+
+def test_angles_and_the_summary_match_the_numbers_worked_by_hand():
+    assert angle_deg((1, 0), (0, 2)) == pytest.approx(90.0)
+    assert angle_deg((1, 1), (-1, -1)) == pytest.approx(180.0)
+    guesses = [polar(s, d) for s, d in GUESSES]
+    assert puck_summary(1, (1.0, 0.0), guesses) == EXPECTED
+    # Only pucks someone predicted get a line; a puck that stops is judged by speed alone.
+    arrows = [Arrow(1, g, (1, 2, 3)) for g in guesses] + [Arrow(0, (0.01, 0.0), (1, 2, 3))]
+    assert summarize([(0.0, 0.0), (1.0, 0.0)], arrows) == [
+        "puck 1: comes to rest; 1 of 1 predicted under 0.05 m/s",
+        EXPECTED,
+    ]
+
+
+def test_round_messages_survive_the_wire_and_stay_bounded():
+    info = RoundInfo(
+        4, "revealed", 2, 3, 3, tuple(Arrow(1, (0.5, 0.25), (255, 0, 0), "C1 Ann") for _ in range(10_000)),
+        ((0.0, 0.0), (1.0, 0.0)), ("x" * 500,) * 100, ((3.0, 4.0), (5.0, 4.0)),
+    )  # fmt: skip
+    data = encode_round(info)
+    assert len(data) < 300_000  # 4000 arrows at most, 32 summary lines of 120 characters
+    (frame_type, payload), *_ = proto.FrameReader(proto.MAX_SERVER_FRAME, sender="the server").feed(data)
+    got = parse_round(payload)
+    assert frame_type == proto.ROUND == 9
+    assert len(got.arrows) == 4000 and got.arrows[0] == Arrow(1, (0.5, 0.25), (255, 0, 0), "C1 Ann")
+    assert len(got.summary) == 32 and len(got.summary[0]) == 120
+    assert got.truth == ((0.0, 0.0), (1.0, 0.0)) and got.from_m == ((3.0, 4.0), (5.0, 4.0))
+    bad = json.loads(payload)
+    bad["truth"] = [[1e300, 0]]
+    with pytest.raises(proto.ProtocolError, match="too fast"):
+        parse_round(json.dumps(bad).encode())
+
+
+BAD_PREDICTS = {
+    "not JSON": (b"{round: 1}", "not valid JSON"),
+    "a missing field": (b'{"round": 1, "puck": 0}', 'missing the field "vel_mps"'),
+    "an unknown field": (b'{"round": 1, "puck": 0, "vel_mps": [1, 0], "mass": 9}', "unknown field"),
+    "a text puck": (b'{"round": 1, "puck": "0", "vel_mps": [1, 0]}', "PREDICT puck must be a whole number"),
+    "a fractional round": (b'{"round": 1.5, "puck": 0, "vel_mps": [1, 0]}', "PREDICT round must be a whole number"),
+    "NaN": (b'{"round": 1, "puck": 0, "vel_mps": [NaN, 0]}', "not a finite number"),
+    "1e400": (b'{"round": 1, "puck": 0, "vel_mps": [1e400, 0]}', "must be a finite number"),
+    "a single number": (b'{"round": 1, "puck": 0, "vel_mps": 3}', "pair [vx, vy]"),
+    "too fast": (b'{"round": 1, "puck": 0, "vel_mps": [100, 1]}', "faster than 100 m/s"),
+    "a negative puck": (b'{"round": 1, "puck": -1, "vel_mps": [1, 0]}', "puck -1 is not on the table"),
+    "a puck not there": (b'{"round": 1, "puck": 2, "vel_mps": [1, 0]}', "puck 2 is not on the table"),
+    "a round never opened": (b'{"round": 7, "puck": 0, "vel_mps": [1, 0]}', "round 7 was never opened"),
+}
+
+
+@pytest.fixture
+def server():
+    with GameServer(host="127.0.0.1", port=0) as s:
+        yield s
+
+
+@pytest.mark.parametrize("case", BAD_PREDICTS, ids=list(BAD_PREDICTS))
+def test_a_bad_predict_is_refused_with_an_error_naming_the_problem(server, case):
+    payload, hint = BAD_PREDICTS[case]
+    server.predictions.open(1, 2)
+    bad = RawClient(server.port)
+    try:
+        bad.hello("Bea")
+        bad.send(frame(proto.PREDICT, payload))
+        sentence = bad.expect_error()
+    finally:
+        bad.close()
+    assert hint in sentence, sentence
+    assert server.predictions.count() == 0
+
+
+def test_a_stale_predict_is_ignored_and_a_good_one_kept_latest_first(server):
+    server.predictions.open(1, 2)
+    server.predictions.open(2, 2)  # round 1 is over: a guess for it crossed the reveal
+    student = RawClient(server.port)
+    try:
+        student.hello("Cy")
+        student.send(encode_predict(1, 0, (1.0, 0.0)))
+        student.send(encode_predict(2, 1, (0.5, 0.0)))
+        student.send(encode_predict(2, 1, (0.0, 0.75)))  # changed before the reveal: latest wins
+        student.send(encode_predict(2, 0, (-0.25, 0.0)))
+        wait_until(lambda: len(server.predictions.arrows()) == 2, what="two guesses kept")
+        assert [(a.puck, a.vel_mps) for a in server.predictions.arrows()] == [(0, (-0.25, 0.0)), (1, (0.0, 0.75))]
+        assert server.predictions.count() == 1 and server.player_count == 1  # still at the table
+    finally:
+        student.close()
+    assert len(encode_predict(2, 1, (-MAX_PREDICT_SPEED_MPS, 1e-300))) < 120  # far under the 1 KiB cap
+    with pytest.raises(proto.ProtocolError):
+        parse_predict(b'{"round": 1, "puck": 0, "vel_mps": [0, 0], "round": 2}', 2)
+
+
+# ---------------------------------------------------------------- a whole round
+
+
+def head_on_app(tmp_path: Path, server=None) -> App:
+    (tmp_path / "head_on.py").write_text(HEAD_ON)
+    app = App(DemoShelf([BUILTIN_DIR, tmp_path]), demo_key="5", headless=True, server=server)
+    pygame.event.clear()
+    return app
+
+
+def next_round(student: RawClient, until) -> RoundInfo:
+    """The next ROUND this student reads for which `until(info)` holds."""
+    while True:
+        info = parse_round(student.next_of(proto.ROUND))
+        if until(info):
+            return info
+
+
+def frames_until(app: App, condition, what: str) -> None:
+    """Run app frames (simulated time) until `condition()`; bounded by WAIT_S of real time."""
+
+    def step():
+        app.frame(FRAME_S)
+        return condition()
+
+    wait_until(step, WAIT_S, what)
+
+
+def test_three_students_predict_over_real_sockets_then_the_reveal_sums_them_up(server, tmp_path):
+    app = head_on_app(tmp_path, server)
+    students = [RawClient(server.port) for _ in range(3)]
+    try:
+        for name, s in zip(("Ann", "Ben", "Cat"), students):
+            s.hello(name)
+        frames_until(app, lambda: app.student_count() == 3, "three students at the table")
+        press(app, pygame.K_F6)
+        assert app.predict.state == "open" and app.paused
+        for s in students:
+            info = next_round(s, lambda i: i.state == "open")
+            assert (info.pucks, info.players, info.arrows) == (2, 3, ())
+            assert info.from_m == tuple(map(tuple, app.table.pos_m.round(5)))  # where the pucks froze
+        for s, (speed, deg) in zip(students, GUESSES):
+            s.send(encode_predict(info.round_id, 1, polar(speed, deg)))
+        frames_until(app, lambda: "PREDICT: 3 of 3 predicted" in app.status_line(), "3 of 3 on the projector")
+        assert next_round(students[0], lambda i: i.predicted == 3).arrows == ()  # a count, no arrows yet
+        t0 = app.table.time_s
+        frames_until(app, lambda: app.table.time_s == t0, "the table stays frozen while the round is open")
+
+        press(app, pygame.K_F6)  # reveal: the table plays until the collision is over
+        assert not app.paused and len(app.predict.arrows) == 3
+        frames_until(app, lambda: app.predict.settled, "the collision to be over")
+        assert app.paused and app.table.collision_count >= 1
+        assert app.predict.truth[1] == pytest.approx((1.0, 0.0), abs=1e-6)
+        assert app.predict.summary == (EXPECTED,)
+        for s in students:
+            info = next_round(s, lambda i: i.state == "revealed" and bool(i.truth))
+            assert info.summary == (EXPECTED,) and len(info.arrows) == 3
+            assert {a.color for a in info.arrows} == {(255, 52, 179), (210, 180, 140), (0, 255, 255)}
+            assert {a.label for a in info.arrows} == {""}  # names only when the teacher shows them
+        press(app, pygame.K_F6, mod=pygame.KMOD_SHIFT)
+        info = next_round(students[1], lambda i: bool(i.arrows[0].label))
+        assert sorted(a.label for a in info.arrows) == ["C1 Ann", "C2 Ben", "C3 Cat"]
+
+        press(app, pygame.K_F6)  # closes the round
+        assert next_round(students[2], lambda i: i.state == "closed").arrows == ()
+        assert not app.predict.active and app.paused
+    finally:
+        for s in students:
+            s.close()
+
+
+def test_a_player_window_drags_an_arrow_and_sends_predict(server, tmp_path):
+    app = head_on_app(tmp_path, server)
+    net = NetPlayer("127.0.0.1", server.port, name="Dee")
+    net.connect()
+    try:
+        frames_until(app, lambda: app.student_count() == 1 and net.latest() is not None, "the student to join")
+        press(app, pygame.K_F6)
+        wait_until(lambda: net.round is not None and net.round.state == "open", what="the ROUND at the student")
+        guesses = StudentGuesses()
+        scene = net.latest()
+        assert not guesses.press(net.round, (8.0, 1.0), scene.radius_m)  # not on a puck: the cursor as usual
+        assert guesses.press(net.round, (5.1, 4.0), scene.radius_m)  # on puck 1
+        assert guesses.drag(net.round, (5.0, 6.0)) == (1, pytest.approx((0.0, 2.0)))
+        assert net.send_predict(1, guesses.guesses[1])
+        frames_until(app, lambda: "1 of 1 predicted" in app.status_line(), "the student's guess counted")
+        assert [a.vel_mps for a in server.predictions.arrows()] == [pytest.approx((0.0, 2.0))]
+        assert net.state == PlayerState.CONNECTED
+    finally:
+        net.close()
+
+
+def test_a_student_window_turns_a_mouse_drag_on_a_puck_into_predict(server, tmp_path):
+    app = head_on_app(tmp_path, server)
+    net = NetPlayer("127.0.0.1", server.port, name="Eve")
+    net.connect()
+    try:
+        frames_until(app, lambda: app.student_count() == 1 and net.latest() is not None, "the student to join")
+        press(app, pygame.K_F6)
+        wait_until(lambda: net.round is not None and net.round.state == "open", what="the ROUND at the student")
+        window = PlayerApp(net, headless=True)
+        env = Environment(DEFAULT_SIZE_PX, width_m=app.table.width_m)  # the student's view as it opens
+        puck = tuple(float(v) for v in env.to_screen(np.array(net.round.from_m[1])))
+        tip = tuple(float(v) for v in env.to_screen(np.array(net.round.from_m[1]) + np.array([0.0, 1.5])))
+        pygame.event.clear()
+        post_mouse(pygame.MOUSEBUTTONDOWN, puck)
+        post_mouse(pygame.MOUSEMOTION, tip)
+        post_mouse(pygame.MOUSEBUTTONUP, tip)
+        seen: list = []  # what the server holds, read before the window closes (a leaver's guesses go)
+        window.run(seconds=WAIT_S, until=lambda: seen.extend(server.predictions.arrows()) or seen)
+        (arrow,) = seen
+        assert (arrow.puck, arrow.label) == (1, "C1 Eve")
+        assert arrow.vel_mps == pytest.approx((0.0, 1.5), abs=2 * app.table.width_m / DEFAULT_SIZE_PX[0])
+        assert window.button == 0  # the drag never pressed the cursor's button
+    finally:
+        net.close()
+
+
+def post_mouse(kind: int, pos, button: int = 1) -> None:
+    if kind == pygame.MOUSEMOTION:
+        pygame.event.post(pygame.event.Event(kind, pos=pos, rel=(0, 0), buttons=(1, 0, 0)))
+    else:
+        pygame.event.post(pygame.event.Event(kind, pos=pos, button=button))
+
+
+def test_the_local_mouse_predicts_on_the_teachers_window(tmp_path):
+    app = head_on_app(tmp_path)
+    press(app, pygame.K_F6)
+    assert "PREDICT: 0 of 0 predicted" in app.status_line()
+    puck = tuple(float(v) for v in app.env.to_screen(app.table.pos_m[1]))
+    tip = tuple(float(v) for v in app.env.to_screen(app.table.pos_m[1] + np.array(polar(1.1, 10.0))))
+    post_mouse(pygame.MOUSEBUTTONDOWN, puck)
+    post_mouse(pygame.MOUSEMOTION, tip)
+    post_mouse(pygame.MOUSEBUTTONUP, tip)
+    app.frame(FRAME_S)
+    assert app.local.held is None  # the drag drew an arrow; it grabbed nothing
+    assert app.predict.local[1] == pytest.approx(
+        polar(1.1, 10.0), abs=2 * app.table.width_m / app.window.surface.get_width()
+    )
+    assert "PREDICT: 1 of 1 predicted" in app.status_line()
+    press(app, pygame.K_F6)
+    frames_until(app, lambda: app.predict.settled, "the collision to be over")
+    (line,) = app.predict.summary
+    assert line == "puck 2: median 10 deg off; 0 of 1 within 5 deg; speeds within 20 %: 1 of 1"
+
+
+def test_nobody_s_string_touches_the_pucks_while_the_reveal_plays(server, tmp_path):
+    app = head_on_app(tmp_path, server)
+    student = RawClient(server.port)
+    try:
+        student.hello("Flo")
+        frames_until(app, lambda: app.student_count() == 1, "the student to join")
+        press(app, pygame.K_F6)
+        press(app, pygame.K_F6)  # reveal at once
+        x, y = app.table.pos_m[1]
+        student.send(proto.encode_input((x, y), 1))  # grab puck 2 ...
+        student.send(proto.encode_input((x, y + 3.0), 1))  # ... and pull it up hard
+        frames_until(app, lambda: app.predict.settled, "the collision to be over")
+        assert app.predict.truth[1] == pytest.approx((1.0, 0.0), abs=1e-6)  # as if nobody were there
+    finally:
+        student.close()
+
+
+def test_a_student_who_joins_mid_round_is_told_at_once(server, tmp_path):
+    app = head_on_app(tmp_path, server)
+    press(app, pygame.K_F6)
+    late = RawClient(server.port)
+    try:
+        late.hello("Gus")
+        info = next_round(late, lambda i: True)  # the first ROUND, without waiting for a count change
+        assert (info.round_id, info.state, info.pucks) == (1, "open", 2)
+        late.send(encode_predict(info.round_id, 0, (0.0, 0.0)))
+        frames_until(app, lambda: "1 of 1 predicted" in app.status_line(), "the late guess counted")
+    finally:
+        late.close()
