@@ -153,9 +153,9 @@ class _Round:
 
     fa: np.ndarray  # flat indices of body a's velocity and pseudo-velocity: 2 a, 2 a + 1
     fb: np.ndarray
-    n: np.ndarray  # (m, 1) complex
-    wa: np.ndarray  # (2 m,) inverse masses, each twice
-    wb: np.ndarray
+    nc: np.ndarray  # (m, 1) complex conjugate normals, to project velocities
+    na: np.ndarray  # (m, 2) complex: the velocity change of body a per unit impulse
+    nb: np.ndarray  # the same for body b
     k: np.ndarray  # (m, 1) effective mass 1 / (wa + wb)
     w_max: float  # the largest wa + wb, to turn an impulse into a speed
     target: np.ndarray  # (m, 2): least relative normal velocity, and pseudo-velocity
@@ -270,11 +270,12 @@ class ContactSolver:
         out = []
         both = np.arange(2)
         for r in self._rounds:
-            twice = np.repeat(r, 2)
+            n = c.n.take(r[:, None])
             out.append(
                 _Round(
                     (2 * c.a.take(r)[:, None] + both).ravel(), (2 * c.b.take(r)[:, None] + both).ravel(),
-                    c.n.take(r[:, None]), wa.take(twice), wb.take(twice), k.take(r[:, None]),
+                    n.conjugate(), np.repeat(n * wa.take(r)[:, None], 2, axis=1),
+                    np.repeat(n * wb.take(r)[:, None], 2, axis=1), k.take(r[:, None]),
                     float((wa.take(r) + wb.take(r)).max()), target.take(r, axis=0), impulse.take(r, axis=0),
                 )
             )  # fmt: skip
@@ -306,9 +307,8 @@ def _apply(flat: np.ndarray, g: _Round, impulse: np.ndarray) -> None:
     indexing is several times cheaper than 2-D). The walls' row takes many
     writes in one round, all of them zero (wb = 0).
     """
-    push = (impulse * g.n).reshape(-1)
-    flat[g.fa] += push * g.wa
-    flat[g.fb] -= push * g.wb
+    flat[g.fa] += (impulse * g.na).reshape(-1)
+    flat[g.fb] -= (impulse * g.nb).reshape(-1)
 
 
 def _iterate(w: np.ndarray, rounds: list[_Round]) -> int:
@@ -318,7 +318,7 @@ def _iterate(w: np.ndarray, rounds: list[_Round]) -> int:
         worst = 0.0
         for g in rounds:
             dv = (flat.take(g.fa) - flat.take(g.fb)).reshape(-1, 2)
-            vn = (g.n.conjugate() * dv).real
+            vn = (g.nc * dv).real
             new = np.maximum(g.impulse + g.k * (g.target - vn), 0.0)
             change = new - g.impulse
             g.impulse = new
