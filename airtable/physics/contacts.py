@@ -49,9 +49,11 @@ ITERATIONS = 10
 SOLVER = "gs"
 OMEGA = 1.0
 CONVERGED_MPS = 1e-7
-# Rounds go bottom-up by horizontal bands this many radii high (random inside
-# a band): support from the floor then travels up a pile within one
-# iteration. Bands of one contact each would be exact Gauss-Seidel from the
+# The first iteration's rounds go bottom-up by horizontal bands this many
+# radii high (random inside a band): support from the floor then travels up a
+# pile within one iteration. The later iterations only refine that answer and
+# take the fewer rounds of a colouring in no order (about 15 against 38 on an
+# 800-puck pile, each round costing numpy's fixed price). Bands of one contact each would be exact Gauss-Seidel from the
 # bottom but need a round per contact of the tallest stack; random order
 # alone is as cheap as these bands, and a 300-puck pile then keeps 3x the jitter.
 BAND_RADII = 8.0
@@ -160,6 +162,7 @@ class _Round:
     w_max: float  # the largest wa + wb, to turn an impulse into a speed
     target: np.ndarray  # (m, 2): least relative normal velocity, and pseudo-velocity
     impulse: np.ndarray  # (m, 2) accumulated, >= 0
+    r: np.ndarray  # the round's contact numbers
 
 
 class ContactSolver:
@@ -170,7 +173,8 @@ class ContactSolver:
         self._impulses = np.empty((0, 2))
         self._rows = -1
         self._round_keys: np.ndarray | None = None
-        self._rounds: list[np.ndarray] = []
+        self._rounds: list[np.ndarray] = []  # bottom-up by bands: the first iteration
+        self._free_rounds: list[np.ndarray] = []  # fewer rounds, in no order: the later iterations
         self.count = 0  # contacts in the last step
         self.iterations = 0  # iterations the last step needed
 
@@ -229,20 +233,20 @@ class ContactSolver:
             self._keys, self._impulses = np.empty(0, dtype=np.int64), np.empty((0, 2))
             return False
         self._y, self._r_mean = pos[:, 1], float(radius.mean())
-        rounds = self._gather(c, mass, len(pc.a), dt)
+        rounds, later = self._gather(c, mass, len(pc.a), dt)
         w = np.zeros((len(pos) + 1, 2), dtype=complex)  # velocities and pseudo-velocities; the last row: walls
         w[:-1, 0] = _as_complex(vel)
         v0 = w[:-1, 0].copy()
         for g in rounds:  # warm start: last step's velocity impulses first
             _apply(w.reshape(-1), g, g.impulse * np.array([1.0, 0.0]))
-        self.iterations = _iterate(w, rounds)
+        self.iterations, rounds = _iterate(w, rounds, later, len(c.a))
         self._keep(c, rounds)
         moved = (w[:-1, 0] - v0 + w[:-1, 1]) * dt
         pos += np.column_stack([moved.real, moved.imag])
         vel[:, 0], vel[:, 1] = w[:-1, 0].real, w[:-1, 0].imag
         return True
 
-    def _gather(self, c: _Contacts, mass, n_pairs: int, dt: float) -> list[_Round]:
+    def _gather(self, c: _Contacts, mass, n_pairs: int, dt: float) -> tuple[list[_Round], list[_Round]]:
         """Per round: the bodies, inverse masses, targets and the warm-start impulses."""
         rows = len(mass)
         inv = np.append(1.0 / mass, 0.0)  # the walls never move
@@ -263,23 +267,15 @@ class ContactSolver:
         if self._round_keys is None or not np.array_equal(self._round_keys, c.keys):
             virtual = c.b.copy()
             virtual[n_pairs:] = rows + 1 + np.arange(len(c.b) - n_pairs)  # each wall contact its own body
-            self._rounds = colour_rounds(c.a, virtual, rows + 1 + len(c.b) - n_pairs, self._bands(c))
+            bodies = rows + 1 + len(c.b) - n_pairs
+            self._rounds = colour_rounds(c.a, virtual, bodies, self._bands(c))
+            self._free_rounds = colour_rounds(c.a, virtual, bodies)
             self._round_keys = c.keys.copy()
         wa, wb = inv.take(c.a), inv.take(c.b)
-        k = 1.0 / (wa + wb)
-        out = []
-        both = np.arange(2)
-        for r in self._rounds:
-            n = c.n.take(r[:, None])
-            out.append(
-                _Round(
-                    (2 * c.a.take(r)[:, None] + both).ravel(), (2 * c.b.take(r)[:, None] + both).ravel(),
-                    n.conjugate(), np.repeat(n * wa.take(r)[:, None], 2, axis=1),
-                    np.repeat(n * wb.take(r)[:, None], 2, axis=1), k.take(r[:, None]),
-                    float((wa.take(r) + wb.take(r)).max()), target.take(r, axis=0), impulse.take(r, axis=0),
-                )
-            )  # fmt: skip
-        return out
+        return (
+            _rounds(c, self._rounds, wa, wb, target, impulse),
+            _rounds(c, self._free_rounds, wa, wb, target, impulse),
+        )
 
     def _bands(self, c: _Contacts) -> np.ndarray | None:
         """Priorities bottom-up by bands of height (BAND_RADII radii), scrambled within a band."""
@@ -294,10 +290,29 @@ class ContactSolver:
     def _keep(self, c: _Contacts, rounds: list[_Round]) -> None:
         """Keep this step's impulses by contact key, for the next step's warm start."""
         impulses = np.empty((len(c.keys), 2))
-        for r, g in zip(self._rounds, rounds, strict=True):
-            impulses[r] = g.impulse
+        for g in rounds:
+            impulses[g.r] = g.impulse
         order = np.argsort(c.keys)
         self._keys, self._impulses = c.keys.take(order), impulses.take(order, axis=0)
+
+
+def _rounds(c: _Contacts, rounds, wa, wb, target, impulse) -> list[_Round]:
+    """Gather each round's contacts once per step: all rounds in one go, then each a slice (a view)."""
+    order = np.concatenate(rounds)
+    ends = np.cumsum([len(r) for r in rounds])
+    starts = ends - [len(r) for r in rounds]
+    n = c.n.take(order)[:, None]
+    wa, wb = wa.take(order), wb.take(order)
+    both = np.arange(2)
+    fa, fb = 2 * c.a.take(order)[:, None] + both, 2 * c.b.take(order)[:, None] + both
+    nc, na, nb = n.conjugate(), np.repeat(n * wa[:, None], 2, axis=1), np.repeat(n * wb[:, None], 2, axis=1)
+    k, w_max = (1.0 / (wa + wb))[:, None], np.maximum.reduceat(wa + wb, starts)
+    target, impulse = target.take(order, axis=0), impulse.take(order, axis=0)
+    return [
+        _Round(fa[s:e].ravel(), fb[s:e].ravel(), nc[s:e], na[s:e], nb[s:e], k[s:e], float(w_max[q]),
+               target[s:e], impulse[s:e], r)
+        for q, (s, e, r) in enumerate(zip(starts, ends, rounds, strict=True))
+    ]  # fmt: skip
 
 
 def _apply(flat: np.ndarray, g: _Round, impulse: np.ndarray) -> None:
@@ -311,10 +326,18 @@ def _apply(flat: np.ndarray, g: _Round, impulse: np.ndarray) -> None:
     flat[g.fb] -= (impulse * g.nb).reshape(-1)
 
 
-def _iterate(w: np.ndarray, rounds: list[_Round]) -> int:
-    """Sequential impulses, round by round, until converged or ITERATIONS; return the iterations used."""
+def _iterate(w: np.ndarray, rounds: list[_Round], later: list[_Round], count: int) -> tuple[int, list[_Round]]:
+    """Sequential impulses, round by round, until converged or ITERATIONS; return the iterations used
+    and the rounds that hold the impulses.
+
+    The first iteration goes bottom-up (`rounds`), so support from the floor
+    travels up a pile; the later ones only refine it and take the fewer
+    rounds of `later`, which get the impulses so far.
+    """
     flat = w.reshape(-1)
     for it in range(1, ITERATIONS + 1):
+        if it == 2:
+            rounds = _handover(rounds, later, count)
         worst = 0.0
         for g in rounds:
             dv = (flat.take(g.fa) - flat.take(g.fb)).reshape(-1, 2)
@@ -325,5 +348,15 @@ def _iterate(w: np.ndarray, rounds: list[_Round]) -> int:
             _apply(flat, g, change)
             worst = max(worst, float(np.abs(change).max() * g.w_max))
         if worst < CONVERGED_MPS:
-            return it
-    return ITERATIONS
+            return it, rounds
+    return ITERATIONS, rounds
+
+
+def _handover(rounds: list[_Round], later: list[_Round], count: int) -> list[_Round]:
+    """Give `later` the impulses accumulated in `rounds` (the same contacts, other rounds)."""
+    impulses = np.empty((count, 2))
+    for g in rounds:
+        impulses[g.r] = g.impulse
+    for g in later:
+        g.impulse = impulses.take(g.r, axis=0)
+    return later
