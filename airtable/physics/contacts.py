@@ -159,7 +159,9 @@ class _Round:
     na: np.ndarray  # (m, 2) complex: the velocity change of body a per unit impulse
     nb: np.ndarray  # the same for body b
     k: np.ndarray  # (m, 1) effective mass 1 / (wa + wb)
-    w_max: float  # the largest wa + wb, to turn an impulse into a speed
+    change: np.ndarray  # (m, 2) the last iteration's change of impulse: a view into `changes`
+    changes: np.ndarray  # (all contacts, 2): every round's `change`, to find the largest once per iteration
+    w_max: np.ndarray  # (all contacts, 1) per contact, its round's largest wa + wb: impulse to speed
     target: np.ndarray  # (m, 2): least relative normal velocity, and pseudo-velocity
     impulse: np.ndarray  # (m, 2) accumulated, >= 0
     r: np.ndarray  # the round's contact numbers
@@ -306,12 +308,15 @@ def _rounds(c: _Contacts, rounds, wa, wb, target, impulse) -> list[_Round]:
     both = np.arange(2)
     fa, fb = 2 * c.a.take(order)[:, None] + both, 2 * c.b.take(order)[:, None] + both
     nc, na, nb = n.conjugate(), np.repeat(n * wa[:, None], 2, axis=1), np.repeat(n * wb[:, None], 2, axis=1)
-    k, w_max = (1.0 / (wa + wb))[:, None], np.maximum.reduceat(wa + wb, starts)
+    k = (1.0 / (wa + wb))[:, None]
+    lengths = [len(r) for r in rounds]
+    w_max = np.repeat(np.maximum.reduceat(wa + wb, starts), lengths)[:, None]
+    changes = np.zeros((len(order), 2))
     target, impulse = target.take(order, axis=0), impulse.take(order, axis=0)
     return [
-        _Round(fa[s:e].ravel(), fb[s:e].ravel(), nc[s:e], na[s:e], nb[s:e], k[s:e], float(w_max[q]),
+        _Round(fa[s:e].ravel(), fb[s:e].ravel(), nc[s:e], na[s:e], nb[s:e], k[s:e], changes[s:e], changes, w_max,
                target[s:e], impulse[s:e], r)
-        for q, (s, e, r) in enumerate(zip(starts, ends, rounds, strict=True))
+        for s, e, r in zip(starts, ends, rounds, strict=True)
     ]  # fmt: skip
 
 
@@ -338,16 +343,15 @@ def _iterate(w: np.ndarray, rounds: list[_Round], later: list[_Round], count: in
     for it in range(1, ITERATIONS + 1):
         if it == 2:
             rounds = _handover(rounds, later, count)
-        worst = 0.0
-        for g in rounds:
-            dv = (flat.take(g.fa) - flat.take(g.fb)).reshape(-1, 2)
-            vn = (g.nc * dv).real
+        for g in rounds:  # as _apply, but with the velocities already at hand (no body twice in a round)
+            va, vb = flat.take(g.fa), flat.take(g.fb)
+            vn = (g.nc * (va - vb).reshape(-1, 2)).real
             new = np.maximum(g.impulse + g.k * (g.target - vn), 0.0)
-            change = new - g.impulse
+            np.subtract(new, g.impulse, out=g.change)
             g.impulse = new
-            _apply(flat, g, change)
-            worst = max(worst, float(np.abs(change).max() * g.w_max))
-        if worst < CONVERGED_MPS:
+            flat[g.fa] = va + (g.change * g.na).reshape(-1)
+            flat[g.fb] = vb - (g.change * g.nb).reshape(-1)
+        if rounds and float((np.abs(rounds[0].changes) * rounds[0].w_max).max()) < CONVERGED_MPS:
             return it, rounds
     return ITERATIONS, rounds
 
