@@ -49,9 +49,11 @@ ITERATIONS = 10
 SOLVER = "gs"
 OMEGA = 1.0
 CONVERGED_MPS = 1e-7
-# Rounds go bottom-up by horizontal bands this many radii high (random inside
-# a band): support from the floor then travels up a pile within one
-# iteration. Bands of one contact each would be exact Gauss-Seidel from the
+# The first iteration's rounds go bottom-up by horizontal bands this many
+# radii high (random inside a band): support from the floor then travels up a
+# pile within one iteration. The later iterations only refine that answer and
+# take the fewer rounds of a colouring in no order (about 15 against 38 on an
+# 800-puck pile, each round costing numpy's fixed price). Bands of one contact each would be exact Gauss-Seidel from the
 # bottom but need a round per contact of the tallest stack; random order
 # alone is as cheap as these bands, and a 300-puck pile then keeps 3x the jitter.
 BAND_RADII = 8.0
@@ -153,13 +155,16 @@ class _Round:
 
     fa: np.ndarray  # flat indices of body a's velocity and pseudo-velocity: 2 a, 2 a + 1
     fb: np.ndarray
-    n: np.ndarray  # (m, 1) complex
-    wa: np.ndarray  # (2 m,) inverse masses, each twice
-    wb: np.ndarray
+    nc: np.ndarray  # (m, 1) complex conjugate normals, to project velocities
+    na: np.ndarray  # (m, 2) complex: the velocity change of body a per unit impulse
+    nb: np.ndarray  # the same for body b
     k: np.ndarray  # (m, 1) effective mass 1 / (wa + wb)
-    w_max: float  # the largest wa + wb, to turn an impulse into a speed
+    change: np.ndarray  # (m, 2) the last iteration's change of impulse: a view into `changes`
+    changes: np.ndarray  # (all contacts, 2): every round's `change`, to find the largest once per iteration
+    w_max: np.ndarray  # (all contacts, 1) per contact, its round's largest wa + wb: impulse to speed
     target: np.ndarray  # (m, 2): least relative normal velocity, and pseudo-velocity
     impulse: np.ndarray  # (m, 2) accumulated, >= 0
+    r: np.ndarray  # the round's contact numbers
 
 
 class ContactSolver:
@@ -170,7 +175,8 @@ class ContactSolver:
         self._impulses = np.empty((0, 2))
         self._rows = -1
         self._round_keys: np.ndarray | None = None
-        self._rounds: list[np.ndarray] = []
+        self._rounds: list[np.ndarray] = []  # bottom-up by bands: the first iteration
+        self._free_rounds: list[np.ndarray] = []  # fewer rounds, in no order: the later iterations
         self.count = 0  # contacts in the last step
         self.iterations = 0  # iterations the last step needed
 
@@ -220,20 +226,20 @@ class ContactSolver:
             self._keys, self._impulses = np.empty(0, dtype=np.int64), np.empty((0, 2))
             return False
         self._y, self._r_mean = pos[:, 1], float(radius.mean())
-        rounds = self._gather(c, mass, len(pc.a), dt)
+        rounds, later = self._gather(c, mass, len(pc.a), dt)
         w = np.zeros((len(pos) + 1, 2), dtype=complex)  # velocities and pseudo-velocities; the last row: walls
         w[:-1, 0] = _as_complex(vel)
         v0 = w[:-1, 0].copy()
         for g in rounds:  # warm start: last step's velocity impulses first
             _apply(w.reshape(-1), g, g.impulse * np.array([1.0, 0.0]))
-        self.iterations = _iterate(w, rounds)
+        self.iterations, rounds = _iterate(w, rounds, later, len(c.a))
         self._keep(c, rounds)
         moved = (w[:-1, 0] - v0 + w[:-1, 1]) * dt
         pos += np.column_stack([moved.real, moved.imag])
         vel[:, 0], vel[:, 1] = w[:-1, 0].real, w[:-1, 0].imag
         return True
 
-    def _gather(self, c: _Contacts, mass, n_pairs: int, dt: float) -> list[_Round]:
+    def _gather(self, c: _Contacts, mass, n_pairs: int, dt: float) -> tuple[list[_Round], list[_Round]]:
         """Per round: the bodies, inverse masses, targets and the warm-start impulses."""
         rows = len(mass)
         inv = np.append(1.0 / mass, 0.0)  # the walls never move
@@ -254,22 +260,15 @@ class ContactSolver:
         if self._round_keys is None or not np.array_equal(self._round_keys, c.keys):
             virtual = c.b.copy()
             virtual[n_pairs:] = rows + 1 + np.arange(len(c.b) - n_pairs)  # each wall contact its own body
-            self._rounds = colour_rounds(c.a, virtual, rows + 1 + len(c.b) - n_pairs, self._bands(c))
+            bodies = rows + 1 + len(c.b) - n_pairs
+            self._rounds = colour_rounds(c.a, virtual, bodies, self._bands(c))
+            self._free_rounds = colour_rounds(c.a, virtual, bodies)
             self._round_keys = c.keys.copy()
         wa, wb = inv.take(c.a), inv.take(c.b)
-        k = 1.0 / (wa + wb)
-        out = []
-        both = np.arange(2)
-        for r in self._rounds:
-            twice = np.repeat(r, 2)
-            out.append(
-                _Round(
-                    (2 * c.a.take(r)[:, None] + both).ravel(), (2 * c.b.take(r)[:, None] + both).ravel(),
-                    c.n.take(r[:, None]), wa.take(twice), wb.take(twice), k.take(r[:, None]),
-                    float((wa.take(r) + wb.take(r)).max()), target.take(r, axis=0), impulse.take(r, axis=0),
-                )
-            )  # fmt: skip
-        return out
+        return (
+            _rounds(c, self._rounds, wa, wb, target, impulse),
+            _rounds(c, self._free_rounds, wa, wb, target, impulse),
+        )
 
     def _bands(self, c: _Contacts) -> np.ndarray | None:
         """Priorities bottom-up by bands of height (BAND_RADII radii), scrambled within a band."""
@@ -284,10 +283,32 @@ class ContactSolver:
     def _keep(self, c: _Contacts, rounds: list[_Round]) -> None:
         """Keep this step's impulses by contact key, for the next step's warm start."""
         impulses = np.empty((len(c.keys), 2))
-        for r, g in zip(self._rounds, rounds, strict=True):
-            impulses[r] = g.impulse
+        for g in rounds:
+            impulses[g.r] = g.impulse
         order = np.argsort(c.keys)
         self._keys, self._impulses = c.keys.take(order), impulses.take(order, axis=0)
+
+
+def _rounds(c: _Contacts, rounds, wa, wb, target, impulse) -> list[_Round]:
+    """Gather each round's contacts once per step: all rounds in one go, then each a slice (a view)."""
+    order = np.concatenate(rounds)
+    ends = np.cumsum([len(r) for r in rounds])
+    starts = ends - [len(r) for r in rounds]
+    n = c.n.take(order)[:, None]
+    wa, wb = wa.take(order), wb.take(order)
+    both = np.arange(2)
+    fa, fb = 2 * c.a.take(order)[:, None] + both, 2 * c.b.take(order)[:, None] + both
+    nc, na, nb = n.conjugate(), np.repeat(n * wa[:, None], 2, axis=1), np.repeat(n * wb[:, None], 2, axis=1)
+    k = (1.0 / (wa + wb))[:, None]
+    lengths = [len(r) for r in rounds]
+    w_max = np.repeat(np.maximum.reduceat(wa + wb, starts), lengths)[:, None]
+    changes = np.zeros((len(order), 2))
+    target, impulse = target.take(order, axis=0), impulse.take(order, axis=0)
+    return [
+        _Round(fa[s:e].ravel(), fb[s:e].ravel(), nc[s:e], na[s:e], nb[s:e], k[s:e], changes[s:e], changes, w_max,
+               target[s:e], impulse[s:e], r)
+        for s, e, r in zip(starts, ends, rounds, strict=True)
+    ]  # fmt: skip
 
 
 def _apply(flat: np.ndarray, g: _Round, impulse: np.ndarray) -> None:
@@ -297,24 +318,40 @@ def _apply(flat: np.ndarray, g: _Round, impulse: np.ndarray) -> None:
     indexing is several times cheaper than 2-D). The walls' row takes many
     writes in one round, all of them zero (wb = 0).
     """
-    push = (impulse * g.n).reshape(-1)
-    flat[g.fa] += push * g.wa
-    flat[g.fb] -= push * g.wb
+    flat[g.fa] += (impulse * g.na).reshape(-1)
+    flat[g.fb] -= (impulse * g.nb).reshape(-1)
 
 
-def _iterate(w: np.ndarray, rounds: list[_Round]) -> int:
-    """Sequential impulses, round by round, until converged or ITERATIONS; return the iterations used."""
+def _iterate(w: np.ndarray, rounds: list[_Round], later: list[_Round], count: int) -> tuple[int, list[_Round]]:
+    """Sequential impulses, round by round, until converged or ITERATIONS; return the iterations used
+    and the rounds that hold the impulses.
+
+    The first iteration goes bottom-up (`rounds`), so support from the floor
+    travels up a pile; the later ones only refine it and take the fewer
+    rounds of `later`, which get the impulses so far.
+    """
     flat = w.reshape(-1)
     for it in range(1, ITERATIONS + 1):
-        worst = 0.0
-        for g in rounds:
-            dv = (flat.take(g.fa) - flat.take(g.fb)).reshape(-1, 2)
-            vn = (g.n.conjugate() * dv).real
+        if it == 2:
+            rounds = _handover(rounds, later, count)
+        for g in rounds:  # as _apply, but with the velocities already at hand (no body twice in a round)
+            va, vb = flat.take(g.fa), flat.take(g.fb)
+            vn = (g.nc * (va - vb).reshape(-1, 2)).real
             new = np.maximum(g.impulse + g.k * (g.target - vn), 0.0)
-            change = new - g.impulse
+            np.subtract(new, g.impulse, out=g.change)
             g.impulse = new
-            _apply(flat, g, change)
-            worst = max(worst, float(np.abs(change).max() * g.w_max))
-        if worst < CONVERGED_MPS:
-            return it
-    return ITERATIONS
+            flat[g.fa] = va + (g.change * g.na).reshape(-1)
+            flat[g.fb] = vb - (g.change * g.nb).reshape(-1)
+        if rounds and float((np.abs(rounds[0].changes) * rounds[0].w_max).max()) < CONVERGED_MPS:
+            return it, rounds
+    return ITERATIONS, rounds
+
+
+def _handover(rounds: list[_Round], later: list[_Round], count: int) -> list[_Round]:
+    """Give `later` the impulses accumulated in `rounds` (the same contacts, other rounds)."""
+    impulses = np.empty((count, 2))
+    for g in rounds:
+        impulses[g.r] = g.impulse
+    for g in later:
+        g.impulse = impulses.take(g.r, axis=0)
+    return later
