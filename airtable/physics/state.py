@@ -70,8 +70,9 @@ PLAIN_TYPES = (bool, int, float, str, type(None))
 # the rounds it solves in, kept while the contacts stay the same (their order depends on where
 # the pucks were when they were formed, so they change results). The stage replaces these
 # arrays each step and never changes them in place, so a state keeps references.
-CONTACT_KEPT = ("_keys", "_impulses", "_rows", "_round_keys", "_rounds", "count", "iterations")
+CONTACT_KEPT = ("_keys", "_impulses", "_rows", "_round_keys", "_rounds", "_free_rounds", "count", "iterations")
 # Worked out afresh at the start of every contact stage: nothing to keep.
+ROUND_LISTS = (CONTACT_KEPT.index("_rounds"), CONTACT_KEPT.index("_free_rounds"))  # lists of arrays, kept as tuples
 CONTACT_SCRATCH = frozenset({"_y", "_r_mean"})
 # The Python objects of one state beside its arrays' data (the state, its dicts and tuples,
 # the arrays' headers): tracemalloc measures 1.0 to 1.2 kB, with or without springs.
@@ -219,15 +220,17 @@ def _contact_state(table: AirTable, like: TableState | None) -> tuple | None:
             f"the contact stage keeps {sorted(unknown)}: airtable/physics/state.py must learn to capture it"
         )
     kept = [getattr(solver, name) for name in CONTACT_KEPT]
-    kept[4] = tuple(kept[4])  # the list of rounds, as it is now
+    for k in ROUND_LISTS:
+        kept[k] = tuple(kept[k])  # the list of rounds, as it is now
     old = like.contacts if like is not None else None
     if old is None:
         return tuple(kept)
     same = [_same_part(a, b) for a, b in zip(kept, old, strict=True)]
     if all(same):
         return old
-    if same[4]:
-        kept[4] = old[4]  # the same rounds: one tuple for both
+    for k in ROUND_LISTS:
+        if same[k]:
+            kept[k] = old[k]  # the same rounds: one tuple for both
     return tuple(kept)
 
 
@@ -244,8 +247,8 @@ def _contact_arrays(state: TableState) -> tuple:
     """The contact stage's arrays in `state` (for counting bytes)."""
     if state.contacts is None:
         return ()
-    keys, impulses, _, round_keys, rounds = state.contacts[:5]
-    return (keys, impulses, *(() if round_keys is None else (round_keys,)), *rounds)
+    keys, impulses, _, round_keys, rounds, free_rounds = state.contacts[:6]
+    return (keys, impulses, *(() if round_keys is None else (round_keys,)), *rounds, *free_rounds)
 
 
 def _restore_contacts(table: AirTable, kept: tuple | None) -> None:
@@ -253,7 +256,7 @@ def _restore_contacts(table: AirTable, kept: tuple | None) -> None:
     if solver is None or kept is None:
         return
     for name, value in zip(CONTACT_KEPT, kept, strict=True):
-        setattr(solver, name, list(value) if name == "_rounds" else value)
+        setattr(solver, name, list(value) if name in ("_rounds", "_free_rounds") else value)
 
 
 def capture(table: AirTable, like: TableState | None = None) -> TableState:
