@@ -200,7 +200,7 @@ def test_three_students_predict_over_real_sockets_then_the_reveal_sums_them_up(s
             assert {a.color for a in info.arrows} == {(255, 52, 179), (210, 180, 140), (0, 255, 255)}
             assert {a.label for a in info.arrows} == {""}  # names only when the teacher shows them
         press(app, pygame.K_F6, mod=pygame.KMOD_SHIFT)
-        info = next_round(students[1], lambda i: bool(i.arrows[0].label))
+        info = next_round(students[1], lambda i: bool(i.arrows and i.arrows[0].label))
         assert sorted(a.label for a in info.arrows) == ["C1 Ann", "C2 Ben", "C3 Cat"]
 
         press(app, pygame.K_F6)  # closes the round
@@ -315,3 +315,23 @@ def test_a_student_who_joins_mid_round_is_told_at_once(server, tmp_path):
         frames_until(app, lambda: "1 of 1 predicted" in app.status_line(), "the late guess counted")
     finally:
         late.close()
+
+
+def test_the_anonymous_projector_hides_the_names_on_the_arrows(server, tmp_path):
+    app = head_on_app(tmp_path, server)
+    student = RawClient(server.port)
+    try:
+        student.hello("Hal")
+        frames_until(app, lambda: app.student_count() == 1, "the student to join")
+        press(app, pygame.K_F6)
+        student.send(encode_predict(1, 1, (1.0, 0.0)))
+        frames_until(app, lambda: "1 of 1 predicted" in app.status_line(), "the guess counted")
+        press(app, pygame.K_F6)
+        press(app, pygame.K_F6, mod=pygame.KMOD_SHIFT)  # names on
+        assert [a.label for a in next_round(student, lambda i: bool(i.arrows and i.arrows[0].label)).arrows] == [
+            "C1 Hal"
+        ]
+        press(app, pygame.K_F5)  # the anonymous projector: no names anywhere
+        assert [a.label for a in next_round(student, lambda i: bool(i.arrows) and not i.arrows[0].label).arrows] == [""]
+    finally:
+        student.close()

@@ -86,6 +86,7 @@ class PredictRound:
         self.pucks = 0
         self.from_m: tuple[tuple[float, float], ...] = ()  # where the pucks stood when the round opened
         self.show_names = False  # labels on the revealed arrows (Shift+F6)
+        self.names_sent = False  # whether the last ROUND carried names
         self.local: dict[int, tuple[float, float]] = {}  # the local mouse's guesses
         self.dragging: int | None = None  # the puck whose arrow the local mouse drags
         self.arrows: tuple[Arrow, ...] = ()
@@ -137,8 +138,8 @@ class PredictRound:
         self.truth = tuple((float(v[0]), float(v[1])) for v in table.vel_mps[:n])
         self.summary = tuple(summarize(self.truth, self.arrows))
 
-    def info(self, predicted: int, players: int) -> RoundInfo:
-        """What the ROUND message says now (arrows only after the reveal)."""
+    def info(self, predicted: int, players: int, names: bool = False) -> RoundInfo:
+        """What the ROUND message says now (arrows only after the reveal; their labels only with `names`)."""
         shown = self.state == "revealed"
         return RoundInfo(
             self.round_id,
@@ -146,7 +147,7 @@ class PredictRound:
             self.pucks,
             predicted,
             players,
-            tuple(a if self.show_names else replace(a, label="") for a in self.arrows) if shown else (),
+            tuple(a if names else replace(a, label="") for a in self.arrows) if shown else (),
             self.truth if shown else (),
             self.summary if shown else (),
             self.from_m,
@@ -196,7 +197,8 @@ def publish(app: App) -> None:
         return
     r = app.predict
     r.predicted, r.players = _counts(app)
-    info = r.info(r.predicted, r.players)
+    r.names_sent = names_shown(app)
+    info = r.info(r.predicted, r.players, r.names_sent)
     if info.state == "open" and book.accepts() != (info.round_id, info.pucks):
         book.open(info.round_id, info.pucks)
     elif info.state != "open":
@@ -224,12 +226,17 @@ def predict_key(app: App) -> None:
     publish(app)
 
 
+def names_shown(app: App) -> bool:
+    """Names on the revealed arrows: only when the teacher shows them (Shift+F6),
+    and never while the projector is anonymous (F5, room.py)."""
+    room = getattr(app, "room", None)
+    return app.predict.show_names and not (room is not None and room.anonymous)
+
+
 def toggle_names(app: App) -> None:
     """Shift+F6: names on the revealed arrows, here and on the students' windows."""
     app.predict.show_names = not app.predict.show_names
     app.say(f"prediction names {'shown' if app.predict.show_names else 'hidden'}")
-    if app.predict.active:
-        publish(app)
 
 
 def end_round(app: App) -> None:
@@ -255,6 +262,8 @@ def after_frame(app: App) -> None:
         r.settle(app.table)
         publish(app)
     elif r.state == "open" and _counts(app) != (r.predicted, r.players):
+        publish(app)
+    elif r.state == "revealed" and names_shown(app) != r.names_sent:  # F5 (anonymous) or Shift+F6
         publish(app)
 
 

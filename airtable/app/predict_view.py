@@ -12,7 +12,7 @@ from __future__ import annotations
 from collections.abc import Mapping, Sequence
 from typing import TYPE_CHECKING
 
-from airtable.app.predict import ARROW_S, LOCAL_COLOR, count_text
+from airtable.app.predict import ARROW_S, LOCAL_COLOR, count_text, names_shown
 from airtable.net.predictions import RoundInfo
 
 if TYPE_CHECKING:
@@ -64,6 +64,6 @@ def draw_predict(app: App) -> None:
     r = app.predict
     if not r.active:
         return
-    info = r.info(r.predicted, r.players)
+    info = r.info(r.predicted, r.players, names_shown(app))
     # The volunteer at the teacher's laptop sees their own arrows; the students' stay hidden until the reveal.
     paint_round(app.painter, info, r.local, LOCAL_COLOR, count_text(app))

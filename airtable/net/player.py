@@ -533,7 +533,6 @@ class PlayerApp:
         self._drawn_from: tuple = ()  # the restarts and view the trails were drawn in
         self._welcome: proto.Welcome | None = None
         self.predicting = StudentGuesses()  # our arrows in a prediction round
-        self._round_painter = None
 
     def run(
         self, seconds: float | None = None, screenshot: str | None = None, until: Callable[[], bool] | None = None
@@ -722,12 +721,10 @@ class PlayerApp:
         self.predicting.follow(info)
         if info is None or info.state == "closed":
             return
-        if self._round_painter is None or self._round_painter.w is not self.window:
-            from airtable.app.window import AidsPainter
-
-            self._round_painter = AidsPainter(self.window)
         count = f"{info.predicted} of {info.players} predicted"
-        paint_round(self._round_painter, info, self.predicting.guesses, color, count)
+        paint_round(
+            self.painter, info, self.predicting.guesses, color, count
+        )  # the aids' painter: labels avoid each other
 
 
 def fit_drawing_budget(scene: Scene, env) -> Scene:
