@@ -230,8 +230,7 @@ class ContactSolver:
         w = np.zeros((len(pos) + 1, 2), dtype=complex)  # velocities and pseudo-velocities; the last row: walls
         w[:-1, 0] = _as_complex(vel)
         v0 = w[:-1, 0].copy()
-        for g in rounds:  # warm start: last step's velocity impulses first
-            _apply(w.reshape(-1), g, g.impulse * np.array([1.0, 0.0]))
+        w[:-1, 0] += _warm_push(c, mass, self._warm)  # warm start: last step's velocity impulses first
         self.iterations, rounds = _iterate(w, rounds, later, len(c.a))
         self._keep(c, rounds)
         moved = (w[:-1, 0] - v0 + w[:-1, 1]) * dt
@@ -253,6 +252,7 @@ class ContactSolver:
             ]
         )
         impulse = np.zeros((len(c.keys), 2))  # pseudo-velocities start from nothing each step
+        self._warm = impulse[:, 0]
         if len(self._keys):
             found = np.searchsorted(self._keys, c.keys).clip(0, len(self._keys) - 1)
             hit = np.flatnonzero(self._keys.take(found) == c.keys)
@@ -311,15 +311,17 @@ def _rounds(c: _Contacts, rounds, wa, wb, target, impulse) -> list[_Round]:
     ]  # fmt: skip
 
 
-def _apply(flat: np.ndarray, g: _Round, impulse: np.ndarray) -> None:
-    """Add impulse (m, 2) along each contact's normal to body a, minus it to body b.
-
-    flat: the (rows + 1, 2) velocities seen as one row of numbers (1-D fancy
-    indexing is several times cheaper than 2-D). The walls' row takes many
-    writes in one round, all of them zero (wb = 0).
-    """
-    flat[g.fa] += (impulse * g.na).reshape(-1)
-    flat[g.fb] -= (impulse * g.nb).reshape(-1)
+def _warm_push(c: _Contacts, mass: np.ndarray, impulse: np.ndarray) -> np.ndarray:
+    """The velocity change (complex, per puck) from every contact's warm-start impulse at once:
+    a sum, so the order of the contacts does not matter."""
+    rows = len(mass)
+    push = impulse * c.n
+    a = push / mass.take(c.a)
+    walls = c.b == rows
+    b = push / np.where(walls, 1.0, mass.take(c.b.clip(max=rows - 1)))
+    b[walls] = 0.0
+    out = np.bincount(c.a, a.real, rows) - np.bincount(c.b, b.real, rows + 1)[:rows]
+    return out + 1j * (np.bincount(c.a, a.imag, rows) - np.bincount(c.b, b.imag, rows + 1)[:rows])
 
 
 def _iterate(w: np.ndarray, rounds: list[_Round], later: list[_Round], count: int) -> tuple[int, list[_Round]]:
@@ -334,7 +336,11 @@ def _iterate(w: np.ndarray, rounds: list[_Round], later: list[_Round], count: in
     for it in range(1, ITERATIONS + 1):
         if it == 2:
             rounds = _handover(rounds, later, count)
-        for g in rounds:  # as _apply, but with the velocities already at hand (no body twice in a round)
+        # Velocities as one row of numbers (1-D fancy indexing is several times
+        # cheaper than 2-D). No body appears twice in a round, so each writes
+        # back what it read plus its change; the walls' row takes many writes,
+        # all the same (wb = 0).
+        for g in rounds:
             va, vb = flat.take(g.fa), flat.take(g.fb)
             vn = (g.nc * (va - vb).reshape(-1, 2)).real
             new = np.maximum(g.impulse + g.k * (g.target - vn), 0.0)
