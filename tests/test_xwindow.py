@@ -66,6 +66,17 @@ def find_window(display: str, title: str = "Air Table") -> str | None:
     return None
 
 
+def window_size(display: str, wid: str) -> tuple[int, int] | None:
+    """The window's size as X has it now (None once it is gone)."""
+    out = subprocess.run(
+        ["xwininfo", "-id", wid], env={**os.environ, "DISPLAY": display}, capture_output=True, text=True
+    ).stdout
+    sizes = dict(
+        line.strip().split(": ", 1) for line in out.splitlines() if line.strip().startswith(("Width", "Height"))
+    )
+    return (int(sizes["Width"]), int(sizes["Height"])) if len(sizes) == 2 else None
+
+
 def test_demo_key_and_mouse_drag_in_a_real_window(display, tmp_path):
     shot = tmp_path / "final.png"
     env = {**os.environ, "DISPLAY": display, "SDL_VIDEODRIVER": "x11"}
@@ -127,7 +138,7 @@ def test_the_table_follows_a_resize_of_the_window(display, tmp_path):
     try:
         wid = wait_for(lambda: find_window(display), what="the window")
         xdotool(display, "windowsize", "--sync", wid, "1000", "500")
-        time.sleep(1.0)  # a few frames at the new size
+        wait_for(lambda: window_size(display, wid) == (1000, 500), what="the new size")
         xdotool(display, "windowfocus", "--sync", wid)
         xdotool(display, "key", "Escape")
         assert app.wait(timeout=20) == 0, app.stderr.read().decode()
@@ -181,7 +192,7 @@ def test_f11_toggles_desktop_fullscreen_and_back(display, tmp_path):
         xdotool(display, "windowfocus", "--sync", wid)
         xdotool(display, "key", "F11")
         wid = wait_for(lambda: find_window(display), what="the fullscreen window")  # SDL may make a new one
-        time.sleep(1.0)
+        time.sleep(1.0)  # SDL settles into fullscreen before it takes keys again
         xdotool(display, "windowfocus", "--sync", wid)
         xdotool(display, "key", "F12")  # a screenshot while fullscreen
         wait_for(shot.exists, what="the screenshot")
@@ -218,8 +229,10 @@ def test_f11_in_the_app_fills_the_screen(display, tmp_path):
         wid = wait_for(lambda: find_window(display), what="the window")
         xdotool(display, "windowfocus", "--sync", wid)
         xdotool(display, "key", "F11")
-        time.sleep(1.0)
-        wid = wait_for(lambda: find_window(display), what="the fullscreen window")
+        wid = wait_for(
+            lambda: (w := find_window(display)) and window_size(display, w) == (1024, 900) and w,
+            what="the fullscreen window",
+        )
         xdotool(display, "windowfocus", "--sync", wid)
         xdotool(display, "key", "Escape")
         assert app.wait(timeout=20) == 0, app.stderr.read().decode()

@@ -73,7 +73,7 @@ PLAIN_TYPES = (bool, int, float, str, type(None))
 CONTACT_KEPT = ("_keys", "_impulses", "_rows", "_round_keys", "_rounds", "_free_rounds", "count", "iterations")
 # Worked out afresh at the start of every contact stage: nothing to keep.
 ROUND_LISTS = (CONTACT_KEPT.index("_rounds"), CONTACT_KEPT.index("_free_rounds"))  # lists of arrays, kept as tuples
-CONTACT_SCRATCH = frozenset({"_y", "_r_mean"})
+CONTACT_SCRATCH = frozenset({"_y", "_r_mean", "_warm"})  # worked out afresh in each solve
 # The Python objects of one state beside its arrays' data (the state, its dicts and tuples,
 # the arrays' headers): tracemalloc measures 1.0 to 1.2 kB, with or without springs.
 STATE_OVERHEAD_BYTES = 1600
