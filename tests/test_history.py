@@ -158,3 +158,15 @@ def test_a_table_too_big_for_the_budget_keeps_no_moment():
     assert h.record(table)
     assert len(h) == 0 and h.nbytes == 0
     assert not h.back(table) and h.timeline() is None
+
+
+def test_its_own_count_is_never_below_what_it_really_holds_with_contacts():
+    table = gas_scene(10, seed=2)
+    table.gravity_on, table.cr_puck, table.cr_wall = True, 0.0, 0.0  # a pile: the contact stage keeps its rounds
+
+    def fill(h: History) -> None:
+        h.record(table)
+        frames(table, h, 300, steps=1, dt_s=1 / 60)
+
+    held, counted, dropped = measured_bytes(fill, BUDGET_BYTES)
+    assert dropped == 0 and held <= counted

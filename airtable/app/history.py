@@ -7,7 +7,11 @@ with the one before it whatever did not change (masses, radii, springs,
 colours, a still puck's position), so a moment costs about its positions and
 velocities. The oldest moments go first once `budget_bytes` is reached: a
 few pucks keep many minutes, ten thousand a few seconds, and no size ever
-holds more than the budget.
+holds more than the budget. Measured (frames of 4 steps of 1/240 s, under
+gravity): 10 pucks 2.5 kB a frame (30 s: 4.4 MB; 64 MB: about 7 minutes),
+99 pucks 10.5 kB (30 s: 18.6 MB), 1000 pucks settling into a pile 122 kB
+(8.8 s in 64 MB: the contact stage's warm start is most of it), 10000 pucks
+about 330-480 kB (2 to 3.4 s).
 
 While paused the view moves through the history (`back`, `forward`, by
 frames or by seconds), restoring the table at each moment, so everything

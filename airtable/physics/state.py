@@ -77,6 +77,8 @@ CONTACT_SCRATCH = frozenset({"_y", "_r_mean", "_warm"})  # worked out afresh in 
 # The Python objects of one state beside its arrays' data (the state, its dicts and tuples,
 # the arrays' headers): tracemalloc measures 1.0 to 1.2 kB, with or without springs.
 STATE_OVERHEAD_BYTES = 1600
+# A numpy array's own object beside its data (sys.getsizeof of an empty array).
+ARRAY_HEADER_BYTES = 112
 
 
 @dataclass(frozen=True, eq=False)
@@ -107,8 +109,11 @@ class TableState:
     def parts(self) -> Iterator[tuple[object, int]]:
         """(object, bytes) of every sizeable part: the arrays and the handle tuples (some may be shared)."""
         for a in (*self.pucks.values(), *self.springs.values(), *(self.neighbours or ()), *_contact_arrays(self)):
-            yield a, a.nbytes
-        for t in (self.puck_handles, self.spring_handles):
+            yield a, a.nbytes + ARRAY_HEADER_BYTES
+        tuples = (self.puck_handles, self.spring_handles)
+        if self.contacts is not None:
+            tuples += (self.contacts, self.contacts[4])
+        for t in tuples:
             yield t, sys.getsizeof(t)
 
     @property
