@@ -118,6 +118,8 @@ def test_freeze_gravity_and_corrections(app):
     assert app.table.puck_correction == "perfect-kiss"
     press(app, pygame.K_z)
     assert app.table.puck_correction == "two-step"
+    press(app, pygame.K_p)  # p goes round all three
+    assert app.table.puck_correction == "perfect-kiss"
 
 
 def test_zoom_keys_keep_the_point_under_the_cursor(app):

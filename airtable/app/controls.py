@@ -18,6 +18,7 @@ from typing import TYPE_CHECKING
 import pygame
 
 from airtable.app import aids, lessons, predict, rewind, room, world
+from airtable.physics.pairs import CORRECTION_MODES
 
 if TYPE_CHECKING:
     from airtable.app.app import App
@@ -66,8 +67,10 @@ def toggle_gravity(app: App) -> None:
 
 
 def toggle_correction(app: App) -> None:
+    """The next correction mode: off, two-step, perfect kiss, off, ..."""
+    modes = CORRECTION_MODES
     t = app.table
-    t.puck_correction = "two-step" if t.puck_correction == "off" else "off"
+    t.puck_correction = modes[(modes.index(t.puck_correction) + 1) % len(modes)]
 
 
 def toggle_perfect_kiss(app: App) -> None:
@@ -198,7 +201,7 @@ BINDINGS: tuple[Binding, ...] = (
     ),
     Binding("f", "freeze: all velocities to zero", {pygame.K_f: freeze}),
     Binding("g", "gravity on/off (restitution 0.9 with gravity, 1.0 without)", {pygame.K_g: toggle_gravity}),
-    Binding("p", "puck penetration correction off / two-step", {pygame.K_p: toggle_correction}),
+    Binding("p", "correction: off, two-step, perfect kiss in turn", {pygame.K_p: toggle_correction}),
     Binding("z", "perfect kiss on/off", {pygame.K_z: toggle_perfect_kiss}),
     Binding("h / n (hold)", "zoom in / out about the cursor", {pygame.K_h: zoom_in, pygame.K_n: zoom_out}, held=True),
     Binding("mouse wheel", "zoom in / out about the cursor"),
