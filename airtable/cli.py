@@ -155,6 +155,7 @@ def write_starter_demo(path: Path) -> Path:
 def start_server(args):
     """Start the network server, or explain on stderr why students cannot join."""
     try:
+        from airtable.app.glyphs import NameCheck, drawable_characters
         from airtable.net.identity import load_key
         from airtable.net.server import GameServer
     except ImportError:
@@ -166,6 +167,7 @@ def start_server(args):
         max_clients=args.max_clients,
         snapshot_hz=args.snapshot_hz,
         token_key=load_key(),  # kept in the config folder: students keep their seats across restarts
+        name_refusal=NameCheck(drawable_characters()),  # names the projector would draw as boxes are refused
     )
     try:
         server.start()

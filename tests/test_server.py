@@ -902,3 +902,16 @@ def test_load_tool_measures_a_small_run(make_server, make_loop):
     report = result.report()
     assert "p50" in report and "p99" in report and "snapshots/s" in report and "verdict" in report
     wait_until(lambda: server.connection_count == 0, what="the load players to leave")
+
+
+def test_a_name_the_teachers_screen_cannot_draw_is_refused_with_a_sentence(make_server, clients):
+    from airtable.app.glyphs import NameCheck, drawable_characters
+
+    server = make_server(name_refusal=NameCheck(drawable_characters()))
+    for name in ("Zoë", "Σοφία", "Женя"):  # Latin, Greek, Cyrillic: the default font has them
+        assert clients(server.port).hello(name).name == name
+    for name, ch in (("שלום", "ש"), ("李", "李"), ("Bo 😀", "😀")):
+        c = clients(server.port)
+        c.send(proto.encode_hello(name))
+        sentence = c.expect_error()
+        assert f"{ch!r} (U+{ord(ch):04X}), which the teacher's screen cannot draw" in sentence

@@ -203,6 +203,7 @@ class GameServer:
         limit_loopback: bool = False,
         password_wait_s: float = FIRST_PASSWORD_WAIT_S,
         token_key: bytes | None = None,
+        name_refusal: Callable[[str], str | None] | None = None,
     ) -> None:
         validate_server_options(port, max_clients, snapshot_hz, timeout_s)
         self.host = host
@@ -235,6 +236,7 @@ class GameServer:
         self._next_publish = 0.0
 
         self._gate = Gate(handshakes_per_address, players_per_address, limit_loopback, password_wait_s)
+        self._name_refusal = name_refusal  # a name the teacher's screen cannot draw (app/glyphs.py), or None
         self._init_network_thread_state()
 
     def _init_network_thread_state(self) -> None:
@@ -698,6 +700,8 @@ class GameServer:
         if not self._password_ok(conn, hello, now):
             return
         refusal = self._gate.seat_refusal(conn.host)
+        if refusal is None and hello.name and self._name_refusal is not None:
+            refusal = self._name_refusal(hello.name)
         if refusal is not None:
             self._fail(conn, refusal)
             return
