@@ -45,7 +45,7 @@ ASPECT = 8.0 / 7.0  # width / height, as the default window
 DT_S = 1.0 / 120.0
 
 # Targets: ours / pymunk time ratio by N, and the deepest overlap allowed.
-TARGET_RATIO = {1000: 2.0, 10000: 1.2}
+TARGET_RATIO = {1000: 1.3, 10000: 0.3}
 TARGET_OVERLAP_MM = 10.0
 
 
