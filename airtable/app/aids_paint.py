@@ -298,18 +298,9 @@ class AidsPainter:
             min(w // 2, int(CHART_SIZE_PX[0] * max(scale, 0.6))),
             min(h // 2, int(CHART_SIZE_PX[1] * max(scale, 0.6))),
         )
-        pad = self.w.line_px(4)
-        name = CHART_CORNERS[(self.chart_corner or 0) if corner is None else corner]
-        rect = pygame.Rect((0, 0), size)
-        if name.startswith("top"):
-            rect.top = self.w.hud_bottom_px + pad
-        else:
-            rect.bottom = self.w.status_top_px - pad
-        if name.endswith("right"):
-            rect.right = w - pad
-        else:
-            rect.left = pad
-        return rect
+        return place_in_corner(
+            self.w, pygame.Rect((0, 0), size), (self.chart_corner or 0) if corner is None else corner
+        )
 
     def energy_chart(self, series: dict[str, np.ndarray], latest: dict[str, float], note: str | None) -> None:
         """Strip chart of energies (left scale) and |momentum| (right scale) in a corner panel."""
@@ -371,3 +362,18 @@ class AidsPainter:
         self.label(
             [(line, TEXT_COLOR) for line in lines], (x, y), gap=self.w.font.get_height(), font=self.w.font, always=True
         )
+
+
+def place_in_corner(window, rect: pygame.Rect, corner: int) -> pygame.Rect:
+    """`rect` moved into CHART_CORNERS[corner]: under the HUD or above the status bar, a margin from the side."""
+    pad = window.line_px(4)
+    name = CHART_CORNERS[corner]
+    if name.startswith("top"):
+        rect.top = window.hud_bottom_px + pad
+    else:
+        rect.bottom = window.status_top_px - pad
+    if name.endswith("right"):
+        rect.right = window.surface.get_width() - pad
+    else:
+        rect.left = pad
+    return rect

@@ -15,7 +15,7 @@ from collections.abc import Sequence
 import numpy as np
 import pygame
 
-from airtable.app.aids_paint import CHART_COLORS, CHART_CORNERS
+from airtable.app.aids_paint import CHART_COLORS, CHART_CORNERS, place_in_corner
 from airtable.app.momenta import VALUE_HEADINGS, MomentaAround, PuckValues, fit_chains, tip_to_tail
 from airtable.app.panel_view import ACCENT, DIM_TEXT, TEXT_COLOR
 
@@ -57,16 +57,7 @@ class LessonsPainter:
         w, h = self.w.surface.get_size()
         pad = self.w.line_px(4)
         rect = pygame.Rect(0, 0, min(size[0], w // 2 - 2 * pad), min(size[1], h // 2 - 2 * pad))
-        name = CHART_CORNERS[corner]
-        if name.startswith("top"):
-            rect.top = self.w.hud_bottom_px + pad
-        else:
-            rect.bottom = self.w.status_top_px - pad
-        if name.endswith("right"):
-            rect.right = w - pad
-        else:
-            rect.left = pad
-        return rect
+        return place_in_corner(self.w, rect, corner)
 
     def _panel(self, rect: pygame.Rect) -> None:
         back = pygame.Surface(rect.size, pygame.SRCALPHA)
