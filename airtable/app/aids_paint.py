@@ -147,16 +147,7 @@ class AidsPainter:
         """An arrow from start_m along vector_m (both in metres)."""
         start = np.asarray(start_m, dtype=float)
         a, b = self._px(start), self._px(start + np.asarray(vector_m, dtype=float))
-        length = math.hypot(b[0] - a[0], b[1] - a[1])
-        if length < 1.0 or not math.isfinite(length):
-            return
-        width = width or self.w.line_px(2)
-        pygame.draw.line(self.w.surface, color, a, b, width)
-        ux, uy = (b[0] - a[0]) / length, (b[1] - a[1]) / length
-        head = min(5.0 * width, 0.4 * length)
-        left = (b[0] - head * (ux - 0.5 * uy), b[1] - head * (uy + 0.5 * ux))
-        right = (b[0] - head * (ux + 0.5 * uy), b[1] - head * (uy - 0.5 * ux))
-        pygame.draw.polygon(self.w.surface, color, [b, left, right])
+        draw_arrow_px(self.w.surface, color, a, b, width or self.w.line_px(2), head_widths=5.0)
 
     def arrows(self, starts_m: np.ndarray, vectors_m: np.ndarray, color) -> None:
         for s, v in zip(starts_m, vectors_m):
@@ -377,3 +368,17 @@ def place_in_corner(window, rect: pygame.Rect, corner: int) -> pygame.Rect:
     else:
         rect.left = pad
     return rect
+
+
+def draw_arrow_px(surface: pygame.Surface, color, a, b, width: int, head_widths: float) -> None:
+    """A line from pixel a to b with a head `head_widths` line widths long (at most 0.4 of the arrow);
+    nothing for an arrow under a pixel or of no finite length."""
+    length = math.hypot(b[0] - a[0], b[1] - a[1])
+    if not 1.0 <= length < math.inf:
+        return
+    pygame.draw.line(surface, color, a, b, width)
+    ux, uy = (b[0] - a[0]) / length, (b[1] - a[1]) / length
+    head = min(head_widths * width, 0.4 * length)
+    left = (b[0] - head * (ux - 0.5 * uy), b[1] - head * (uy + 0.5 * ux))
+    right = (b[0] - head * (ux + 0.5 * uy), b[1] - head * (uy - 0.5 * ux))
+    pygame.draw.polygon(surface, color, [b, left, right])

@@ -15,7 +15,7 @@ from collections.abc import Sequence
 import numpy as np
 import pygame
 
-from airtable.app.aids_paint import CHART_COLORS, CHART_CORNERS, place_in_corner
+from airtable.app.aids_paint import CHART_COLORS, CHART_CORNERS, draw_arrow_px, place_in_corner
 from airtable.app.momenta import VALUE_HEADINGS, MomentaAround, PuckValues, fit_chains, tip_to_tail
 from airtable.app.panel_view import ACCENT, DIM_TEXT, TEXT_COLOR
 
@@ -71,15 +71,7 @@ class LessonsPainter:
         return self.w.surface.blit(font.render(text, True, color), pos)
 
     def _arrow_px(self, a, b, color, width: int) -> None:
-        length = math.hypot(b[0] - a[0], b[1] - a[1])
-        if length < 1.0:
-            return
-        pygame.draw.line(self.w.surface, color, a, b, width)
-        ux, uy = (b[0] - a[0]) / length, (b[1] - a[1]) / length
-        head = min(4.0 * width, 0.4 * length)
-        left = (b[0] - head * (ux - 0.5 * uy), b[1] - head * (uy + 0.5 * ux))
-        right = (b[0] - head * (ux + 0.5 * uy), b[1] - head * (uy - 0.5 * ux))
-        pygame.draw.polygon(self.w.surface, color, [b, left, right])
+        draw_arrow_px(self.w.surface, color, a, b, width, head_widths=4.0)
 
     # ------------------------------------------------------------ momenta diagram
 
