@@ -456,16 +456,7 @@ class NetPlayer:
         info = self.round
         if info is None or info.state != "open":
             return False
-        frame = encode_predict(info.round_id, puck, clamp_speed(vel_mps))
-        with self._send_lock:
-            sock = self._sock
-            if sock is None or self.state != PlayerState.CONNECTED:
-                return False
-            try:
-                sock.sendall(frame)
-            except OSError:
-                return False
-        return True
+        return self._send_frame(encode_predict(info.round_id, puck, clamp_speed(vel_mps)))
 
     def _record(self, cursor_m: Sequence[float], button: int, keys: Iterable[str]) -> proto.InputRecord:
         welcome = self.welcome
@@ -474,6 +465,10 @@ class NetPlayer:
 
     def _send(self, record: proto.InputRecord, now: float) -> bool:
         frame = proto.encode_input(record.cursor_m, record.button, record.keys)
+        return self._send_frame(frame, on_sent=lambda: self._throttle.sent(record, now))
+
+    def _send_frame(self, frame: bytes, on_sent: Callable[[], None] | None = None) -> bool:
+        """Send one frame while connected (on_sent runs under the send lock once it is out); False if not."""
         with self._send_lock:
             sock = self._sock
             if sock is None or self.state != PlayerState.CONNECTED:
@@ -487,7 +482,8 @@ class NetPlayer:
                 except OSError:
                     pass
                 return False
-            self._throttle.sent(record, now)
+            if on_sent is not None:
+                on_sent()
         return True
 
     def close(self, bye: bool = True) -> None:
