@@ -22,6 +22,8 @@ import sys
 import time
 from pathlib import Path
 
+from airtable.processes import stop_process
+
 TARGETS = {"app": 20.0, "client": 15.0}  # most per cent of one core while still
 WARM_UP_S = 2.0
 READY_TIMEOUT_S = 30.0
@@ -63,12 +65,7 @@ def measure(cmd: list[str], env: dict[str, str], window_s: float) -> float:
         cpu1, t1 = cpu_seconds(proc.pid), time.monotonic()
         return 100.0 * (cpu1 - cpu0) / (t1 - t0)
     finally:
-        proc.terminate()
-        try:
-            proc.wait(timeout=10)
-        except subprocess.TimeoutExpired:
-            proc.kill()
-            proc.wait()
+        stop_process(proc)
 
 
 def _child_app(how: str) -> None:
@@ -111,8 +108,7 @@ def cpu_section(args: argparse.Namespace) -> bool:
             ok &= _report(label, measure(cmd, env, window_s), TARGETS[kind])
         ok &= _report("student client, still table", _client_share(env, window_s), TARGETS["client"])
     finally:
-        xvfb.terminate()
-        xvfb.wait()
+        stop_process(xvfb)
     print()
     return ok
 
@@ -127,8 +123,7 @@ def _client_share(env: dict[str, str], window_s: float) -> float:
         client = [sys.executable, "-m", "airtable.net.player", f"127.0.0.1:{port}", "--name", "bench"]
         return measure(client, env, window_s)
     finally:
-        server.terminate()
-        server.wait(timeout=10)
+        stop_process(server)
 
 
 def _report(label: str, share: float, target: float) -> bool:

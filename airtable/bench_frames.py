@@ -27,6 +27,7 @@ import sys
 import time
 
 from airtable.bench_cpu import start_xvfb
+from airtable.processes import stop_process
 
 SCREEN = "1920x1080"
 PUCKS = 10000
@@ -60,8 +61,7 @@ def window_section(args: argparse.Namespace) -> bool:
     finally:
         for proc in (wm, xvfb):
             if proc is not None:
-                proc.terminate()
-                proc.wait(timeout=10)
+                stop_process(proc)
     print()
     return ok
 

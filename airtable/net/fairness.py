@@ -31,6 +31,8 @@ import time
 from collections.abc import Sequence
 from dataclasses import dataclass
 
+from airtable.processes import stop_process
+
 PORT = 8888
 READY = "fairness-server-ready"
 BENCH_MBIT = (5, 10, 20)
@@ -149,12 +151,7 @@ def measure_rates(mbit: float, clients: int = 30, seconds: float = 5.0, demo: st
             args = ("measure", "--clients", str(clients), "--seconds", str(seconds))
             done = ns.run(py, "-m", "airtable.net.fairness", *args, timeout_s=seconds + 90)
         finally:
-            server.terminate()
-            try:
-                server.wait(timeout=10)
-            except subprocess.TimeoutExpired:
-                server.kill()
-                server.wait(timeout=10)
+            stop_process(server)
             server.stdout.close()
     result = json.loads(done.stdout.strip().splitlines()[-1])
     return Rates(mbit, result["rates"], result["mean_bytes"], result["mbit"], result["fps"])
