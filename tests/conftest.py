@@ -41,8 +41,10 @@ def press(app, key: int, mod: int = 0, frames: int = 1, unicode: str = "") -> No
         app.frame(FRAME_S)
 
 
-def wait_until(condition: Callable[[], object], timeout_s: float = WAIT_S, what: str = "condition") -> object:
-    """Poll `condition` until it is truthy and return it; fail after `timeout_s` (a bound, not a delay)."""
+def wait_until(
+    condition: Callable[[], object], timeout_s: float = WAIT_S, what: str = "condition", poll_s: float = 0.005
+) -> object:
+    """Poll `condition` every `poll_s` until truthy and return it; fail after `timeout_s` (a bound, not a delay)."""
     deadline = time.monotonic() + timeout_s
     while True:
         value = condition()
@@ -50,4 +52,4 @@ def wait_until(condition: Callable[[], object], timeout_s: float = WAIT_S, what:
             return value
         if time.monotonic() > deadline:
             pytest.fail(f"timed out after {timeout_s} s waiting for {what}")
-        time.sleep(0.005)
+        time.sleep(poll_s)

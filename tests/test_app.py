@@ -197,6 +197,21 @@ def test_mouse_drags_and_flings_a_puck(app):
     assert np.linalg.norm(puck.pos_m - p0) > 0.01
 
 
+def test_a_press_and_a_quick_move_in_one_frame_grab_the_puck_under_the_press(app):
+    # On a slow frame (or a quick flick) the press and the move arrive together: the grab is where the button went down.
+    press(app, pygame.K_1)
+    puck = app.table.pucks[0]
+    grab = to_px(app, puck.pos_m)
+    away = to_px(app, (5.0, 0.3))
+    assert app.table.puck_at(app.env.to_world(away)) is None
+    pygame.event.post(pygame.event.Event(pygame.MOUSEMOTION, pos=grab, rel=(0, 0), buttons=(0, 0, 0)))
+    pygame.event.post(pygame.event.Event(pygame.MOUSEBUTTONDOWN, pos=grab, button=1))
+    pygame.event.post(pygame.event.Event(pygame.MOUSEMOTION, pos=away, rel=(1, 1), buttons=(1, 0, 0)))
+    app.frame(FRAME_S)
+    assert app.local.held is puck
+    np.testing.assert_allclose(app.local.cursor_m, app.env.to_world(away))  # and it pulls toward where the cursor is now
+
+
 def test_clicking_empty_table_grabs_nothing(app):
     empty = to_px(app, (5.0, 0.3))
     assert app.table.puck_at(app.env.to_world(empty)) is None

@@ -6,11 +6,11 @@ import os
 import shutil
 import subprocess
 import sys
-import time
 
 import numpy as np
 import pygame
 import pytest
+from conftest import wait_until
 
 pytestmark = [
     pytest.mark.xvfb,
@@ -22,14 +22,9 @@ pytestmark = [
 ORANGE = (255, 165, 0)
 
 
-def wait_for(condition, timeout_s: float = 15.0, what: str = "condition"):
-    deadline = time.monotonic() + timeout_s
-    while time.monotonic() < deadline:
-        value = condition()
-        if value:
-            return value
-        time.sleep(0.1)
-    raise AssertionError(f"timed out waiting for {what}")
+def wait_for(condition, what: str = "condition"):
+    """Wait on X (each poll runs a tool): a longer bound and a slower poll than the in-process waits."""
+    return wait_until(condition, timeout_s=15.0, what=what, poll_s=0.1)
 
 
 @pytest.fixture
@@ -77,15 +72,48 @@ def window_size(display: str, wid: str) -> tuple[int, int] | None:
     return (int(sizes["Width"]), int(sizes["Height"])) if len(sizes) == 2 else None
 
 
+def orange_centre(path) -> np.ndarray | None:
+    """Where the orange puck is in a screenshot (None while the file is missing or half written)."""
+    try:
+        image = pygame.surfarray.array3d(pygame.image.load(str(path)))
+    except (pygame.error, FileNotFoundError):
+        return None
+    orange = np.argwhere(np.all(image == ORANGE, axis=2))
+    return orange.mean(axis=0) if len(orange) > 20 else None
+
+
+def sized_window(display: str, size: tuple[int, int]) -> str | None:
+    """The app's window once X has it at `size` (SDL may make a new window when it goes fullscreen)."""
+    wid = find_window(display)
+    return wid if wid and window_size(display, wid) == size else None
+
+
+def key_taken(display: str, wid: str, key: str) -> bool:
+    """Focus the window and press `key`; True, so a wait can repeat a key whose effect it then checks."""
+    xdotool(display, "windowfocus", "--sync", wid)
+    xdotool(display, "key", key)
+    return True
+
+
 def test_demo_key_and_mouse_drag_in_a_real_window(display, tmp_path):
     shot = tmp_path / "final.png"
     env = {**os.environ, "DISPLAY": display, "SDL_VIDEODRIVER": "x11"}
     app = subprocess.Popen(
         [sys.executable, "-m", "airtable", "--no-server", "--demo", "2", "--seconds", "60", "--screenshot", str(shot)],
         env=env,
+        cwd=tmp_path,  # F12 saves into ./screenshots: the test looks there
         stdout=subprocess.PIPE,
         stderr=subprocess.PIPE,
     )
+    pygame.display.init()
+
+    def pulled_far_enough():
+        # A screenshot now (F12), then the newest one: has the string pulled the puck down and right?
+        xdotool(display, "key", "F12")
+        shots = sorted((tmp_path / "screenshots").glob("*.png"), key=lambda p: p.stat().st_mtime_ns)
+        centre = orange_centre(shots[-1]) if shots else None
+        return centre is not None and centre[0] > 405 + 50 and centre[1] > 383 + 50
+
     try:
         wid = wait_for(lambda: find_window(display), what="the window")
         xdotool(display, "windowfocus", "--sync", wid)
@@ -93,28 +121,22 @@ def test_demo_key_and_mouse_drag_in_a_real_window(display, tmp_path):
         xdotool(display, "key", "3")
         wait_for(lambda: "Demo 3" in xdotool(display, "getwindowname", wid), what="demo 3 to start")
         # Demo 3's orange puck sits at (4.5, 4.5) m: pixel (405, 383) of the 900 x 788 window.
-        xdotool(display, "mousemove", "--window", wid, "405", "383")
-        time.sleep(0.3)  # let SDL see the pointer arrive before the press
+        # X delivers the move before the press, and SDL reads them in that order: no wait needed between.
+        xdotool(display, "mousemove", "--window", wid, "--sync", "405", "383")
         xdotool(display, "mousedown", "1")
-        time.sleep(0.3)
-        xdotool(display, "mousemove", "--window", wid, "700", "650")
-        time.sleep(2.0)  # the string pulls the puck over; the final check does not depend on how far
+        xdotool(display, "mousemove", "--window", wid, "--sync", "700", "650")
+        wait_for(pulled_far_enough, what="the string to pull the puck toward the cursor")
         xdotool(display, "mouseup", "1")
         xdotool(display, "key", "space")  # pause, so the puck stays where the string left it
-        time.sleep(0.3)
         xdotool(display, "key", "Escape")
         assert app.wait(timeout=20) == 0, app.stderr.read().decode()
     finally:
         if app.poll() is None:
             app.kill()
             app.wait()
-    pygame.display.init()
-    image = pygame.surfarray.array3d(pygame.image.load(str(shot)))
-    orange = np.argwhere(np.all(image == ORANGE, axis=2))
-    assert len(orange) > 20
-    centre = orange.mean(axis=0)
+    centre = orange_centre(shot)
     # It was pulled toward the cursor: down and to the right of where it started.
-    assert centre[0] > 405 + 50 and centre[1] > 383 + 50
+    assert centre is not None and centre[0] > 405 + 50 and centre[1] > 383 + 50
 
 
 WALL = (255, 69, 0)
@@ -191,16 +213,13 @@ def test_f11_toggles_desktop_fullscreen_and_back(display, tmp_path):
         wid = wait_for(lambda: find_window(display), what="the window")
         xdotool(display, "windowfocus", "--sync", wid)
         xdotool(display, "key", "F11")
-        wid = wait_for(lambda: find_window(display), what="the fullscreen window")  # SDL may make a new one
-        time.sleep(1.0)  # SDL settles into fullscreen before it takes keys again
-        xdotool(display, "windowfocus", "--sync", wid)
-        xdotool(display, "key", "F12")  # a screenshot while fullscreen
-        wait_for(shot.exists, what="the screenshot")
+        wid = wait_for(lambda: sized_window(display, (1024, 900)), what="the fullscreen window")  # may be a new one
+        # SDL takes keys again only once it has settled into fullscreen: a screenshot (F12) may be asked
+        # for again until one is written, which also tells that the next key will be seen.
+        wait_for(lambda: key_taken(display, wid, "F12") and shot.exists(), what="the screenshot")
         xdotool(display, "key", "F11")  # and back to the window
-        wid = wait_for(lambda: find_window(display), what="the window again")
-        time.sleep(1.0)
-        xdotool(display, "windowfocus", "--sync", wid)
-        xdotool(display, "key", "Escape")
+        wid = wait_for(lambda: sized_window(display, (640, 480)), what="the window again")
+        wait_for(lambda: key_taken(display, wid, "Escape") and proc.poll() is not None, what="the driver to quit")
         assert proc.wait(timeout=20) == 0, proc.stderr.read().decode()
         assert proc.stdout.read().decode().split() == ["size", "640", "480", "0"]
     finally:
@@ -229,10 +248,7 @@ def test_f11_in_the_app_fills_the_screen(display, tmp_path):
         wid = wait_for(lambda: find_window(display), what="the window")
         xdotool(display, "windowfocus", "--sync", wid)
         xdotool(display, "key", "F11")
-        wid = wait_for(
-            lambda: (w := find_window(display)) and window_size(display, w) == (1024, 900) and w,
-            what="the fullscreen window",
-        )
+        wid = wait_for(lambda: sized_window(display, (1024, 900)), what="the fullscreen window")
         xdotool(display, "windowfocus", "--sync", wid)
         xdotool(display, "key", "Escape")
         assert app.wait(timeout=20) == 0, app.stderr.read().decode()

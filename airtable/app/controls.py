@@ -362,6 +362,8 @@ def handle_mouse(app: App, event: pygame.event.Event) -> None:
                 app.panning = True
             else:
                 app.mouse_button = event.button
+                # Grab where the button went down: a press and a quick move can share one frame.
+                app.local.set_input(app.table, app.env.to_world(event.pos), event.button)
         else:
             app.panning = False
             if event.button == app.mouse_button:
