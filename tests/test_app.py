@@ -209,7 +209,7 @@ def test_a_press_and_a_quick_move_in_one_frame_grab_the_puck_under_the_press(app
     pygame.event.post(pygame.event.Event(pygame.MOUSEMOTION, pos=away, rel=(1, 1), buttons=(1, 0, 0)))
     app.frame(FRAME_S)
     assert app.local.held is puck
-    np.testing.assert_allclose(app.local.cursor_m, app.env.to_world(away))  # and it pulls toward where the cursor is now
+    np.testing.assert_allclose(app.local.cursor_m, app.env.to_world(away))  # and pulls toward the cursor now
 
 
 def test_clicking_empty_table_grabs_nothing(app):

@@ -407,15 +407,18 @@ def test_joins_leaves_and_cursors_are_applied_every_frame_even_without_steps(mak
 
 
 def test_the_event_queue_stays_bounded_while_nobody_takes_it(make_server):
-    """20,000 join/leave cycles while the game loop never calls update_clients."""
+    """2,000 join/leave cycles while the game loop never calls update_clients.
+
+    The bound is 240 events: a leak of even one event a cycle passes it by the
+    third check."""
     server = make_server(max_clients=30)
-    for i in range(20_000):
+    for i in range(2_000):
         with socket.create_connection(("127.0.0.1", server.port), timeout=WAIT_S) as s:
             s.sendall(proto.encode_hello() + proto.encode_input((1, 1), 0) + proto.encode_bye())
             s.settimeout(WAIT_S)
             while s.recv(65536):  # the server closes after the BYE
                 pass
-        if i % 2000 == 0:
+        if i % 200 == 0:
             assert server.pending_events <= 2 * 30 + 30 * MAX_QUEUED_INPUTS
     wait_until(lambda: server.player_count == 0, what="the last leave")
     assert server.pending_events == 0, "every join was withdrawn by its leave"

@@ -60,8 +60,8 @@ def test_a_jelly_on_stiff_springs_replays_while_dragged(demos, cr):
     assert table.notices  # the implicit springs were noticed, and stay noticed once
 
 
-@pytest.mark.parametrize("cr", RESTITUTIONS)
-@pytest.mark.parametrize("mode", ["two-step", "perfect-kiss", "off"])
+# Every mode and every restitution at least once (the full cross of twelve took 6 s of the suite).
+@pytest.mark.parametrize(("mode", "cr"), [("two-step", 1.0), ("perfect-kiss", 0.7), ("off", 0.3), ("two-step", 0.0)])
 def test_a_gas_under_gravity_replays(cr, mode):
     table = gas_scene(300, seed=3)  # beyond brute force: the neighbour list is in play
     table.gravity_on = True
