@@ -456,8 +456,8 @@ class App:
 
     def _draw_timeline(self) -> None:
         """While paused (or in the past), where the view is in the history."""
-        timeline = self.history.timeline()
-        if (self.paused or self.history.in_past) and timeline is not None and timeline.frames > 1:
+        timeline = rewind.timeline_shown(self)
+        if timeline is not None:
             self.timeline_painter.timeline(timeline)
 
     def _draw_panel(self) -> None:

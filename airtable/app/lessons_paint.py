@@ -16,7 +16,7 @@ import numpy as np
 import pygame
 
 from airtable.app.aids_paint import CHART_COLORS, CHART_CORNERS, draw_arrow_px, place_in_corner
-from airtable.app.momenta import VALUE_HEADINGS, MomentaAround, PuckValues, fit_chains, tip_to_tail
+from airtable.app.momenta import VALUE_HEADINGS, MomentaView, PuckValues, fit_chains, tip_to_tail
 from airtable.app.panel_view import ACCENT, DIM_TEXT, TEXT_COLOR
 
 TOTAL_COLOR = CHART_COLORS["momentum_Ns"]  # the chart's |momentum| colour
@@ -79,7 +79,7 @@ class LessonsPainter:
         u = max(self.w.unit, 0.6)
         return (int(MOMENTA_SIZE_PX[0] * u), int(MOMENTA_SIZE_PX[1] * u))
 
-    def momenta_diagram(self, m: MomentaAround | None, corner: int) -> pygame.Rect:
+    def momenta_diagram(self, m: MomentaView | None, corner: int) -> pygame.Rect:
         """Before and after the latest collision: each puck's momentum tip to tail (its colour), and the total."""
         font, pad = self.w.label_font, self.w.line_px(4)
         line_h = font.get_linesize()
@@ -93,18 +93,16 @@ class LessonsPainter:
         self._panel(rect)
         self._text(f"momenta, collision at t = {m.t_s:.2f} s", (rect.x + pad, rect.y + pad), TEXT_COLOR)
         half = pygame.Rect(0, 0, (rect.width - 3 * pad) // 2, rect.height - 2 * pad - 3 * line_h)
-        rows = m.shown()
         chains = []
-        for momenta in (m.before_Ns, m.after_Ns):
-            tails, tips = tip_to_tail(momenta[rows])
-            total = momenta.sum(axis=0)
-            chains.append((tails, tips, total))
+        for momenta, total in ((m.before_Ns, m.total_before_Ns), (m.after_Ns, m.total_after_Ns)):
+            tails, tips = tip_to_tail(momenta)
+            chains.append((tails, tips, np.asarray(total, dtype=float)))
         fit = fit_chains([np.vstack([t, p, tot[None]]) for t, p, tot in chains], half.size)
         for side, (name, (tails, tips, total)) in enumerate(zip(("before", "after"), chains)):
             box = half.move(rect.x + pad + side * (half.width + pad), rect.y + pad + line_h)
             pygame.draw.rect(self.w.surface, (60, 60, 60), box, 1)
             self._text(name, (box.x + pad, box.y + pad // 2), DIM_TEXT)
-            self._chain(fit, side, box, tails, tips, total, m.colors[rows])
+            self._chain(fit, side, box, tails, tips, total, m.colors)
             self._text(f"total ({total[0]:.3g}, {total[1]:.3g}) N s", (box.x, box.bottom + pad // 2), TOTAL_COLOR)
             self._text(f"|total| {math.hypot(*total):.4g} N s", (box.x, box.bottom + pad // 2 + line_h), TOTAL_COLOR)
         return rect

@@ -18,6 +18,7 @@ from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
     from airtable.app.app import App
+    from airtable.app.history import Timeline
 
 JUMP_S = 1.0  # Shift+, / Shift+. : this much simulated time
 
@@ -46,6 +47,15 @@ def _forward(app: App, frames: int = 0, seconds: float = 0.0) -> bool:
     if moved:
         _moved(app)
     return moved
+
+
+def timeline_shown(app: App) -> Timeline | None:
+    """The timeline the bar shows: while paused (or in the past) with more than one moment kept, else None.
+    The teacher's window draws it, and the students' windows get it in the AIDS frames."""
+    timeline = app.history.timeline()
+    if (app.paused or app.history.in_past) and timeline is not None and timeline.frames > 1:
+        return timeline
+    return None
 
 
 def step_back(app: App) -> None:
