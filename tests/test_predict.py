@@ -16,7 +16,7 @@ from test_server import RawClient, frame
 from airtable.app.app import App
 from airtable.app.demo_loader import BUILTIN_DIR, DemoShelf
 from airtable.app.environment import DEFAULT_SIZE_PX, Environment
-from airtable.app.predict import StudentGuesses, angle_deg, puck_summary, summarize
+from airtable.app.predict import FROZEN_NOTICE, StudentGuesses, angle_deg, puck_summary, summarize
 from airtable.net import protocol as proto
 from airtable.net.player import NetPlayer, PlayerApp, PlayerState
 from airtable.net.predictions import (
@@ -335,3 +335,121 @@ def test_the_anonymous_projector_hides_the_names_on_the_arrows(server, tmp_path)
         assert [a.label for a in next_round(student, lambda i: bool(i.arrows) and not i.arrows[0].label).arrows] == [""]
     finally:
         student.close()
+
+
+# ---------------------------------------------------------------- Space during a round
+
+
+def test_space_cannot_resume_the_table_while_students_predict(tmp_path):
+    app = head_on_app(tmp_path)
+    press(app, pygame.K_F6)
+    t0 = app.table.time_s
+    press(app, pygame.K_SPACE, frames=10)
+    assert app.paused and app.table.time_s == t0 and app.predict.state == "open"
+    assert app.message == FROZEN_NOTICE  # one line saying why, and what does reveal
+    press(app, pygame.K_PERIOD)  # nor does a single step or the history move it
+    press(app, pygame.K_COMMA, mod=pygame.KMOD_SHIFT)
+    assert app.table.time_s == t0 and app.history.at is None
+    press(app, pygame.K_F6)  # the round key reveals, and the table plays
+    assert not app.paused and app.predict.state == "revealed"
+
+
+def test_space_pauses_a_playing_reveal_and_after_the_freeze_closes_the_round(tmp_path):
+    app = head_on_app(tmp_path)
+    press(app, pygame.K_F6)
+    app.predict.local[1] = (1.0, 0.0)
+    press(app, pygame.K_F6)
+    press(app, pygame.K_SPACE)  # the teacher stops the reveal to point at something
+    t0 = app.table.time_s
+    for _ in range(5):
+        app.frame(FRAME_S)
+    assert app.paused and app.table.time_s == t0 and app.predict.state == "revealed"
+    press(app, pygame.K_SPACE)  # and lets it play on
+    assert not app.paused
+    frames_until(app, lambda: app.predict.settled, "the collision to be over")
+    assert app.paused and app.predict.summary  # frozen on the truth
+    press(app, pygame.K_SPACE)  # the class has seen it: Space goes on with the lesson
+    assert app.predict.state == "closed" and not app.paused
+    assert "round closed" in app.message
+    t1 = app.table.time_s
+    for _ in range(5):
+        app.frame(FRAME_S)
+    assert app.table.time_s > t1
+    press(app, pygame.K_SPACE)
+    assert app.paused  # Space is pause / resume again
+
+
+# ---------------------------------------------------------------- the summary fits the window
+
+
+LONG_SUMMARY = (
+    "puck 12: median 12 deg off; 9 of 28 within 5 deg; speeds within 20 %: 17 of 28",
+    "puck 13: comes to rest; 3 of 28 predicted under 0.05 m/s",
+)
+
+
+def _text_spy(painter) -> list:
+    """Every line the painter's legend and labels write: (text, x, font)."""
+    drawn, original = [], painter._text
+
+    def spy(text, pos_px, color, *, center=False, font=None):
+        drawn.append((text, pos_px[0], font or painter.w.label_font))
+        return original(text, pos_px, color, center=center, font=font)
+
+    painter._text = spy
+    return drawn
+
+
+def _check_fits(drawn, width: int, summary) -> None:
+    lines = [(t, x, f) for t, x, f in drawn if t.strip()]
+    assert lines
+    for text, x, font in lines:
+        assert x >= 0 and x + font.size(text)[0] <= width, (text, width)
+    words = " ".join(t for t, _, _ in lines).split()
+    for line in summary:  # every word of every summary line is drawn, in order: wrapped, never cut
+        joined = " ".join(words)
+        assert " ".join(line.split()) in joined, line
+
+
+@pytest.mark.parametrize("size", [(480, 360), (640, 480), (1280, 720)])
+def test_the_summary_wraps_to_the_teachers_window(tmp_path, size):
+    (tmp_path / "head_on.py").write_text(HEAD_ON)
+    app = App(DemoShelf([BUILTIN_DIR, tmp_path]), demo_key="5", headless=True, window_size_px=size)
+    pygame.event.clear()
+    press(app, pygame.K_F6)
+    app.predict.local[1] = polar(1.1, 10.0)
+    press(app, pygame.K_F6)
+    app.paused = True
+    app.predict.settle(app.table)  # frozen on the truth at once: the wrapping, not the collision, is tested
+    app.predict.summary = (*app.predict.summary, *LONG_SUMMARY)
+    drawn = _text_spy(app.painter)
+    app.draw()
+    assert app.window.surface.get_size() == size
+    _check_fits(drawn, size[0], app.predict.summary)
+
+
+@pytest.mark.parametrize("size", [(480, 360), (640, 480), (1280, 720)])
+def test_the_summary_wraps_to_a_students_window(size):
+    from airtable.app.aids_paint import AidsPainter
+    from airtable.app.window import GameWindow
+
+    info = RoundInfo(
+        3, "revealed", 2, 28, 28, (Arrow(1, (1.0, 0.1), (255, 0, 0)),), ((0.0, 0.0), (1.0, 0.0)),
+        ("puck 2: median 10 deg off; 1 of 3 within 5 deg; speeds within 20 %: 2 of 3", *LONG_SUMMARY),
+        ((3.0, 4.0), (5.0, 4.0)),
+    )  # fmt: skip
+
+    class Net:
+        round = info
+
+    student = PlayerApp(Net(), headless=True)
+    student.window = GameWindow(Environment(size, width_m=10.0), headless=True, size_px=size)
+    student.painter = AidsPainter(student.window)
+    drawn = _text_spy(student.painter)
+    student._draw_round((0, 255, 0))
+    _check_fits(drawn, size[0], info.summary)
+    open_round = RoundInfo(4, "open", 2, 17, 28, from_m=info.from_m)
+    Net.round = open_round
+    drawn.clear()
+    student._draw_round((0, 255, 0))
+    _check_fits(drawn, size[0], ("17 of 28 predicted",))

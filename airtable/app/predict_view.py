@@ -12,6 +12,7 @@ from __future__ import annotations
 from collections.abc import Mapping, Sequence
 from typing import TYPE_CHECKING
 
+from airtable.app.panel_view import wrap
 from airtable.app.predict import ARROW_S, LOCAL_COLOR, count_text, names_shown
 from airtable.net.predictions import RoundInfo
 
@@ -21,6 +22,26 @@ if TYPE_CHECKING:
 PROMPT_COLOR = (255, 220, 90)
 TRUTH_COLOR = (255, 255, 255)
 PROMPT = ("PREDICT: drag an arrow from a puck,", "its velocity once the collision is over")
+INDENT = "    "  # before the second and later lines of a wrapped line
+
+
+def fit_lines(font, lines, width_px: int) -> list[tuple[str, tuple[int, int, int]]]:
+    """`lines` of (text, colour) wrapped at word breaks to `width_px`; a line's later pieces indented."""
+    indent_px = font.size(INDENT)[0]
+    out = []
+    for text, color in lines:
+        first, *rest = wrap(font, text, width_px) or [""]
+        out.append((first, color))
+        if rest:
+            out.extend((INDENT + piece, color) for piece in wrap(font, " ".join(rest), width_px - indent_px))
+    return out
+
+
+def _legend(painter, lines) -> None:
+    """The painter's legend (at the left, under the HUD), every line within the window's width."""
+    w = painter.w
+    width = w.surface.get_width() - 4 * w.line_px(4)  # the legend starts 2 pads in; as much room on the right
+    painter.legend(fit_lines(w.font, lines, width))
 
 
 def paint_round(
@@ -37,7 +58,7 @@ def paint_round(
         lines = [(text, PROMPT_COLOR) for text in PROMPT]
         if count:
             lines.append((count, PROMPT_COLOR))
-        painter.legend(lines)
+        _legend(painter, lines)
         return
     if info.state != "revealed":
         return
@@ -50,9 +71,9 @@ def paint_round(
         if puck < len(starts):
             painter.arrow(starts[puck], (vel[0] * ARROW_S, vel[1] * ARROW_S), TRUTH_COLOR, bold)
     if info.truth:
-        painter.legend([("the truth in bold white", TRUTH_COLOR), *((s, PROMPT_COLOR) for s in info.summary)])
+        _legend(painter, [("the truth in bold white", TRUTH_COLOR), *((s, PROMPT_COLOR) for s in info.summary)])
     else:
-        painter.legend([("revealed: playing until the collision is over", PROMPT_COLOR)])
+        _legend(painter, [("revealed: playing until the collision is over", PROMPT_COLOR)])
 
 
 def _tip(start: Sequence[float], vel: Sequence[float]) -> tuple[float, float]:

@@ -16,6 +16,8 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING
 
+from airtable.app.predict import holds_the_table
+
 if TYPE_CHECKING:
     from airtable.app.app import App
     from airtable.app.history import Timeline
@@ -29,6 +31,8 @@ def _moved(app: App) -> None:
 
 
 def _back(app: App, frames: int = 0, seconds: float = 0.0) -> None:
+    if holds_the_table(app):
+        return
     app.paused = True
     h = app.history
     moved = h.back_seconds(app.table, seconds) if seconds else h.back(app.table, frames)
@@ -68,6 +72,8 @@ def jump_back(app: App) -> None:
 
 def step_forward(app: App) -> None:
     """Forward one frame through the history; at the newest moment, one new physics step (while paused)."""
+    if holds_the_table(app):
+        return
     if not app.paused:
         app.say("'.' steps once while paused (Space pauses)")
     elif not _forward(app, frames=1):
@@ -76,6 +82,8 @@ def step_forward(app: App) -> None:
 
 
 def jump_forward(app: App) -> None:
+    if holds_the_table(app):
+        return
     if not app.paused:
         app.say("Shift+. jumps forward through the history while paused (Space pauses)")
     elif not _forward(app, seconds=JUMP_S):
