@@ -248,17 +248,21 @@ def pause_key(app: App) -> bool:
     return False
 
 
-def holds_the_table(app: App) -> bool:
-    """True (and says so) while a round needs the table as it is: open, or revealed and playing.
-    The rewind keys then leave the table alone."""
+def round_holds(app: App) -> bool:
+    """True while a round needs the table as it is: open, or revealed and still playing."""
     r = app.predict
-    if r.state == "open":
+    return r.state == "open" or (r.state == "revealed" and not r.settled)
+
+
+def holds_the_table(app: App) -> bool:
+    """True, and says why, while a round holds the table (round_holds): the rewind keys leave it alone."""
+    if not round_holds(app):
+        return False
+    if app.predict.state == "open":
         app.say(FROZEN_NOTICE)
-        return True
-    if r.state == "revealed" and not r.settled:
+    else:
         app.say("the reveal plays until the collision is over; then , and . step through it")
-        return True
-    return False
+    return True
 
 
 def names_shown(app: App) -> bool:

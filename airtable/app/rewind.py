@@ -16,7 +16,7 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING
 
-from airtable.app.predict import holds_the_table
+from airtable.app.predict import holds_the_table, round_holds
 
 if TYPE_CHECKING:
     from airtable.app.app import App
@@ -54,8 +54,11 @@ def _forward(app: App, frames: int = 0, seconds: float = 0.0) -> bool:
 
 
 def timeline_shown(app: App) -> Timeline | None:
-    """The timeline the bar shows: while paused (or in the past) with more than one moment kept, else None.
-    The teacher's window draws it, and the students' windows get it in the AIDS frames."""
+    """The timeline the bar shows: while paused (or in the past) with more than one moment kept, and no
+    prediction round holding the table (its keys are off then), else None. The teacher's window draws
+    it, and the students' windows get it in the AIDS frames."""
+    if round_holds(app):
+        return None
     timeline = app.history.timeline()
     if (app.paused or app.history.in_past) and timeline is not None and timeline.frames > 1:
         return timeline

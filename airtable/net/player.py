@@ -717,15 +717,15 @@ class PlayerApp:
             win.draw_panel(scene.title, [net.aids.notes], large=True)
         win.present()
 
-    def _draw_round(self, color) -> None:
+    def _draw_round(self, color) -> list:
+        """The prediction round, if one is under way; returns the lines of text written and where."""
         info = self.net.round
         self.predicting.follow(info)
         if info is None or info.state == "closed":
-            return
+            return []
         count = f"{info.predicted} of {info.players} predicted"
-        paint_round(
-            self.painter, info, self.predicting.guesses, color, count
-        )  # the aids' painter: labels avoid each other
+        # The aids' painter: its labels and these lines avoid each other.
+        return paint_round(self.painter, info, self.predicting.guesses, color, count)
 
 
 def fit_drawing_budget(scene: Scene, env) -> Scene:
