@@ -56,7 +56,11 @@ def draw_student_aids(paint: AidsPainter, scene: Scene, state: StudentAids, now_
 def draw_student_lessons(paint, timeline_paint, scene: Scene, state: StudentAids, mouse_m) -> None:
     """The teacher's lesson panels on a student's frame, where the teacher has them: the momenta diagram,
     the values panel (of the puck under this student's cursor when there are many) and the timeline bar.
-    `paint` is the window's LessonsPainter, `timeline_paint` its TimelinePainter."""
+    `paint` is the window's LessonsPainter, `timeline_paint` its TimelinePainter. The bar first, as
+    on the teacher's window: the panels stand clear of it."""
+    timeline = state.timeline()
+    if timeline is not None:
+        timeline_paint.timeline(timeline)
     momenta = state.momenta_view(scene.color_rgb)
     if momenta is not None:
         corner, view = momenta
@@ -68,9 +72,6 @@ def draw_student_lessons(paint, timeline_paint, scene: Scene, state: StudentAids
         n = len(scene.color_rgb)
         colors = [scene.color_rgb[int(r.name)] if r.speed_mps is not None and int(r.name) < n else None for r in rows]
         paint.values_panel(rows, colors, VALUES_HINT, corner)
-    timeline = state.timeline()
-    if timeline is not None:
-        timeline_paint.timeline(timeline)
 
 
 def puck_under(scene: Scene, point_m) -> int | None:
