@@ -10,15 +10,17 @@ import pytest
 from conftest import FRAME_S, press
 
 from airtable.app.app import App
-from airtable.app.lessons_paint import TOTAL_COLOR
+from airtable.app.lessons_paint import TOTAL_COLOR, fitting, momenta_scale, total_texts
 from airtable.app.momenta import (
     MomentaLog,
+    MomentaView,
     fit_chains,
     momenta_around_collisions,
     tip_to_tail,
     values_for,
 )
 from airtable.app.panel_view import ACCENT
+from airtable.app.rewind import timeline_shown
 from airtable.physics.table import AirTable
 
 
@@ -139,3 +141,43 @@ def test_the_panels_and_the_chart_take_different_corners(app):
     press(app, pygame.K_c)  # the chart takes the corner over the fewest pucks; a panel there moves
     corners = app.lessons.painter.corners
     assert len({corners["momenta"], corners["values"], app.painter.chart_corner}) == 3
+
+
+def test_round_off_shows_as_zero_and_the_totals_fit_their_box():
+    m = MomentaView(
+        1.0, np.arange(2), np.array([[0.0954, 0.0], [0.0, 0.0]]), np.array([[0.02, 0.05], [0.0754, -0.05]]),
+        np.array([0.0954, 0.0]), np.array([0.0954, 1.39e-17]), np.zeros((2, 3), np.uint8),
+    )  # fmt: skip
+    assert momenta_scale(m) == pytest.approx(0.0954)
+    components, size = total_texts(m.total_after_Ns, momenta_scale(m))
+    assert components[0] == "total (0.0954, 0) N s" and size[0] == "|total| 0.0954 N s"
+    pygame.font.init()
+    font = pygame.font.Font(None, 20)
+    narrow = font.size("(0.0954, 0) N s")[0]
+    assert fitting(font, components, narrow) == "(0.0954, 0) N s"  # the longest that fits
+    assert font.size(fitting(font, components, 20))[0] <= 20  # none fits: cut
+
+
+@pytest.mark.parametrize("size", [(640, 480), (1280, 720)])
+def test_the_panels_stand_clear_of_paused_and_the_timeline(demos, size):
+    app = App(demos, demo_key="8", headless=True, window_size_px=size)
+    pygame.event.clear()
+    press(app, pygame.K_d)
+    press(app, pygame.K_t)
+    for _ in range(240):
+        app.frame(FRAME_S)
+        if app.lessons.momenta.latest is not None:
+            break
+    press(app, pygame.K_SPACE)  # paused: PAUSED at the top, the timeline bar at the bottom
+    drawn = {}
+    paint = app.lessons.painter
+    for name in ("momenta_diagram", "values_panel"):
+        original = getattr(paint, name)
+        setattr(paint, name, lambda *a, _f=original, _n=name: drawn.setdefault(_n, _f(*a)))
+    app.draw()
+    others = [b for b in app.window.label_boxes if b not in drawn.values()]  # PAUSED, the bar, the HUD ...
+    assert len(drawn) == 2 and timeline_shown(app) is not None
+    for rect in drawn.values():
+        assert app.window.surface.get_rect().contains(rect)
+        assert rect.collidelist(others) < 0, (rect, others)
+    assert not drawn["momenta_diagram"].colliderect(drawn["values_panel"])

@@ -16,7 +16,9 @@ from test_server import RawClient, frame
 from airtable.app.app import App
 from airtable.app.demo_loader import BUILTIN_DIR, DemoShelf
 from airtable.app.environment import DEFAULT_SIZE_PX, Environment
-from airtable.app.predict import StudentGuesses, angle_deg, puck_summary, summarize
+from airtable.app.predict import FROZEN_NOTICE, StudentGuesses, angle_deg, puck_summary, summarize
+from airtable.app.predict_view import draw_predict
+from airtable.app.rewind import timeline_shown
 from airtable.net import protocol as proto
 from airtable.net.player import NetPlayer, PlayerApp, PlayerState
 from airtable.net.predictions import (
@@ -335,3 +337,106 @@ def test_the_anonymous_projector_hides_the_names_on_the_arrows(server, tmp_path)
         assert [a.label for a in next_round(student, lambda i: bool(i.arrows) and not i.arrows[0].label).arrows] == [""]
     finally:
         student.close()
+
+
+# ---------------------------------------------------------------- Space during a round
+
+
+def test_space_cannot_resume_the_table_while_students_predict(tmp_path):
+    app = head_on_app(tmp_path)
+    press(app, pygame.K_F6)
+    t0 = app.table.time_s
+    press(app, pygame.K_SPACE, frames=10)
+    assert app.paused and app.table.time_s == t0 and app.predict.state == "open"
+    assert app.message == FROZEN_NOTICE  # one line saying why, and what does reveal
+    assert timeline_shown(app) is None  # paused, but the history's keys are off: no timeline bar
+    press(app, pygame.K_PERIOD)  # nor does a single step or the history move it
+    press(app, pygame.K_COMMA, mod=pygame.KMOD_SHIFT)
+    assert app.table.time_s == t0 and app.history.at is None
+    press(app, pygame.K_F6)  # the round key reveals, and the table plays
+    assert not app.paused and app.predict.state == "revealed"
+
+
+def test_space_pauses_a_playing_reveal_and_after_the_freeze_closes_the_round(tmp_path):
+    app = head_on_app(tmp_path)
+    press(app, pygame.K_F6)
+    app.predict.local[1] = (1.0, 0.0)
+    press(app, pygame.K_F6)
+    press(app, pygame.K_SPACE)  # the teacher stops the reveal to point at something
+    t0 = app.table.time_s
+    for _ in range(5):
+        app.frame(FRAME_S)
+    assert app.paused and app.table.time_s == t0 and app.predict.state == "revealed"
+    press(app, pygame.K_SPACE)  # and lets it play on
+    assert not app.paused
+    frames_until(app, lambda: app.predict.settled, "the collision to be over")
+    assert app.paused and app.predict.summary  # frozen on the truth
+    press(app, pygame.K_SPACE)  # the class has seen it: Space goes on with the lesson
+    assert app.predict.state == "closed" and not app.paused
+    assert "round closed" in app.message
+    t1 = app.table.time_s
+    for _ in range(5):
+        app.frame(FRAME_S)
+    assert app.table.time_s > t1
+    press(app, pygame.K_SPACE)
+    assert app.paused  # Space is pause / resume again
+
+
+# ---------------------------------------------------------------- the summary fits the window
+
+
+LONG_SUMMARY = (
+    "puck 12: median 12 deg off; 9 of 28 within 5 deg; speeds within 20 %: 17 of 28",
+    "puck 13: comes to rest; 3 of 28 predicted under 0.05 m/s",
+)
+
+
+def _check_fits(placed, width: int, summary) -> None:
+    """Every line drawn lies within the window's width, and every word of `summary` is drawn, in order."""
+    assert placed
+    for text, rect in placed:
+        assert rect.left >= 0 and rect.right <= width, (text, rect, width)
+    words = " ".join(" ".join(t for t, _ in placed).split())
+    for line in summary:  # wrapped, never cut
+        assert " ".join(line.split()) in words, line
+
+
+@pytest.mark.parametrize("size", [(480, 360), (640, 480), (1280, 720)])
+def test_the_summary_wraps_to_the_teachers_window(tmp_path, size):
+    (tmp_path / "head_on.py").write_text(HEAD_ON)
+    app = App(DemoShelf([BUILTIN_DIR, tmp_path]), demo_key="5", headless=True, window_size_px=size)
+    pygame.event.clear()
+    press(app, pygame.K_F6)
+    app.predict.local[1] = polar(1.1, 10.0)
+    press(app, pygame.K_F6)
+    app.paused = True
+    app.predict.settle(app.table)  # frozen on the truth at once: the wrapping, not the collision, is tested
+    app.predict.summary = (*app.predict.summary, *LONG_SUMMARY)
+    app.draw()
+    assert app.window.surface.get_size() == size
+    _check_fits(draw_predict(app), size[0], app.predict.summary)
+
+
+@pytest.mark.parametrize("size", [(480, 360), (640, 480), (1280, 720)])
+def test_the_summary_wraps_to_a_students_window(size):
+    from airtable.app.aids_paint import AidsPainter
+    from airtable.app.window import GameWindow
+
+    info = RoundInfo(
+        3, "revealed", 2, 28, 28, (Arrow(1, (1.0, 0.1), (255, 0, 0)),), ((0.0, 0.0), (1.0, 0.0)),
+        ("puck 2: median 10 deg off; 1 of 3 within 5 deg; speeds within 20 %: 2 of 3", *LONG_SUMMARY),
+        ((3.0, 4.0), (5.0, 4.0)),
+    )  # fmt: skip
+
+    class Net:
+        round = info
+
+    student = PlayerApp(Net(), headless=True)
+    student.window = GameWindow(Environment(size, width_m=10.0), headless=True, size_px=size)
+    student.painter = AidsPainter(student.window)
+    placed = student._draw_round((0, 255, 0))
+    _check_fits(placed, size[0], info.summary)
+    if size[0] < 600:  # a narrow window breaks a summary line between its parts, not inside one
+        assert any(t.strip().startswith("speeds within 20 %") for t, _ in placed)
+    Net.round = RoundInfo(4, "open", 2, 17, 28, from_m=info.from_m)
+    _check_fits(student._draw_round((0, 255, 0)), size[0], ("17 of 28 predicted",))

@@ -14,9 +14,11 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from airtable.app import aids
+from airtable.app import aids, rewind
+from airtable.app.history import Timeline
+from airtable.app.momenta import FEW_PUCKS, MomentaView, PuckValues, every_puck_values, puck_values
 from airtable.net import aids_wire
-from airtable.net.aids_wire import AidsFrame, AnnotationRecord, SharedAids
+from airtable.net.aids_wire import AidsFrame, AnnotationRecord, SharedAids, SharedLessons
 
 if TYPE_CHECKING:
     from airtable.app.app import App
@@ -68,7 +70,8 @@ def annotation_of(r: AnnotationRecord, born_s: float) -> aids.Annotation:
 def shared_aids(app: App) -> SharedAids | None:
     """What the teacher's aids show now; None when every one is off (the students then get no AIDS bytes)."""
     notes = (app.demo.notes or "(no notes)") if app.show_notes and app.demo is not None else None
-    if not (app.trails or app.vectors or app.show_annotations or app.show_chart or notes is not None):
+    lessons = shared_lessons(app)
+    if not (app.trails or app.vectors or app.show_annotations or app.show_chart or notes is not None or lessons):
         return None
     t, paint = app.table, app.painter
     values, amount, vel_amount, com = None, 1.0, 1.0, (0.0, 0.0, 0.0, 0.0)
@@ -103,7 +106,46 @@ def shared_aids(app: App) -> SharedAids | None:
         chart_corner=corner,
         chart_history=history,
         notes=notes,
+        lessons=lessons,
     )
+
+
+def shared_lessons(app: App) -> SharedLessons | None:
+    """The lesson panels the teacher's window shows (momenta, values, the timeline bar); None if none is."""
+    lessons, t = app.lessons, app.table
+    timeline = rewind.timeline_shown(app)
+    if not (lessons.show_momenta or lessons.show_values or timeline is not None):
+        return None
+    corners = lessons.painter.corners if lessons.painter is not None else {}
+    latest = lessons.momenta.latest
+    rows: list[int] = []
+    every = len(t.pos_m) <= FEW_PUCKS
+    if lessons.show_values:
+        rows = list(range(len(t.pos_m))) if every else _pointed(app)
+    return SharedLessons(
+        momenta_on=lessons.show_momenta,
+        momenta_corner=corners.get("momenta") or 0,
+        momenta=None if latest is None else latest.view,
+        values_on=lessons.show_values,
+        values_corner=corners.get("values") or 0,
+        values_every=every,
+        value_rows=tuple(rows),
+        value_mass_kg=t.mass_kg[rows],
+        value_vel_mps=t.vel_mps[rows],
+        timeline=None
+        if timeline is None
+        else (timeline.oldest_s, timeline.newest_s, timeline.view_s, timeline.frames, timeline.index),
+    )
+
+
+def _pointed(app: App) -> list[int]:
+    """The pucks under the students' cursors (each student's values panel shows the one under its own)."""
+    found = set()
+    for client in app.clients[1:]:
+        puck = app.table.puck_at(client.cursor_m) if client.active else None
+        if puck is not None:
+            found.add(puck.index)
+    return sorted(found)[: aids_wire.MAX_VALUE_ROWS]
 
 
 def _chart_history(chart: aids.EnergyChart) -> np.ndarray:
@@ -192,6 +234,46 @@ class StudentAids:
         """(series, latest, note) of the chart, read while the network thread is not appending."""
         with self._lock:
             return self.chart.series(), self.chart.latest(), self.chart.euler_wiggle_note(scene)
+
+    def momenta_view(self, colors: np.ndarray) -> tuple[int, MomentaView | None] | None:
+        """(corner, diagram) while the teacher shows the momenta diagram, else None; the rows drawn in
+        `colors` (the snapshot's puck colours), as the teacher's window draws them."""
+        frame = self.frame
+        if frame is None or not frame.lesson_flags & aids_wire.MOMENTA:
+            return None
+        m = frame.momenta
+        if m is None:
+            return frame.momenta_corner, None
+        colors = np.asarray(colors, dtype=np.uint8).reshape(-1, 3)
+        known = m.rows < len(colors)
+        shown = np.full((len(m.rows), 3), 200, np.uint8)
+        shown[known] = colors[m.rows[known]]
+        view = MomentaView(
+            m.t_s, m.rows, m.before_Ns, m.after_Ns, np.array(m.total_before_Ns), np.array(m.total_after_Ns), shown
+        )
+        return frame.momenta_corner, view
+
+    def values_rows(self, pointed: int | None) -> tuple[int, list[PuckValues]] | None:
+        """(corner, rows) while the teacher shows the values panel, else None: every puck and the total
+        when there are few, else the puck `pointed` at (under this student's cursor) if the frame has it."""
+        frame = self.frame
+        if frame is None or not frame.lesson_flags & aids_wire.VALUES:
+            return None
+        mass, vel, rows = frame.value_mass_kg, frame.value_vel_mps, frame.value_rows
+        if frame.values_every:
+            return frame.values_corner, every_puck_values(mass, vel)
+        at = np.flatnonzero(rows == pointed) if pointed is not None else ()
+        if not len(at):
+            return frame.values_corner, []
+        k = int(at[0])
+        return frame.values_corner, puck_values(mass[k : k + 1], vel[k : k + 1], [pointed])
+
+    def timeline(self) -> Timeline | None:
+        """Where the teacher's view is in the history while the teacher's window shows the bar, else None."""
+        frame = self.frame
+        if frame is None or frame.timeline is None:
+            return None
+        return Timeline(*frame.timeline)
 
     def live_annotations(self, now_s: float) -> list[aids.Annotation]:
         with self._lock:

@@ -13,6 +13,8 @@ from airtable.app import aids
 from airtable.app.aids_paint import AidsPainter
 from airtable.app.aids_share import StudentAids
 from airtable.app.aids_view import COM_COLOR
+from airtable.app.lessons_view import VALUES_HINT
+from airtable.app.momenta import FEW_PUCKS
 from airtable.app.scene import Scene
 from airtable.net import aids_wire
 
@@ -49,6 +51,35 @@ def draw_student_aids(paint: AidsPainter, scene: Scene, state: StudentAids, now_
         paint.annotation(annotation, now_s)
     if state.shows("i"):
         _inspect(paint, scene, state, mouse_m)
+
+
+def draw_student_lessons(paint, timeline_paint, scene: Scene, state: StudentAids, mouse_m) -> None:
+    """The teacher's lesson panels on a student's frame, where the teacher has them: the momenta diagram,
+    the values panel (of the puck under this student's cursor when there are many) and the timeline bar.
+    `paint` is the window's LessonsPainter, `timeline_paint` its TimelinePainter. The bar first, as
+    on the teacher's window: the panels stand clear of it."""
+    timeline = state.timeline()
+    if timeline is not None:
+        timeline_paint.timeline(timeline)
+    momenta = state.momenta_view(scene.color_rgb)
+    if momenta is not None:
+        corner, view = momenta
+        paint.momenta_diagram(view, corner)
+    pointed = puck_under(scene, mouse_m) if len(scene.pos_m) > FEW_PUCKS else None
+    values = state.values_rows(pointed)
+    if values is not None:
+        corner, rows = values
+        n = len(scene.color_rgb)
+        colors = [scene.color_rgb[int(r.name)] if r.speed_mps is not None and int(r.name) < n else None for r in rows]
+        paint.values_panel(rows, colors, VALUES_HINT, corner)
+
+
+def puck_under(scene: Scene, point_m) -> int | None:
+    """The row of the puck under `point_m` (the last drawn, on top, as the teacher's table picks), or None."""
+    pos = np.asarray(scene.pos_m, dtype=float).reshape(-1, 2)
+    d2 = (pos[:, 0] - point_m[0]) ** 2 + (pos[:, 1] - point_m[1]) ** 2
+    inside = np.flatnonzero(d2 <= np.asarray(scene.radius_m, dtype=float) ** 2)
+    return int(inside[-1]) if len(inside) else None
 
 
 def _vectors(paint: AidsPainter, scene: Scene, state: StudentAids) -> None:

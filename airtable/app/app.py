@@ -447,8 +447,8 @@ class App:
         projected = self.room.projected(scene or self.scene())  # names hidden if anonymous
         self.window.draw(projected, trails=self.trails, hud=self.hud_lines())
         draw_alert(self)  # the network thread failed: students can no longer join
-        draw_lessons(self)  # first: the aids' labels then place themselves around its panels
-        self._draw_timeline()
+        self._draw_timeline()  # first: the lesson panels then stand clear of it
+        draw_lessons(self)  # before the aids: their labels then place themselves around its panels
         draw_aids(self)
         draw_predict(self)
         self._draw_panel()
@@ -456,8 +456,8 @@ class App:
 
     def _draw_timeline(self) -> None:
         """While paused (or in the past), where the view is in the history."""
-        timeline = self.history.timeline()
-        if (self.paused or self.history.in_past) and timeline is not None and timeline.frames > 1:
+        timeline = rewind.timeline_shown(self)
+        if timeline is not None:
             self.timeline_painter.timeline(timeline)
 
     def _draw_panel(self) -> None:

@@ -53,7 +53,8 @@ KEYPAD_KEYS = (*(getattr(pygame, f"K_KP_{d}") for d in "1234567890"),)
 
 
 def toggle_pause(app: App) -> None:
-    app.paused = not app.paused
+    if not predict.pause_key(app):  # a prediction round decides what Space does while it is under way
+        app.paused = not app.paused
 
 
 def freeze(app: App) -> None:

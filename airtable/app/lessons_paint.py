@@ -16,12 +16,38 @@ import numpy as np
 import pygame
 
 from airtable.app.aids_paint import CHART_COLORS, CHART_CORNERS, draw_arrow_px, place_in_corner
-from airtable.app.momenta import VALUE_HEADINGS, MomentaAround, PuckValues, fit_chains, tip_to_tail
-from airtable.app.panel_view import ACCENT, DIM_TEXT, TEXT_COLOR
+from airtable.app.momenta import VALUE_HEADINGS, MomentaView, PuckValues, fit_chains, tip_to_tail
+from airtable.app.panel_view import ACCENT, DIM_TEXT, TEXT_COLOR, shorten
 
 TOTAL_COLOR = CHART_COLORS["momentum_Ns"]  # the chart's |momentum| colour
 PANEL_FILL = (0, 0, 0, 215)
 MOMENTA_SIZE_PX = (480, 250)  # at 720 px tall, like the chart
+
+
+def momenta_scale(m: MomentaView) -> float:
+    """The size of the largest momentum in the diagram (N s): below a billionth of it is round-off."""
+    sizes = [np.abs(np.asarray(a, dtype=float)).max(initial=0.0) for a in (m.before_Ns, m.after_Ns)]
+    sizes += [np.abs(np.asarray(t, dtype=float)).max() for t in (m.total_before_Ns, m.total_after_Ns)]
+    return float(max(sizes))
+
+
+def total_texts(total, scale: float) -> tuple[tuple[str, ...], tuple[str, ...]]:
+    """The two lines under a chain, each longest first: the total's components, and its size.
+    A component under a billionth of `scale` is round-off (1.39e-17 after a hit along x) and shows as 0."""
+    x, y = (0.0 if abs(v) < 1e-9 * scale else float(v) + 0.0 for v in total)
+    size = math.hypot(x, y)
+    return (
+        (f"total ({x:.3g}, {y:.3g}) N s", f"({x:.3g}, {y:.3g}) N s", f"({x:.3g}, {y:.3g})"),
+        (f"|total| {size:.4g} N s", f"|p| {size:.4g} N s", f"{size:.4g}"),
+    )
+
+
+def fitting(font: pygame.font.Font, texts: Sequence[str], width: int) -> str:
+    """The first of `texts` (longest first) that fits `width` pixels; else the last, cut to fit."""
+    for text in texts:
+        if font.size(text)[0] <= width:
+            return text
+    return shorten(font, texts[-1], width)
 
 
 class LessonsPainter:
@@ -53,11 +79,23 @@ class LessonsPainter:
         return self.corners[panel]
 
     def corner_rect(self, size: tuple[int, int], corner: int) -> pygame.Rect:
-        """A box of `size` in `corner`: under the HUD or above the status bar, at most half the window."""
+        """A box of `size` in `corner`: under the HUD or above the status bar, at most half the window,
+        moved down (a top corner) or up (a bottom one) past the text already drawn there (PAUSED, the
+        timeline bar and its label, another panel)."""
         w, h = self.w.surface.get_size()
         pad = self.w.line_px(4)
         rect = pygame.Rect(0, 0, min(size[0], w // 2 - 2 * pad), min(size[1], h // 2 - 2 * pad))
-        return place_in_corner(self.w, rect, corner)
+        rect = place_in_corner(self.w, rect, corner)
+        top, boxes = CHART_CORNERS[corner].startswith("top"), self.w.label_boxes
+        for _ in range(len(boxes)):
+            hit = rect.collidelist(boxes)
+            if hit < 0:
+                break
+            if top:
+                rect.top = boxes[hit].bottom + pad
+            else:
+                rect.bottom = boxes[hit].top - pad
+        return rect
 
     def _panel(self, rect: pygame.Rect) -> None:
         back = pygame.Surface(rect.size, pygame.SRCALPHA)
@@ -79,7 +117,7 @@ class LessonsPainter:
         u = max(self.w.unit, 0.6)
         return (int(MOMENTA_SIZE_PX[0] * u), int(MOMENTA_SIZE_PX[1] * u))
 
-    def momenta_diagram(self, m: MomentaAround | None, corner: int) -> pygame.Rect:
+    def momenta_diagram(self, m: MomentaView | None, corner: int) -> pygame.Rect:
         """Before and after the latest collision: each puck's momentum tip to tail (its colour), and the total."""
         font, pad = self.w.label_font, self.w.line_px(4)
         line_h = font.get_linesize()
@@ -91,22 +129,21 @@ class LessonsPainter:
             return rect
         rect = self.corner_rect(self.momenta_size(), corner)
         self._panel(rect)
-        self._text(f"momenta, collision at t = {m.t_s:.2f} s", (rect.x + pad, rect.y + pad), TEXT_COLOR)
+        title = (f"momenta, collision at t = {m.t_s:.2f} s", f"collision at t = {m.t_s:.2f} s", f"t = {m.t_s:.2f} s")
+        self._text(fitting(font, title, rect.width - 2 * pad), (rect.x + pad, rect.y + pad), TEXT_COLOR)
         half = pygame.Rect(0, 0, (rect.width - 3 * pad) // 2, rect.height - 2 * pad - 3 * line_h)
-        rows = m.shown()
         chains = []
-        for momenta in (m.before_Ns, m.after_Ns):
-            tails, tips = tip_to_tail(momenta[rows])
-            total = momenta.sum(axis=0)
-            chains.append((tails, tips, total))
+        for momenta, total in ((m.before_Ns, m.total_before_Ns), (m.after_Ns, m.total_after_Ns)):
+            tails, tips = tip_to_tail(momenta)
+            chains.append((tails, tips, np.asarray(total, dtype=float)))
         fit = fit_chains([np.vstack([t, p, tot[None]]) for t, p, tot in chains], half.size)
         for side, (name, (tails, tips, total)) in enumerate(zip(("before", "after"), chains)):
             box = half.move(rect.x + pad + side * (half.width + pad), rect.y + pad + line_h)
             pygame.draw.rect(self.w.surface, (60, 60, 60), box, 1)
             self._text(name, (box.x + pad, box.y + pad // 2), DIM_TEXT)
-            self._chain(fit, side, box, tails, tips, total, m.colors[rows])
-            self._text(f"total ({total[0]:.3g}, {total[1]:.3g}) N s", (box.x, box.bottom + pad // 2), TOTAL_COLOR)
-            self._text(f"|total| {math.hypot(*total):.4g} N s", (box.x, box.bottom + pad // 2 + line_h), TOTAL_COLOR)
+            self._chain(fit, side, box, tails, tips, total, m.colors)
+            for k, texts in enumerate(total_texts(total, momenta_scale(m))):
+                self._text(fitting(font, texts, box.width), (box.x, box.bottom + pad // 2 + k * line_h), TOTAL_COLOR)
         return rect
 
     def _chain(self, fit, side: int, box: pygame.Rect, tails, tips, total, colors) -> None:

@@ -33,7 +33,8 @@ def draw_lessons(app: App) -> None:
     if lessons.show_momenta:
         corner = paint.choose_corner("momenta", points, taken)
         taken.append(corner)
-        paint.momenta_diagram(lessons.momenta.latest, corner)
+        latest = lessons.momenta.latest
+        paint.momenta_diagram(None if latest is None else latest.view, corner)
     if lessons.show_values:
         puck = t.puck_at(app.env.to_world(app.mouse_px)) if len(t.pos_m) > FEW_PUCKS else None
         rows = values_for(t, None if puck is None else puck.index)

@@ -12,14 +12,16 @@ the step. The pucks that did not collide have the same arrow in both.
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 
-from airtable.physics.table import AirTable
+from airtable.physics.table import AirTable, kinetic_energy_J
 
 FEW_PUCKS = 6  # the values panel lists every puck up to this many, else the puck under the cursor
-MAX_DIAGRAM_PUCKS = 40  # more than this: the diagram draws the pucks that collided, and the total of all
+MAX_DIAGRAM_PUCKS = 40  # more than this: the diagram draws the pucks that collided (at most this many), and the total
 
 
 @dataclass(frozen=True)
@@ -41,9 +43,45 @@ class MomentaAround:
         return self.after_Ns.sum(axis=0)
 
     def shown(self) -> np.ndarray:
-        """The rows the diagram draws: all of them, or only those that collided when there are many."""
+        """The rows the diagram draws: all of them when there are few; else those that collided, and of
+        those, when there are still too many, the MAX_DIAGRAM_PUCKS whose momentum changed most (row order)."""
         n = len(self.before_Ns)
-        return np.arange(n) if n <= MAX_DIAGRAM_PUCKS else np.flatnonzero(self.collided)
+        if n <= MAX_DIAGRAM_PUCKS:
+            return np.arange(n)
+        rows = np.flatnonzero(self.collided)
+        if len(rows) > MAX_DIAGRAM_PUCKS:
+            change = self.after_Ns[rows] - self.before_Ns[rows]
+            biggest = np.argsort(-np.hypot(change[:, 0], change[:, 1]), kind="stable")[:MAX_DIAGRAM_PUCKS]
+            rows = np.sort(rows[biggest])
+        return rows
+
+    @cached_property
+    def view(self) -> MomentaView:
+        """What the diagram draws (made once: the students' AIDS frames send it as it is)."""
+        rows = self.shown()
+        return MomentaView(
+            self.t_s,
+            rows,
+            self.before_Ns[rows],
+            self.after_Ns[rows],
+            self.total_before_Ns,
+            self.total_after_Ns,
+            self.colors[rows],
+        )
+
+
+@dataclass(frozen=True, eq=False)
+class MomentaView:
+    """The diagram as drawn: the shown rows' momenta before and after (K, 2), the totals of all pucks (2,),
+    the rows' colours (K, 3). The teacher's window makes it from MomentaAround; a student's from an AIDS frame."""
+
+    t_s: float
+    rows: np.ndarray  # (K,) puck rows
+    before_Ns: np.ndarray
+    after_Ns: np.ndarray
+    total_before_Ns: np.ndarray
+    total_after_Ns: np.ndarray
+    colors: np.ndarray
 
 
 def momenta_around_collisions(table: AirTable) -> MomentaAround | None:
@@ -133,25 +171,35 @@ class PuckValues:
 VALUE_HEADINGS = ("puck", "m kg", "|v| m/s", "|p| N s", "KE J")  # mass, speed, momentum, kinetic energy
 
 
-def puck_values(table: AirTable, rows) -> list[PuckValues]:
-    """Mass, speed, |momentum| and kinetic energy of the pucks in `rows` (named by row, as in the CSV)."""
+def puck_values(mass_kg: np.ndarray, vel_mps: np.ndarray, rows: Sequence[int]) -> list[PuckValues]:
+    """Mass, speed, |momentum| and kinetic energy of each puck (named by its row, as in the CSV);
+    `mass_kg` (K,) and `vel_mps` (K, 2) are those of `rows`."""
     out = []
-    for k in rows:
-        m = float(table.mass_kg[k])
-        v = table.vel_mps[k]
+    for k, row in enumerate(rows):
+        m = float(mass_kg[k])
+        v = vel_mps[k]
         speed = math.hypot(float(v[0]), float(v[1]))
-        out.append(PuckValues(str(int(k)), m, speed, m * speed, 0.5 * m * speed * speed))
+        out.append(PuckValues(str(int(row)), m, speed, m * speed, 0.5 * m * speed * speed))
     return out
+
+
+def every_puck_values(mass_kg: np.ndarray, vel_mps: np.ndarray) -> list[PuckValues]:
+    """Every puck and, if there are several, their total (the teacher's table, or a student's copy of it)."""
+    mass_kg, vel_mps = np.asarray(mass_kg, dtype=float), np.asarray(vel_mps, dtype=float).reshape(-1, 2)
+    n = len(mass_kg)
+    rows = puck_values(mass_kg, vel_mps, range(n))
+    if n > 1:
+        p = mass_kg @ vel_mps
+        total = PuckValues("total", float(mass_kg.sum()), None, math.hypot(*p), kinetic_energy_J(mass_kg, vel_mps))
+        rows.append(total)
+    return rows
 
 
 def values_for(table: AirTable, cursor_row: int | None) -> list[PuckValues]:
     """Every puck and their total when there are few; else the puck under the cursor (none: empty)."""
     n = len(table.pos_m)
     if n <= FEW_PUCKS:
-        rows = puck_values(table, range(n))
-        if n > 1:
-            p = table.momentum_Ns()
-            total = PuckValues("total", float(table.mass_kg.sum()), None, math.hypot(*p), table.kinetic_energy_J())
-            rows.append(total)
-        return rows
-    return [] if cursor_row is None else puck_values(table, [cursor_row])
+        return every_puck_values(table.mass_kg, table.vel_mps)
+    if cursor_row is None:
+        return []
+    return puck_values(table.mass_kg[[cursor_row]], table.vel_mps[[cursor_row]], [cursor_row])

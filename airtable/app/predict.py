@@ -226,6 +226,45 @@ def predict_key(app: App) -> None:
     publish(app)
 
 
+FROZEN_NOTICE = "the table stays frozen while students predict: F6 reveals"
+
+
+def pause_key(app: App) -> bool:
+    """Space during a round; True if the round took it (else Space pauses and resumes as always).
+
+    Open: refused with a notice, since the table is what the students predict.
+    Revealed and frozen on the truth: the lesson goes on, so the round closes and
+    the table runs. While the reveal plays, Space pauses and resumes it as usual."""
+    r = app.predict
+    if r.state == "open":
+        app.say(FROZEN_NOTICE)
+        return True
+    if r.settled:
+        r.close()
+        publish(app)
+        app.paused = False
+        app.say("prediction round closed: the table runs on")
+        return True
+    return False
+
+
+def round_holds(app: App) -> bool:
+    """True while a round needs the table as it is: open, or revealed and still playing."""
+    r = app.predict
+    return r.state == "open" or (r.state == "revealed" and not r.settled)
+
+
+def holds_the_table(app: App) -> bool:
+    """True, and says why, while a round holds the table (round_holds): the rewind keys leave it alone."""
+    if not round_holds(app):
+        return False
+    if app.predict.state == "open":
+        app.say(FROZEN_NOTICE)
+    else:
+        app.say("the reveal plays until the collision is over; then , and . step through it")
+    return True
+
+
 def names_shown(app: App) -> bool:
     """Names on the revealed arrows: only when the teacher shows them (Shift+F6),
     and never while the projector is anonymous (F5, room.py)."""

@@ -12,6 +12,9 @@ from __future__ import annotations
 from collections.abc import Mapping, Sequence
 from typing import TYPE_CHECKING
 
+import pygame
+
+from airtable.app.panel_view import wrap
 from airtable.app.predict import ARROW_S, LOCAL_COLOR, count_text, names_shown
 from airtable.net.predictions import RoundInfo
 
@@ -21,12 +24,73 @@ if TYPE_CHECKING:
 PROMPT_COLOR = (255, 220, 90)
 TRUTH_COLOR = (255, 255, 255)
 PROMPT = ("PREDICT: drag an arrow from a puck,", "its velocity once the collision is over")
+INDENT = "    "  # before the second and later lines of a wrapped line
+
+
+LEGEND_FILL = (0, 0, 0, 190)  # behind the round's lines: dark enough to read, a puck beneath still shows
+
+
+def _clauses(font, text: str, width_px: int) -> list[str]:
+    """`text` in lines of at most `width_px`, broken after its "; " where it can (a summary's parts stay
+    whole), else between words."""
+    parts = [p + ";" for p in text.split("; ")]
+    parts[-1] = parts[-1][:-1]
+    lines: list[str] = []
+    for part in parts:
+        trial = f"{lines[-1]} {part}" if lines else part
+        if lines and font.size(trial)[0] <= width_px:
+            lines[-1] = trial
+        elif font.size(part)[0] <= width_px:
+            lines.append(part)
+        else:
+            lines.extend(wrap(font, part, width_px))
+    return lines or [""]
+
+
+def fit_lines(font, lines, width_px: int) -> list[tuple[str, tuple[int, int, int]]]:
+    """`lines` of (text, colour) wrapped to `width_px` (at "; " first, then between words); a line's
+    later pieces indented."""
+    indent_px = font.size(INDENT)[0]
+    out = []
+    for text, color in lines:
+        first, *rest = _clauses(font, text, width_px)
+        out.append((first, color))
+        if rest:
+            out.extend((INDENT + piece, color) for piece in _clauses(font, " ".join(rest), width_px - indent_px))
+    return out
+
+
+def _legend(painter, lines) -> list[tuple[str, pygame.Rect]]:
+    """The round's lines at the left, under the HUD (below whatever is there), each within the window's
+    width, on a translucent panel; returns each line and where it went."""
+    w = painter.w
+    font, pad = w.font, w.line_px(4)
+    lines = fit_lines(font, lines, w.surface.get_width() - 4 * pad)  # 2 pads in; as much room on the right
+    line_h = font.get_linesize()
+    width = max(font.size(t)[0] for t, _ in lines)
+    block = pygame.Rect(2 * pad, w.hud_bottom_px + pad, width, line_h * len(lines)).inflate(pad, pad // 2)
+    taken = painter._taken
+    for _ in range(len(taken)):  # slide down past whatever is in the way
+        hit = block.collidelist(taken)
+        if hit < 0:
+            break
+        block.top = taken[hit].bottom + pad
+    back = pygame.Surface(block.size, pygame.SRCALPHA)
+    back.fill(LEGEND_FILL)
+    w.surface.blit(back, block)
+    placed = []
+    for k, (text, color) in enumerate(lines):
+        rect = w.surface.blit(font.render(text, True, color), (2 * pad, block.top + pad // 4 + k * line_h))
+        placed.append((text, rect))
+    taken.append(block)
+    return placed
 
 
 def paint_round(
     painter, info: RoundInfo, own: Mapping[int, Sequence[float]], own_color, count: str | None = None
-) -> None:
-    """Draw the round `info` with `own` guesses (puck -> velocity) onto `painter`'s window."""
+) -> list[tuple[str, pygame.Rect]]:
+    """Draw the round `info` with `own` guesses (puck -> velocity) onto `painter`'s window;
+    returns the lines of text it wrote and where (none for a closed round)."""
     w = painter.w
     thin, bold = max(1, w.line_px(1)), w.line_px(4)
     starts = info.from_m
@@ -37,10 +101,9 @@ def paint_round(
         lines = [(text, PROMPT_COLOR) for text in PROMPT]
         if count:
             lines.append((count, PROMPT_COLOR))
-        painter.legend(lines)
-        return
+        return _legend(painter, lines)
     if info.state != "revealed":
-        return
+        return []
     for a in info.arrows:
         if a.puck < len(starts):
             painter.arrow(starts[a.puck], (a.vel_mps[0] * ARROW_S, a.vel_mps[1] * ARROW_S), a.color, thin)
@@ -50,20 +113,20 @@ def paint_round(
         if puck < len(starts):
             painter.arrow(starts[puck], (vel[0] * ARROW_S, vel[1] * ARROW_S), TRUTH_COLOR, bold)
     if info.truth:
-        painter.legend([("the truth in bold white", TRUTH_COLOR), *((s, PROMPT_COLOR) for s in info.summary)])
-    else:
-        painter.legend([("revealed: playing until the collision is over", PROMPT_COLOR)])
+        return _legend(painter, [("the truth in bold white", TRUTH_COLOR), *((s, PROMPT_COLOR) for s in info.summary)])
+    return _legend(painter, [("revealed: playing until the collision is over", PROMPT_COLOR)])
 
 
 def _tip(start: Sequence[float], vel: Sequence[float]) -> tuple[float, float]:
     return (start[0] + vel[0] * ARROW_S, start[1] + vel[1] * ARROW_S)
 
 
-def draw_predict(app: App) -> None:
-    """The round on the teacher's window (the projector): a count while open, everything once revealed."""
+def draw_predict(app: App) -> list[tuple[str, pygame.Rect]]:
+    """The round on the teacher's window (the projector): a count while open, everything once revealed.
+    Returns the lines of text written and where."""
     r = app.predict
     if not r.active:
-        return
+        return []
     info = r.info(r.predicted, r.players, names_shown(app))
     # The volunteer at the teacher's laptop sees their own arrows; the students' stay hidden until the reveal.
-    paint_round(app.painter, info, r.local, LOCAL_COLOR, count_text(app))
+    return paint_round(app.painter, info, r.local, LOCAL_COLOR, count_text(app))

@@ -16,8 +16,11 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING
 
+from airtable.app.predict import holds_the_table, round_holds
+
 if TYPE_CHECKING:
     from airtable.app.app import App
+    from airtable.app.history import Timeline
 
 JUMP_S = 1.0  # Shift+, / Shift+. : this much simulated time
 
@@ -28,6 +31,8 @@ def _moved(app: App) -> None:
 
 
 def _back(app: App, frames: int = 0, seconds: float = 0.0) -> None:
+    if holds_the_table(app):
+        return
     app.paused = True
     h = app.history
     moved = h.back_seconds(app.table, seconds) if seconds else h.back(app.table, frames)
@@ -48,6 +53,18 @@ def _forward(app: App, frames: int = 0, seconds: float = 0.0) -> bool:
     return moved
 
 
+def timeline_shown(app: App) -> Timeline | None:
+    """The timeline the bar shows: while paused (or in the past) with more than one moment kept, and no
+    prediction round holding the table (its keys are off then), else None. The teacher's window draws
+    it, and the students' windows get it in the AIDS frames."""
+    if round_holds(app):
+        return None
+    timeline = app.history.timeline()
+    if (app.paused or app.history.in_past) and timeline is not None and timeline.frames > 1:
+        return timeline
+    return None
+
+
 def step_back(app: App) -> None:
     _back(app, frames=1)
 
@@ -58,6 +75,8 @@ def jump_back(app: App) -> None:
 
 def step_forward(app: App) -> None:
     """Forward one frame through the history; at the newest moment, one new physics step (while paused)."""
+    if holds_the_table(app):
+        return
     if not app.paused:
         app.say("'.' steps once while paused (Space pauses)")
     elif not _forward(app, frames=1):
@@ -66,6 +85,8 @@ def step_forward(app: App) -> None:
 
 
 def jump_forward(app: App) -> None:
+    if holds_the_table(app):
+        return
     if not app.paused:
         app.say("Shift+. jumps forward through the history while paused (Space pauses)")
     elif not _forward(app, seconds=JUMP_S):

@@ -17,7 +17,14 @@ What it carries, and how compactly:
 - the chart: the newest sample (5 float32; its time is the snapshot's); the student keeps the
   history, and gets the teacher's last seconds (at most MAX_CHART_HISTORY samples) once, when
   the chart first reaches it;
-- the notes: their text only when this student does not hold it yet.
+- the notes: their text only when this student does not hold it yet;
+- the lesson panels (format 2, only while one is on; format 1 frames are
+  unchanged): which of the momenta diagram, the values panel and the rewind
+  timeline the teacher shows, in which corner; the diagram's rows (16 bytes
+  each, at most MAX_MOMENTA_ROWS, with the totals of all pucks) only when
+  this student does not hold that collision yet; the values panel's pucks
+  (mass and velocity, 16 bytes each: every puck when there are few, else
+  the pucks under the students' cursors); the timeline's times and frames.
 
 `AidsEncoder` (server) caches one encoding per (tick, what the student
 holds), so students on the same footing share it. `AidsDecoder` (player)
@@ -37,7 +44,8 @@ from airtable.net.codec import _bad, _deflate, _inflate, _Reader, pack_residuals
 from airtable.net.protocol import AIDS, MAX_DRAWN_PUCKS, ProtocolError, encode_frame
 
 AIDS_MAGIC = b"ATAD"
-AIDS_VERSION = 1
+AIDS_VERSION = 1  # no lesson panel on: the frame as it always was
+LESSONS_VERSION = 2  # a lesson flags byte follows the header, then the panels' sections at the end
 
 TRAILS = 1
 ANNOTATIONS = 2
@@ -48,6 +56,13 @@ NOTES = 32
 NOTES_TEXT = 64  # the notes' text is in this frame
 VECTOR_KEY = 128  # the vector values are not a delta (no base)
 
+# The lesson flags byte (format 2).
+MOMENTA = 1  # the momenta diagram is on: its corner and the serial of the collision it shows
+MOMENTA_ROWS = 2  # that collision's rows follow (this student does not hold them yet)
+VALUES = 4  # the values panel is on: its corner and its pucks' masses and velocities
+TIMELINE = 8  # the rewind timeline bar is on: where the view is in the history
+LESSON_FLAGS = MOMENTA | MOMENTA_ROWS | VALUES | TIMELINE
+
 ARROW_STEPS = 1000  # vector values travel in thousandths of the arrow scale
 MAX_VALUE = 1 << 20  # steps: an arrow of at most a kilometre (the scale keeps real ones under 1 m)
 MAX_ANNOTATIONS = 8
@@ -56,6 +71,10 @@ MAX_NOTES_BYTES = 16_384
 MAX_VECTOR_HISTORY = 8  # ticks of vector values kept as bases
 MAX_CHART_HISTORY = 600  # samples of the teacher's chart sent once to a student who lacks them
 MAX_COORD_M = 1e6  # a position or length beyond this is not a picture of a table
+MAX_MOMENTA_ROWS = 64  # arrows in a momenta diagram (momenta.MAX_DIAGRAM_PUCKS draws at most 40)
+MAX_VALUE_ROWS = 256  # pucks in the values panel's section: every puck when few, else one per student
+MAX_HISTORY_FRAMES = 1 << 31
+MAX_NUMBER = 1e30  # any momentum, mass, velocity or time beyond this is not physics
 
 _HEAD = struct.Struct("<4sBBI")  # magic, version, flags, tick seq
 _VEC = struct.Struct("<H6fBBI")  # N, amount, velocity amount, com x, y, vx, vy, width, deflated, block size
@@ -68,6 +87,11 @@ _TARGET = struct.Struct("<8f")
 _CHART = struct.Struct("<5fB")
 HISTORY_FOLLOWS = 128
 _NOTES = struct.Struct("<HH")  # notes version, text size (then deflated text)
+_LESSONS = struct.Struct("<B")  # the lesson flags, right after the header (format 2)
+_MOMENTA = struct.Struct("<BI")  # corner, serial of the collision shown (0: none yet)
+_MOMENTA_ROWS = struct.Struct("<d4fH")  # time, total before x y, total after x y, K; K u32 rows; K x 4 f4
+_VALUES = struct.Struct("<BBH")  # corner, every puck (1) or the pointed ones (0), R; R u32 rows; R x 3 f4
+_TIMELINE = struct.Struct("<3dII")  # oldest, newest, view s; frames kept, the one on view
 
 
 @dataclass(frozen=True, eq=False)
@@ -78,6 +102,40 @@ class AnnotationRecord:
     numbers: tuple[float, ...]  # contact 2, normal 2, overlap, separation, 4 positions x 2, radius i, radius j
     angle_deg: float | None = None
     target: tuple[float, ...] | None = None  # actual, ideal deg, pos 2, push dir 2, ideal dir 2
+
+
+@dataclass(frozen=True, eq=False)
+class SharedLessons:
+    """The teacher's lesson panels and rewind bar at one tick, as the app hands them to the server."""
+
+    momenta_on: bool = False
+    momenta_corner: int = 0  # aids_paint.CHART_CORNERS
+    momenta: object = None  # the diagram's momenta.MomentaView (a new object: a new collision); None: none yet
+    values_on: bool = False
+    values_corner: int = 0
+    values_every: bool = True  # the rows are every puck (a few); else those under the students' cursors
+    value_rows: tuple[int, ...] = ()
+    value_mass_kg: np.ndarray | None = None  # (R,)
+    value_vel_mps: np.ndarray | None = None  # (R, 2)
+    timeline: tuple[float, float, float, int, int] | None = None  # oldest, newest, view s; frames, index
+
+    @property
+    def flags(self) -> int:
+        f = MOMENTA if self.momenta_on else 0
+        f |= VALUES if self.values_on else 0
+        return f | (TIMELINE if self.timeline is not None else 0)
+
+
+@dataclass(frozen=True)
+class MomentaRecord:
+    """A momenta diagram as it travels: the rows drawn, their momenta (K, 2) and the totals of all pucks."""
+
+    t_s: float
+    rows: np.ndarray
+    before_Ns: np.ndarray
+    after_Ns: np.ndarray
+    total_before_Ns: tuple[float, float]
+    total_after_Ns: tuple[float, float]
 
 
 @dataclass(frozen=True, eq=False)
@@ -98,6 +156,11 @@ class SharedAids:
     notes: str | None = None  # the lecture notes, while their panel is open
 
     annotations_on: bool = False
+    lessons: SharedLessons | None = None  # the momenta diagram, the values panel, the timeline (format 2)
+
+    @property
+    def lesson_flags(self) -> int:
+        return 0 if self.lessons is None else self.lessons.flags
 
     @property
     def flags(self) -> int:
@@ -117,6 +180,7 @@ class AidsViewer:
     annotation_serial: int = 0
     notes_version: int = -1
     chart_synced: bool = False  # has the chart's history (and every sample since)
+    momenta_serial: int = 0  # the collision whose momenta it holds
 
 
 @dataclass
@@ -127,6 +191,7 @@ class _Prepared:
     values: np.ndarray | None  # int64 (2N,): x of N then y of N
     serials: tuple[int, ...]  # of the live annotations, oldest first
     notes_version: int
+    momenta_serial: int = 0  # of the collision the diagram shows (0: none yet)
 
     @property
     def base_key(self) -> tuple:
@@ -147,10 +212,11 @@ class AidsEncoder:
         self._notes: str | None = None
         self._notes_version = 0
         self._cache: dict[tuple, bytes] = {}
+        self._momenta: tuple[object, int] = (None, 0)  # the diagram's momenta and their serial
 
     def prepare(self, aids: SharedAids | None, seq: int) -> _Prepared | None:
         """The aids of tick `seq`, made ready (O(N), outside any lock); None, or every aid off: nothing to send."""
-        return None if aids is None or not aids.flags else self._prepare(aids, seq)
+        return None if aids is None or not (aids.flags or aids.lesson_flags) else self._prepare(aids, seq)
 
     def publish(self, prepared: _Prepared | None) -> None:
         """Make `prepared` the newest (the snapshot encoder calls this with its tick, under its lock)."""
@@ -185,7 +251,18 @@ class AidsEncoder:
         self._serials = known  # forget the faded ones (and ids that could be reused)
         if aids.notes is not None and aids.notes != self._notes:
             self._notes, self._notes_version = aids.notes, (self._notes_version + 1) & 0xFFFF
-        return _Prepared(seq, aids.flags, aids, values, tuple(serials), self._notes_version)
+        return _Prepared(seq, aids.flags, aids, values, tuple(serials), self._notes_version, self._momenta_serial(aids))
+
+    def _momenta_serial(self, aids: SharedAids) -> int:
+        """A serial per collision the diagram shows (a new MomentaView object is a new one); 0 for none."""
+        momenta = aids.lessons.momenta if aids.lesson_flags & MOMENTA else None
+        if momenta is None:
+            return 0
+        held, serial = self._momenta
+        if held is not momenta:
+            serial = serial % 0xFFFFFFFF + 1  # wraps past 0, which means "none"
+            self._momenta = (momenta, serial)
+        return serial
 
     def frame_for(self, viewer: AidsViewer, state: tuple | None = None) -> bytes:
         """The AIDS frame for `viewer` at the tick of `state` (default: the newest); b"" with every aid off.
@@ -199,11 +276,14 @@ class AidsEncoder:
         fresh = [s for s in p.serials if s > viewer.annotation_serial]
         send_notes = bool(p.flags & NOTES) and viewer.notes_version != p.notes_version
         sync = bool(p.flags & CHART) and not viewer.chart_synced and p.aids.chart_history is not None
-        key = (p.seq, viewer.vector_seq if base is not None else 0, len(fresh), send_notes, sync)
+        rows = p.momenta_serial != 0 and viewer.momenta_serial != p.momenta_serial
+        key = (p.seq, viewer.vector_seq if base is not None else 0, len(fresh), send_notes, sync, rows)
         data = cache.get(key)
         if data is None:
-            data = cache[key] = encode_frame(AIDS, encode_aids(p, base, len(fresh), send_notes, notes, sync))
+            data = cache[key] = encode_frame(AIDS, encode_aids(p, base, len(fresh), send_notes, notes, sync, rows))
         viewer.chart_synced = bool(p.flags & CHART)
+        if p.aids.lesson_flags & MOMENTA:
+            viewer.momenta_serial = p.momenta_serial
         if p.values is not None:
             viewer.vector_seq = p.seq
         if p.serials:
@@ -228,7 +308,13 @@ def _f32(values) -> list[float]:
 
 
 def encode_aids(
-    p: _Prepared, base: np.ndarray | None, fresh: int, send_notes: bool, notes: str | None, history: bool = False
+    p: _Prepared,
+    base: np.ndarray | None,
+    fresh: int,
+    send_notes: bool,
+    notes: str | None,
+    history: bool = False,
+    momenta_rows: bool = False,
 ) -> bytes:
     """The AIDS payload for one tick and one footing (see the module's docstring)."""
     flags = p.flags | (NOTES_TEXT if send_notes else 0)
@@ -264,7 +350,45 @@ def encode_aids(
         parts.append(_NOTES.pack(p.notes_version, len(raw)))
         packed = _deflate(raw)
         parts.append(len(packed).to_bytes(2, "little") + packed)
-    return _HEAD.pack(AIDS_MAGIC, AIDS_VERSION, flags, p.seq & 0xFFFFFFFF) + b"".join(parts)
+    lessons = p.aids.lessons
+    if lessons is None or not lessons.flags:
+        return _HEAD.pack(AIDS_MAGIC, AIDS_VERSION, flags, p.seq & 0xFFFFFFFF) + b"".join(parts)
+    lesson_flags = lessons.flags | (MOMENTA_ROWS if momenta_rows else 0)
+    head = _HEAD.pack(AIDS_MAGIC, LESSONS_VERSION, flags, p.seq & 0xFFFFFFFF) + _LESSONS.pack(lesson_flags)
+    return head + b"".join(parts) + _lessons_bytes(lessons, lesson_flags, p.momenta_serial)
+
+
+def _lessons_bytes(a: SharedLessons, flags: int, serial: int) -> bytes:
+    """The lesson panels' sections, in flag order."""
+    out = b""
+    if flags & MOMENTA:
+        out += _MOMENTA.pack(a.momenta_corner & 3, serial)
+    if flags & MOMENTA_ROWS:
+        m = a.momenta
+        rows = np.asarray(m.rows, dtype=np.int64)[:MAX_MOMENTA_ROWS]
+        k = len(rows)
+        numbers = np.hstack([np.asarray(m.before_Ns, dtype=float)[:k], np.asarray(m.after_Ns, dtype=float)[:k]])
+        totals = _f32((*m.total_before_Ns, *m.total_after_Ns))
+        out += _MOMENTA_ROWS.pack(_f32((m.t_s,))[0], *totals, k)
+        out += rows.astype("<u4").tobytes() + _f32_block(numbers)
+    if flags & VALUES:
+        rows = np.asarray(a.value_rows, dtype=np.int64)[:MAX_VALUE_ROWS]
+        k = len(rows)
+        numbers = np.column_stack(
+            [np.asarray(a.value_mass_kg, dtype=float)[:k], np.asarray(a.value_vel_mps, dtype=float).reshape(-1, 2)[:k]]
+        )
+        out += _VALUES.pack(a.values_corner & 3, int(a.values_every), k)
+        out += rows.astype("<u4").tobytes() + _f32_block(numbers)
+    if flags & TIMELINE:
+        oldest, newest, view, frames, index = a.timeline
+        out += _TIMELINE.pack(*_f32((oldest, newest, view)), min(int(frames), MAX_HISTORY_FRAMES), int(index))
+    return out
+
+
+def _f32_block(numbers: np.ndarray) -> bytes:
+    """Finite float32s, row by row (non-finite become 0, the huge are cut)."""
+    clean = np.clip(np.nan_to_num(numbers, nan=0.0, posinf=0.0, neginf=0.0), -MAX_NUMBER, MAX_NUMBER)
+    return clean.astype("<f4").tobytes()
 
 
 def _chart_bytes(a: SharedAids, history: bool) -> bytes:
@@ -307,6 +431,15 @@ class AidsFrame:
     chart_corner: int = 0
     chart_history: np.ndarray | None = None  # (H, 6), only when it came in this frame
     notes: str | None = None  # only when its text came in this frame
+    lesson_flags: int = 0
+    momenta_corner: int = 0
+    momenta: MomentaRecord | None = None  # the diagram's collision (held from an earlier frame, or new)
+    values_corner: int = 0
+    values_every: bool = True
+    value_rows: np.ndarray | None = None  # (R,) int
+    value_mass_kg: np.ndarray | None = None  # (R,)
+    value_vel_mps: np.ndarray | None = None  # (R, 2)
+    timeline: tuple[float, float, float, int, int] | None = None  # oldest, newest, view s; frames, index
 
     @property
     def vectors(self) -> int:
@@ -321,22 +454,13 @@ class AidsDecoder:
     values_key: tuple = ()  # their quantity flag and scale
     values_seq: int = 0
     notes: str | None = None
+    momenta_serial: int = 0  # the collision whose momenta this client holds (0: none)
+    momenta: MomentaRecord | None = None
 
     def feed(self, payload: bytes, seq: int, pucks: int, time_s: float = 0.0) -> AidsFrame:
         """Check and decode; `seq`, `pucks` and `time_s` are those of the snapshot just decoded."""
-        payload = bytes(payload)
-        if len(payload) < _HEAD.size:
-            raise ProtocolError(f"the aids frame is only {len(payload)} bytes, less than its {_HEAD.size} byte header")
-        magic, version, flags, aseq = _HEAD.unpack_from(payload)
-        if magic != AIDS_MAGIC or version != AIDS_VERSION:
-            raise _bad("an aids frame of another version")
-        if aseq != seq & 0xFFFFFFFF:
-            raise _bad(f"aids for tick {aseq} right after tick {seq}")
-        if flags & VELOCITY and flags & MOMENTUM:
-            raise _bad("aids asking for velocity and momentum arrows at once")
-        r = _Reader(payload, "aids frame")
-        r.take(_HEAD.size)
-        out = AidsFrame(seq=aseq, flags=flags)
+        r, out = _header(bytes(payload), seq)
+        flags = out.flags
         if flags & (VELOCITY | MOMENTUM):
             self._vectors(r, out, pucks)
         if flags & ANNOTATIONS:
@@ -347,8 +471,30 @@ class AidsDecoder:
             if not flags & NOTES:
                 raise _bad("notes text while the notes are off")
             out.notes = self.notes = _notes(r)
+        if out.lesson_flags & MOMENTA:
+            self._momenta(r, out, pucks)
+        if out.lesson_flags & VALUES:
+            _values(r, out, pucks)
+        if out.lesson_flags & TIMELINE:
+            out.timeline = _timeline(r)
         r.done()
         return out
+
+    def _momenta(self, r: _Reader, out: AidsFrame, pucks: int) -> None:
+        corner, serial = _MOMENTA.unpack(r.take(_MOMENTA.size))
+        if corner > 3:
+            raise _bad(f"a momenta diagram in corner {corner}")
+        out.momenta_corner = corner
+        if out.lesson_flags & MOMENTA_ROWS:
+            if serial == 0:
+                raise _bad("momenta rows for no collision")
+            self.momenta = _momenta_rows(r, pucks)
+        elif serial == 0:
+            self.momenta = None
+        elif serial != self.momenta_serial:
+            raise _bad(f"momenta of collision {serial}, which this client was never sent")
+        self.momenta_serial = serial
+        out.momenta = self.momenta
 
     def _vectors(self, r: _Reader, out: AidsFrame, pucks: int) -> None:
         n, amount, vel_amount, cx, cy, cvx, cvy, width, deflated, size = _VEC.unpack(r.take(_VEC.size))
@@ -373,6 +519,75 @@ class AidsDecoder:
         self.values, self.values_seq, self.values_key = values, out.seq, (kind, amount)
         out.values = np.column_stack([values[:n], values[n:]]) * (amount / ARROW_STEPS)
         out.amount, out.velocity_amount = amount, vel_amount
+
+
+def _header(payload: bytes, seq: int) -> tuple[_Reader, AidsFrame]:
+    """The header checked (and format 2's lesson flags): a reader past it, and the frame to fill."""
+    if len(payload) < _HEAD.size:
+        raise ProtocolError(f"the aids frame is only {len(payload)} bytes, less than its {_HEAD.size} byte header")
+    magic, version, flags, aseq = _HEAD.unpack_from(payload)
+    if magic != AIDS_MAGIC or version not in (AIDS_VERSION, LESSONS_VERSION):
+        raise _bad("an aids frame of another version")
+    if aseq != seq & 0xFFFFFFFF:
+        raise _bad(f"aids for tick {aseq} right after tick {seq}")
+    if flags & VELOCITY and flags & MOMENTUM:
+        raise _bad("aids asking for velocity and momentum arrows at once")
+    r = _Reader(payload, "aids frame")
+    r.take(_HEAD.size)
+    out = AidsFrame(seq=aseq, flags=flags)
+    if version == LESSONS_VERSION:
+        (lf,) = _LESSONS.unpack(r.take(_LESSONS.size))
+        if not lf or lf & ~LESSON_FLAGS or (lf & MOMENTA_ROWS and not lf & MOMENTA):
+            raise _bad(f"lesson panels flagged {lf}")
+        out.lesson_flags = lf
+    return r, out
+
+
+def _rows(r: _Reader, count: int, pucks: int, what: str) -> np.ndarray:
+    """`count` u32 puck rows, strictly increasing and on the table."""
+    rows = r.array("<u4", (count,)).astype(np.int64)
+    if count and (rows[-1] >= pucks or (np.diff(rows) <= 0).any()):
+        raise _bad(f"{what} rows that are not distinct pucks of the table's {pucks}, in order")
+    return rows
+
+
+def _numbers(r: _Reader, shape: tuple[int, int], what: str) -> np.ndarray:
+    numbers = r.array("<f4", shape).astype(float)
+    if not (np.isfinite(numbers).all() and (np.abs(numbers) <= MAX_NUMBER).all()):
+        raise _bad(f"{what} that are not finite numbers")
+    return numbers
+
+
+def _momenta_rows(r: _Reader, pucks: int) -> MomentaRecord:
+    t_s, bx, by, ax, ay, count = _MOMENTA_ROWS.unpack(r.take(_MOMENTA_ROWS.size))
+    if count > min(MAX_MOMENTA_ROWS, pucks):
+        raise _bad(f"a momenta diagram of {count} pucks on a table of {pucks} (at most {MAX_MOMENTA_ROWS})")
+    t_s, *totals = _finite((t_s, bx, by, ax, ay), "momenta total")
+    rows = _rows(r, count, pucks, "momenta")
+    numbers = _numbers(r, (count, 4), "momenta")
+    return MomentaRecord(t_s, rows, numbers[:, :2], numbers[:, 2:], tuple(totals[:2]), tuple(totals[2:]))
+
+
+def _values(r: _Reader, out: AidsFrame, pucks: int) -> None:
+    corner, every, count = _VALUES.unpack(r.take(_VALUES.size))
+    if corner > 3 or every > 1:
+        raise _bad(f"a values panel in corner {corner} with flag {every}")
+    if count > min(MAX_VALUE_ROWS, pucks) or (every and count != pucks):
+        raise _bad(f"values of {count} pucks on a table of {pucks}")
+    rows = _rows(r, count, pucks, "values")
+    numbers = _numbers(r, (count, 3), "values")
+    if count and (numbers[:, 0] <= 0).any():
+        raise _bad("a puck of no mass in the values panel")
+    out.values_corner, out.values_every = corner, bool(every)
+    out.value_rows, out.value_mass_kg, out.value_vel_mps = rows, numbers[:, 0], numbers[:, 1:]
+
+
+def _timeline(r: _Reader) -> tuple[float, float, float, int, int]:
+    oldest, newest, view, frames, index = _TIMELINE.unpack(r.take(_TIMELINE.size))
+    oldest, newest, view = _finite((oldest, newest, view), "timeline time")
+    if not (oldest <= view <= newest and 2 <= frames <= MAX_HISTORY_FRAMES and index < frames):
+        raise _bad(f"a timeline at {view} s of {oldest} to {newest} s, frame {index} of {frames}")
+    return (oldest, newest, view, frames, index)
 
 
 def _finite(values, what: str) -> tuple[float, ...]:

@@ -526,6 +526,8 @@ class PlayerApp:
         self.keys: set[str] = set()
         self.show_help = False  # F1: the keys of this window
         self.painter = None  # the AidsPainter, once the window is open
+        self.lessons_painter = None  # the LessonsPainter (momenta, values) and
+        self.timeline_painter = None  # the TimelinePainter, likewise
         self._drawn_from: tuple = ()  # the restarts and view the trails were drawn in
         self._welcome: proto.Welcome | None = None
         self.predicting = StudentGuesses()  # our arrows in a prediction round
@@ -567,13 +569,15 @@ class PlayerApp:
     def _open_window(self) -> None:
         import pygame
 
-        from airtable.app.window import GameWindow
+        from airtable.app.window import GameWindow, LessonsPainter, TimelinePainter
 
         self._welcome = self.net.welcome
         from airtable.app.aids_paint import AidsPainter
 
         self.window = GameWindow(self._new_env(), caption=self._caption(), headless=self.headless)
         self.painter = AidsPainter(self.window)
+        self.lessons_painter = LessonsPainter(self.window)
+        self.timeline_painter = TimelinePainter(self.window)
         if not self.headless:
             pygame.mouse.set_visible(False)  # our arrow, drawn each frame, is the pointer
 
@@ -688,7 +692,7 @@ class PlayerApp:
                 print(f"airtable-client: could not draw a frame ({self.draw_error}); carrying on", file=sys.stderr)
 
     def _draw(self, scene: Scene, cursor_m: np.ndarray, focused: bool) -> None:
-        from airtable.app.aids_student_view import STUDENT_KEYS, draw_student_aids
+        from airtable.app.aids_student_view import STUDENT_KEYS, draw_student_aids, draw_student_lessons
 
         net, win, welcome = self.net, self.window, self._welcome
         me = welcome.label if welcome else ""
@@ -702,6 +706,7 @@ class PlayerApp:
             banner=net.banner_text or student_banner(scene, me),
             hud_color=color,
         )
+        draw_student_lessons(self.lessons_painter, self.timeline_painter, scene, net.aids, cursor_m)
         draw_student_aids(self.painter, scene, net.aids, time.monotonic(), cursor_m)
         if extra and me:  # not in the snapshots yet: the arrow alone
             win.draw_cursor(me, color, cursor_m)
@@ -712,15 +717,15 @@ class PlayerApp:
             win.draw_panel(scene.title, [net.aids.notes], large=True)
         win.present()
 
-    def _draw_round(self, color) -> None:
+    def _draw_round(self, color) -> list:
+        """The prediction round, if one is under way; returns the lines of text written and where."""
         info = self.net.round
         self.predicting.follow(info)
         if info is None or info.state == "closed":
-            return
+            return []
         count = f"{info.predicted} of {info.players} predicted"
-        paint_round(
-            self.painter, info, self.predicting.guesses, color, count
-        )  # the aids' painter: labels avoid each other
+        # The aids' painter: its labels and these lines avoid each other.
+        return paint_round(self.painter, info, self.predicting.guesses, color, count)
 
 
 def fit_drawing_budget(scene: Scene, env) -> Scene:
