@@ -79,3 +79,33 @@ def test_stamped_pucks_overlap_in_their_own_order_as_blitted_ones_do() -> None:
     image = drawn((320, 240), centers, r_px, colors, sprites)
     assert stamped == [6]
     assert np.array_equal(image, blitted_one_by_one((320, 240), centers, r_px, colors))
+
+
+def drawn_big_one_by_one(size, centers, r_px, colors) -> np.ndarray:
+    """The reference for big pucks: every one drawn alone, in order."""
+    from airtable.app.pucks_view import draw_puck
+
+    target = pygame.Surface(size)
+    target.fill(TABLE_BLUE)
+    for (x, y), r, c in zip(centers.tolist(), r_px.tolist(), colors.tolist()):
+        draw_puck(target, tuple(c), (round(x), round(y)), r)
+    return pygame.surfarray.array3d(target)
+
+
+def test_thousands_of_big_pucks_draw_only_what_shows_and_look_the_same() -> None:
+    # 3000 pucks of radius 200-400 px on a 320 x 240 target: stacked on five discs, or each big enough to fill it.
+    # Drawn alone each costs its area; only the last filling one and those after it, one per disc, can show.
+    rng = np.random.default_rng(3)
+    spots = np.array([[0.0, 0.0], [320.0, 240.0], [0.0, 240.0], [160.4, 119.6], [500.0, 120.0]])
+    centers = spots[rng.integers(0, 5, 3000)]
+    r_px = rng.choice([200, 400], 3000)
+    colors = rng.integers(0, 256, (3000, 3), dtype=np.uint8)
+    calls = []
+    real_circle = pygame.draw.circle
+    pygame.draw.circle = lambda *a, **k: calls.append(a) or real_circle(*a, **k)
+    try:
+        image = drawn((320, 240), centers, r_px, colors, PuckSprites())
+    finally:
+        pygame.draw.circle = real_circle
+    assert np.array_equal(image, drawn_big_one_by_one((320, 240), centers, r_px, colors))
+    assert len(calls) <= 2 * 9  # at most the nine discs left (two circles each), where 3000 pucks were drawn

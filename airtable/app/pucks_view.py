@@ -139,8 +139,10 @@ def draw_pucks(target: pygame.Surface, sprites: PuckSprites, centers: np.ndarray
         centers, r_px, colors = centers[visible], r_px[visible], colors[visible]
     big = r_px > SPRITE_MAX_RADIUS_PX
     if big.any():  # few on screen at once: a big puck covers much of it
-        for (x, y), r, c in zip(centers[big].tolist(), r_px[big].tolist(), colors[big].tolist()):
-            draw_puck(target, tuple(c), (round(x), round(y)), r)
+        at, r_big, c_big = np.rint(centers[big]).astype(np.int64), r_px[big], colors[big]
+        shown = _big_ones_shown(at, r_big, target.get_clip())
+        for (x, y), r, c in zip(at[shown].tolist(), r_big[shown].tolist(), c_big[shown].tolist()):
+            draw_puck(target, tuple(c), (x, y), r)
         small = ~big
         centers, r_px, colors = centers[small], r_px[small], colors[small]
     if len(r_px) == 0:
@@ -160,6 +162,20 @@ def draw_pucks(target: pygame.Surface, sprites: PuckSprites, centers: np.ndarray
         images = [sprites.get(r, color) for r, color in sprite_of]
         sources = map(images.__getitem__, inverse.tolist())
         target.fblits(list(zip(sources, zip(corner[:, 0].tolist(), corner[:, 1].tolist()))))
+
+
+def _big_ones_shown(at: np.ndarray, r_px: np.ndarray, clip: pygame.Rect) -> np.ndarray:
+    """Which big pucks can be seen, in drawing order: none under a later one whose core fills the whole
+    clip, and of pucks on the very same disc only the last. Each big puck costs its area in pixels, so a
+    snapshot of thousands of them (a table zoomed in on a crowd) would take seconds a frame if all were drawn."""
+    inner = r_px - np.maximum(2, r_px // 6)  # ring_width_px, for every puck at once
+    far_x = np.maximum(np.abs(at[:, 0] - clip.left), np.abs(at[:, 0] - clip.right))
+    far_y = np.maximum(np.abs(at[:, 1] - clip.top), np.abs(at[:, 1] - clip.bottom))
+    fills = np.flatnonzero(far_x**2 + far_y**2 < inner**2)  # as draw_puck tests it: fills the clip
+    keep = np.arange(fills[-1] if len(fills) else 0, len(r_px))
+    discs = np.column_stack((at[keep], r_px[keep]))
+    _, last_from_end = np.unique(discs[::-1], axis=0, return_index=True)
+    return keep[np.sort(len(keep) - 1 - last_from_end)]
 
 
 def _stampable(target: pygame.Surface) -> bool:
