@@ -53,3 +53,10 @@ def wait_until(
         if time.monotonic() > deadline:
             pytest.fail(f"timed out after {timeout_s} s waiting for {what}")
         time.sleep(poll_s)
+
+
+def server_frames(data: bytes) -> list[tuple[int, bytes]]:
+    """The (type, payload) frames in bytes a server sent, read as a player reads them (all checks on)."""
+    from airtable.net import protocol
+
+    return protocol.FrameReader(protocol.MAX_SERVER_FRAME, sender="the server").feed(data)

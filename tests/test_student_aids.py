@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pygame
 import pytest
-from conftest import post_key
+from conftest import post_key, server_frames
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
@@ -37,15 +37,6 @@ def _scene(n: int = 3, aids_: SharedAids | None = None, t: float = 0.0) -> Scene
     )
 
 
-def _frames(data: bytes) -> list[tuple[int, bytes]]:
-    out, k = [], 0
-    while k < len(data):
-        size = int.from_bytes(data[k : k + 4], "big")
-        out.append((data[k + 4], data[k + 5 : k + 4 + size]))
-        k += 4 + size
-    return out
-
-
 class _Student:
     """The decoding side without sockets: the snapshot decoder, then the aids decoder."""
 
@@ -54,7 +45,7 @@ class _Student:
 
     def take(self, data: bytes, now_s: float = 0.0) -> list:
         got = []
-        for kind, payload in _frames(data):
+        for kind, payload in server_frames(data):
             if kind == LAYOUT:
                 self.snaps.feed_layout(payload)
             elif kind == SNAPSHOT:
@@ -133,7 +124,7 @@ def test_annotations_are_sent_once_and_forgotten_as_the_teacher_forgets_them():
 
 def _payload(enc: AidsEncoder, viewer: AidsViewer) -> bytes:
     data = enc.frame_for(viewer)
-    ((kind, payload),) = _frames(data)
+    ((kind, payload),) = server_frames(data)
     assert kind == AIDS
     return payload
 

@@ -10,7 +10,7 @@ from pathlib import Path
 import numpy as np
 import pygame
 import pytest
-from conftest import FRAME_S, WAIT_S, press, wait_until
+from conftest import FRAME_S, WAIT_S, press, server_frames, wait_until
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
@@ -44,15 +44,6 @@ DEMO = (
 VARIATIONS = "VARIATIONS = ['three pucks', 'nine pucks']\n"
 
 
-def _frames(data: bytes) -> list[tuple[int, bytes]]:
-    out, k = [], 0
-    while k < len(data):
-        size = int.from_bytes(data[k : k + 4], "big")
-        out.append((data[k + 4], data[k + 5 : k + 4 + size]))
-        k += 4 + size
-    return out
-
-
 def _view(k: int = 3) -> MomentaView:
     before = np.array([[1.0, 0.0], [0.0, 0.0], [0.0, 0.25]])[:k]
     after = np.array([[-0.5, 0.0], [1.5, 0.0], [0.0, 0.25]])[:k]
@@ -79,7 +70,7 @@ def _shared(view=None, **lessons) -> SharedAids:
 
 
 def _payload(enc: AidsEncoder, viewer: AidsViewer) -> bytes:
-    ((kind, payload),) = _frames(enc.frame_for(viewer))
+    ((kind, payload),) = server_frames(enc.frame_for(viewer))
     assert kind == AIDS
     return payload
 

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import contextlib
 import os
 import shutil
 import subprocess
@@ -95,16 +96,62 @@ def key_taken(display: str, wid: str, key: str) -> bool:
     return True
 
 
+@contextlib.contextmanager
+def running(display: str, args: list[str], cwd=None):
+    """A process on the display and the id of its window; killed if the test leaves it running."""
+    env = {**os.environ, "DISPLAY": display, "SDL_VIDEODRIVER": "x11"}
+    proc = subprocess.Popen(args, env=env, cwd=cwd, stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+    try:
+        yield proc, wait_for(lambda: find_window(display), what="the window")
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+            proc.wait()
+
+
+def demo_2(shot) -> list[str]:
+    """The app on demo 2, which saves a screenshot to `shot` when it quits."""
+    return [
+        sys.executable,
+        "-m",
+        "airtable",
+        "--no-server",
+        "--demo",
+        "2",
+        "--seconds",
+        "60",
+        "--screenshot",
+        str(shot),
+    ]
+
+
+def quit_with_escape(display: str, wid: str, proc: subprocess.Popen) -> None:
+    assert key_taken(display, wid, "Escape") and proc.wait(timeout=20) == 0, proc.stderr.read().decode()
+
+
+WALL = (255, 69, 0)
+TABLE_ASPECT = 10.0 / 8.7556
+
+
+def wall_columns(image: np.ndarray, row: int) -> np.ndarray:
+    """The x of every wall-coloured pixel on one row of a screenshot."""
+    return np.flatnonzero(np.all(image[:, row] == WALL, axis=1))
+
+
+def assert_table_fills_the_height(shot, size: tuple[int, int]) -> np.ndarray:
+    """The screenshot is `size`, and the table fills its height, centred, with its aspect kept."""
+    pygame.display.init()
+    image = pygame.surfarray.array3d(pygame.image.load(str(shot)))
+    (w, h) = size
+    assert image.shape[:2] == size
+    left = round((w - h * TABLE_ASPECT) / 2)
+    xs = wall_columns(image, h // 2)
+    assert abs(xs.min() - left) <= 2 and abs(xs.max() - (w - 1 - left)) <= 2
+    return image
+
+
 def test_demo_key_and_mouse_drag_in_a_real_window(display, tmp_path):
     shot = tmp_path / "final.png"
-    env = {**os.environ, "DISPLAY": display, "SDL_VIDEODRIVER": "x11"}
-    app = subprocess.Popen(
-        [sys.executable, "-m", "airtable", "--no-server", "--demo", "2", "--seconds", "60", "--screenshot", str(shot)],
-        env=env,
-        cwd=tmp_path,  # F12 saves into ./screenshots: the test looks there
-        stdout=subprocess.PIPE,
-        stderr=subprocess.PIPE,
-    )
     pygame.display.init()
 
     def pulled_far_enough():
@@ -114,8 +161,7 @@ def test_demo_key_and_mouse_drag_in_a_real_window(display, tmp_path):
         centre = orange_centre(shots[-1]) if shots else None
         return centre is not None and centre[0] > 405 + 50 and centre[1] > 383 + 50
 
-    try:
-        wid = wait_for(lambda: find_window(display), what="the window")
+    with running(display, demo_2(shot), cwd=tmp_path) as (app, wid):  # F12 saves into ./screenshots
         xdotool(display, "windowfocus", "--sync", wid)
         assert "Demo 2" in xdotool(display, "getwindowname", wid)
         xdotool(display, "key", "3")
@@ -128,53 +174,20 @@ def test_demo_key_and_mouse_drag_in_a_real_window(display, tmp_path):
         wait_for(pulled_far_enough, what="the string to pull the puck toward the cursor")
         xdotool(display, "mouseup", "1")
         xdotool(display, "key", "space")  # pause, so the puck stays where the string left it
-        xdotool(display, "key", "Escape")
-        assert app.wait(timeout=20) == 0, app.stderr.read().decode()
-    finally:
-        if app.poll() is None:
-            app.kill()
-            app.wait()
+        quit_with_escape(display, wid, app)
     centre = orange_centre(shot)
     # It was pulled toward the cursor: down and to the right of where it started.
     assert centre is not None and centre[0] > 405 + 50 and centre[1] > 383 + 50
 
 
-WALL = (255, 69, 0)
-TABLE_ASPECT = 10.0 / 8.7556
-
-
-def wall_columns(image: np.ndarray, row: int) -> np.ndarray:
-    """The x of every wall-coloured pixel on one row of a screenshot."""
-    return np.flatnonzero(np.all(image[:, row] == WALL, axis=1))
-
-
 def test_the_table_follows_a_resize_of_the_window(display, tmp_path):
     shot = tmp_path / "resized.png"
-    env = {**os.environ, "DISPLAY": display, "SDL_VIDEODRIVER": "x11"}
-    app = subprocess.Popen(
-        [sys.executable, "-m", "airtable", "--no-server", "--demo", "2", "--seconds", "60", "--screenshot", str(shot)],
-        env=env,
-        stdout=subprocess.PIPE,
-        stderr=subprocess.PIPE,
-    )
-    try:
-        wid = wait_for(lambda: find_window(display), what="the window")
+    with running(display, demo_2(shot)) as (app, wid):
         xdotool(display, "windowsize", "--sync", wid, "1000", "500")
         wait_for(lambda: window_size(display, wid) == (1000, 500), what="the new size")
-        xdotool(display, "windowfocus", "--sync", wid)
-        xdotool(display, "key", "Escape")
-        assert app.wait(timeout=20) == 0, app.stderr.read().decode()
-    finally:
-        if app.poll() is None:
-            app.kill()
-            app.wait()
-    pygame.display.init()
-    image = pygame.surfarray.array3d(pygame.image.load(str(shot)))
-    assert image.shape[:2] == (1000, 500)
+        quit_with_escape(display, wid, app)
     # The 500 px tall table is 571 px wide and centred: walls near x = 214 and 785, not at the old edges.
-    left = round((1000 - 500 * TABLE_ASPECT) / 2)
-    xs = wall_columns(image, 250)
-    assert abs(xs.min() - left) <= 2 and abs(xs.max() - (999 - left)) <= 2
+    image = assert_table_fills_the_height(shot, (1000, 500))
     ys = np.flatnonzero(np.all(image[500] == WALL, axis=1))
     assert ys.min() <= 2 and ys.max() >= 497  # top and bottom walls at the window's edges
 
@@ -205,14 +218,8 @@ sys.exit(3)
 
 def test_f11_toggles_desktop_fullscreen_and_back(display, tmp_path):
     shot = tmp_path / "full.png"
-    env = {**os.environ, "DISPLAY": display, "SDL_VIDEODRIVER": "x11"}
-    proc = subprocess.Popen(
-        [sys.executable, "-c", FULLSCREEN_DRIVER, str(shot)], env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE
-    )
-    try:
-        wid = wait_for(lambda: find_window(display), what="the window")
-        xdotool(display, "windowfocus", "--sync", wid)
-        xdotool(display, "key", "F11")
+    with running(display, [sys.executable, "-c", FULLSCREEN_DRIVER, str(shot)]) as (proc, wid):
+        key_taken(display, wid, "F11")
         wid = wait_for(lambda: sized_window(display, (1024, 900)), what="the fullscreen window")  # may be a new one
         # SDL takes keys again only once it has settled into fullscreen: a screenshot (F12) may be asked
         # for again until one is written, which also tells that the next key will be seen.
@@ -222,46 +229,17 @@ def test_f11_toggles_desktop_fullscreen_and_back(display, tmp_path):
         wait_for(lambda: key_taken(display, wid, "Escape") and proc.poll() is not None, what="the driver to quit")
         assert proc.wait(timeout=20) == 0, proc.stderr.read().decode()
         assert proc.stdout.read().decode().split() == ["size", "640", "480", "0"]
-    finally:
-        if proc.poll() is None:
-            proc.kill()
-            proc.wait()
-    pygame.display.init()
-    image = pygame.surfarray.array3d(pygame.image.load(str(shot)))
-    assert image.shape[:2] == (1024, 900)  # the whole Xvfb screen
-    # The table fills the height of the 1024 x 900 screen, centred: side walls at x = 30 and 993.
-    left = round((1024 - 900 * TABLE_ASPECT) / 2)
-    xs = wall_columns(image, 450)
-    assert abs(xs.min() - left) <= 2 and abs(xs.max() - (1023 - left)) <= 2
+    # The table fills the height of the whole 1024 x 900 Xvfb screen, centred: side walls at x = 30 and 993.
+    assert_table_fills_the_height(shot, (1024, 900))
 
 
 def test_f11_in_the_app_fills_the_screen(display, tmp_path):
     shot = tmp_path / "app_full.png"
-    env = {**os.environ, "DISPLAY": display, "SDL_VIDEODRIVER": "x11"}
-    app = subprocess.Popen(
-        [sys.executable, "-m", "airtable", "--no-server", "--demo", "2", "--seconds", "60", "--screenshot", str(shot)],
-        env=env,
-        stdout=subprocess.PIPE,
-        stderr=subprocess.PIPE,
-    )
-    try:
-        wid = wait_for(lambda: find_window(display), what="the window")
-        xdotool(display, "windowfocus", "--sync", wid)
-        xdotool(display, "key", "F11")
+    with running(display, demo_2(shot)) as (app, wid):
+        key_taken(display, wid, "F11")
         wid = wait_for(lambda: sized_window(display, (1024, 900)), what="the fullscreen window")
-        xdotool(display, "windowfocus", "--sync", wid)
-        xdotool(display, "key", "Escape")
-        assert app.wait(timeout=20) == 0, app.stderr.read().decode()
-    finally:
-        if app.poll() is None:
-            app.kill()
-            app.wait()
-    pygame.display.init()
-    image = pygame.surfarray.array3d(pygame.image.load(str(shot)))
-    assert image.shape[:2] == (1024, 900)
-    left = round((1024 - 900 * TABLE_ASPECT) / 2)
-    xs = wall_columns(image, 450)
-    assert abs(xs.min() - left) <= 2 and abs(xs.max() - (1023 - left)) <= 2
+        quit_with_escape(display, wid, app)
+    assert_table_fills_the_height(shot, (1024, 900))
 
 
 def test_on_x11_the_window_keeps_its_pixels_in_the_plain_framebuffer(display):
