@@ -14,6 +14,7 @@ from airtable.app.lessons_paint import TOTAL_COLOR, fitting, momenta_scale, tota
 from airtable.app.momenta import (
     MomentaLog,
     MomentaView,
+    every_puck_values,
     fit_chains,
     momenta_around_collisions,
     tip_to_tail,
@@ -87,6 +88,14 @@ def test_values_of_few_pucks_and_of_the_puck_under_the_cursor():
         t.add_puck((1.0 + k, 6.0))
     assert values_for(t, None) == []  # seven pucks: only the one under the cursor
     assert [r.name for r in values_for(t, 1)] == ["1"]
+
+
+def test_a_cradles_still_pucks_show_zero_not_round_off():
+    # After a cradle's hit the still pucks keep 1e-13 m/s of round-off; equal and opposite momenta sum to 1e-17.
+    rows = every_puck_values(np.array([0.2, 0.2, 0.2]), np.array([[1e-13, 0.0], [-2e-14, 0.0], [4.0, 0.0]]))
+    assert [r.cells()[2:] for r in rows[:3]] == [("0", "0", "0"), ("0", "0", "0"), ("4", "0.8", "1.6")]
+    opposite = every_puck_values(np.array([0.2, 0.2]), np.array([[1.0, 0.0], [-1.0 + 1e-16, 0.0]]))
+    assert opposite[2].cells() == ("total", "0.4", "", "0", "0.2")
 
 
 def pixels_of(app: App, color) -> int:

@@ -168,6 +168,7 @@ class PuckValues:
         return (self.name, f"{self.mass_kg:.3g}", speed, f"{self.momentum_Ns:.3g}", f"{self.kinetic_J:.3g}")
 
 
+ROUND_OFF_MPS = 1e-9  # a nanometre a second: below it a speed is the round-off of a collision, shown as 0
 VALUE_HEADINGS = ("puck", "m kg", "|v| m/s", "|p| N s", "KE J")  # mass, speed, momentum, kinetic energy
 
 
@@ -179,6 +180,7 @@ def puck_values(mass_kg: np.ndarray, vel_mps: np.ndarray, rows: Sequence[int]) -
         m = float(mass_kg[k])
         v = vel_mps[k]
         speed = math.hypot(float(v[0]), float(v[1]))
+        speed = 0.0 if speed < ROUND_OFF_MPS else speed  # a cradle's still pucks keep 1e-13 m/s of round-off
         out.append(PuckValues(str(int(row)), m, speed, m * speed, 0.5 * m * speed * speed))
     return out
 
@@ -189,8 +191,9 @@ def every_puck_values(mass_kg: np.ndarray, vel_mps: np.ndarray) -> list[PuckValu
     n = len(mass_kg)
     rows = puck_values(mass_kg, vel_mps, range(n))
     if n > 1:
-        p = mass_kg @ vel_mps
-        total = PuckValues("total", float(mass_kg.sum()), None, math.hypot(*p), kinetic_energy_J(mass_kg, vel_mps))
+        p = math.hypot(*(mass_kg @ vel_mps))
+        p = 0.0 if p < 1e-9 * sum(r.momentum_Ns for r in rows) else p  # equal and opposite: round-off, not 1e-17
+        total = PuckValues("total", float(mass_kg.sum()), None, p, kinetic_energy_J(mass_kg, vel_mps))
         rows.append(total)
     return rows
 
