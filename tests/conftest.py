@@ -60,3 +60,22 @@ def server_frames(data: bytes) -> list[tuple[int, bytes]]:
     from airtable.net import protocol
 
     return protocol.FrameReader(protocol.MAX_SERVER_FRAME, sender="the server").feed(data)
+
+
+def frames_until(app, condition: Callable[[], object], what: str = "condition", max_frames: int | None = None):
+    """Run app frames (1/60 s of simulated time each) until `condition()` holds, and return its value.
+
+    Bounded by `max_frames` where the condition depends on the table alone, else by WAIT_S of real time
+    (students' sockets take what real time they take, however fast the frames run)."""
+    if max_frames is None:
+
+        def step():
+            app.frame(FRAME_S)
+            return condition()
+
+        return wait_until(step, WAIT_S, what)
+    for _ in range(max_frames):
+        if value := condition():
+            return value
+        app.frame(FRAME_S)
+    pytest.fail(f"{what} did not happen within {max_frames} frames")

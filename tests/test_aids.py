@@ -7,6 +7,7 @@ import math
 import numpy as np
 import pygame
 import pytest
+from conftest import FRAME_S, frames_until, post_key, press
 
 from airtable.app import aids
 from airtable.app.app import App
@@ -14,24 +15,11 @@ from airtable.app.demo_loader import BUILTIN_DIR, discover
 from airtable.cli import main
 from airtable.physics.table import AirTable
 
-FRAME_S = 1 / 60
-
 
 def make_app(demos, key="1", **kw) -> App:
     app = App(demos, demo_key=key, headless=True, **kw)
     pygame.event.clear()
     return app
-
-
-def post_key(key: int, down: bool = True) -> None:
-    kind = pygame.KEYDOWN if down else pygame.KEYUP
-    pygame.event.post(pygame.event.Event(kind, key=key, mod=0, unicode="", scancode=0))
-
-
-def press(app: App, key: int) -> None:
-    post_key(key)
-    post_key(key, down=False)
-    app.frame(FRAME_S)
 
 
 def frame_pixels(app: App) -> np.ndarray:
@@ -84,8 +72,7 @@ def test_annotations_draw_at_a_collision(demos):
         app = make_app(demos, "2p")
         if on:
             press(app, pygame.K_a)
-        while app.table.collision_count == 0:
-            app.frame(FRAME_S)
+        frames_until(app, lambda app=app: app.table.collision_count, what="the first collision", max_frames=600)
         app.frame(0.0)  # redraw without stepping
         shots.append(frame_pixels(app))
     assert changed_fraction(*shots) > 0.002
@@ -94,8 +81,7 @@ def test_annotations_draw_at_a_collision(demos):
 def test_annotations_fade_out(demos):
     app = make_app(demos, "2p")
     press(app, pygame.K_a)
-    while app.table.collision_count == 0:
-        app.frame(FRAME_S)
+    frames_until(app, lambda: app.table.collision_count, what="the first collision", max_frames=600)
     assert len(app.collision_log.live(app.clock_s)) == 1
     app.paused = True
     for _ in range(int(aids.ANNOTATION_LIFE_S / FRAME_S) + 2):
@@ -140,8 +126,7 @@ def test_slow_motion_runs_fewer_steps_of_the_same_size(demos):
 
 def test_collision_counter_on_the_status_line(demos):
     app = make_app(demos, "2p")
-    while app.table.collision_count == 0:
-        app.frame(FRAME_S)
+    frames_until(app, lambda: app.table.collision_count, what="the first collision", max_frames=600)
     assert app.table.collision_count == 1 and "1 collision" in app.status_parts()  # singular
 
 

@@ -10,7 +10,7 @@ from pathlib import Path
 import numpy as np
 import pygame
 import pytest
-from conftest import FRAME_S, WAIT_S, press, wait_until
+from conftest import FRAME_S, WAIT_S, frames_until, press, wait_until
 from test_server import RawClient, frame
 
 from airtable.app.app import App
@@ -158,16 +158,6 @@ def next_round(student: RawClient, until) -> RoundInfo:
         info = parse_round(student.next_of(proto.ROUND))
         if until(info):
             return info
-
-
-def frames_until(app: App, condition, what: str) -> None:
-    """Run app frames (simulated time) until `condition()`; bounded by WAIT_S of real time."""
-
-    def step():
-        app.frame(FRAME_S)
-        return condition()
-
-    wait_until(step, WAIT_S, what)
 
 
 def test_three_students_predict_over_real_sockets_then_the_reveal_sums_them_up(server, tmp_path):

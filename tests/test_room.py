@@ -10,7 +10,7 @@ import time
 import numpy as np
 import pygame
 import pytest
-from conftest import FRAME_S, WAIT_S, press, wait_until
+from conftest import FRAME_S, WAIT_S, frames_until, press, wait_until
 
 from airtable.app import room, roster_view
 from airtable.app.app import App
@@ -78,14 +78,6 @@ def served(demos, request):
         return s
 
     return app, server, join
-
-
-def frames_until(app: App, condition, what: str):
-    def check():
-        app.frame(FRAME_S)
-        return condition()
-
-    return wait_until(check, what=what)
 
 
 def two_pucks(app: App) -> None:

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pygame
 import pytest
-from conftest import post_key, server_frames
+from conftest import FRAME_S, post_key, server_frames
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
@@ -20,8 +20,6 @@ from airtable.net.codec import SnapshotDecoder, SnapshotEncoder, Viewer
 from airtable.net.player import NetPlayer, PlayerApp
 from airtable.net.protocol import AIDS, LAYOUT, SNAPSHOT, ProtocolError
 from airtable.net.server import GameServer
-
-FRAME_S = 1 / 60
 
 
 def _scene(n: int = 3, aids_: SharedAids | None = None, t: float = 0.0) -> Scene:
