@@ -282,10 +282,10 @@ def serve(
     for line in server.join_lines():
         print(line, flush=True)
     loop = TableLoop(server, table, fps=fps, dt_s=dt_s, title=title).start()
-    start = time.monotonic()
+    end = math.inf if seconds is None else time.monotonic() + seconds
     try:
-        while seconds is None or time.monotonic() - start < seconds:
-            time.sleep(min(5.0, seconds - (time.monotonic() - start)) if seconds is not None else 5.0)
+        while (left := end - time.monotonic()) > 0:
+            time.sleep(min(5.0, left))
             print(f"{loop.fps:.1f} fps, {len(server.player_names())} players", flush=True)
     except KeyboardInterrupt:
         pass
