@@ -822,7 +822,7 @@ def test_the_command_line_can_refuse_what_the_server_would_with_the_same_sentenc
 
 def test_a_stalled_client_only_misses_snapshots(make_server, make_loop, clients):
     server = make_server(snapshot_hz=60)
-    table, _, _ = table_for(gas=1000)  # moving pucks: 1-3 KB snapshots fill a stalled socket in a few ticks
+    table, _, _ = table_for(gas=1000)  # colliding pucks: 1.2 KB snapshots fill a stalled socket in a few ticks
     loop = make_loop(server, table, fps=60)
     stalled = RawClient.__new__(RawClient)
     sock = socket.socket()
@@ -868,11 +868,13 @@ def test_snapshots_are_capped_at_snapshot_hz(make_server, make_loop, clients):
     c.next_of(proto.SNAPSHOT)
     start = time.monotonic()
     count = 0
-    while count < 10:  # each wait is bounded by next_frame's timeout
+    for _ in range(1000):
         if c.next_frame()[0] == proto.SNAPSHOT:
             count += 1
+            if count == 10:
+                break
     # The loop publishes 120 times a second: uncapped, 10 snapshots would come in 0.08 s, not 0.5.
-    assert count <= 20 * (time.monotonic() - start) * 1.2 + 2
+    assert count == 10 and count <= 20 * (time.monotonic() - start) * 1.2 + 2
 
 
 # ---------------------------------------------------------------- addresses and ports
