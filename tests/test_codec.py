@@ -1,4 +1,4 @@
-"""Snapshot format 2: round trips, sharing, layouts, restarts, sizes and strict decoding."""
+"""Snapshot format 2: round trips of every field, sharing, layouts, restarts, sizes and strict decoding."""
 
 from __future__ import annotations
 
@@ -9,7 +9,9 @@ import numpy as np
 import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
+from hypothesis.extra import numpy as hnp
 
+from airtable import AirTable, Client
 from airtable.app.scene import CursorView, Scene
 from airtable.net import bench_net
 from airtable.net.codec import (
@@ -73,18 +75,47 @@ def moving_scene(t: float, n: int = 20, cursors: int = 3, **extra) -> Scene:
 
 
 def assert_same(decoded: Scene, scene: Scene) -> None:
+    """Every field of `scene` came through: positions to half a unit, times to a
+    microsecond, the frame rate to a hundredth, the rest exactly."""
     half_unit = 0.5 / UNITS_PER_M + 1e-12
-    assert np.abs(decoded.pos_m - scene.pos_m).max() <= half_unit
+    assert (decoded.width_m, decoded.height_m) == (scene.width_m, scene.height_m)
+    assert np.abs(decoded.pos_m - scene.pos_m).max(initial=0) <= half_unit
     assert np.array_equal(decoded.radius_m, scene.radius_m)
     assert np.array_equal(decoded.color_rgb, scene.color_rgb)
-    assert np.array_equal(decoded.spring_pairs, scene.spring_pairs)
+    assert np.array_equal(decoded.spring_pairs, scene.spring_pairs) and decoded.spring_pairs.dtype == np.intp
+    assert np.array_equal(decoded.spring_length_m, scene.spring_length_m)
+    assert np.array_equal(decoded.spring_width_m, scene.spring_width_m)
+    assert np.array_equal(decoded.spring_color_rgb, scene.spring_color_rgb)
     assert decoded.title == scene.title and decoded.status == scene.status
+    assert decoded.gravity_on == scene.gravity_on and decoded.puck_correction == scene.puck_correction
     assert decoded.zoom == scene.zoom and decoded.origin_m == scene.origin_m
     assert decoded.time_s == pytest.approx(scene.time_s, abs=1e-6)
+    assert decoded.fps == pytest.approx(scene.fps, abs=0.005)
     assert len(decoded.cursors) == len(scene.cursors)
     for a, b in zip(decoded.cursors, scene.cursors, strict=True):
         assert (a.name, a.color, a.button, a.held) == (b.name, b.color, b.button, b.held)
         assert np.abs(np.subtract(a.cursor_m, b.cursor_m)).max() <= half_unit
+
+
+def round_trip(scene: Scene) -> Scene:
+    """`scene` as a new player decodes it: a LAYOUT and a keyframe."""
+    enc = SnapshotEncoder()
+    enc.add(scene)
+    return feed(SnapshotDecoder(), enc.frames_for(Viewer())).scene
+
+
+def keyframe_payloads(scene: Scene) -> tuple[bytes, bytes]:
+    """The LAYOUT and SNAPSHOT payloads a new player gets for `scene`."""
+    enc = SnapshotEncoder()
+    enc.add(scene)
+    (k1, layout), (k2, tick) = split_frames(enc.frames_for(Viewer()))
+    assert (k1, k2) == (LAYOUT, SNAPSHOT)
+    return layout, tick
+
+
+def assert_sentence(error: ProtocolError) -> None:
+    message = str(error)
+    assert "\n" not in message and len(message.split()) >= 5, message
 
 
 def test_every_tick_and_every_third_tick_decode_to_the_scene():
@@ -150,6 +181,105 @@ def test_a_restart_or_new_puck_count_starts_a_new_epoch_with_a_keyframe():
         assert_same(got.scene, scene)
         epochs.append(got.epoch)
     assert epochs == [0, 0, 0, 1, 1, 2]
+
+
+def table_scene() -> Scene:
+    """A real table: three pucks, a spring, gravity on, a player holding a puck with button 3."""
+    table = AirTable()
+    a = table.add_puck((2, 2), 0.3, color="orange")
+    b = table.add_puck((4, 2), 0.2, color="cyan")
+    table.add_puck((6, 6), 0.5)
+    table.add_spring(a, b, 1.5, color="gold")
+    table.gravity_on = True
+    table.puck_correction = "perfect-kiss"
+    c = Client(name="C2 Zoë", color=(255, 52, 179))
+    c.set_input(table, (4.05, 2.0), 3)
+    table.step(1 / 240)
+    return Scene.from_table(
+        table,
+        [Client(), c],
+        title="Demo 6: Spring triangle",
+        status="gravity on   t = 0.00 s",
+        fps=59.94,
+        zoom=1.5,
+        origin_m=(-1.0, 0.25),
+    )
+
+
+def test_a_table_scene_round_trips_every_field():
+    scene = table_scene()
+    back = round_trip(scene)
+    assert_same(back, scene)
+    assert back.cursors[1].name == "C2 Zoë" and back.cursors[1].held == 1 and back.cursors[1].button == 3
+    assert back.gravity_on and back.puck_correction == "perfect-kiss" and back.fps == 59.94
+    assert back.pos_m.flags.writeable
+
+
+def test_an_empty_table_round_trips():
+    scene = Scene(10.0, 8.7556, np.zeros((0, 2)), np.zeros(0), np.zeros((0, 3), np.uint8))
+    back = round_trip(scene)
+    assert_same(back, scene)
+    assert back.pos_m.shape == (0, 2) and back.cursors == ()
+
+
+def test_unprintable_text_is_cleaned_when_encoding():
+    scene = dataclasses.replace(moving_scene(0.0), status="line one\nline\x00two", title="a\tb")
+    back = round_trip(scene)
+    assert back.status == "line one line two" and back.title == "a b"
+
+
+# What str.isprintable() accepts: no control/format characters and no spaces but " ".
+printable_text = st.text(st.characters(blacklist_categories=("C", "Z"), whitelist_characters=" "), max_size=30)
+
+
+@st.composite
+def scenes(draw) -> Scene:
+    """Valid scenes, up to the edges of what a player accepts (sizes, aspect, zoom, origin, radii)."""
+    n = draw(st.integers(0, 20))
+    s = draw(st.integers(0, 10)) if n else 0
+    c = draw(st.integers(0, 5))
+    width_m = draw(st.floats(0.1, 1000))
+    height_m = draw(st.floats(max(0.1, width_m / 99), min(1000, width_m * 99)))
+    size = max(width_m, height_m)
+    x = st.floats(-size, width_m + size)
+    y = st.floats(-size, height_m + size)
+    cursors = tuple(
+        CursorView(
+            name=draw(printable_text),
+            color=draw(st.tuples(*[st.integers(0, 255)] * 3)),
+            cursor_m=(draw(x), draw(y)),
+            button=draw(st.integers(0, 3)),
+            held=draw(st.integers(-1, n - 1)),
+        )
+        for _ in range(c)
+    )
+    pos = np.column_stack([draw(hnp.arrays(float, (n,), elements=x)), draw(hnp.arrays(float, (n,), elements=y))])
+    return Scene(
+        width_m=width_m,
+        height_m=height_m,
+        pos_m=pos.reshape(n, 2),
+        radius_m=draw(hnp.arrays(float, (n,), elements=st.floats(1e-3, min(10, size)))),
+        color_rgb=draw(hnp.arrays(np.uint8, (n, 3))),
+        spring_pairs=draw(hnp.arrays(np.intp, (s, 2), elements=st.integers(0, max(n - 1, 0)))),
+        spring_length_m=draw(hnp.arrays(float, (s,), elements=st.floats(0, min(100, size)))),
+        spring_width_m=draw(hnp.arrays(float, (s,), elements=st.floats(0, min(1, size)))),
+        spring_color_rgb=draw(hnp.arrays(np.uint8, (s, 3))),
+        cursors=cursors,
+        title=draw(printable_text),
+        status=draw(printable_text),
+        gravity_on=draw(st.booleans()),
+        puck_correction=draw(st.sampled_from(["off", "two-step", "perfect-kiss"])),
+        time_s=draw(st.floats(0, 1e6)),
+        fps=draw(st.floats(0, 655)),  # centi-fps travel in 16 bits
+        zoom=draw(st.floats(0.05, 200)),
+        origin_m=(draw(x), draw(y)),
+    )
+
+
+@given(scenes())
+@settings(max_examples=50, deadline=None)
+def test_valid_scenes_at_the_edges_round_trip(scene):
+    assert_same(round_trip(scene), scene)
 
 
 def test_a_student_far_behind_gets_a_keyframe():
@@ -228,12 +358,66 @@ def test_a_held_puck_out_of_range_is_refused():
         feed(dec, enc.frames_for(viewer))
 
 
-def test_a_layout_claiming_too_many_pucks_is_refused_before_inflating():
+@pytest.mark.parametrize(
+    ("offset", "count", "hint"),
+    [
+        (8, MAX_DRAWN_PUCKS + 1, f"{MAX_DRAWN_PUCKS + 1} pucks"),
+        (8, 0xFFFFFFFF, "4294967295 pucks"),
+        (12, 0xFFFFFFFF, "4294967295 springs"),
+        (16, 0xFFFFFFFF, "4294967295 cursors"),
+    ],
+)
+def test_a_layout_claiming_too_many_things_is_refused_before_inflating(offset, count, hint):
     _, _, _, frames = primed()
     payload = bytearray(frames[0][1])
-    payload[8:12] = (MAX_DRAWN_PUCKS + 1).to_bytes(4, "little")
-    with pytest.raises(ProtocolError, match="more than this client draws"):
+    payload[offset : offset + 4] = count.to_bytes(4, "little")
+    with pytest.raises(ProtocolError, match="more than this client draws") as err:
         SnapshotDecoder().feed_layout(bytes(payload))
+    assert hint in str(err.value)
+
+
+@pytest.mark.parametrize(
+    ("frame", "offset", "value", "hint"),
+    [
+        (LAYOUT, 0, b"XXXX", "does not start with ATLY"),
+        (LAYOUT, 4, b"\x01", "version 1"),
+        (LAYOUT, 20, struct.pack("<d", float("nan")), "table size"),
+        (LAYOUT, 20, struct.pack("<d", -1.0), "table size"),
+        (SNAPSHOT, 0, b"XXXX", "does not start with ATSN"),
+        (SNAPSHOT, 16, struct.pack("<q", 1 << 62), "time out of range"),
+        (SNAPSHOT, 31, struct.pack("<d", float("nan")), "zoom"),  # a keyframe's view follows its header
+    ],
+)
+def test_header_checks(frame, offset, value, hint):
+    layout, tick = keyframe_payloads(moving_scene(0.0))
+    payload = bytearray(layout if frame == LAYOUT else tick)
+    payload[offset : offset + len(value)] = value
+    dec = SnapshotDecoder()
+    with pytest.raises(ProtocolError, match=hint):
+        if frame == LAYOUT:
+            dec.feed_layout(bytes(payload))
+        else:
+            dec.feed_layout(layout)
+            dec.feed_tick(bytes(payload))
+
+
+def test_every_truncation_and_any_extra_byte_is_a_protocol_error():
+    """Of a LAYOUT, a keyframe and a delta: every byte of each is needed, and no more."""
+    layout, keyframe = keyframe_payloads(table_scene())
+    after_layout = SnapshotDecoder()
+    after_layout.feed_layout(layout)
+    _, _, primed_dec, frames = primed()
+    primed_dec.feed_layout(frames[0][1])
+    delta = frames[1][1]
+    cases = [(layout, SnapshotDecoder().feed_layout), (keyframe, after_layout.feed_tick), (delta, primed_dec.feed_tick)]
+    for payload, decode in cases:
+        for broken in [*(payload[:cut] for cut in range(len(payload))), payload + b"\0"]:
+            with pytest.raises(ProtocolError) as err:
+                decode(broken)
+            assert_sentence(err.value)
+    # A refused frame leaves the decoder as it was: the whole delta still decodes.
+    red = np.tile(np.array([1, 2, 3], np.uint8), (20, 1))
+    assert_same(primed_dec.feed_tick(delta).scene, moving_scene(2 / 30, color_rgb=red))
 
 
 def _decode_all(dec: SnapshotDecoder, frames: list[tuple[int, bytes]]):
@@ -277,9 +461,11 @@ def test_mutated_frames_raise_only_protocol_errors(which, edits, cut, tail):
         decoded = _decode_all(dec, mutated)
     except ProtocolError as e:
         assert str(e)
-    else:
-        assert np.isfinite(decoded.scene.pos_m).all()
-        assert all(-1 <= c.held < len(decoded.scene.pos_m) for c in decoded.scene.cursors)
+    else:  # whatever decodes is safe to draw: finite, in range, printable
+        scene = decoded.scene
+        assert np.isfinite(scene.pos_m).all() and (scene.radius_m > 0).all()
+        assert all(-1 <= c.held < len(scene.pos_m) and 0 <= c.button <= 3 for c in scene.cursors)
+        assert scene.title.isprintable() and scene.status.isprintable()
 
 
 def test_a_forgotten_tick_is_not_sent_to_a_player_who_joins_later():

@@ -45,7 +45,10 @@ def start_table(cleanup, port: int = 0, **options) -> tuple[GameServer, TableLoo
 
 
 def player(cleanup, port: int, **options) -> NetPlayer:
+    """A NetPlayer that asks again soon: the waits a classroom needs are seconds."""
     options.setdefault("max_backoff_s", 0.3)
+    options.setdefault("first_backoff_s", 0.05)
+    options.setdefault("full_backoff_s", 0.05)
     net = NetPlayer("127.0.0.1", port, **options)
     cleanup(net.close)
     return net
@@ -180,7 +183,8 @@ def test_player_reconnects_when_the_server_comes_back(cleanup):
 def test_a_player_cut_off_by_a_restart_waits_when_the_table_is_now_full(cleanup):
     server, loop = start_table(cleanup)
     port = server.port
-    net = player(cleanup, port, max_backoff_s=0.5)
+    # The first try comes 0.25 s after the server went away: time for the squatter to sit down first.
+    net = player(cleanup, port, first_backoff_s=0.25)
     net.connect()
     loop.stop()
     server.stop()
@@ -215,10 +219,10 @@ def test_a_full_table_is_waited_for_on_screen_and_joined_when_a_place_frees(caps
     first = RawClient(server.port)
     cleanup(first.close)
     first.hello()
-    assert main([f"127.0.0.1:{server.port}", "--headless", "--seconds", "0.3"]) == 0
+    assert main([f"127.0.0.1:{server.port}", "--headless", "--seconds", "0.1"]) == 0
     out = capsys.readouterr().out
     assert "server full" in out and "waiting for a place" in out
-    net = player(cleanup, server.port, max_backoff_s=0.5)
+    net = player(cleanup, server.port)
     assert net.connect() is None and net.state == net.WAITING
     assert net.banner_text.startswith("the table is full: asking again in")
     first.send(proto.encode_bye())
@@ -389,6 +393,10 @@ class ScriptedServer:
 
     def close(self) -> None:
         self._stop.set()
+        try:
+            self.listener.shutdown(socket.SHUT_RDWR)  # wakes the accept() at once
+        except OSError:
+            pass
         self.thread.join(timeout=5)
         self.listener.close()
         for c in self.conns:

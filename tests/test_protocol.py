@@ -1,32 +1,17 @@
-"""The wire protocol: framing, validation of every client field, SNAPSHOT round trips."""
+"""The wire protocol: framing, validation of every client field, WELCOME and ERROR, addresses.
+
+Snapshots (format 2) are tested in test_codec.py."""
 
 from __future__ import annotations
 
 import json
 import struct
 
-import numpy as np
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
-from hypothesis.extra import numpy as hnp
 
-from airtable import AirTable, Client
-from airtable.app.scene import CursorView, Scene
 from airtable.net import protocol as proto
-
-
-def scenes_equal(a: Scene, b: Scene) -> bool:
-    """Field by field; Scene's own == would compare numpy arrays ambiguously."""
-    for name in Scene.__dataclass_fields__:
-        x, y = getattr(a, name), getattr(b, name)
-        if isinstance(x, np.ndarray) or isinstance(y, np.ndarray):
-            x, y = np.asarray(x), np.asarray(y)
-            if x.shape != y.shape or x.dtype.kind != y.dtype.kind or not np.array_equal(x, y):
-                return False
-        elif x != y:
-            return False
-    return True
 
 
 def assert_sentence(message: str, *hints: str) -> None:
@@ -256,171 +241,6 @@ def test_error_sentences_come_back_printable():
     assert t == proto.ERROR
     assert proto.parse_error(payload) == "server full really"
     assert "unreadable" in proto.parse_error(b"\xff")
-
-
-# ---------------------------------------------------------------- SNAPSHOT
-
-
-def table_scene() -> Scene:
-    table = AirTable()
-    a = table.add_puck((2, 2), 0.3, color="orange")
-    b = table.add_puck((4, 2), 0.2, color="cyan")
-    table.add_puck((6, 6), 0.5)
-    table.add_spring(a, b, 1.5, color="gold")
-    table.gravity_on = True
-    table.puck_correction = "perfect-kiss"
-    c = Client(name="C2 Zoë", color=(255, 52, 179))
-    c.set_input(table, (4.05, 2.0), 3)
-    table.step(1 / 240)
-    return Scene.from_table(
-        table,
-        [Client(), c],
-        title="Demo 6: Spring triangle",
-        status="gravity on   t = 0.00 s",
-        fps=59.94,
-        zoom=1.5,
-        origin_m=(-1.0, 0.25),
-    )
-
-
-def test_snapshot_round_trip_of_a_table_scene():
-    scene = table_scene()
-    back = proto.decode_snapshot(proto.encode_snapshot(scene))
-    assert scenes_equal(scene, back)
-    assert back.cursors[1] == CursorView("C2 Zoë", (255, 52, 179), scene.cursors[1].cursor_m, 3, 1)
-    assert back.pos_m.flags.writeable and back.spring_pairs.dtype == np.intp
-
-
-def test_snapshot_layout_header():
-    payload = proto.encode_snapshot(table_scene())
-    assert payload[:4] == b"ATSN" and payload[4] == proto.SNAPSHOT_VERSION and payload[5] == proto.FLAG_GRAVITY
-    assert struct.unpack_from("<III", payload, 8) == (3, 1, 2)
-
-
-def test_empty_scene_round_trip():
-    scene = Scene(10.0, 8.7556, np.zeros((0, 2)), np.zeros(0), np.zeros((0, 3), np.uint8))
-    assert scenes_equal(scene, proto.decode_snapshot(proto.encode_snapshot(scene)))
-
-
-finite = st.floats(-1e6, 1e6, allow_nan=False)
-# What str.isprintable() accepts: no control/format characters and no spaces but " ".
-printable_text = st.text(st.characters(blacklist_categories=("C", "Z"), whitelist_characters=" "), max_size=30)
-
-
-@st.composite
-def scenes(draw) -> Scene:
-    """Valid scenes, up to the edges of what a player accepts."""
-    n = draw(st.integers(0, 20))
-    s = draw(st.integers(0, 10)) if n else 0
-    c = draw(st.integers(0, 5))
-    width_m = draw(st.floats(0.1, 1000))
-    height_m = draw(st.floats(max(0.1, width_m / 99), min(1000, width_m * 99)))
-    size = max(width_m, height_m)
-    x = st.floats(-size, width_m + size)
-    y = st.floats(-size, height_m + size)
-    color = hnp.arrays(np.uint8, (n, 3))
-    cursors = tuple(
-        CursorView(
-            name=draw(printable_text),
-            color=draw(st.tuples(*[st.integers(0, 255)] * 3)),
-            cursor_m=(draw(x), draw(y)),
-            button=draw(st.integers(0, 3)),
-            held=draw(st.integers(-1, n - 1)),
-        )
-        for _ in range(c)
-    )
-    pos = np.column_stack([draw(hnp.arrays(float, (n,), elements=x)), draw(hnp.arrays(float, (n,), elements=y))])
-    return Scene(
-        width_m=width_m,
-        height_m=height_m,
-        pos_m=pos.reshape(n, 2),
-        radius_m=draw(hnp.arrays(float, (n,), elements=st.floats(1e-3, min(10, size)))),
-        color_rgb=draw(color),
-        spring_pairs=draw(hnp.arrays(np.intp, (s, 2), elements=st.integers(0, max(n - 1, 0)))),
-        spring_length_m=draw(hnp.arrays(float, (s,), elements=st.floats(0, min(100, size)))),
-        spring_width_m=draw(hnp.arrays(float, (s,), elements=st.floats(0, min(1, size)))),
-        spring_color_rgb=draw(hnp.arrays(np.uint8, (s, 3))),
-        cursors=cursors,
-        title=draw(printable_text),
-        status=draw(printable_text),
-        gravity_on=draw(st.booleans()),
-        puck_correction=draw(st.sampled_from(["off", "two-step", "perfect-kiss"])),
-        time_s=draw(st.floats(0, 1e6)),
-        fps=draw(st.floats(0, 1000)),
-        zoom=draw(st.floats(0.05, 200)),
-        origin_m=(draw(x), draw(y)),
-    )
-
-
-@given(scenes())
-@settings(max_examples=100, deadline=None)
-def test_snapshot_round_trip(scene):
-    assert scenes_equal(scene, proto.decode_snapshot(proto.encode_snapshot(scene)))
-
-
-def test_every_truncation_of_a_snapshot_is_a_protocol_error():
-    payload = proto.encode_snapshot(table_scene())
-    for cut in range(len(payload)):
-        with pytest.raises(proto.ProtocolError):
-            proto.decode_snapshot(payload[:cut])
-    with pytest.raises(proto.ProtocolError):
-        proto.decode_snapshot(payload + b"\0")
-
-
-@given(scenes(), st.data())
-@settings(max_examples=100, deadline=None)
-def test_garbled_snapshots_decode_or_raise_protocol_error(scene, data):
-    payload = bytearray(proto.encode_snapshot(scene))
-    for _ in range(data.draw(st.integers(1, 8))):
-        i = data.draw(st.integers(0, len(payload) - 1))
-        payload[i] = data.draw(st.integers(0, 255))
-    try:
-        back = proto.decode_snapshot(bytes(payload))
-    except proto.ProtocolError as e:
-        assert_sentence(str(e))
-        return
-    # Whatever decodes is safe to draw: finite, in range, printable.
-    assert np.isfinite(back.pos_m).all() and (back.radius_m > 0).all()
-    assert all(-1 <= c.held < len(back.pos_m) and 0 <= c.button <= 3 for c in back.cursors)
-    assert back.title.isprintable() and back.status.isprintable()
-
-
-@given(st.binary(max_size=400))
-@settings(max_examples=200, deadline=None)
-def test_random_bytes_never_leak_other_errors(data):
-    with pytest.raises(proto.ProtocolError):
-        proto.decode_snapshot(data)
-
-
-def test_snapshot_claiming_billions_of_pucks_is_refused_without_allocating():
-    payload = bytearray(proto.encode_snapshot(table_scene()))
-    struct.pack_into("<I", payload, 8, 0xFFFFFFFF)
-    with pytest.raises(proto.ProtocolError) as err:
-        proto.decode_snapshot(bytes(payload))
-    assert "4294967295 pucks" in str(err.value)
-
-
-@pytest.mark.parametrize(
-    "offset, value, hint",
-    [
-        (0, b"XXXX", "ATSN"),
-        (4, b"\x02", "version 2"),
-        (20, struct.pack("<d", float("nan")), "not finite"),
-        (20, struct.pack("<d", -1.0), "table size"),
-    ],
-)
-def test_snapshot_header_checks(offset, value, hint):
-    payload = bytearray(proto.encode_snapshot(table_scene()))
-    payload[offset : offset + len(value)] = value
-    with pytest.raises(proto.ProtocolError) as err:
-        proto.decode_snapshot(bytes(payload))
-    assert hint in str(err.value)
-
-
-def test_unprintable_text_is_cleaned_when_encoding():
-    scene = table_scene()
-    scene.status = "line one\nline\x00two"
-    assert proto.decode_snapshot(proto.encode_snapshot(scene)).status == "line one line two"
 
 
 # ---------------------------------------------------------------- addresses

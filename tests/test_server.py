@@ -24,7 +24,7 @@ from airtable.colors import rgb
 from airtable.net import protocol as proto
 from airtable.net.codec import SnapshotDecoder
 from airtable.net.events import MAX_QUEUED_INPUTS, EventQueue, PlayerInput, PlayerJoined, PlayerLeft
-from airtable.net.loadtest import TableLoop, grid_table, run_load
+from airtable.net.loadtest import TableLoop, grid_table, table_for
 from airtable.net.server import (
     COURSE_COLORS,
     RESERVED_FDS,
@@ -226,8 +226,10 @@ class Arena:
 
 @pytest.fixture(scope="module")
 def arena(request):
-    """One server with a running table and an honest player, shared by the bad-client tests."""
-    server = GameServer(host="127.0.0.1", port=0, timeout_s=3.0)
+    """One server with a running table and an honest player, shared by the bad-client tests.
+
+    Snapshots go out at the loop's 120 fps, so the honest player's next three come in 25 ms."""
+    server = GameServer(host="127.0.0.1", port=0, timeout_s=3.0, snapshot_hz=120)
     server.start()
     request.addfinalizer(server.stop)
     loop = TableLoop(server, grid_table(), fps=120).start()
@@ -553,17 +555,17 @@ def test_fuzz_random_frames_and_bytes_never_hurt_the_honest_client(arena):
 
 
 def test_half_a_frame_then_silence_is_dropped_after_the_timeout(make_server, clients):
-    server = make_server(timeout_s=0.3)
+    server = make_server(timeout_s=0.1)
     c = clients(server.port)
     c.send(proto.encode_hello()[:7])
     sentence = c.expect_error()
-    assert "0.3 s" in sentence and "join again" in sentence
+    assert "0.1 s" in sentence and "join again" in sentence
     c.close()
     wait_until(lambda: server.connection_count == 0, what="the silent connection to be gone")
 
 
 def test_password(make_server, clients):
-    server = make_server(password="sesame", password_wait_s=0.2)
+    server = make_server(password="sesame", password_wait_s=0.05)
     c = clients(server.port)
     c.send(proto.encode_hello("Ann"))
     assert "needs a password" in c.expect_error()
@@ -586,7 +588,7 @@ def test_password(make_server, clients):
 
 
 def test_wrong_passwords_earn_a_growing_wait_then_a_lockout_and_few_log_lines(make_server, clients, caplog):
-    server = make_server(password="sesame", password_wait_s=0.05)
+    server = make_server(password="sesame", password_wait_s=0.01)  # waits of 0.01, 0.02, 0.04, 0.08 s
     answers = []
 
     def guess(password: str) -> str:
@@ -640,10 +642,10 @@ def test_handshakes_have_their_own_cap_and_the_refusal_says_busy_not_full(make_s
 
 
 def test_a_handshake_that_says_nothing_is_dropped_after_its_deadline(make_server, clients):
-    server = make_server(hello_timeout_s=0.3, timeout_s=30)
+    server = make_server(hello_timeout_s=0.1, timeout_s=30)
     c = clients(server.port)
     kind, payload = c.next_frame()
-    assert kind == proto.ERROR and "no HELLO came within 0.3 s" in proto.parse_error(payload)
+    assert kind == proto.ERROR and "no HELLO came within 0.1 s" in proto.parse_error(payload)
     c.close()
     wait_until(lambda: server.connection_count == 0, what="the silent handshake to be gone")
 
@@ -779,8 +781,10 @@ def test_more_players_than_descriptors_gives_one_warning_not_a_flood(caplog):
         assert server.max_clients + server.max_handshakes <= in_use + 120 - RESERVED_FDS
         for _ in range(300):  # both ends of each connection live in this process
             try:
-                held.append(socket.create_connection(("127.0.0.1", server.port), timeout=WAIT_S))
-            except OSError:
+                held.append(socket.create_connection(("127.0.0.1", server.port), timeout=0.2))
+            except TimeoutError:  # a full backlog dropped the SYN: the next one gets through
+                continue
+            except OSError:  # out of descriptors
                 break
         wait_until(lambda: server.connection_count > 0, what="some connections")
     finally:
@@ -818,7 +822,7 @@ def test_the_command_line_can_refuse_what_the_server_would_with_the_same_sentenc
 
 def test_a_stalled_client_only_misses_snapshots(make_server, make_loop, clients):
     server = make_server(snapshot_hz=60)
-    table = grid_table(60, 40)  # 2400 pucks: 65 KB snapshots fill a stalled socket fast
+    table, _, _ = table_for(gas=1000)  # colliding pucks: 1.2 KB snapshots fill a stalled socket in a few ticks
     loop = make_loop(server, table, fps=60)
     stalled = RawClient.__new__(RawClient)
     sock = socket.socket()
@@ -829,23 +833,29 @@ def test_a_stalled_client_only_misses_snapshots(make_server, make_loop, clients)
         stalled.hello()  # ...and then never reads again
         reader = clients(server.port)
         reader.hello()
-        frames0 = loop.frames
-        start = time.monotonic()
-        received = 0
-        while time.monotonic() - start < 1.0:
-            if reader.next_frame()[0] == proto.SNAPSHOT:
-                received += 1
-        elapsed = time.monotonic() - start
-        assert received >= 10, "the reading client still gets snapshots"
-        assert loop.frames - frames0 >= 0.5 * 60 * elapsed, "the game loop never waited for the stalled client"
-        assert server.connection_count == 2
 
         # The stalled socket really is full: the roster shows it missing snapshots.
         def missing() -> bool:
+            for _ in range(2):  # the reader keeps reading meanwhile
+                reader.next_frame()
             seats = {seat.name: seat for seat in server.roster()}
-            return seats["C1"].snapshots_per_s < 0.5 * seats["C2"].snapshots_per_s
+            return len(seats) == 2 and seats["C1"].snapshots_per_s < 0.5 * seats["C2"].snapshots_per_s
 
         wait_until(missing, what="the stalled player to miss snapshots")
+        # Meanwhile the reading client gets its snapshots and the game loop never waits:
+        # 30 snapshots (half a second at 60 a second) while the loop keeps at least half speed.
+        frames0 = loop.frames
+        start = time.monotonic()
+        received = 0
+        for _ in range(1000):
+            if reader.next_frame()[0] == proto.SNAPSHOT:
+                received += 1
+                if received == 30:
+                    break
+        elapsed = time.monotonic() - start
+        assert received == 30, "the reading client still gets snapshots"
+        assert loop.frames - frames0 >= 0.5 * 60 * elapsed, "the game loop never waited for the stalled client"
+        assert server.connection_count == 2
     finally:
         sock.close()
 
@@ -858,10 +868,13 @@ def test_snapshots_are_capped_at_snapshot_hz(make_server, make_loop, clients):
     c.next_of(proto.SNAPSHOT)
     start = time.monotonic()
     count = 0
-    while time.monotonic() - start < 1.0:
+    for _ in range(1000):
         if c.next_frame()[0] == proto.SNAPSHOT:
             count += 1
-    assert count <= 20 * (time.monotonic() - start) * 1.2 + 2
+            if count == 10:
+                break
+    # The loop publishes 120 times a second: uncapped, 10 snapshots would come in 0.08 s, not 0.5.
+    assert count == 10 and count <= 20 * (time.monotonic() - start) * 1.2 + 2
 
 
 # ---------------------------------------------------------------- addresses and ports
@@ -893,18 +906,6 @@ def test_stop_says_bye_and_closes(make_server, make_loop, clients):
     while (got := c.next_frame()) is not None:
         frames.append(got[0])
     assert frames[-1:] == [proto.BYE]
-
-
-def test_load_tool_measures_a_small_run(make_server, make_loop):
-    server = make_server()
-    make_loop(server, grid_table(), fps=60)
-    result = run_load("127.0.0.1", server.port, clients=3, seconds=1.0)
-    assert result.connected == 3 and len(result.snapshot_rates) == 3
-    assert result.latencies_s and all(0 <= t < WAIT_S for t in result.latencies_s)
-    assert result.baseline_fps > 0 and result.loaded_fps
-    report = result.report()
-    assert "p50" in report and "p99" in report and "snapshots/s" in report and "verdict" in report
-    wait_until(lambda: server.connection_count == 0, what="the load players to leave")
 
 
 def test_a_name_the_teachers_screen_cannot_draw_is_refused_with_a_sentence(make_server, clients):

@@ -17,8 +17,11 @@ from airtable.net.server import GameServer
 
 
 def scene(k: int, color=(255, 255, 255)) -> Scene:
-    n = 40
-    pos = np.column_stack([0.5 + 0.2 * np.arange(n) + 0.01 * k, np.full(n, 2.0 + 0.001 * k)])
+    """400 pucks drifting with a wobble the server cannot predict: each tick about 360 bytes."""
+    n = 400
+    i = np.arange(n)
+    wobble = 0.002 * np.sin(k * (1.0 + i))
+    pos = np.column_stack([0.5 + 0.02 * i + 0.01 * k + wobble, 2.0 + 0.001 * k + wobble])
     colors = np.tile(np.array(color, np.uint8), (n, 1))
     return Scene(10.0, 8.7556, pos, np.full(n, 0.1), colors, title="wire test", status=f"k = {k}", time_s=k / 30)
 
@@ -67,6 +70,9 @@ def server():
     s.stop()
 
 
+LAST = 40  # ticks: about 14 KB, more than twice what b's small window takes
+
+
 def _status(k: int):
     return lambda p: p.scene is not None and p.scene.status == f"k = {k}"
 
@@ -74,7 +80,7 @@ def _status(k: int):
 def publish_after_a_period(server: GameServer, frame: Scene) -> None:
     """publish() sends at most snapshot_hz a second: let one period pass so this one goes."""
     t = time.monotonic()
-    wait_until(lambda: time.monotonic() - t > 2.0 / server.snapshot_hz, what="a snapshot period")
+    wait_until(lambda: time.monotonic() - t > 2.0 / server.snapshot_hz, what="a snapshot period", poll_s=0.0005)
     server.publish(frame)
 
 
@@ -82,17 +88,17 @@ def test_a_player_that_reads_slowly_is_skipped_and_catches_up(server):
     a, b = Player(server.port), Player(server.port, receive_buffer=4096)
     try:
         wait_until(lambda: len(server.player_names()) == 2, what="both players")
-        for k in range(1, 151):  # a reads every tick; b reads none: its small window soon fills
+        for k in range(1, LAST + 1):  # a reads every tick; b reads none: its small window soon fills
             publish_after_a_period(server, scene(k))
             a.read_until(_status(k), f"tick {k}")
-        b.read_until(_status(150), "the newest tick")
+        b.read_until(_status(LAST), "the newest tick")
         for p in (a, b):
-            assert np.abs(p.scene.pos_m - scene(150).pos_m).max() <= 0.5 / 4000 + 1e-12
+            assert np.abs(p.scene.pos_m - scene(LAST).pos_m).max() <= 0.5 / 4000 + 1e-12
         assert b.snapshots < a.snapshots  # b was skipped, and its deltas still decoded
         assert (a.layouts, b.layouts) == (1, 1)
-        publish_after_a_period(server, scene(151, color=(255, 0, 0)))  # new colours: a new layout
+        publish_after_a_period(server, scene(LAST + 1, color=(255, 0, 0)))  # new colours: a new layout
         for p in (a, b):
-            p.read_until(_status(151), "the red tick")
+            p.read_until(_status(LAST + 1), "the red tick")
             assert p.layouts == 2 and tuple(p.scene.color_rgb[0]) == (255, 0, 0)
     finally:
         a.close()

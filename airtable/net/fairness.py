@@ -13,8 +13,9 @@ Needs root (or CAP_NET_ADMIN) and the `ip` and `tc` tools; `available()` says
 why not where they are missing. Only loopback addresses are used, every wait
 is bounded, and the namespace is deleted in a `finally`.
 
-The two halves that run inside the namespace are subcommands of this module:
-`serve` (the table and its server) and `measure` (the players; prints JSON).
+Inside the namespace run the load tool's own table server (`python -m
+airtable.net.loadtest --serve`) and this module's `measure` subcommand (the
+players; prints JSON).
 """
 
 from __future__ import annotations
@@ -34,7 +35,6 @@ from dataclasses import dataclass
 from airtable.processes import stop_process
 
 PORT = 8888
-READY = "fairness-server-ready"
 BENCH_MBIT = (5, 10, 20)
 START_TIMEOUT_S = 30.0
 
@@ -118,7 +118,7 @@ class Rates:
 
 
 def _wait_ready(proc: subprocess.Popen, timeout_s: float) -> None:
-    """Wait (bounded) for the server's ready line."""
+    """Wait (bounded) for the server's first 'join with:' line: it is listening."""
     sel = selectors.DefaultSelector()
     sel.register(proc.stdout, selectors.EVENT_READ)
     deadline = time.monotonic() + timeout_s
@@ -129,7 +129,7 @@ def _wait_ready(proc: subprocess.Popen, timeout_s: float) -> None:
             line = proc.stdout.readline()
             if not line:
                 break
-            if line.strip() == READY:
+            if line.startswith("join with: "):
                 return
     finally:
         sel.close()
@@ -140,8 +140,9 @@ def measure_rates(mbit: float, clients: int = 30, seconds: float = 5.0, demo: st
     """Run a demo table and `clients` players in a namespace held to `mbit` Mbit/s."""
     py = sys.executable
     with Namespace(mbit) as ns:
+        table = ("--serve", "--host", "127.0.0.1", "--port", str(PORT), "--demo", demo, "--seconds", str(seconds + 60))
         server = subprocess.Popen(
-            ns.command(py, "-m", "airtable.net.fairness", "serve", "--demo", demo, "--seconds", str(seconds + 60)),
+            ns.command(py, "-m", "airtable.net.loadtest", *table),
             stdout=subprocess.PIPE,
             stderr=subprocess.DEVNULL,
             text=True,
@@ -157,34 +158,14 @@ def measure_rates(mbit: float, clients: int = 30, seconds: float = 5.0, demo: st
     return Rates(mbit, result["rates"], result["mean_bytes"], result["mbit"], result["fps"])
 
 
-# ---------------------------------------------------------------- the halves inside the namespace
-
-
-def serve(demo_key: str, seconds: float) -> int:
-    """A headless demo table with a server on 127.0.0.1:PORT, for `seconds` at most."""
-    from airtable.net.loadtest import TableLoop, table_for
-    from airtable.net.server import GameServer
-
-    table, dt_s, title = table_for(demo_key)
-    server = GameServer(host="127.0.0.1", port=PORT, max_clients=200)
-    server.start()
-    loop = TableLoop(server, table, fps=60, dt_s=dt_s, title=title).start()
-    print(READY, flush=True)
-    try:
-        time.sleep(seconds)
-    except KeyboardInterrupt:
-        pass
-    finally:
-        loop.stop()
-        server.stop()
-    return 0
+# ---------------------------------------------------------------- the players inside the namespace
 
 
 def measure(clients: int, seconds: float) -> int:
     """Players from the load tool; prints one JSON line with each one's rate."""
     from airtable.net.loadtest import run_load
 
-    result = run_load("127.0.0.1", PORT, clients=clients, seconds=seconds)
+    result = run_load("127.0.0.1", PORT, clients=clients, seconds=seconds, baseline_s=0.0)  # no baseline read
     fps = statistics.median(result.loaded_fps) if result.loaded_fps else 0.0
     print(
         json.dumps(
@@ -218,9 +199,6 @@ def bench(mbits: Sequence[float] = BENCH_MBIT, clients: int = 30, seconds: float
 def main(argv: Sequence[str] | None = None) -> int:
     parser = argparse.ArgumentParser(prog="python -m airtable.net.fairness", description=__doc__.splitlines()[0])
     sub = parser.add_subparsers(dest="command")
-    s = sub.add_parser("serve")
-    s.add_argument("--demo", default="4")
-    s.add_argument("--seconds", type=float, default=60.0)
     m = sub.add_parser("measure")
     m.add_argument("--clients", type=int, default=30)
     m.add_argument("--seconds", type=float, default=5.0)
@@ -228,8 +206,6 @@ def main(argv: Sequence[str] | None = None) -> int:
     parser.add_argument("--clients", type=int, default=30)
     parser.add_argument("--seconds", type=float, default=5.0)
     args = parser.parse_args(argv)
-    if args.command == "serve":
-        return serve(args.demo, min(args.seconds, 3600.0))
     if args.command == "measure":
         return measure(args.clients, args.seconds)
     bench(args.mbit, args.clients, args.seconds)

@@ -282,10 +282,10 @@ def serve(
     for line in server.join_lines():
         print(line, flush=True)
     loop = TableLoop(server, table, fps=fps, dt_s=dt_s, title=title).start()
-    start = time.monotonic()
+    end = math.inf if seconds is None else time.monotonic() + seconds
     try:
-        while seconds is None or time.monotonic() - start < seconds:
-            time.sleep(min(5.0, seconds - (time.monotonic() - start)) if seconds is not None else 5.0)
+        while (left := end - time.monotonic()) > 0:
+            time.sleep(min(5.0, left))
             print(f"{loop.fps:.1f} fps, {len(server.player_names())} players", flush=True)
     except KeyboardInterrupt:
         pass
@@ -352,10 +352,10 @@ def _tell(workers: list[tuple], message: tuple) -> None:
             pass
 
 
-def _run_workers(workers: list[tuple], seconds: float, timeout_s: float) -> list[WorkerReport]:
+def _run_workers(workers: list[tuple], seconds: float, timeout_s: float, baseline_s: float) -> list[WorkerReport]:
     """Step the workers through: first player (baseline), the rest join, play, report."""
     for _, pipe in workers:
-        _expect(pipe, "joined-first", WORKER_START_S + timeout_s + BASELINE_S)
+        _expect(pipe, "joined-first", WORKER_START_S + timeout_s + baseline_s)
     _tell(workers, ("connect",))
     for _, pipe in workers:
         _expect(pipe, "ready", WORKER_START_S + 4 * timeout_s)
@@ -400,21 +400,23 @@ def run_load(
     input_hz: float = 60.0,
     timeout_s: float = 5.0,
     processes: int | None = None,
+    baseline_s: float = BASELINE_S,
 ) -> LoadResult:
     """Connect `clients` simulated players from `processes` worker processes for
-    `seconds` and measure (see the module docstring)."""
+    `seconds` and measure (see the module docstring); the first player watches
+    `baseline_s` alone before the others join."""
     processes = default_processes(clients) if processes is None else processes
     _check_args(clients, seconds, input_hz, processes)
     shares = [clients // processes + (1 if k < clients % processes else 0) for k in range(processes)]
     specs, first = [], 0
     for k, count in enumerate(shares):
         specs.append(
-            WorkerSpec(host, port, first, count, password, input_hz, timeout_s, True, BASELINE_S if k == 0 else 0.0)
+            WorkerSpec(host, port, first, count, password, input_hz, timeout_s, True, baseline_s if k == 0 else 0.0)
         )
         first += count
     workers = _start_workers(specs)
     try:
-        reports = _run_workers(workers, seconds, timeout_s)
+        reports = _run_workers(workers, seconds, timeout_s, baseline_s)
     finally:
         for proc, pipe in workers:
             proc.join(timeout=5.0)

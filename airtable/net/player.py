@@ -139,6 +139,8 @@ class NetPlayer:
         on_snapshot: Callable[[Scene, float], None] | None = None,
         protocol_version: int = proto.PROTOCOL_VERSION,
         max_backoff_s: float = MAX_BACKOFF_S,
+        first_backoff_s: float = FIRST_BACKOFF_S,
+        full_backoff_s: float = FIRST_FULL_BACKOFF_S,
     ) -> None:
         self.host = host
         self.port = int(port)
@@ -148,6 +150,8 @@ class NetPlayer:
         self.on_snapshot = on_snapshot
         self.protocol_version = protocol_version  # other than 1 only to test the server's answer
         self.max_backoff_s = max_backoff_s
+        self.first_backoff_s = first_backoff_s  # the first wait after the server went away
+        self.full_backoff_s = full_backoff_s  # the least wait before asking a full table again
         self.state = PlayerState.CONNECTING
         self.error: str | None = None
         self.waiting_because: str | None = None  # the server's sentence while WAITING
@@ -204,7 +208,7 @@ class NetPlayer:
             if not e.full:
                 self.state, self.error = PlayerState.FAILED, str(e)
                 raise PlayerError(str(e)) from None
-            self._wait_for_place(str(e), FIRST_FULL_BACKOFF_S)
+            self._wait_for_place(str(e), self.full_backoff_s)
             opened = None
         if opened is not None:
             self._adopt(opened[0], opened[1])
@@ -409,7 +413,7 @@ class NetPlayer:
 
     def _reconnect(self) -> tuple | None:
         """Try again with backoff until connected (the tuple of _open), failed or closed (None)."""
-        backoff = FIRST_BACKOFF_S if self.state != PlayerState.WAITING else FIRST_FULL_BACKOFF_S
+        backoff = self.first_backoff_s if self.state != PlayerState.WAITING else self.full_backoff_s
         self.next_try = time.monotonic() + backoff
         while not self._closed.wait(max(0.0, self.next_try - time.monotonic())):
             try:
@@ -420,7 +424,7 @@ class NetPlayer:
                     return None
                 backoff = min(backoff * 2, self.max_backoff_s)
                 if e.full:
-                    self._wait_for_place(str(e), max(backoff, FIRST_FULL_BACKOFF_S))
+                    self._wait_for_place(str(e), max(backoff, self.full_backoff_s))
                 else:
                     self.next_try = time.monotonic() + backoff
         return None

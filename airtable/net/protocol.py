@@ -6,10 +6,10 @@ snapshot format 2 (codec.py: what moves, coded against what each player holds,
 and what rarely changes); BYE is empty. README documents every byte.
 
 Everything that comes off the network is checked here and turned into small
-immutable values (`Hello`, `InputRecord`, `Welcome`, a `Scene`); a bad message
-raises `ProtocolError` whose text is a sentence a person can act on. Nothing is
-ever built from network bytes except numbers, strings and numpy arrays of a
-fixed dtype.
+immutable values (`Hello`, `InputRecord`, `Welcome`; codec.py makes a `Scene`
+with the bounds below); a bad message raises `ProtocolError` whose text is a
+sentence a person can act on. Nothing is ever built from network bytes except
+numbers, strings and numpy arrays of a fixed dtype.
 """
 
 from __future__ import annotations
@@ -22,9 +22,6 @@ import unicodedata
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
 
-import numpy as np
-
-from airtable.app.scene import CursorView, Scene
 from airtable.physics.table import TABLE_HEIGHT_M, TABLE_WIDTH_M
 
 PROTOCOL_VERSION = 2
@@ -59,7 +56,7 @@ CLIENT_FRAMES = frozenset({HELLO, INPUT, BYE, PREDICT})
 # bytes and a HELLO with the longest name and password under 1000, so a
 # client cannot make the server parse more than it needs.
 MAX_CLIENT_FRAME = 1024
-# Snapshots grow with the number of pucks (27 bytes each); this allows the
+# Snapshots grow with the number of pucks; this allows the
 # drawing budget below with room to spare, while a bogus length cannot eat memory.
 MAX_SERVER_FRAME = 16 * 1024 * 1024
 
@@ -598,129 +595,13 @@ def encode_bye() -> bytes:
     return encode_frame(BYE)
 
 
-# ---------------------------------------------------------------- SNAPSHOT
-
-SNAPSHOT_MAGIC = b"ATSN"
-SNAPSHOT_VERSION = 1
-FLAG_GRAVITY = 1
-# magic, version, flags, reserved, n_pucks, n_springs, n_cursors,
-# width_m, height_m, time_s, fps, zoom, origin_x_m, origin_y_m (little-endian)
-_SNAP_HEADER = struct.Struct("<4sBBHIII7d")
-_F8 = np.dtype("<f8")
-_U1 = np.dtype("u1")
-_U4 = np.dtype("<u4")
-_I4 = np.dtype("<i4")
-# Bytes per row of each section: pucks (pos 16, radius 8, colour 3), springs
-# (pair 8, length 8, width 8, colour 3), cursors (pos 16, colour 3, button 1, held 4).
-_PUCK_BYTES = 16 + 8 + 3
-_SPRING_BYTES = 8 + 8 + 8 + 3
-_CURSOR_BYTES = 16 + 3 + 1 + 4
-_MAX_TEXT_BYTES = 0xFFFF
+# ---------------------------------------------------------------- what a player can draw
 
 
 def printable(text: str) -> str:
     """`text` with every unprintable character (newline, NUL, ...) replaced by a space."""
     text = str(text)
     return text if text.isprintable() else "".join(c if c.isprintable() else " " for c in text)
-
-
-def _text_bytes(text: str) -> bytes:
-    # Only printable text goes out, so the player can draw any string it receives.
-    raw = printable(text).encode("utf-8")
-    if len(raw) > _MAX_TEXT_BYTES:  # cut at a character boundary rather than fail the frame
-        raw = raw[:_MAX_TEXT_BYTES].decode("utf-8", "ignore").encode("utf-8")
-    return len(raw).to_bytes(2, "little") + raw
-
-
-def _array_bytes(values, dtype: np.dtype, shape: tuple[int, ...]) -> bytes:
-    return np.ascontiguousarray(np.asarray(values).reshape(shape), dtype=dtype).tobytes()
-
-
-def encode_snapshot(scene: Scene) -> bytes:
-    """The SNAPSHOT payload for `scene` (wrap it with `encode_frame(SNAPSHOT, ...)`).
-
-    Layout (all little-endian, no padding):
-      header  magic "ATSN", u8 version, u8 flags (bit 0 gravity), u16 0,
-              u32 N pucks, u32 S springs, u32 C cursors,
-              f8 width_m, height_m, time_s, fps, zoom, origin_x_m, origin_y_m
-      pucks   pos_m N x 2 f8, radius_m N f8, color_rgb N x 3 u1
-      springs pairs S x 2 u4, length_m S f8, width_m S f8, color_rgb S x 3 u1
-      cursors cursor_m C x 2 f8, color C x 3 u1, button C u1, held C i4 (-1: none)
-      text    title, status, puck_correction, then C cursor names,
-              each as u16 byte count + UTF-8 bytes
-    """
-    n = len(scene.pos_m)
-    s = len(scene.spring_pairs)
-    cursors = scene.cursors
-    c = len(cursors)
-    flags = FLAG_GRAVITY if scene.gravity_on else 0
-    header = _SNAP_HEADER.pack(
-        SNAPSHOT_MAGIC,
-        SNAPSHOT_VERSION,
-        flags,
-        0,
-        n,
-        s,
-        c,
-        float(scene.width_m),
-        float(scene.height_m),
-        float(scene.time_s),
-        float(scene.fps),
-        float(scene.zoom),
-        float(scene.origin_m[0]),
-        float(scene.origin_m[1]),
-    )
-    parts = [
-        header,
-        _array_bytes(scene.pos_m, _F8, (n, 2)),
-        _array_bytes(scene.radius_m, _F8, (n,)),
-        _array_bytes(scene.color_rgb, _U1, (n, 3)),
-        _array_bytes(scene.spring_pairs, _U4, (s, 2)),
-        _array_bytes(scene.spring_length_m, _F8, (s,)),
-        _array_bytes(scene.spring_width_m, _F8, (s,)),
-        _array_bytes(scene.spring_color_rgb, _U1, (s, 3)),
-        _array_bytes([cv.cursor_m for cv in cursors], _F8, (c, 2)),
-        _array_bytes([cv.color for cv in cursors], _U1, (c, 3)),
-        _array_bytes([cv.button for cv in cursors], _U1, (c,)),
-        _array_bytes([cv.held for cv in cursors], _I4, (c,)),
-        _text_bytes(scene.title),
-        _text_bytes(scene.status),
-        _text_bytes(scene.puck_correction),
-        *(_text_bytes(cv.name) for cv in cursors),
-    ]
-    return b"".join(parts)
-
-
-class _Cut:
-    """Reads consecutive sections of a payload whose total size was checked up front."""
-
-    def __init__(self, payload: bytes, offset: int) -> None:
-        self.payload = payload
-        self.offset = offset
-
-    def array(self, dtype: np.dtype, shape: tuple[int, ...]) -> np.ndarray:
-        count = int(np.prod(shape, dtype=np.int64))
-        a = np.frombuffer(self.payload, dtype=dtype, count=count, offset=self.offset).reshape(shape)
-        self.offset += count * dtype.itemsize
-        return a
-
-    def text(self, what: str) -> str:
-        end = self.offset + 2
-        if end > len(self.payload):
-            raise ProtocolError(f"the snapshot is cut short in its {what}")
-        size = int.from_bytes(self.payload[self.offset : end], "little")
-        if end + size > len(self.payload):
-            raise ProtocolError(f"the snapshot is cut short in its {what}")
-        try:
-            value = self.payload[end : end + size].decode("utf-8")
-        except UnicodeDecodeError:
-            raise ProtocolError(f"the snapshot's {what} is not valid UTF-8") from None
-        self.offset = end + size
-        return value
-
-
-def _bad(what: str) -> ProtocolError:
-    return ProtocolError(f"the snapshot has {what}; the server may run a different airtable version")
 
 
 def table_size_problem(width_m: float, height_m: float) -> str | None:
@@ -732,155 +613,6 @@ def table_size_problem(width_m: float, height_m: float) -> str | None:
             f"{MIN_TABLE_M:g} to {MAX_TABLE_M:g} m and at most {MAX_TABLE_ASPECT:g} times each other)"
         )
     return None
-
-
-@dataclass(frozen=True)
-class _Header:
-    flags: int
-    n: int  # pucks
-    s: int  # springs
-    c: int  # cursors
-    width_m: float
-    height_m: float
-    time_s: float
-    fps: float
-    zoom: float
-    origin_m: tuple[float, float]
-
-
-def _read_header(payload: bytes) -> _Header:
-    """The header, with counts checked against the drawing budget and the payload size."""
-    if len(payload) < _SNAP_HEADER.size:
-        raise ProtocolError(f"the snapshot is only {len(payload)} bytes, less than its {_SNAP_HEADER.size} byte header")
-    magic, version, flags, _, n, s, c, *floats = _SNAP_HEADER.unpack_from(payload)
-    if magic != SNAPSHOT_MAGIC:
-        raise ProtocolError("the snapshot does not start with ATSN; is the server an airtable server?")
-    if version != SNAPSHOT_VERSION:
-        raise ProtocolError(
-            f"the snapshot format is version {version} but this client reads version {SNAPSHOT_VERSION}; "
-            "install the same airtable version as the teacher's"
-        )
-    if n > MAX_DRAWN_PUCKS or s > MAX_DRAWN_SPRINGS or c > MAX_DRAWN_CURSORS:
-        raise _bad(
-            f"{n} pucks, {s} springs and {c} cursors, more than this client draws "
-            f"({MAX_DRAWN_PUCKS}, {MAX_DRAWN_SPRINGS} and {MAX_DRAWN_CURSORS})"
-        )
-    fixed = _SNAP_HEADER.size + n * _PUCK_BYTES + s * _SPRING_BYTES + c * _CURSOR_BYTES
-    # Each text section needs at least its 2-byte count.
-    if fixed + 2 * (3 + c) > len(payload):
-        raise ProtocolError(
-            f"the snapshot claims {n} pucks, {s} springs and {c} cursors but is only {len(payload)} bytes long"
-        )
-    if not all(math.isfinite(v) for v in floats):
-        raise _bad("a number that is not finite in its header")
-    width_m, height_m, time_s, fps, zoom, ox, oy = floats
-    header = _Header(flags, n, s, c, width_m, height_m, time_s, fps, zoom, (ox, oy))
-    _check_view(header)
-    return header
-
-
-def _check_view(h: _Header) -> None:
-    problem = table_size_problem(h.width_m, h.height_m)
-    if problem:
-        raise _bad(problem)
-    if not MIN_VIEW_ZOOM <= h.zoom <= MAX_VIEW_ZOOM:
-        raise _bad(f"a zoom of {h.zoom:g}, outside {MIN_VIEW_ZOOM:g} to {MAX_VIEW_ZOOM:g}")
-    x0, y0, x1, y1 = cursor_limits(h.width_m, h.height_m)
-    if not (x0 <= h.origin_m[0] <= x1 and y0 <= h.origin_m[1] <= y1):
-        raise _bad(f"a view origin {h.origin_m} far off the table")
-    if not 0 <= h.fps <= 1e6:
-        raise _bad(f"a frame rate of {h.fps:g}")
-
-
-def _within(points: np.ndarray, h: _Header) -> bool:
-    x0, y0, x1, y1 = cursor_limits(h.width_m, h.height_m)
-    return bool(((points[:, 0] >= x0) & (points[:, 0] <= x1) & (points[:, 1] >= y0) & (points[:, 1] <= y1)).all())
-
-
-def _read_bodies(cut: _Cut, h: _Header) -> dict:
-    """Pucks and springs, each checked against the table before anything uses them."""
-    size = max(h.width_m, h.height_m)
-    pos, radius, color = cut.array(_F8, (h.n, 2)), cut.array(_F8, (h.n,)), cut.array(_U1, (h.n, 3))
-    pairs, length, width = cut.array(_U4, (h.s, 2)), cut.array(_F8, (h.s,)), cut.array(_F8, (h.s,))
-    spring_color = cut.array(_U1, (h.s, 3))
-    if not (np.isfinite(pos).all() and _within(pos, h)):
-        raise _bad("a puck position that is not finite or far off the table")
-    if not (np.isfinite(radius).all() and ((radius > 0) & (radius <= size)).all()):
-        raise _bad("a puck radius that is not between 0 and the table's size")
-    if not (np.isfinite(length).all() and np.isfinite(width).all()):
-        raise _bad("a spring size that is not finite")
-    if not (((length >= 0) & (length <= 100 * size)).all() and ((width >= 0) & (width <= size)).all()):
-        raise _bad("a spring longer or wider than the table allows")
-    if h.s and int(pairs.max()) >= h.n:
-        raise _bad("a spring joined to a puck that is not there")
-    # frombuffer views are read-only and may be unaligned: copy into owned native arrays.
-    return dict(
-        pos_m=pos.astype(float),
-        radius_m=radius.astype(float),
-        color_rgb=color.copy(),
-        spring_pairs=pairs.astype(np.intp),
-        spring_length_m=length.astype(float),
-        spring_width_m=width.astype(float),
-        spring_color_rgb=spring_color.copy(),
-    )
-
-
-def _read_cursors(cut: _Cut, h: _Header) -> tuple[np.ndarray, ...]:
-    pos, color = cut.array(_F8, (h.c, 2)), cut.array(_U1, (h.c, 3))
-    button, held = cut.array(_U1, (h.c,)), cut.array(_I4, (h.c,))
-    if not (np.isfinite(pos).all() and _within(pos, h)):
-        raise _bad("a cursor position that is not finite or far off the table")
-    if h.c and (int(button.max()) > 3 or int(held.min()) < -1 or int(held.max()) >= h.n):
-        raise _bad("a cursor with a bad button or held puck")
-    return pos, color, button, held
-
-
-def _cursor_views(arrays: tuple[np.ndarray, ...], names: list[str]) -> tuple[CursorView, ...]:
-    pos, color, button, held = arrays
-    return tuple(
-        CursorView(
-            name=names[i],
-            color=(int(color[i, 0]), int(color[i, 1]), int(color[i, 2])),
-            cursor_m=(float(pos[i, 0]), float(pos[i, 1])),
-            button=int(button[i]),
-            held=int(held[i]),
-        )
-        for i in range(len(names))
-    )
-
-
-def decode_snapshot(payload: bytes) -> Scene:
-    """Check and decode a SNAPSHOT payload into a Scene; anything wrong raises ProtocolError.
-
-    Every number is bounded before use (table size, zoom, origin, positions and
-    radii against the table, counts against the drawing budget), so a scene
-    that decodes can be drawn."""
-    payload = bytes(payload)
-    h = _read_header(payload)
-    cut = _Cut(payload, _SNAP_HEADER.size)
-    bodies = _read_bodies(cut, h)
-    cursor_arrays = _read_cursors(cut, h)
-    title, status, correction = cut.text("title"), cut.text("status"), cut.text("puck correction mode")
-    names = [cut.text("cursor names")[: 2 * MAX_NAME_CHARS + 8] for _ in range(h.c)]
-    title, status = title[:MAX_DRAWN_TEXT_CHARS], status[:MAX_DRAWN_TEXT_CHARS]
-    if cut.offset != len(payload):
-        raise _bad(f"{len(payload) - cut.offset} bytes too many at its end")
-    if not all(t.isprintable() for t in (title, status, correction, *names)):
-        raise _bad("unprintable text")
-    return Scene(
-        width_m=h.width_m,
-        height_m=h.height_m,
-        **bodies,
-        cursors=_cursor_views(cursor_arrays, names),
-        title=title,
-        status=status,
-        gravity_on=bool(h.flags & FLAG_GRAVITY),
-        puck_correction=correction,
-        time_s=h.time_s,
-        fps=h.fps,
-        zoom=h.zoom,
-        origin_m=h.origin_m,
-    )
 
 
 def parse_host_port(text: str, default_port: int = DEFAULT_PORT) -> tuple[str, int]:
