@@ -182,7 +182,7 @@ def test_three_students_predict_over_real_sockets_then_the_reveal_sums_them_up(s
 
         press(app, pygame.K_F6)  # reveal: the table plays until the collision is over
         assert not app.paused and len(app.predict.arrows) == 3
-        frames_until(app, lambda: app.predict.settled, "the collision to be over")
+        frames_until(app, lambda: app.predict.settled, "the collision to be over", max_frames=600)
         assert app.paused and app.table.collision_count >= 1
         assert app.predict.truth[1] == pytest.approx((1.0, 0.0), abs=1e-6)
         assert app.predict.summary == (EXPECTED,)
@@ -273,7 +273,7 @@ def test_the_local_mouse_predicts_on_the_teachers_window(tmp_path):
     )
     assert "PREDICT: 1 of 1 predicted" in app.status_line()
     press(app, pygame.K_F6)
-    frames_until(app, lambda: app.predict.settled, "the collision to be over")
+    frames_until(app, lambda: app.predict.settled, "the collision to be over", max_frames=600)
     (line,) = app.predict.summary
     assert line == "puck 2: median 10 deg off; 0 of 1 within 5 deg; speeds within 20 %: 1 of 1"
 
@@ -289,7 +289,7 @@ def test_nobody_s_string_touches_the_pucks_while_the_reveal_plays(server, tmp_pa
         x, y = app.table.pos_m[1]
         student.send(proto.encode_input((x, y), 1))  # grab puck 2 ...
         student.send(proto.encode_input((x, y + 3.0), 1))  # ... and pull it up hard
-        frames_until(app, lambda: app.predict.settled, "the collision to be over")
+        frames_until(app, lambda: app.predict.settled, "the collision to be over", max_frames=600)
         assert app.predict.truth[1] == pytest.approx((1.0, 0.0), abs=1e-6)  # as if nobody were there
     finally:
         student.close()
@@ -359,7 +359,7 @@ def test_space_pauses_a_playing_reveal_and_after_the_freeze_closes_the_round(tmp
     assert app.paused and app.table.time_s == t0 and app.predict.state == "revealed"
     press(app, pygame.K_SPACE)  # and lets it play on
     assert not app.paused
-    frames_until(app, lambda: app.predict.settled, "the collision to be over")
+    frames_until(app, lambda: app.predict.settled, "the collision to be over", max_frames=600)
     assert app.paused and app.predict.summary  # frozen on the truth
     press(app, pygame.K_SPACE)  # the class has seen it: Space goes on with the lesson
     assert app.predict.state == "closed" and not app.paused
