@@ -51,25 +51,25 @@ def xdotool(display: str, *args: str) -> str:
     return out.stdout.strip()
 
 
+def xwininfo(display: str, *args: str) -> str:
+    env = {**os.environ, "DISPLAY": display}
+    return subprocess.run(["xwininfo", *args], env=env, capture_output=True, text=True, timeout=20).stdout
+
+
 def find_window(display: str, title: str = "Air Table") -> str | None:
+    """The window once it is on screen: keys sent to a window not yet mapped are lost."""
     # `xdotool search --name` misses SDL's windows on some builds; xwininfo lists them all.
-    tree = subprocess.run(
-        ["xwininfo", "-root", "-tree"], env={**os.environ, "DISPLAY": display}, capture_output=True, text=True
-    ).stdout
-    for line in tree.splitlines():
+    for line in xwininfo(display, "-root", "-tree").splitlines():
         if f'"{title}' in line:
-            return str(int(line.split()[0], 16))
+            wid = str(int(line.split()[0], 16))
+            return wid if "IsViewable" in xwininfo(display, "-id", wid) else None
     return None
 
 
 def window_size(display: str, wid: str) -> tuple[int, int] | None:
     """The window's size as X has it now (None once it is gone)."""
-    out = subprocess.run(
-        ["xwininfo", "-id", wid], env={**os.environ, "DISPLAY": display}, capture_output=True, text=True
-    ).stdout
-    sizes = dict(
-        line.strip().split(": ", 1) for line in out.splitlines() if line.strip().startswith(("Width", "Height"))
-    )
+    lines = xwininfo(display, "-id", wid).splitlines()
+    sizes = dict(line.strip().split(": ", 1) for line in lines if line.strip().startswith(("Width", "Height")))
     return (int(sizes["Width"]), int(sizes["Height"])) if len(sizes) == 2 else None
 
 
