@@ -6,6 +6,8 @@ import dataclasses
 import os
 import socket
 import struct
+import subprocess
+import sys
 import threading
 import time
 
@@ -592,3 +594,11 @@ def test_extreme_but_valid_snapshots_never_crash_hang_or_bloat_the_client(cleanu
 
     stream()
     assert peak[0] - before < 500, f"the client grew by {peak[0] - before:.0f} MB"
+
+
+def test_the_client_command_starts_with_its_own_line_not_pygames_banner():
+    env = {k: v for k, v in os.environ.items() if k != "PYGAME_HIDE_SUPPORT_PROMPT"}
+    code = "import sys; from airtable.client_cli import main; sys.exit(main(['127.0.0.1:1']))"  # nobody on port 1
+    out = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True, timeout=60)
+    assert out.returncode == 1
+    assert out.stdout == "" and out.stderr.startswith("airtable-client: connection refused by 127.0.0.1:1"), out
