@@ -153,12 +153,10 @@ def colour_rounds(a: np.ndarray, b: np.ndarray, n_bodies: int, prio: np.ndarray 
 class _Round:
     """One round's contacts, gathered once per step: targets and impulses as (m, 2) [velocity, position]."""
 
-    fa: np.ndarray  # flat indices of body a's velocity and pseudo-velocity: 2 a, 2 a + 1
-    fb: np.ndarray
-    nc: np.ndarray  # (m, 1) complex conjugate normals, to project velocities
-    na: np.ndarray  # (m, 2) complex: the velocity change of body a per unit impulse
-    nb: np.ndarray  # the same for body b
-    k: np.ndarray  # (m, 1) effective mass 1 / (wa + wb)
+    fab: np.ndarray  # flat indices of body a's velocity and pseudo-velocity (2 a, 2 a + 1), then body b's
+    nc: np.ndarray  # (m, 2) complex conjugate normals, to project velocities
+    nab: np.ndarray  # (2, m, 2) complex: the velocity change of body a per unit impulse, and minus body b's
+    k: np.ndarray  # (m, 2) effective mass 1 / (wa + wb)
     change: np.ndarray  # (m, 2) the last iteration's change of impulse: a view into `changes`
     changes: np.ndarray  # (all contacts, 2): every round's `change`, to find the largest once per iteration
     w_max: np.ndarray  # (all contacts, 1) per contact, its round's largest wa + wb: impulse to speed
@@ -292,23 +290,30 @@ class ContactSolver:
 def _rounds(c: _Contacts, rounds, wa, wb, target, impulse) -> list[_Round]:
     """Gather each round's contacts once per step: all rounds in one go, then each a slice (a view)."""
     order = np.concatenate(rounds)
-    ends = np.cumsum([len(r) for r in rounds])
-    starts = ends - [len(r) for r in rounds]
-    n = c.n.take(order)[:, None]
+    lengths = [len(r) for r in rounds]
+    ends = np.cumsum(lengths)
+    starts = ends - lengths
+    n = np.repeat(c.n.take(order)[:, None], 2, axis=1)  # (m, 2): no broadcasting in the rounds
     wa, wb = wa.take(order), wb.take(order)
     both = np.arange(2)
     fa, fb = 2 * c.a.take(order)[:, None] + both, 2 * c.b.take(order)[:, None] + both
-    nc, na, nb = n.conjugate(), np.repeat(n * wa[:, None], 2, axis=1), np.repeat(n * wb[:, None], 2, axis=1)
-    k = (1.0 / (wa + wb))[:, None]
-    lengths = [len(r) for r in rounds]
+    na, nb = n * wa[:, None], n * wb[:, None]
+    # Body a's rows of a round, then body b's, side by side: one gather and one write per round.
+    fab, nab = _a_then_b(fa, fb, starts, ends), _a_then_b(na, -nb, starts, ends)
+    k = np.repeat((1.0 / (wa + wb))[:, None], 2, axis=1)
     w_max = np.repeat(np.maximum.reduceat(wa + wb, starts), lengths)[:, None]
     changes = np.zeros((len(order), 2))
     target, impulse = target.take(order, axis=0), impulse.take(order, axis=0)
     return [
-        _Round(fa[s:e].ravel(), fb[s:e].ravel(), nc[s:e], na[s:e], nb[s:e], k[s:e], changes[s:e], changes, w_max,
-               target[s:e], impulse[s:e], r)
-        for s, e, r in zip(starts, ends, rounds, strict=True)
+        _Round(fab[2 * s : 2 * e].ravel(), n[s:e].conjugate(), nab[2 * s : 2 * e].reshape(2, e - s, 2), k[s:e],
+               changes[s:e], changes, w_max, target[s:e], impulse[s:e], r)
+        for s, e, r in zip(starts.tolist(), ends.tolist(), rounds, strict=True)
     ]  # fmt: skip
+
+
+def _a_then_b(xa: np.ndarray, xb: np.ndarray, starts, ends) -> np.ndarray:
+    """Rows of xa and xb regrouped round by round: the round's rows of xa, then its rows of xb."""
+    return np.concatenate([x[s:e] for s, e in zip(starts.tolist(), ends.tolist(), strict=True) for x in (xa, xb)])
 
 
 def _warm_push(c: _Contacts, mass: np.ndarray, impulse: np.ndarray) -> np.ndarray:
@@ -341,13 +346,13 @@ def _iterate(w: np.ndarray, rounds: list[_Round], later: list[_Round], count: in
         # back what it read plus its change; the walls' row takes many writes,
         # all the same (wb = 0).
         for g in rounds:
-            va, vb = flat.take(g.fa), flat.take(g.fb)
-            vn = (g.nc * (va - vb).reshape(-1, 2)).real
+            v = flat.take(g.fab).reshape(2, -1, 2)  # body a's rows, then body b's
+            vn = (g.nc * (v[0] - v[1])).real
             new = np.maximum(g.impulse + g.k * (g.target - vn), 0.0)
             np.subtract(new, g.impulse, out=g.change)
             g.impulse = new
-            flat[g.fa] = va + (g.change * g.na).reshape(-1)
-            flat[g.fb] = vb - (g.change * g.nb).reshape(-1)
+            v += g.change * g.nab
+            flat[g.fab] = v.reshape(-1)
         if rounds and float((np.abs(rounds[0].changes) * rounds[0].w_max).max()) < CONVERGED_MPS:
             return it, rounds
     return ITERATIONS, rounds
