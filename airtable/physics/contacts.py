@@ -175,6 +175,7 @@ class ContactSolver:
         self._round_keys: np.ndarray | None = None
         self._rounds: list[np.ndarray] = []  # bottom-up by bands: the first iteration
         self._free_rounds: list[np.ndarray] = []  # fewer rounds, in no order: the later iterations
+        self._layouts: tuple[_Layout, _Layout] | None = None  # of _rounds and _free_rounds, while they stay
         self.count = 0  # contacts in the last step
         self.iterations = 0  # iterations the last step needed
 
@@ -262,11 +263,14 @@ class ContactSolver:
             self._rounds = colour_rounds(c.a, virtual, bodies, self._bands(c))
             self._free_rounds = colour_rounds(c.a, virtual, bodies)
             self._round_keys = c.keys.copy()
+        if self._layouts is None or self._layouts[0].source is not self._rounds:
+            self._layouts = (_Layout(self._rounds, c.a, c.b), _Layout(self._free_rounds, c.a, c.b))
         wa, wb = inv.take(c.a), inv.take(c.b)
-        return (
-            _rounds(c, self._rounds, wa, wb, target, impulse),
-            _rounds(c, self._free_rounds, wa, wb, target, impulse),
-        )
+        n = np.repeat(c.n[:, None], 2, axis=1)  # (m, 2): no broadcasting in the rounds
+        nab = np.concatenate([n * wa[:, None], -(n * wb[:, None])])
+        k = np.repeat((1.0 / (wa + wb))[:, None], 2, axis=1)
+        values = (n.conjugate(), nab, k, wa + wb, target, impulse)
+        return self._layouts[0].fill(*values), self._layouts[1].fill(*values)
 
     def _bands(self, c: _Contacts) -> np.ndarray | None:
         """Priorities bottom-up by bands of height (BAND_RADII radii), scrambled within a band."""
@@ -287,33 +291,50 @@ class ContactSolver:
         self._keys, self._impulses = c.keys.take(order), impulses.take(order, axis=0)
 
 
-def _rounds(c: _Contacts, rounds, wa, wb, target, impulse) -> list[_Round]:
-    """Gather each round's contacts once per step: all rounds in one go, then each a slice (a view)."""
-    order = np.concatenate(rounds)
-    lengths = [len(r) for r in rounds]
-    ends = np.cumsum(lengths)
-    starts = ends - lengths
-    n = np.repeat(c.n.take(order)[:, None], 2, axis=1)  # (m, 2): no broadcasting in the rounds
-    wa, wb = wa.take(order), wb.take(order)
-    both = np.arange(2)
-    fa, fb = 2 * c.a.take(order)[:, None] + both, 2 * c.b.take(order)[:, None] + both
-    na, nb = n * wa[:, None], n * wb[:, None]
-    # Body a's rows of a round, then body b's, side by side: one gather and one write per round.
-    fab, nab = _a_then_b(fa, fb, starts, ends), _a_then_b(na, -nb, starts, ends)
-    k = np.repeat((1.0 / (wa + wb))[:, None], 2, axis=1)
-    w_max = np.repeat(np.maximum.reduceat(wa + wb, starts), lengths)[:, None]
-    changes = np.zeros((len(order), 2))
-    target, impulse = target.take(order, axis=0), impulse.take(order, axis=0)
-    return [
-        _Round(fab[2 * s : 2 * e].ravel(), n[s:e].conjugate(), nab[2 * s : 2 * e].reshape(2, e - s, 2), k[s:e],
-               changes[s:e], changes, w_max, target[s:e], impulse[s:e], r)
-        for s, e, r in zip(starts.tolist(), ends.tolist(), rounds, strict=True)
-    ]  # fmt: skip
+class _Layout:
+    """One colouring's rounds laid out once: index arrays, buffers, and each round's views into them.
 
+    Built when the colouring changes (in a pile at rest, seldom); each step
+    then refills the buffers in place, and the rounds, whose arrays are views
+    of them, are ready. That saves making a dozen arrays and a `_Round` per
+    round at every step.
+    """
 
-def _a_then_b(xa: np.ndarray, xb: np.ndarray, starts, ends) -> np.ndarray:
-    """Rows of xa and xb regrouped round by round: the round's rows of xa, then its rows of xb."""
-    return np.concatenate([x[s:e] for s, e in zip(starts.tolist(), ends.tolist(), strict=True) for x in (xa, xb)])
+    def __init__(self, rounds: list[np.ndarray], a: np.ndarray, b: np.ndarray) -> None:
+        self.source = rounds  # the colouring laid out (compared by identity: a restored state brings new lists)
+        self.order = order = np.concatenate(rounds)
+        m = len(order)
+        self.lengths = [len(r) for r in rounds]
+        ends = np.cumsum(self.lengths)
+        self.starts = ends - self.lengths
+        bounds = list(zip(self.starts.tolist(), ends.tolist(), strict=True))
+        # Body a's rows of a round, then body b's, side by side: one gather and one write per round.
+        # Rows of [everything about body a; everything about body b], contact by contact.
+        self.ab_rows = np.concatenate([x for s, e in bounds for x in (order[s:e], m + order[s:e])])
+        both = np.arange(2)
+        fab = np.concatenate([2 * a[:, None] + both, 2 * b[:, None] + both]).take(self.ab_rows, axis=0)
+        self.nc, self.nab = np.empty((m, 2), dtype=complex), np.empty((2 * m, 2), dtype=complex)
+        self.k, self.target, self.impulse = np.empty((m, 2)), np.empty((m, 2)), np.empty((m, 2))
+        self.changes, self.w_max = np.zeros((m, 2)), np.empty((m, 1))
+        self.rounds = [
+            _Round(fab[2 * s : 2 * e].ravel(), self.nc[s:e], self.nab[2 * s : 2 * e].reshape(2, e - s, 2),
+                   self.k[s:e], self.changes[s:e], self.changes, self.w_max, self.target[s:e], self.impulse[s:e], r)
+            for (s, e), r in zip(bounds, rounds, strict=True)
+        ]  # fmt: skip
+        self._impulses = [g.impulse for g in self.rounds]
+
+    def fill(self, nc, nab, k, w_sum, target, impulse) -> list[_Round]:
+        """This step's values (contact by contact; nab: body a's rows, then body b's) into the rounds."""
+        order = self.order
+        np.take(nc, order, axis=0, out=self.nc, mode="clip")  # "clip": no bounds check, no buffering
+        np.take(nab, self.ab_rows, axis=0, out=self.nab, mode="clip")
+        np.take(k, order, axis=0, out=self.k, mode="clip")
+        np.take(target, order, axis=0, out=self.target, mode="clip")
+        np.take(impulse, order, axis=0, out=self.impulse, mode="clip")
+        self.w_max[:, 0] = np.repeat(np.maximum.reduceat(w_sum.take(order), self.starts), self.lengths)
+        for g, view in zip(self.rounds, self._impulses, strict=True):
+            g.impulse = view  # the iterations rebind it to each new value
+        return self.rounds
 
 
 def _warm_push(c: _Contacts, mass: np.ndarray, impulse: np.ndarray) -> np.ndarray:

@@ -74,6 +74,9 @@ CONTACT_KEPT = ("_keys", "_impulses", "_rows", "_round_keys", "_rounds", "_free_
 # Worked out afresh at the start of every contact stage: nothing to keep.
 ROUND_LISTS = (CONTACT_KEPT.index("_rounds"), CONTACT_KEPT.index("_free_rounds"))  # lists of arrays, kept as tuples
 CONTACT_SCRATCH = frozenset({"_y", "_r_mean", "_warm"})  # worked out afresh in each solve
+# Laid out from the kept rounds and rebuilt whenever they are other lists (as restored ones are):
+# it changes no result, so a state need not keep it.
+CONTACT_CACHE = frozenset({"_layouts"})
 # The Python objects of one state beside its arrays' data (the state, its dicts and tuples,
 # the arrays' headers): tracemalloc measures 1.0 to 1.2 kB, with or without springs.
 STATE_OVERHEAD_BYTES = 1600
@@ -219,7 +222,7 @@ def _contact_state(table: AirTable, like: TableState | None) -> tuple | None:
     solver = getattr(table, "_contacts", None)
     if solver is None:
         return None
-    unknown = set(vars(solver)) - set(CONTACT_KEPT) - CONTACT_SCRATCH
+    unknown = set(vars(solver)) - set(CONTACT_KEPT) - CONTACT_SCRATCH - CONTACT_CACHE
     if unknown:
         raise TypeError(
             f"the contact stage keeps {sorted(unknown)}: airtable/physics/state.py must learn to capture it"
