@@ -91,7 +91,10 @@ def _pair_contacts(pos, vel, ci, cj, reach, rest, held, margin) -> _Contacts:
     i, j = ci.take(near), cj.take(near)
     n, dist = vectors.unit_vectors(vectors.take(d, near), i + j)
     vn = vectors.dot_rows(vectors.take(vel, i) - vectors.take(vel, j), n)
-    slow = np.flatnonzero((vn >= -np.maximum(rest.take(i), rest.take(j))) | held(i, j))
+    slow = vn >= -np.maximum(rest.take(i), rest.take(j))
+    fast = np.flatnonzero(~slow)  # few, even in a pile: look only these up among the held pairs
+    slow[fast] = held(i.take(fast), j.take(fast))
+    slow = np.flatnonzero(slow)
     i, j = i.take(slow), j.take(slow)
     nc = _as_complex(vectors.take(n, slow))
     count = len(pos)
@@ -172,7 +175,8 @@ class ContactSolver:
         self._keys = np.empty(0, dtype=np.int64)  # sorted
         self._impulses = np.empty((0, 2))
         self._rows = -1
-        self._round_keys: np.ndarray | None = None
+        self._round_keys: np.ndarray | None = None  # the contacts the rounds are for, in their order
+        self._key_order = np.empty(0, dtype=np.intp)  # argsort of _round_keys
         self._rounds: list[np.ndarray] = []  # bottom-up by bands: the first iteration
         self._free_rounds: list[np.ndarray] = []  # fewer rounds, in no order: the later iterations
         self._layouts: tuple[_Layout, _Layout] | None = None  # of _rounds and _free_rounds, while they stay
@@ -252,17 +256,23 @@ class ContactSolver:
         )
         impulse = np.zeros((len(c.keys), 2))  # pseudo-velocities start from nothing each step
         self._warm = impulse[:, 0]
-        if len(self._keys):
+        same = self._round_keys is not None and np.array_equal(self._round_keys, c.keys)
+        if same and len(self._keys) == len(c.keys):
+            # The contacts of the last step, in the same order (not a step with none
+            # between): each finds its impulse where _keep sorted it.
+            impulse[self._key_order, 0] = self._impulses[:, 0]
+        elif len(self._keys):
             found = np.searchsorted(self._keys, c.keys).clip(0, len(self._keys) - 1)
             hit = np.flatnonzero(self._keys.take(found) == c.keys)
             impulse[hit, 0] = self._impulses[found.take(hit), 0]
-        if self._round_keys is None or not np.array_equal(self._round_keys, c.keys):
+        if not same:
             virtual = c.b.copy()
             virtual[n_pairs:] = rows + 1 + np.arange(len(c.b) - n_pairs)  # each wall contact its own body
             bodies = rows + 1 + len(c.b) - n_pairs
             self._rounds = colour_rounds(c.a, virtual, bodies, self._bands(c))
             self._free_rounds = colour_rounds(c.a, virtual, bodies)
             self._round_keys = c.keys.copy()
+            self._key_order = np.argsort(c.keys)
         if self._layouts is None or self._layouts[0].source is not self._rounds:
             self._layouts = (_Layout(self._rounds, c.a, c.b), _Layout(self._free_rounds, c.a, c.b))
         wa, wb = inv.take(c.a), inv.take(c.b)
@@ -287,7 +297,7 @@ class ContactSolver:
         impulses = np.empty((len(c.keys), 2))
         for g in rounds:
             impulses[g.r] = g.impulse
-        order = np.argsort(c.keys)
+        order = self._key_order  # c.keys are _round_keys: sorted once per colouring
         self._keys, self._impulses = c.keys.take(order), impulses.take(order, axis=0)
 
 
