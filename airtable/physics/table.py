@@ -597,7 +597,7 @@ class AirTable:
         """
         pos, vel, radius, mass = self.pos_m, self.vel_mps, self.radius_m, self.mass_kg
         ci, cj, reach = self._neighbours.pairs(pos, radius)
-        order = self._neighbours.order
+        order = self._neighbours.sorted_order
         i, j = self._colliding(rest, *broadphase.overlapping_pairs(pos, ci, cj, reach, order))
         records, moved = [], []
         for attempt in range(1 + EXTRA_PASSES):
