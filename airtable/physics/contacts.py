@@ -154,18 +154,15 @@ def colour_rounds(a: np.ndarray, b: np.ndarray, n_bodies: int, prio: np.ndarray 
 
 @dataclass
 class _Round:
-    """One round's contacts, gathered once per step: targets and impulses as (m, 2) [velocity, position]."""
+    """One round's contacts: views into its _Layout's buffers; targets and impulses as (m, 2) [velocity, position]."""
 
     fab: np.ndarray  # flat indices of body a's velocity and pseudo-velocity (2 a, 2 a + 1), then body b's
     nc: np.ndarray  # (m, 2) complex conjugate normals, to project velocities
     nab: np.ndarray  # (2, m, 2) complex: the velocity change of body a per unit impulse, and minus body b's
     k: np.ndarray  # (m, 2) effective mass 1 / (wa + wb)
-    change: np.ndarray  # (m, 2) the last iteration's change of impulse: a view into `changes`
-    changes: np.ndarray  # (all contacts, 2): every round's `change`, to find the largest once per iteration
-    w_max: np.ndarray  # (all contacts, 1) per contact, its round's largest wa + wb: impulse to speed
+    change: np.ndarray  # (m, 2) the last iteration's change of impulse
     target: np.ndarray  # (m, 2): least relative normal velocity, and pseudo-velocity
     impulse: np.ndarray  # (m, 2) accumulated, >= 0
-    r: np.ndarray  # the round's contact numbers
 
 
 class ContactSolver:
@@ -229,19 +226,19 @@ class ContactSolver:
             self._keys, self._impulses = np.empty(0, dtype=np.int64), np.empty((0, 2))
             return False
         self._y, self._r_mean = pos[:, 1], float(radius.mean())
-        rounds, later = self._gather(c, mass, len(pc.a), dt)
+        first, later = self._gather(c, mass, len(pc.a), dt)
         w = np.zeros((len(pos) + 1, 2), dtype=complex)  # velocities and pseudo-velocities; the last row: walls
         w[:-1, 0] = _as_complex(vel)
         v0 = w[:-1, 0].copy()
         w[:-1, 0] += _warm_push(c, mass, self._warm)  # warm start: last step's velocity impulses first
-        self.iterations, rounds = _iterate(w, rounds, later, len(c.a))
-        self._keep(c, rounds)
+        self.iterations, layout = _iterate(w, first, later)
+        self._keep(c, layout)
         moved = (w[:-1, 0] - v0 + w[:-1, 1]) * dt
         pos += np.column_stack([moved.real, moved.imag])
         vel[:, 0], vel[:, 1] = w[:-1, 0].real, w[:-1, 0].imag
         return True
 
-    def _gather(self, c: _Contacts, mass, n_pairs: int, dt: float) -> tuple[list[_Round], list[_Round]]:
+    def _gather(self, c: _Contacts, mass, n_pairs: int, dt: float) -> tuple[_Layout, _Layout]:
         """Per round: the bodies, inverse masses, targets and the warm-start impulses."""
         rows = len(mass)
         inv = np.append(1.0 / mass, 0.0)  # the walls never move
@@ -292,11 +289,9 @@ class ContactSolver:
         scramble = (np.arange(m, dtype=np.uint64) * np.uint64(0x9E3779B1)) % np.uint64(1 << 32)
         return band * np.uint64(1 << 32) + scramble
 
-    def _keep(self, c: _Contacts, rounds: list[_Round]) -> None:
+    def _keep(self, c: _Contacts, layout: _Layout) -> None:
         """Keep this step's impulses by contact key, for the next step's warm start."""
-        impulses = np.empty((len(c.keys), 2))
-        for g in rounds:
-            impulses[g.r] = g.impulse
+        impulses = layout.impulses()
         order = self._key_order  # c.keys are _round_keys: sorted once per colouring
         self._keys, self._impulses = c.keys.take(order), impulses.take(order, axis=0)
 
@@ -325,26 +320,38 @@ class _Layout:
         fab = np.concatenate([2 * a[:, None] + both, 2 * b[:, None] + both]).take(self.ab_rows, axis=0)
         self.nc, self.nab = np.empty((m, 2), dtype=complex), np.empty((2 * m, 2), dtype=complex)
         self.k, self.target, self.impulse = np.empty((m, 2)), np.empty((m, 2)), np.empty((m, 2))
+        # Every round's last change of impulse, to find the largest once per iteration, and per
+        # contact its round's largest wa + wb, which turns a change of impulse into one of speed.
         self.changes, self.w_max = np.zeros((m, 2)), np.empty((m, 1))
         self.rounds = [
             _Round(fab[2 * s : 2 * e].ravel(), self.nc[s:e], self.nab[2 * s : 2 * e].reshape(2, e - s, 2),
-                   self.k[s:e], self.changes[s:e], self.changes, self.w_max, self.target[s:e], self.impulse[s:e], r)
-            for (s, e), r in zip(bounds, rounds, strict=True)
+                   self.k[s:e], self.changes[s:e], self.target[s:e], self.impulse[s:e])
+            for s, e in bounds
         ]  # fmt: skip
         self._impulses = [g.impulse for g in self.rounds]
 
-    def fill(self, nc, nab, k, w_sum, target, impulse) -> list[_Round]:
+    def impulses(self) -> np.ndarray:
+        """(contacts, 2) the rounds' impulses so far, contact by contact."""
+        out = np.empty((len(self.order), 2))
+        out[self.order] = np.concatenate([g.impulse for g in self.rounds])
+        return out
+
+    def take_impulses(self, impulses: np.ndarray) -> None:
+        """Start the rounds from these impulses (contact by contact)."""
+        np.take(impulses, self.order, axis=0, out=self.impulse, mode="clip")
+        for g, view in zip(self.rounds, self._impulses, strict=True):
+            g.impulse = view  # the iterations rebind it to each new value
+
+    def fill(self, nc, nab, k, w_sum, target, impulse) -> _Layout:
         """This step's values (contact by contact; nab: body a's rows, then body b's) into the rounds."""
         order = self.order
         np.take(nc, order, axis=0, out=self.nc, mode="clip")  # "clip": no bounds check, no buffering
         np.take(nab, self.ab_rows, axis=0, out=self.nab, mode="clip")
         np.take(k, order, axis=0, out=self.k, mode="clip")
         np.take(target, order, axis=0, out=self.target, mode="clip")
-        np.take(impulse, order, axis=0, out=self.impulse, mode="clip")
         self.w_max[:, 0] = np.repeat(np.maximum.reduceat(w_sum.take(order), self.starts), self.lengths)
-        for g, view in zip(self.rounds, self._impulses, strict=True):
-            g.impulse = view  # the iterations rebind it to each new value
-        return self.rounds
+        self.take_impulses(impulse)
+        return self
 
 
 def _warm_push(c: _Contacts, mass: np.ndarray, impulse: np.ndarray) -> np.ndarray:
@@ -360,23 +367,25 @@ def _warm_push(c: _Contacts, mass: np.ndarray, impulse: np.ndarray) -> np.ndarra
     return out + 1j * (np.bincount(c.a, a.imag, rows) - np.bincount(c.b, b.imag, rows + 1)[:rows])
 
 
-def _iterate(w: np.ndarray, rounds: list[_Round], later: list[_Round], count: int) -> tuple[int, list[_Round]]:
+def _iterate(w: np.ndarray, first: _Layout, later: _Layout) -> tuple[int, _Layout]:
     """Sequential impulses, round by round, until converged or ITERATIONS; return the iterations used
-    and the rounds that hold the impulses.
+    and the layout whose rounds hold the impulses.
 
-    The first iteration goes bottom-up (`rounds`), so support from the floor
+    The first iteration goes bottom-up (`first`), so support from the floor
     travels up a pile; the later ones only refine it and take the fewer
     rounds of `later`, which get the impulses so far.
     """
     flat = w.reshape(-1)
+    layout = first
     for it in range(1, ITERATIONS + 1):
         if it == 2:
-            rounds = _handover(rounds, later, count)
+            later.take_impulses(first.impulses())
+            layout = later
         # Velocities as one row of numbers (1-D fancy indexing is several times
         # cheaper than 2-D). No body appears twice in a round, so each writes
         # back what it read plus its change; the walls' row takes many writes,
         # all the same (wb = 0).
-        for g in rounds:
+        for g in layout.rounds:
             v = flat.take(g.fab).reshape(2, -1, 2)  # body a's rows, then body b's
             vn = (g.nc * (v[0] - v[1])).real
             new = np.maximum(g.impulse + g.k * (g.target - vn), 0.0)
@@ -384,16 +393,6 @@ def _iterate(w: np.ndarray, rounds: list[_Round], later: list[_Round], count: in
             g.impulse = new
             v += g.change * g.nab
             flat[g.fab] = v.reshape(-1)
-        if rounds and float((np.abs(rounds[0].changes) * rounds[0].w_max).max()) < CONVERGED_MPS:
-            return it, rounds
-    return ITERATIONS, rounds
-
-
-def _handover(rounds: list[_Round], later: list[_Round], count: int) -> list[_Round]:
-    """Give `later` the impulses accumulated in `rounds` (the same contacts, other rounds)."""
-    impulses = np.empty((count, 2))
-    for g in rounds:
-        impulses[g.r] = g.impulse
-    for g in later:
-        g.impulse = impulses.take(g.r, axis=0)
-    return later
+        if float((np.abs(layout.changes) * layout.w_max).max()) < CONVERGED_MPS:
+            return it, layout
+    return ITERATIONS, layout
