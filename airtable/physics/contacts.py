@@ -177,6 +177,7 @@ class ContactSolver:
         self._rounds: list[np.ndarray] = []  # bottom-up by bands: the first iteration
         self._free_rounds: list[np.ndarray] = []  # fewer rounds, in no order: the later iterations
         self._layouts: tuple[_Layout, _Layout] | None = None  # of _rounds and _free_rounds, while they stay
+        self._wall_rest: tuple | None = None  # (rest, _impulses, answer) of the last wall_rest
         self.count = 0  # contacts in the last step
         self.iterations = 0  # iterations the last step needed
 
@@ -195,7 +196,10 @@ class ContactSolver:
     def wall_rest(self, rest: np.ndarray) -> np.ndarray:
         """(N, 2) rest speeds towards the walls along x and y: infinite where the puck pressed
         on a wall across that axis in the last step (it rests there whatever its speed)."""
+        if self._wall_rest is not None and self._wall_rest[0] is rest and self._wall_rest[1] is self._impulses:
+            return self._wall_rest[2]  # asked again within the step (walls, then contacts): the same answer
         out = np.repeat(rest[:, None], 2, axis=1)
+        self._wall_rest = (rest, self._impulses, out)
         if len(self._keys) == 0 or self._rows != len(rest):
             return out
         row, other = np.divmod(self._keys, self._rows + 4)

@@ -76,9 +76,9 @@ CONTACT_KEPT = (
 # Worked out afresh at the start of every contact stage: nothing to keep.
 ROUND_LISTS = (CONTACT_KEPT.index("_rounds"), CONTACT_KEPT.index("_free_rounds"))  # lists of arrays, kept as tuples
 CONTACT_SCRATCH = frozenset({"_y", "_r_mean", "_warm"})  # worked out afresh in each solve
-# Laid out from the kept rounds and rebuilt whenever they are other lists (as restored ones are):
-# it changes no result, so a state need not keep it.
-CONTACT_CACHE = frozenset({"_layouts"})
+# Worked out from kept values and used only while those are the very same objects (restored
+# ones are other objects): they change no result, so a state need not keep them.
+CONTACT_CACHE = frozenset({"_layouts", "_wall_rest"})
 # The Python objects of one state beside its arrays' data (the state, its dicts and tuples,
 # the arrays' headers): tracemalloc measures 1.0 to 1.2 kB, with or without springs.
 STATE_OVERHEAD_BYTES = 1600
