@@ -326,7 +326,8 @@ class _Layout:
         self.k, self.target, self.impulse = np.empty((m, 2)), np.empty((m, 2)), np.empty((m, 2))
         # Every round's last change of impulse, to find the largest once per iteration, and per
         # contact its round's largest wa + wb, which turns a change of impulse into one of speed.
-        self.changes, self.w_max = np.zeros((m, 2)), np.empty((m, 1))
+        # (m, 2), both columns alike: an (m, 1) array broadcast against (m, 2) costs twice as much.
+        self.changes, self.w_max = np.zeros((m, 2)), np.empty((m, 2))
         self.rounds = [
             _Round(fab[2 * s : 2 * e].ravel(), self.nc[s:e], self.nab[2 * s : 2 * e].reshape(2, e - s, 2),
                    self.k[s:e], self.changes[s:e], self.target[s:e], self.impulse[s:e])
@@ -353,7 +354,7 @@ class _Layout:
         np.take(nab, self.ab_rows, axis=0, out=self.nab, mode="clip")
         np.take(k, order, axis=0, out=self.k, mode="clip")
         np.take(target, order, axis=0, out=self.target, mode="clip")
-        self.w_max[:, 0] = np.repeat(np.maximum.reduceat(w_sum.take(order), self.starts), self.lengths)
+        self.w_max[:] = np.repeat(np.maximum.reduceat(w_sum.take(order), self.starts), self.lengths)[:, None]
         self.take_impulses(impulse)
         return self
 
