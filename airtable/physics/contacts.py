@@ -277,10 +277,14 @@ class ContactSolver:
         if self._layouts is None or self._layouts[0].source is not self._rounds:
             self._layouts = (_Layout(self._rounds, c.a, c.b), _Layout(self._free_rounds, c.a, c.b))
         wa, wb = inv.take(c.a), inv.take(c.b)
-        n = np.repeat(c.n[:, None], 2, axis=1)  # (m, 2): no broadcasting in the rounds
-        nab = np.concatenate([n * wa[:, None], -(n * wb[:, None])])
-        k = np.repeat((1.0 / (wa + wb))[:, None], 2, axis=1)
-        values = (n.conjugate(), nab, k, wa + wb, target, impulse)
+
+        # Each per-contact number twice, for the velocity and the pseudo-velocity: (m, 2), so
+        # that nothing is broadcast in the rounds (an (m, 1) column costs twice as much).
+        def both(x: np.ndarray) -> np.ndarray:
+            return np.repeat(x[:, None], 2, axis=1)
+
+        nab = both(np.concatenate([c.n * wa, -(c.n * wb)]))
+        values = (both(c.n.conjugate()), nab, both(1.0 / (wa + wb)), wa + wb, target, impulse)
         return self._layouts[0].fill(*values), self._layouts[1].fill(*values)
 
     def _bands(self, c: _Contacts) -> np.ndarray | None:
