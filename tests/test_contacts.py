@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import numpy as np
+import pytest
 
 from airtable.physics import broadphase, contacts
 
@@ -76,3 +77,19 @@ def test_the_rounds_give_the_sequential_result() -> None:
     moved = (w[:-1, 0] - (vel[:, 0] + 1j * vel[:, 1]) + w[:-1, 1]) * dt
     np.testing.assert_allclose(p, pos + np.column_stack([moved.real, moved.imag]), rtol=0, atol=1e-15)
     assert np.all(v[:, 1] > vel[:, 1] + 0.01)  # held up: every puck falls slower than before
+
+
+def test_a_puck_resting_on_the_floor_converges_at_once() -> None:
+    # One puck on the floor, falling at g dt, and moved by it this step (the
+    # stage runs after the positions moved): its one contact takes out the
+    # approach in the first iteration (vy = 0), the second changes nothing,
+    # and the stage stops there instead of running all ITERATIONS.
+    pos, vel = np.array([[0.5, 0.1 - 9.8 / 240 / 240]]), np.array([[0.0, -9.8 / 240]])
+    radius, mass = np.array([0.1]), np.array([0.3 * np.pi * 0.01])
+    none = np.empty(0, dtype=np.intp)
+    solver = contacts.ContactSolver()
+    rest = np.array([2 * 9.8 / 240])
+    assert solver.solve(pos, vel, radius, mass, np.array([1.0, 1.0]), (none, none, np.empty(0)), rest, 1 / 240)
+    assert solver.count == 1 and solver.iterations == 2 < contacts.ITERATIONS
+    assert vel[0, 1] == 0.0 and vel[0, 0] == 0.0
+    assert pos[0, 1] == pytest.approx(0.1, abs=1e-15)  # back where it rests, and no overlap to push out

@@ -339,6 +339,17 @@ class _Layout:
         ]  # fmt: skip
         self._impulses = [g.impulse for g in self.rounds]
 
+    def converged(self) -> bool:
+        """Whether the last iteration changed no speed by CONVERGED_MPS (a change of impulse times w_max).
+
+        The largest change of impulse times the least w_max bounds that from
+        below, and in a pile it is far above: one cheap reduction then answers.
+        """
+        largest = float(np.abs(self.changes).max())
+        if largest * self.w_min >= CONVERGED_MPS:
+            return False
+        return float((np.abs(self.changes) * self.w_max).max()) < CONVERGED_MPS
+
     def impulses(self) -> np.ndarray:
         """(contacts, 2) the rounds' impulses so far, contact by contact."""
         out = np.empty((len(self.order), 2))
@@ -359,6 +370,7 @@ class _Layout:
         np.take(k, order, axis=0, out=self.k, mode="clip")
         np.take(target, order, axis=0, out=self.target, mode="clip")
         self.w_max[:] = np.repeat(np.maximum.reduceat(w_sum.take(order), self.starts), self.lengths)[:, None]
+        self.w_min = float(self.w_max.min())
         self.take_impulses(impulse)
         return self
 
@@ -369,9 +381,7 @@ def _warm_push(c: _Contacts, mass: np.ndarray, impulse: np.ndarray) -> np.ndarra
     rows = len(mass)
     push = impulse * c.n
     a = push / mass.take(c.a)
-    walls = c.b == rows
-    b = push / np.where(walls, 1.0, mass.take(c.b.clip(max=rows - 1)))
-    b[walls] = 0.0
+    b = push / np.append(mass, 1.0).take(c.b)  # the walls' row (b = rows) is dropped below
     out = np.bincount(c.a, a.real, rows) - np.bincount(c.b, b.real, rows + 1)[:rows]
     return out + 1j * (np.bincount(c.a, a.imag, rows) - np.bincount(c.b, b.imag, rows + 1)[:rows])
 
@@ -402,6 +412,6 @@ def _iterate(w: np.ndarray, first: _Layout, later: _Layout) -> tuple[int, _Layou
             g.impulse = new
             v += g.change * g.nab
             flat[g.fab] = v.reshape(-1)
-        if float((np.abs(layout.changes) * layout.w_max).max()) < CONVERGED_MPS:
+        if layout.converged():
             return it, layout
     return ITERATIONS, layout
