@@ -50,6 +50,8 @@ def resolve_walls(
         if hold_slow:
             _hold(pos, vel, radius, size_m, out.take(np.flatnonzero(~fast)))
         out = out.take(np.flatnonzero(fast))
+        if len(out) == 0:
+            return 0  # a pile's usual case: every puck past a wall rests there
     p, v = vectors.take(pos, out), vectors.take(vel, out)
     lo = radius.take(out)[:, None]
     hi = size_m - lo
