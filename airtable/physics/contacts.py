@@ -243,7 +243,8 @@ class ContactSolver:
         return True
 
     def _gather(self, c: _Contacts, mass, n_pairs: int, dt: float) -> tuple[_Layout, _Layout]:
-        """Per round: the bodies, inverse masses, targets and the warm-start impulses."""
+        """This step's targets, masses and warm-start impulses, filled into the layouts of the rounds
+        of the first iteration and of the later ones (colouring the contacts anew if they changed)."""
         rows = len(mass)
         inv = np.append(1.0 / mass, 0.0)  # the walls never move
         # Where the pair was at the start of the step, if it approached: the
