@@ -53,3 +53,20 @@ def test_bench_help(capsys: pytest.CaptureFixture[str]) -> None:
         main(["--help"])
     assert exit_info.value.code == 0
     assert "--quick" in capsys.readouterr().out
+
+
+def test_the_hard_cases_time_the_engines_in_turns() -> None:
+    from airtable import bench_hard
+
+    calls = []
+
+    class Fake:
+        def __init__(self, name: str) -> None:
+            self.name = name
+
+        def step(self, dt_s: float) -> None:
+            calls.append(self.name)
+
+    ms = bench_hard.step_ms([Fake("ours"), Fake("pymunk")], blocks=3, steps=2)
+    assert len(ms) == 2 and all(m >= 0.0 for m in ms)
+    assert calls == ["ours", "ours", "pymunk", "pymunk"] * 3  # block by block, in turns

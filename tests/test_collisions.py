@@ -407,3 +407,23 @@ def test_disjoint_rounds_keep_order_and_never_repeat_a_puck(pair_list: tuple[np.
 def test_cell_sort_matches_a_stable_argsort(n_cells: int) -> None:
     keys = np.random.default_rng(n_cells).integers(0, n_cells, 5000)
     np.testing.assert_array_equal(broadphase._argsort_cells(keys, n_cells), np.argsort(keys, kind="stable"))
+
+
+def test_overlapping_pairs_picked_in_the_kept_order_are_the_sorted_ones() -> None:
+    # A packed box (a pile): most of the neighbour list's pairs overlap, so
+    # overlapping_pairs picks them in the list's kept (i, j) order instead of
+    # sorting them; the answer must be the same pairs in the same order.
+    rng = np.random.default_rng(3)
+    side = 20
+    grid = np.stack(np.meshgrid(np.arange(side), np.arange(side)), -1).reshape(-1, 2) * 0.199 + 0.1
+    pos = grid + rng.uniform(-1e-3, 1e-3, grid.shape)
+    radius = np.full(len(pos), 0.1)
+    neighbours = broadphase.NeighbourList()
+    i, j, reach = neighbours.pairs(pos, radius)
+    picked = broadphase.overlapping_pairs(pos, i, j, reach, neighbours.sorted_order)
+    sorted_ = broadphase.overlapping_pairs(pos, i, j, reach)
+    assert len(picked[0]) * broadphase.SORTED_PICK_SHARE >= len(i)  # the kept order was used
+    assert not np.array_equal(neighbours.sorted_order(), np.arange(len(i)))  # and the list is not in it already
+    assert np.array_equal(picked[0], sorted_[0]) and np.array_equal(picked[1], sorted_[1])
+    bi, bj = broadphase.brute_force_pairs(pos, radius)
+    assert np.array_equal(picked[0], bi) and np.array_equal(picked[1], bj)

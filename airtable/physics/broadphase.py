@@ -12,6 +12,8 @@ keeps the candidates that really overlap, sorted by (i, j).
 
 from __future__ import annotations
 
+from collections.abc import Callable
+
 import numpy as np
 
 from airtable.physics import vectors
@@ -75,15 +77,36 @@ def pair_reach(radius: np.ndarray, i: np.ndarray, j: np.ndarray) -> np.ndarray:
     return radius.take(i) + radius.take(j)
 
 
+# Once one candidate pair in this many overlaps (a pile, not a gas), picking the overlapping
+# pairs in a kept sorted order beats sorting them.
+SORTED_PICK_SHARE = 8
+
+
 def overlapping_pairs(
-    pos: np.ndarray, i: np.ndarray, j: np.ndarray, reach: np.ndarray
+    pos: np.ndarray,
+    i: np.ndarray,
+    j: np.ndarray,
+    reach: np.ndarray,
+    sorted_order: Callable[[], np.ndarray] | None = None,
 ) -> tuple[np.ndarray, np.ndarray]:
-    """The candidate pairs (i, j) closer than `reach`, sorted by (i, j)."""
-    hit = _closer_than(pos, i, j, reach)
+    """The candidate pairs (i, j) closer than `reach`, sorted by (i, j).
+
+    `sorted_order`, if given, returns the permutation that sorts the
+    candidates by (i, j) (NeighbourList.sorted_order, worked out once per
+    build): where many pairs overlap (a pile), they are picked in that order
+    instead of being sorted each time; the result is the same.
+    """
+    d = vectors.take(pos, i) - vectors.take(pos, j)
+    close = vectors.squared_lengths(d) < reach * reach
+    if sorted_order is not None and np.count_nonzero(close) * SORTED_PICK_SHARE >= len(i):
+        order = sorted_order()
+        hit = order.take(np.flatnonzero(close.take(order)))
+        return i.take(hit), j.take(hit)
+    hit = np.flatnonzero(close)
     i, j = i.take(hit), j.take(hit)
     if len(i) > 1:
-        order = np.lexsort((j, i))
-        i, j = i.take(order), j.take(order)
+        by_pair = np.lexsort((j, i))
+        i, j = i.take(by_pair), j.take(by_pair)
     return i, j
 
 
@@ -115,6 +138,12 @@ class NeighbourList:
             self._build(pos, radius)
         return self._i, self._j, self._reach
 
+    def sorted_order(self) -> np.ndarray:
+        """The permutation that sorts the pairs by (i, j), worked out the first time it is asked for."""
+        if self._order is None:
+            self._order = np.lexsort((self._j, self._i))
+        return self._order
+
     def _still_valid(self, pos: np.ndarray, radius: np.ndarray) -> bool:
         if self._built_pos is None or len(pos) != len(self._built_pos) or len(pos) == 0:
             return False
@@ -129,6 +158,7 @@ class NeighbourList:
         reach = pair_reach(radius, i, j)
         near = _closer_than(pos, i, j, reach + skin)
         self._i, self._j, self._reach = i.take(near), j.take(near), reach.take(near)
+        self._order: np.ndarray | None = None  # see sorted_order
         self._built_pos, self._built_radius = pos.copy(), radius.copy()
         self._half_skin_sq = (0.5 * skin) ** 2
         self.builds += 1

@@ -91,7 +91,10 @@ def _pair_contacts(pos, vel, ci, cj, reach, rest, held, margin) -> _Contacts:
     i, j = ci.take(near), cj.take(near)
     n, dist = vectors.unit_vectors(vectors.take(d, near), i + j)
     vn = vectors.dot_rows(vectors.take(vel, i) - vectors.take(vel, j), n)
-    slow = np.flatnonzero((vn >= -np.maximum(rest.take(i), rest.take(j))) | held(i, j))
+    slow = vn >= -np.maximum(rest.take(i), rest.take(j))
+    fast = np.flatnonzero(~slow)  # few, even in a pile: look only these up among the held pairs
+    slow[fast] = held(i.take(fast), j.take(fast))
+    slow = np.flatnonzero(slow)
     i, j = i.take(slow), j.take(slow)
     nc = _as_complex(vectors.take(n, slow))
     count = len(pos)
@@ -151,20 +154,15 @@ def colour_rounds(a: np.ndarray, b: np.ndarray, n_bodies: int, prio: np.ndarray 
 
 @dataclass
 class _Round:
-    """One round's contacts, gathered once per step: targets and impulses as (m, 2) [velocity, position]."""
+    """One round's contacts: views into its _Layout's buffers; targets and impulses as (m, 2) [velocity, position]."""
 
-    fa: np.ndarray  # flat indices of body a's velocity and pseudo-velocity: 2 a, 2 a + 1
-    fb: np.ndarray
-    nc: np.ndarray  # (m, 1) complex conjugate normals, to project velocities
-    na: np.ndarray  # (m, 2) complex: the velocity change of body a per unit impulse
-    nb: np.ndarray  # the same for body b
-    k: np.ndarray  # (m, 1) effective mass 1 / (wa + wb)
-    change: np.ndarray  # (m, 2) the last iteration's change of impulse: a view into `changes`
-    changes: np.ndarray  # (all contacts, 2): every round's `change`, to find the largest once per iteration
-    w_max: np.ndarray  # (all contacts, 1) per contact, its round's largest wa + wb: impulse to speed
+    fab: np.ndarray  # flat indices of body a's velocity and pseudo-velocity (2 a, 2 a + 1), then body b's
+    nc: np.ndarray  # (m, 2) complex conjugate normals, to project velocities
+    nab: np.ndarray  # (2, m, 2) complex: the velocity change of body a per unit impulse, and minus body b's
+    k: np.ndarray  # (m, 2) effective mass 1 / (wa + wb)
+    change: np.ndarray  # (m, 2) the last iteration's change of impulse
     target: np.ndarray  # (m, 2): least relative normal velocity, and pseudo-velocity
     impulse: np.ndarray  # (m, 2) accumulated, >= 0
-    r: np.ndarray  # the round's contact numbers
 
 
 class ContactSolver:
@@ -174,9 +172,12 @@ class ContactSolver:
         self._keys = np.empty(0, dtype=np.int64)  # sorted
         self._impulses = np.empty((0, 2))
         self._rows = -1
-        self._round_keys: np.ndarray | None = None
+        self._round_keys: np.ndarray | None = None  # the contacts the rounds are for, in their order
+        self._key_order = np.empty(0, dtype=np.intp)  # argsort of _round_keys
         self._rounds: list[np.ndarray] = []  # bottom-up by bands: the first iteration
         self._free_rounds: list[np.ndarray] = []  # fewer rounds, in no order: the later iterations
+        self._layouts: tuple[_Layout, _Layout] | None = None  # of _rounds and _free_rounds, while they stay
+        self._wall_rest: tuple | None = None  # (rest, _impulses, answer) of the last wall_rest
         self.count = 0  # contacts in the last step
         self.iterations = 0  # iterations the last step needed
 
@@ -195,7 +196,10 @@ class ContactSolver:
     def wall_rest(self, rest: np.ndarray) -> np.ndarray:
         """(N, 2) rest speeds towards the walls along x and y: infinite where the puck pressed
         on a wall across that axis in the last step (it rests there whatever its speed)."""
+        if self._wall_rest is not None and self._wall_rest[0] is rest and self._wall_rest[1] is self._impulses:
+            return self._wall_rest[2]  # asked again within the step (walls, then contacts): the same answer
         out = np.repeat(rest[:, None], 2, axis=1)
+        self._wall_rest = (rest, self._impulses, out)
         if len(self._keys) == 0 or self._rows != len(rest):
             return out
         row, other = np.divmod(self._keys, self._rows + 4)
@@ -226,20 +230,21 @@ class ContactSolver:
             self._keys, self._impulses = np.empty(0, dtype=np.int64), np.empty((0, 2))
             return False
         self._y, self._r_mean = pos[:, 1], float(radius.mean())
-        rounds, later = self._gather(c, mass, len(pc.a), dt)
+        first, later = self._gather(c, mass, len(pc.a), dt)
         w = np.zeros((len(pos) + 1, 2), dtype=complex)  # velocities and pseudo-velocities; the last row: walls
         w[:-1, 0] = _as_complex(vel)
         v0 = w[:-1, 0].copy()
         w[:-1, 0] += _warm_push(c, mass, self._warm)  # warm start: last step's velocity impulses first
-        self.iterations, rounds = _iterate(w, rounds, later, len(c.a))
-        self._keep(c, rounds)
+        self.iterations, layout = _iterate(w, first, later)
+        self._keep(c, layout)
         moved = (w[:-1, 0] - v0 + w[:-1, 1]) * dt
         pos += np.column_stack([moved.real, moved.imag])
         vel[:, 0], vel[:, 1] = w[:-1, 0].real, w[:-1, 0].imag
         return True
 
-    def _gather(self, c: _Contacts, mass, n_pairs: int, dt: float) -> tuple[list[_Round], list[_Round]]:
-        """Per round: the bodies, inverse masses, targets and the warm-start impulses."""
+    def _gather(self, c: _Contacts, mass, n_pairs: int, dt: float) -> tuple[_Layout, _Layout]:
+        """This step's targets, masses and warm-start impulses, filled into the layouts of the rounds
+        of the first iteration and of the later ones (colouring the contacts anew if they changed)."""
         rows = len(mass)
         inv = np.append(1.0 / mass, 0.0)  # the walls never move
         # Where the pair was at the start of the step, if it approached: the
@@ -253,22 +258,35 @@ class ContactSolver:
         )
         impulse = np.zeros((len(c.keys), 2))  # pseudo-velocities start from nothing each step
         self._warm = impulse[:, 0]
-        if len(self._keys):
+        same = self._round_keys is not None and np.array_equal(self._round_keys, c.keys)
+        if same and len(self._keys) == len(c.keys):
+            # The contacts of the last step, in the same order (not a step with none
+            # between): each finds its impulse where _keep sorted it.
+            impulse[self._key_order, 0] = self._impulses[:, 0]
+        elif len(self._keys):
             found = np.searchsorted(self._keys, c.keys).clip(0, len(self._keys) - 1)
             hit = np.flatnonzero(self._keys.take(found) == c.keys)
             impulse[hit, 0] = self._impulses[found.take(hit), 0]
-        if self._round_keys is None or not np.array_equal(self._round_keys, c.keys):
+        if not same:
             virtual = c.b.copy()
             virtual[n_pairs:] = rows + 1 + np.arange(len(c.b) - n_pairs)  # each wall contact its own body
             bodies = rows + 1 + len(c.b) - n_pairs
             self._rounds = colour_rounds(c.a, virtual, bodies, self._bands(c))
             self._free_rounds = colour_rounds(c.a, virtual, bodies)
             self._round_keys = c.keys.copy()
+            self._key_order = np.argsort(c.keys)
+        if self._layouts is None or self._layouts[0].source is not self._rounds:
+            self._layouts = (_Layout(self._rounds, c.a, c.b), _Layout(self._free_rounds, c.a, c.b))
         wa, wb = inv.take(c.a), inv.take(c.b)
-        return (
-            _rounds(c, self._rounds, wa, wb, target, impulse),
-            _rounds(c, self._free_rounds, wa, wb, target, impulse),
-        )
+
+        # Each per-contact number twice, for the velocity and the pseudo-velocity: (m, 2), so
+        # that nothing is broadcast in the rounds (an (m, 1) column costs twice as much).
+        def both(x: np.ndarray) -> np.ndarray:
+            return np.repeat(x[:, None], 2, axis=1)
+
+        nab = both(np.concatenate([c.n * wa, -(c.n * wb)]))
+        values = (both(c.n.conjugate()), nab, both(1.0 / (wa + wb)), wa + wb, target, impulse)
+        return self._layouts[0].fill(*values), self._layouts[1].fill(*values)
 
     def _bands(self, c: _Contacts) -> np.ndarray | None:
         """Priorities bottom-up by bands of height (BAND_RADII radii), scrambled within a band."""
@@ -280,35 +298,82 @@ class ContactSolver:
         scramble = (np.arange(m, dtype=np.uint64) * np.uint64(0x9E3779B1)) % np.uint64(1 << 32)
         return band * np.uint64(1 << 32) + scramble
 
-    def _keep(self, c: _Contacts, rounds: list[_Round]) -> None:
+    def _keep(self, c: _Contacts, layout: _Layout) -> None:
         """Keep this step's impulses by contact key, for the next step's warm start."""
-        impulses = np.empty((len(c.keys), 2))
-        for g in rounds:
-            impulses[g.r] = g.impulse
-        order = np.argsort(c.keys)
+        impulses = layout.impulses()
+        order = self._key_order  # c.keys are _round_keys: sorted once per colouring
         self._keys, self._impulses = c.keys.take(order), impulses.take(order, axis=0)
 
 
-def _rounds(c: _Contacts, rounds, wa, wb, target, impulse) -> list[_Round]:
-    """Gather each round's contacts once per step: all rounds in one go, then each a slice (a view)."""
-    order = np.concatenate(rounds)
-    ends = np.cumsum([len(r) for r in rounds])
-    starts = ends - [len(r) for r in rounds]
-    n = c.n.take(order)[:, None]
-    wa, wb = wa.take(order), wb.take(order)
-    both = np.arange(2)
-    fa, fb = 2 * c.a.take(order)[:, None] + both, 2 * c.b.take(order)[:, None] + both
-    nc, na, nb = n.conjugate(), np.repeat(n * wa[:, None], 2, axis=1), np.repeat(n * wb[:, None], 2, axis=1)
-    k = (1.0 / (wa + wb))[:, None]
-    lengths = [len(r) for r in rounds]
-    w_max = np.repeat(np.maximum.reduceat(wa + wb, starts), lengths)[:, None]
-    changes = np.zeros((len(order), 2))
-    target, impulse = target.take(order, axis=0), impulse.take(order, axis=0)
-    return [
-        _Round(fa[s:e].ravel(), fb[s:e].ravel(), nc[s:e], na[s:e], nb[s:e], k[s:e], changes[s:e], changes, w_max,
-               target[s:e], impulse[s:e], r)
-        for s, e, r in zip(starts, ends, rounds, strict=True)
-    ]  # fmt: skip
+class _Layout:
+    """One colouring's rounds laid out once: index arrays, buffers, and each round's views into them.
+
+    Built when the colouring changes (in a pile at rest, seldom); each step
+    then refills the buffers in place, and the rounds, whose arrays are views
+    of them, are ready. That saves making a dozen arrays and a `_Round` per
+    round at every step.
+    """
+
+    def __init__(self, rounds: list[np.ndarray], a: np.ndarray, b: np.ndarray) -> None:
+        self.source = rounds  # the colouring laid out (compared by identity: a restored state brings new lists)
+        self.order = order = np.concatenate(rounds)
+        m = len(order)
+        self.lengths = [len(r) for r in rounds]
+        ends = np.cumsum(self.lengths)
+        self.starts = ends - self.lengths
+        bounds = list(zip(self.starts.tolist(), ends.tolist(), strict=True))
+        # Body a's rows of a round, then body b's, side by side: one gather and one write per round.
+        # Rows of [everything about body a; everything about body b], contact by contact.
+        self.ab_rows = np.concatenate([x for s, e in bounds for x in (order[s:e], m + order[s:e])])
+        both = np.arange(2)
+        fab = np.concatenate([2 * a[:, None] + both, 2 * b[:, None] + both]).take(self.ab_rows, axis=0)
+        self.nc, self.nab = np.empty((m, 2), dtype=complex), np.empty((2 * m, 2), dtype=complex)
+        self.k, self.target, self.impulse = np.empty((m, 2)), np.empty((m, 2)), np.empty((m, 2))
+        # Every round's last change of impulse, to find the largest once per iteration, and per
+        # contact its round's largest wa + wb, which turns a change of impulse into one of speed.
+        # (m, 2), both columns alike: an (m, 1) array broadcast against (m, 2) costs twice as much.
+        self.changes, self.w_max = np.zeros((m, 2)), np.empty((m, 2))
+        self.rounds = [
+            _Round(fab[2 * s : 2 * e].ravel(), self.nc[s:e], self.nab[2 * s : 2 * e].reshape(2, e - s, 2),
+                   self.k[s:e], self.changes[s:e], self.target[s:e], self.impulse[s:e])
+            for s, e in bounds
+        ]  # fmt: skip
+        self._impulses = [g.impulse for g in self.rounds]
+
+    def converged(self) -> bool:
+        """Whether the last iteration changed no speed by CONVERGED_MPS (a change of impulse times w_max).
+
+        The largest change of impulse times the least w_max bounds that from
+        below, and in a pile it is far above: one cheap reduction then answers.
+        """
+        largest = float(np.abs(self.changes).max())
+        if largest * self.w_min >= CONVERGED_MPS:
+            return False
+        return float((np.abs(self.changes) * self.w_max).max()) < CONVERGED_MPS
+
+    def impulses(self) -> np.ndarray:
+        """(contacts, 2) the rounds' impulses so far, contact by contact."""
+        out = np.empty((len(self.order), 2))
+        out[self.order] = np.concatenate([g.impulse for g in self.rounds])
+        return out
+
+    def take_impulses(self, impulses: np.ndarray) -> None:
+        """Start the rounds from these impulses (contact by contact)."""
+        np.take(impulses, self.order, axis=0, out=self.impulse, mode="clip")
+        for g, view in zip(self.rounds, self._impulses, strict=True):
+            g.impulse = view  # the iterations rebind it to each new value
+
+    def fill(self, nc, nab, k, w_sum, target, impulse) -> _Layout:
+        """This step's values (contact by contact; nab: body a's rows, then body b's) into the rounds."""
+        order = self.order
+        np.take(nc, order, axis=0, out=self.nc, mode="clip")  # "clip": no bounds check, no buffering
+        np.take(nab, self.ab_rows, axis=0, out=self.nab, mode="clip")
+        np.take(k, order, axis=0, out=self.k, mode="clip")
+        np.take(target, order, axis=0, out=self.target, mode="clip")
+        self.w_max[:] = np.repeat(np.maximum.reduceat(w_sum.take(order), self.starts), self.lengths)[:, None]
+        self.w_min = float(self.w_max.min())
+        self.take_impulses(impulse)
+        return self
 
 
 def _warm_push(c: _Contacts, mass: np.ndarray, impulse: np.ndarray) -> np.ndarray:
@@ -317,47 +382,37 @@ def _warm_push(c: _Contacts, mass: np.ndarray, impulse: np.ndarray) -> np.ndarra
     rows = len(mass)
     push = impulse * c.n
     a = push / mass.take(c.a)
-    walls = c.b == rows
-    b = push / np.where(walls, 1.0, mass.take(c.b.clip(max=rows - 1)))
-    b[walls] = 0.0
+    b = push / np.append(mass, 1.0).take(c.b)  # the walls' row (b = rows) is dropped below
     out = np.bincount(c.a, a.real, rows) - np.bincount(c.b, b.real, rows + 1)[:rows]
     return out + 1j * (np.bincount(c.a, a.imag, rows) - np.bincount(c.b, b.imag, rows + 1)[:rows])
 
 
-def _iterate(w: np.ndarray, rounds: list[_Round], later: list[_Round], count: int) -> tuple[int, list[_Round]]:
+def _iterate(w: np.ndarray, first: _Layout, later: _Layout) -> tuple[int, _Layout]:
     """Sequential impulses, round by round, until converged or ITERATIONS; return the iterations used
-    and the rounds that hold the impulses.
+    and the layout whose rounds hold the impulses.
 
-    The first iteration goes bottom-up (`rounds`), so support from the floor
+    The first iteration goes bottom-up (`first`), so support from the floor
     travels up a pile; the later ones only refine it and take the fewer
     rounds of `later`, which get the impulses so far.
     """
     flat = w.reshape(-1)
+    layout = first
     for it in range(1, ITERATIONS + 1):
         if it == 2:
-            rounds = _handover(rounds, later, count)
+            later.take_impulses(first.impulses())
+            layout = later
         # Velocities as one row of numbers (1-D fancy indexing is several times
         # cheaper than 2-D). No body appears twice in a round, so each writes
         # back what it read plus its change; the walls' row takes many writes,
         # all the same (wb = 0).
-        for g in rounds:
-            va, vb = flat.take(g.fa), flat.take(g.fb)
-            vn = (g.nc * (va - vb).reshape(-1, 2)).real
+        for g in layout.rounds:
+            v = flat.take(g.fab).reshape(2, -1, 2)  # body a's rows, then body b's
+            vn = (g.nc * (v[0] - v[1])).real
             new = np.maximum(g.impulse + g.k * (g.target - vn), 0.0)
             np.subtract(new, g.impulse, out=g.change)
             g.impulse = new
-            flat[g.fa] = va + (g.change * g.na).reshape(-1)
-            flat[g.fb] = vb - (g.change * g.nb).reshape(-1)
-        if rounds and float((np.abs(rounds[0].changes) * rounds[0].w_max).max()) < CONVERGED_MPS:
-            return it, rounds
-    return ITERATIONS, rounds
-
-
-def _handover(rounds: list[_Round], later: list[_Round], count: int) -> list[_Round]:
-    """Give `later` the impulses accumulated in `rounds` (the same contacts, other rounds)."""
-    impulses = np.empty((count, 2))
-    for g in rounds:
-        impulses[g.r] = g.impulse
-    for g in later:
-        g.impulse = impulses.take(g.r, axis=0)
-    return later
+            v += g.change * g.nab
+            flat[g.fab] = v.reshape(-1)
+        if layout.converged():
+            return it, layout
+    return ITERATIONS, layout

@@ -70,10 +70,15 @@ PLAIN_TYPES = (bool, int, float, str, type(None))
 # the rounds it solves in, kept while the contacts stay the same (their order depends on where
 # the pucks were when they were formed, so they change results). The stage replaces these
 # arrays each step and never changes them in place, so a state keeps references.
-CONTACT_KEPT = ("_keys", "_impulses", "_rows", "_round_keys", "_rounds", "_free_rounds", "count", "iterations")
+CONTACT_KEPT = (
+    "_keys", "_impulses", "_rows", "_round_keys", "_key_order", "_rounds", "_free_rounds", "count", "iterations"
+)  # fmt: skip
 # Worked out afresh at the start of every contact stage: nothing to keep.
 ROUND_LISTS = (CONTACT_KEPT.index("_rounds"), CONTACT_KEPT.index("_free_rounds"))  # lists of arrays, kept as tuples
 CONTACT_SCRATCH = frozenset({"_y", "_r_mean", "_warm"})  # worked out afresh in each solve
+# Worked out from kept values and used only while those are the very same objects (restored
+# ones are other objects): they change no result, so a state need not keep them.
+CONTACT_CACHE = frozenset({"_layouts", "_wall_rest"})
 # The Python objects of one state beside its arrays' data (the state, its dicts and tuples,
 # the arrays' headers): tracemalloc measures 1.0 to 1.2 kB, with or without springs.
 STATE_OVERHEAD_BYTES = 1600
@@ -112,7 +117,7 @@ class TableState:
             yield a, a.nbytes + ARRAY_HEADER_BYTES
         tuples = (self.puck_handles, self.spring_handles)
         if self.contacts is not None:
-            tuples += (self.contacts, self.contacts[4])
+            tuples += (self.contacts, self.contacts[CONTACT_KEPT.index("_rounds")])
         for t in tuples:
             yield t, sys.getsizeof(t)
 
@@ -219,7 +224,7 @@ def _contact_state(table: AirTable, like: TableState | None) -> tuple | None:
     solver = getattr(table, "_contacts", None)
     if solver is None:
         return None
-    unknown = set(vars(solver)) - set(CONTACT_KEPT) - CONTACT_SCRATCH
+    unknown = set(vars(solver)) - set(CONTACT_KEPT) - CONTACT_SCRATCH - CONTACT_CACHE
     if unknown:
         raise TypeError(
             f"the contact stage keeps {sorted(unknown)}: airtable/physics/state.py must learn to capture it"
@@ -252,8 +257,9 @@ def _contact_arrays(state: TableState) -> tuple:
     """The contact stage's arrays in `state` (for counting bytes)."""
     if state.contacts is None:
         return ()
-    keys, impulses, _, round_keys, rounds, free_rounds = state.contacts[:6]
-    return (keys, impulses, *(() if round_keys is None else (round_keys,)), *rounds, *free_rounds)
+    kept = dict(zip(CONTACT_KEPT, state.contacts, strict=True))
+    round_keys = () if kept["_round_keys"] is None else (kept["_round_keys"], kept["_key_order"])
+    return (kept["_keys"], kept["_impulses"], *round_keys, *kept["_rounds"], *kept["_free_rounds"])
 
 
 def _restore_contacts(table: AirTable, kept: tuple | None) -> None:

@@ -597,7 +597,8 @@ class AirTable:
         """
         pos, vel, radius, mass = self.pos_m, self.vel_mps, self.radius_m, self.mass_kg
         ci, cj, reach = self._neighbours.pairs(pos, radius)
-        i, j = self._colliding(rest, *broadphase.overlapping_pairs(pos, ci, cj, reach))
+        order = self._neighbours.sorted_order
+        i, j = self._colliding(rest, *broadphase.overlapping_pairs(pos, ci, cj, reach, order))
         records, moved = [], []
         for attempt in range(1 + EXTRA_PASSES):
             if len(i) == 0:
@@ -614,7 +615,7 @@ class AirTable:
             # Parting a pair can push one of its pucks into a third one that
             # was already handled: look again among the same candidates,
             # collide those pairs too, and at last just push apart what is left.
-            i, j = self._colliding(rest, *broadphase.overlapping_pairs(pos, ci, cj, reach - OVERLAP_SLOP_M))
+            i, j = self._colliding(rest, *broadphase.overlapping_pairs(pos, ci, cj, reach - OVERLAP_SLOP_M, order))
         if not moved:
             return np.empty(0, dtype=np.intp)
         self._collision_records += records
@@ -629,7 +630,8 @@ class AirTable:
         pos, vel = self.pos_m, self.vel_mps
         n, _ = vectors.unit_vectors(vectors.take(pos, i) - vectors.take(pos, j), i + j)
         vn = vectors.dot_rows(vectors.take(vel, i) - vectors.take(vel, j), n)
-        fast = np.flatnonzero((vn < -np.maximum(rest.take(i), rest.take(j))) & ~self._contacts.held(i, j))
+        fast = np.flatnonzero(vn < -np.maximum(rest.take(i), rest.take(j)))  # few: look only these up
+        fast = fast.take(np.flatnonzero(~self._contacts.held(i.take(fast), j.take(fast))))
         return i.take(fast), j.take(fast)
 
     def _spring_forces(

@@ -48,8 +48,10 @@ def resolve_walls(
     if rest is not None:
         fast = _fast_ones(pos, vel, radius, size_m, rest, out)
         if hold_slow:
-            _hold(pos, vel, radius, size_m, np.setdiff1d(out, fast))
-        out = fast
+            _hold(pos, vel, radius, size_m, out.take(np.flatnonzero(~fast)))
+        out = out.take(np.flatnonzero(fast))
+        if len(out) == 0:
+            return 0  # a pile's usual case: every puck past a wall rests there
     p, v = vectors.take(pos, out), vectors.take(vel, out)
     lo = radius.take(out)[:, None]
     hi = size_m - lo
@@ -66,13 +68,13 @@ def resolve_walls(
 
 
 def _fast_ones(pos, vel, radius, size_m, rest, out: np.ndarray) -> np.ndarray:
-    """The rows `out` (past a wall) that move into a wall they are past faster than their rest speed."""
+    """Which of the rows `out` (past a wall) move into a wall they are past faster than their rest speed."""
     p, v = vectors.take(pos, out), vectors.take(vel, out)
     lo = radius.take(out)[:, None]
     r = rest.take(out, axis=0)
     r = r[:, None] if r.ndim == 1 else r
     fast = ((p < lo) & (v < -r)) | ((p > size_m - lo) & (v > r))
-    return out.take(np.flatnonzero(fast[:, 0] | fast[:, 1]))
+    return fast[:, 0] | fast[:, 1]
 
 
 def _hold(pos, vel, radius, size_m, rows: np.ndarray) -> None:

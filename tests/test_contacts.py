@@ -1,0 +1,95 @@
+"""The contact stage's vectorised rounds give the sequential-impulse result, contact by contact."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from airtable.physics import broadphase, contacts
+
+
+def _small_pile() -> tuple[np.ndarray, ...]:
+    """Three staggered rows of r = 0.1 m pucks in a 1.0 x 1.0 m box, pressed 0.1 mm into each other and the
+    floor, falling at g dt (one step of 1/240 s under gravity)."""
+    r = 0.1 - 1e-4
+    pos = [(0.1 + 0.2 * k + 0.1 * (row % 2), r + row * 0.1732) for row in range(3) for k in range(4 - row % 2)]
+    pos = np.array(pos)
+    vel = np.zeros_like(pos)
+    vel[:, 1] = -9.8 / 240
+    radius = np.full(len(pos), 0.1)
+    mass = 0.3 * np.pi * radius**2
+    mass[3] *= 5.0  # one heavy puck: the effective masses differ
+    return pos, vel, radius, mass
+
+
+def _sequential(c, rounds, free_rounds, iterations, vel, mass, dt):
+    """Sequential impulses in plain Python, one contact at a time, in the solver's order of contacts."""
+    rows = len(mass)
+    inv = np.append(1.0 / mass, 0.0)
+    w = np.zeros((rows + 1, 2), dtype=complex)  # velocity and pseudo-velocity; the last row: the walls
+    w[:-1, 0] = vel[:, 0] + 1j * vel[:, 1]
+    s0 = c.gap - np.minimum(c.vn, 0.0) * dt
+    target = np.column_stack(
+        [
+            -np.maximum(s0, 0.0) / dt,
+            np.minimum(contacts.POSITION_FRACTION * np.maximum(-s0 - contacts.SLOP_M, 0.0) / dt, contacts.MAX_PUSH_MPS),
+        ]
+    )
+    impulse = np.zeros((len(c.a), 2))
+    for it in range(iterations):
+        for k in np.concatenate(rounds if it == 0 else free_rounds).tolist():
+            a, b, n = int(c.a[k]), int(c.b[k]), complex(c.n[k])
+            wa, wb = inv[a], inv[b]
+            for col in (0, 1):
+                vn = (n.conjugate() * (w[a, col] - w[b, col])).real
+                new = max(impulse[k, col] + (target[k, col] - vn) / (wa + wb), 0.0)
+                change, impulse[k, col] = new - impulse[k, col], new
+                w[a, col] += change * n * wa
+                w[b, col] -= change * n * wb
+    return w
+
+
+def test_the_rounds_give_the_sequential_result() -> None:
+    # Each round solves contacts that share no puck all at once, gathering
+    # body a's and body b's rows in one go and writing them back in one go;
+    # that must be exactly what solving them one after another gives.
+    pos, vel, radius, mass = _small_pile()
+    dt = 1 / 240
+    size = np.array([1.0, 1.0])
+    rest = np.full(len(pos), 2 * 9.8 * dt)
+    solver = contacts.ContactSolver()
+    i, j = broadphase.find_candidate_pairs(pos, radius)
+    candidates = (i, j, broadphase.pair_reach(radius, i, j))
+    margin = contacts.MARGIN_M + (2.0 * float(np.abs(vel).max()) + contacts.MAX_PUSH_MPS) * dt
+    pc = contacts._pair_contacts(pos, vel, *candidates, rest, solver.held, margin)
+    wc = contacts._wall_contacts(pos, vel, radius, size, solver.wall_rest(rest), margin)
+    c = contacts._Contacts(
+        *(np.concatenate([getattr(pc, f), getattr(wc, f)]) for f in contacts._Contacts.__dataclass_fields__)
+    )
+    assert len(pc.a) >= 10 and len(wc.a) >= 5  # puck pairs and walls both take part
+
+    p, v = pos.copy(), vel.copy()
+    assert solver.solve(p, v, radius, mass, size, candidates, rest, dt)
+    assert len(solver._free_rounds) < len(c.a)  # contacts were solved several to a round
+    w = _sequential(c, solver._rounds, solver._free_rounds, solver.iterations, vel, mass, dt)
+
+    np.testing.assert_allclose(v[:, 0] + 1j * v[:, 1], w[:-1, 0], rtol=0, atol=1e-12)
+    moved = (w[:-1, 0] - (vel[:, 0] + 1j * vel[:, 1]) + w[:-1, 1]) * dt
+    np.testing.assert_allclose(p, pos + np.column_stack([moved.real, moved.imag]), rtol=0, atol=1e-15)
+    assert np.all(v[:, 1] > vel[:, 1] + 0.01)  # held up: every puck falls slower than before
+
+
+def test_a_puck_resting_on_the_floor_converges_at_once() -> None:
+    # One puck on the floor, falling at g dt, and moved by it this step (the
+    # stage runs after the positions moved): its one contact takes out the
+    # approach in the first iteration (vy = 0), the second changes nothing,
+    # and the stage stops there instead of running all ITERATIONS.
+    pos, vel = np.array([[0.5, 0.1 - 9.8 / 240 / 240]]), np.array([[0.0, -9.8 / 240]])
+    radius, mass = np.array([0.1]), np.array([0.3 * np.pi * 0.01])
+    none = np.empty(0, dtype=np.intp)
+    solver = contacts.ContactSolver()
+    rest = np.array([2 * 9.8 / 240])
+    assert solver.solve(pos, vel, radius, mass, np.array([1.0, 1.0]), (none, none, np.empty(0)), rest, 1 / 240)
+    assert solver.count == 1 and solver.iterations == 2 < contacts.ITERATIONS
+    assert vel[0, 1] == 0.0 and vel[0, 0] == 0.0
+    assert pos[0, 1] == pytest.approx(0.1, abs=1e-15)  # back where it rests, and no overlap to push out
