@@ -123,7 +123,7 @@ def test_the_history_never_holds_more_than_its_budget(n_pucks):
     table.gravity_on = True
     table.step(1 / 240)  # a neighbour list too, for the big ones
     per_frame = 32 * n_pucks + 2000
-    total_frames = int(1.3 * TEST_BUDGET_BYTES / per_frame) if n_pucks > 10 else 3000
+    total_frames = int(1.3 * TEST_BUDGET_BYTES / per_frame)
 
     def fill(h: History) -> None:
         for _ in range(total_frames):
@@ -136,8 +136,8 @@ def test_the_history_never_holds_more_than_its_budget(n_pucks):
 
     held, counted, dropped = measured_bytes(fill, TEST_BUDGET_BYTES)
     assert held <= TEST_BUDGET_BYTES and counted <= TEST_BUDGET_BYTES
-    if n_pucks > 10:
-        assert dropped > 0 and counted > 0.95 * TEST_BUDGET_BYTES  # full, and the oldest went
+    assert dropped > 0 and counted > 0.95 * TEST_BUDGET_BYTES  # full, and the oldest went
+    if n_pucks > 10:  # (a few pucks' small arrays: Python's own overheads are most of what tracemalloc sees)
         assert held == pytest.approx(counted, rel=0.1)  # its own count is close to the truth
 
 

@@ -289,7 +289,7 @@ def test_same_scene_gives_bit_identical_state() -> None:
     runs = []
     for _ in range(2):
         table, pulls = _busy_scene()
-        for _ in range(300):
+        for _ in range(150):
             table.step(1 / 120, pulls)
         runs.append(table)
     a, b = runs
