@@ -36,8 +36,11 @@ def test_hanging_chain_sags_as_hookes_law_says(k: float, mass_kg: float) -> None
     for p, q in zip(chain, chain[1:], strict=False):
         table.add_spring(p, q, length_m=length, k_Npm=k, damper_Nspm=math.sqrt(k * mass_kg))
     string = [Pull(chain[0].index, top, k, math.sqrt(k * mass_kg))]
-    for _ in range(round(8.0 / DT_S)):
-        table.step(DT_S, string)
+    for _ in range(8):  # seconds: the soft chains need all 8; the stiff ones are still within one
+        for _ in range(round(1.0 / DT_S)):
+            table.step(DT_S, string)
+        if np.abs(table.vel_mps).max() < 1e-9:
+            break
     w = mass_kg * GRAVITY_MPS2
     expected = [top[1] - n * w / k]
     for i in range(1, n):
