@@ -40,7 +40,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from airtable.net.codec import _bad, _deflate, _inflate, _Reader, pack_residuals, unpack_residuals
+from airtable.net.codec import _bad, _deflate, _inflate, _Reader, pack_residuals, unpack_residuals, wire_text
 from airtable.net.protocol import AIDS, MAX_DRAWN_PUCKS, ProtocolError, encode_frame
 
 AIDS_MAGIC = b"ATAD"
@@ -635,10 +635,4 @@ def _notes(r: _Reader) -> str:
     if size > MAX_NOTES_BYTES:
         raise _bad(f"notes of {size} bytes (at most {MAX_NOTES_BYTES})")
     packed = r.take(int.from_bytes(r.take(2), "little"))
-    try:
-        text = _inflate(packed, size, "notes text").decode("utf-8")
-    except UnicodeDecodeError:
-        raise _bad("notes that are not UTF-8") from None
-    if not text.isprintable():
-        raise _bad("unprintable notes")
-    return text
+    return wire_text(_inflate(packed, size, "notes text"), "notes")

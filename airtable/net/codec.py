@@ -205,6 +205,17 @@ def _inflate(data: bytes, size: int, what: str) -> bytes:
     return out
 
 
+def wire_text(raw: bytes, what: str) -> str:
+    """Text from the wire, checked: UTF-8 and printable, else a ProtocolError naming `what` ("a title")."""
+    try:
+        text = raw.decode("utf-8")
+    except UnicodeDecodeError:
+        raise _bad(f"{what} that is not UTF-8") from None
+    if not text.isprintable():
+        raise _bad(f"{what} that is not printable")
+    return text
+
+
 class _Reader:
     """Consecutive fields of a byte string whose size is checked before each read."""
 
@@ -230,13 +241,7 @@ class _Reader:
         size = int.from_bytes(self.take(2), "little")
         if size > limit:
             raise _bad(f"a {what} of {size} bytes (at most {limit})")
-        try:
-            value = self.take(size).decode("utf-8")
-        except UnicodeDecodeError:
-            raise _bad(f"a {what} that is not UTF-8") from None
-        if not value.isprintable():
-            raise _bad(f"an unprintable {what}")
-        return value
+        return wire_text(self.take(size), f"a {what}")
 
     def done(self) -> None:
         if self.offset != len(self.data):
@@ -451,14 +456,7 @@ def _apply_text_delta(old: str, r: _Reader) -> str:
     a = old.encode("utf-8")
     if keep_start + keep_end > len(a) or keep_start + keep_end + size > MAX_STATUS_BYTES:
         raise _bad("a status line that does not fit the previous one")
-    raw = a[:keep_start] + r.take(size) + a[len(a) - keep_end :]
-    try:
-        text = raw.decode("utf-8")
-    except UnicodeDecodeError:
-        raise _bad("a status line that is not UTF-8") from None
-    if not text.isprintable():
-        raise _bad("an unprintable status line")
-    return text
+    return wire_text(a[:keep_start] + r.take(size) + a[len(a) - keep_end :], "a status line")
 
 
 def encode_tick(tick: Tick, b1: Tick | None = None, b2: Tick | None = None) -> tuple[bytes, bool]:
