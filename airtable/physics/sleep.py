@@ -1,0 +1,96 @@
+"""Sleeping: pucks at rest in a pile are set aside until something disturbs them.
+
+A pile that has come to rest still costs a full contact solve every step, and
+an iterative solver never quite converges: the pucks keep a faint jitter.
+Box2D and Chipmunk put bodies to sleep once they have stayed still for a
+while; we do the same, puck by puck (Box2D does it per island):
+
+* a puck falls asleep once its speed has stayed under SLEEP_MPS for SLEEP_S
+  and every puck touching it has too (or sleeps already). Its velocity is
+  then exactly 0 and the step neither moves it nor solves its contacts with
+  the walls or with other sleepers: for the awake pucks resting on it, it is
+  an immovable body, like a wall. Only under gravity (without it a still
+  puck stays still exactly anyway) and never a puck on a spring.
+* it wakes when anything touches or moves it: a velocity, position or force
+  written from outside (a drag, a throw, reverse time, a restore), a cursor
+  string, a spring, an awake puck moving faster than WAKE_MPS coming within
+  reach, or a collision that gives it a velocity. Everything wakes when the
+  world changes: gravity, the table's size, a puck added or removed, the
+  correction mode.
+
+The state of sleep is two columns of the pucks (`still` seconds, `asleep`)
+and the place each sleeper was put to sleep (`rest_pos`), so capture and
+restore keep it with the rest of a puck's row.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from airtable.physics import vectors
+
+# A puck slower than this (m/s) for SLEEP_S seconds, all the while within SLEEP_DRIFT_M of
+# where that time began, falls asleep (with its neighbours). Box2D's default threshold is
+# 0.05 m/s too: a pile's contacts, solved by a few iterations, leave about 0.02 m/s of jitter.
+SLEEP_MPS = 0.05
+SLEEP_DRIFT_M = 0.005
+SLEEP_S = 0.5
+# A sleeper wakes when an awake puck faster than this (m/s) comes within reach.
+WAKE_MPS = 0.1
+# Extra room (m) in "within reach": what a step moves a puck, plus this.
+WAKE_SKIN_M = 1e-3
+
+
+def written_from_outside(pos, vel, force, rest_pos, sleepers: np.ndarray) -> np.ndarray:
+    """The sleepers (rows) given a velocity, position or force since the last step."""
+    v, f = vectors.take(vel, sleepers), vectors.take(force, sleepers)
+    moved = vectors.take(pos, sleepers) != vectors.take(rest_pos, sleepers)
+    touched = (v != 0.0) | (f != 0.0) | moved
+    return sleepers.take(np.flatnonzero(touched[:, 0] | touched[:, 1]))
+
+
+def near_movers(pos, vel, asleep, candidates, dt: float) -> np.ndarray:
+    """The sleepers (rows) within reach of an awake puck faster than WAKE_MPS: the sum of the radii,
+    plus what that puck moves in a step, plus WAKE_SKIN_M."""
+    ci, cj, reach = candidates
+    speed = vectors.lengths(vel)
+    mover = (speed > WAKE_MPS) & ~asleep
+    if not mover.any():
+        return np.empty(0, dtype=np.intp)
+    pick = np.flatnonzero((mover.take(ci) & asleep.take(cj)) | (mover.take(cj) & asleep.take(ci)))
+    i, j = ci.take(pick), cj.take(pick)
+    lim = reach.take(pick) + np.maximum(speed.take(i), speed.take(j)) * dt + WAKE_SKIN_M
+    close = np.flatnonzero(vectors.squared_lengths(vectors.take(pos, i) - vectors.take(pos, j)) < lim * lim)
+    i, j = i.take(close), j.take(close)
+    return np.unique(np.concatenate([i.take(np.flatnonzero(asleep.take(i))), j.take(np.flatnonzero(asleep.take(j)))]))
+
+
+def still_for_long(pos, vel, still, anchor, asleep, free, dt: float) -> np.ndarray | None:
+    """Count this step into each awake puck's still time; return the mask of pucks still for SLEEP_S
+    (`free` ones: no spring or pull), or None if none of them is awake.
+
+    still (s) grows by dt while a puck is slower than SLEEP_MPS and within SLEEP_DRIFT_M of `anchor`
+    (where its still time began); otherwise it starts again from 0 here.
+    """
+    awake = ~asleep
+    slow = vectors.squared_lengths(vel) < SLEEP_MPS * SLEEP_MPS
+    slow &= vectors.squared_lengths(pos - anchor) < SLEEP_DRIFT_M * SLEEP_DRIFT_M
+    still[awake & slow] += dt
+    restart = np.flatnonzero(awake & ~slow)
+    still[restart] = 0.0
+    anchor[restart] = pos[restart]
+    ready = (still > SLEEP_S - 1e-9) & free  # a sum of dt: 120 steps of 1/240 s make 0.4999...
+    return ready if (ready & awake).any() else None
+
+
+def with_still_neighbours(pos, ready, asleep, candidates) -> np.ndarray:
+    """The awake `ready` pucks (rows) every touching neighbour of which is ready or asleep: they fall asleep."""
+    ok = ready | asleep  # a neighbour that lets a puck sleep
+    ci, cj, reach = candidates
+    lim = reach + WAKE_SKIN_M
+    touch = np.flatnonzero(vectors.squared_lengths(vectors.take(pos, ci) - vectors.take(pos, cj)) < lim * lim)
+    i, j = ci.take(touch), cj.take(touch)
+    blocked = np.zeros(len(pos), dtype=bool)
+    blocked[i.take(np.flatnonzero(~ok.take(j)))] = True
+    blocked[j.take(np.flatnonzero(~ok.take(i)))] = True
+    return np.flatnonzero(ready & ~asleep & ~blocked)
