@@ -166,17 +166,18 @@ def test_the_asleep_mask_is_read_only() -> None:
         table.asleep[0] = True
 
 
-def test_a_sleeper_never_moves_while_awake_pucks_rest_on_it() -> None:
-    # Two pucks stacked on the floor: the bottom one falls asleep with the top
-    # one (each is still and touches only still pucks). Wake the top one by
-    # hand: it rests on the sleeper as on a floor, sleeps again 0.5 s later.
-    table = floor_table(xs=(5.0,))
+def test_waking_a_puck_wakes_the_sleepers_it_touches_and_no_others() -> None:
+    # Two pucks stacked on the floor at x = 5 m and one alone at x = 8 m, all
+    # asleep. A velocity written into the top one wakes the stack (the bottom
+    # one must hold it up: Box2D wakes the whole island), not the lone one.
+    # Half a second later the stack sleeps again, where it was.
+    table = floor_table(xs=(5.0, 8.0))
     table.add_puck(pos_m=(5.0, 3 * R_M), radius_m=R_M)
     steps(table, 144)
     assert table.asleep.all()
-    table.pucks[1].vel_mps = (0.0, -1e-3)
+    table.pucks[2].vel_mps = (0.0, -1e-3)
     table.step(DT_S)
-    assert list(table.asleep) == [True, False]
+    assert list(table.asleep) == [False, True, False]
     steps(table, int(sleep.SLEEP_S / DT_S) + 2)
     assert table.asleep.all()
-    assert table.pos_m[1, 1] == pytest.approx(3 * R_M, abs=1e-3)
+    assert table.pos_m[2, 1] == pytest.approx(3 * R_M, abs=1e-3)

@@ -49,6 +49,34 @@ def written_from_outside(pos, vel, force, rest_pos, sleepers: np.ndarray) -> np.
     return sleepers.take(np.flatnonzero(touched[:, 0] | touched[:, 1]))
 
 
+def touching(pos, candidates) -> tuple[np.ndarray, np.ndarray]:
+    """The candidate pairs (i, j) that touch: closer than their reach plus WAKE_SKIN_M."""
+    ci, cj, reach = candidates
+    lim = reach + WAKE_SKIN_M
+    touch = np.flatnonzero(vectors.squared_lengths(vectors.take(pos, ci) - vectors.take(pos, cj)) < lim * lim)
+    return ci.take(touch), cj.take(touch)
+
+
+def island(pos, rows: np.ndarray, asleep, candidates) -> np.ndarray:
+    """`rows` and every sleeper joined to them by a chain of touching sleepers (Box2D wakes a
+    whole island): a sleeper must not stay up in the air when the puck it rests on wakes."""
+    i, j = touching(pos, candidates)
+    both = np.flatnonzero(asleep.take(i) & asleep.take(j))  # the chains run through sleepers
+    i, j = np.concatenate([i.take(both), j.take(both)]), np.concatenate([j.take(both), i.take(both)])
+    woken = np.zeros(len(pos), dtype=bool)
+    woken[rows] = True
+    new = woken & asleep
+    for _ in range(len(pos)):  # each pass reaches one more puck along the chains
+        reached = j.take(np.flatnonzero(new.take(i)))
+        new = np.zeros(len(pos), dtype=bool)
+        new[reached] = True
+        new &= ~woken
+        if not new.any():
+            break
+        woken |= new
+    return np.flatnonzero(woken)
+
+
 def near_movers(pos, vel, asleep, candidates, dt: float) -> np.ndarray:
     """The sleepers (rows) within reach of an awake puck faster than WAKE_MPS: the sum of the radii,
     plus what that puck moves in a step, plus WAKE_SKIN_M."""
@@ -86,10 +114,7 @@ def still_for_long(pos, vel, still, anchor, asleep, free, dt: float) -> np.ndarr
 def with_still_neighbours(pos, ready, asleep, candidates) -> np.ndarray:
     """The awake `ready` pucks (rows) every touching neighbour of which is ready or asleep: they fall asleep."""
     ok = ready | asleep  # a neighbour that lets a puck sleep
-    ci, cj, reach = candidates
-    lim = reach + WAKE_SKIN_M
-    touch = np.flatnonzero(vectors.squared_lengths(vectors.take(pos, ci) - vectors.take(pos, cj)) < lim * lim)
-    i, j = ci.take(touch), cj.take(touch)
+    i, j = touching(pos, candidates)
     blocked = np.zeros(len(pos), dtype=bool)
     blocked[i.take(np.flatnonzero(~ok.take(j)))] = True
     blocked[j.take(np.flatnonzero(~ok.take(i)))] = True

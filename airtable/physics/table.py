@@ -509,7 +509,7 @@ class AirTable:
         if not asleep.any():
             return False
         if world != self._world_key or not (self.sleeping and self.gravity_on):
-            self._set_awake(np.flatnonzero(asleep))
+            self._set_awake(np.flatnonzero(asleep), island=False)
             return False
         pos, vel = self.pos_m, self.vel_mps
         sleepers = np.flatnonzero(asleep)
@@ -525,11 +525,16 @@ class AirTable:
         self._sleepers = sleepers if len(sleepers) else None
         return False
 
-    def _set_awake(self, rows: np.ndarray) -> None:
-        """Wake the pucks in `rows` (their still time starts again)."""
-        if len(rows):
-            self._pucks.view("asleep")[rows] = False
-            self._pucks.view("still")[rows] = 0.0
+    def _set_awake(self, rows: np.ndarray, island: bool = True) -> None:
+        """Wake the pucks in `rows` (their still time starts again) and, with `island`, every
+        sleeper touching them, and every one touching those, and so on (sleep.island)."""
+        if len(rows) == 0:
+            return
+        asleep = self._pucks.view("asleep")
+        if island and len(rows) < self._pucks.n:
+            rows = sleep.island(self.pos_m, rows, asleep, self._neighbours.pairs(self.pos_m, self.radius_m))
+        asleep[rows] = False
+        self._pucks.view("still")[rows] = 0.0
 
     def _wake_hit(self) -> None:
         """Wake the sleepers a collision gave a velocity (this step's stages then move them)."""
