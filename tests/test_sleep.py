@@ -181,3 +181,17 @@ def test_waking_a_puck_wakes_the_sleepers_it_touches_and_no_others() -> None:
     steps(table, int(sleep.SLEEP_S / DT_S) + 2)
     assert table.asleep.all()
     assert table.pos_m[2, 1] == pytest.approx(3 * R_M, abs=1e-3)
+
+
+def test_moving_pucks_leave_the_sleep_columns_alone_so_a_history_shares_them() -> None:
+    # Three pucks thrown at 1 m/s sideways under gravity are never slower
+    # than SLEEP_MPS: their still time stays 0 and their anchor where it was.
+    table = floor_table(xs=(2.0, 5.0, 8.0), y_m=4.0)
+    table.vel_mps[:] = (1.0, 0.0)
+    table.step(DT_S)
+    first = capture(table)
+    table.step(DT_S)
+    second = capture(table, like=first)
+    assert second.pucks["still"] is first.pucks["still"]
+    assert second.pucks["rest_pos"] is first.pucks["rest_pos"]
+    assert second.pucks["pos"] is not first.pucks["pos"]

@@ -97,16 +97,18 @@ def still_for_long(pos, vel, still, anchor, asleep, free, dt: float) -> np.ndarr
     """Count this step into each awake puck's still time; return the mask of pucks still for SLEEP_S
     (`free` ones: no spring or pull), or None if none of them is awake.
 
-    still (s) grows by dt while a puck is slower than SLEEP_MPS and within SLEEP_DRIFT_M of `anchor`
-    (where its still time began); otherwise it starts again from 0 here.
+    A puck slower than SLEEP_MPS starts its still time (dt) at its position (`anchor`); it grows by
+    dt while the puck stays slow and within SLEEP_DRIFT_M of there, and is 0 otherwise. Moving
+    pucks keep 0 and their anchor: nothing changes in the columns, so a history of states shares them.
     """
     awake = ~asleep
-    slow = vectors.squared_lengths(vel) < SLEEP_MPS * SLEEP_MPS
-    slow &= vectors.squared_lengths(pos - anchor) < SLEEP_DRIFT_M * SLEEP_DRIFT_M
-    still[awake & slow] += dt
-    restart = np.flatnonzero(awake & ~slow)
-    still[restart] = 0.0
-    anchor[restart] = pos[restart]
+    slow = awake & (vectors.squared_lengths(vel) < SLEEP_MPS * SLEEP_MPS)
+    start = np.flatnonzero(slow & (still == 0.0))
+    near = vectors.squared_lengths(pos - anchor) < SLEEP_DRIFT_M * SLEEP_DRIFT_M
+    still[np.flatnonzero(slow & near & (still > 0.0))] += dt
+    still[np.flatnonzero(awake & ~(slow & near))] = 0.0
+    anchor[start] = pos[start]
+    still[start] = dt
     ready = (still > SLEEP_S - 1e-9) & free  # a sum of dt: 120 steps of 1/240 s make 0.4999...
     return ready if (ready & awake).any() else None
 
