@@ -92,13 +92,23 @@ def test_a_velocity_or_position_written_into_a_sleeper_wakes_it() -> None:
     assert b.pos_m[0] == 7.5
 
 
-def test_a_cursor_string_wakes_a_sleeper() -> None:
+def test_a_slow_drag_wakes_the_sleepers_it_pushes() -> None:
+    # A cursor string of 1 N with 20 N s/m of drag moves a puck at most
+    # 1 / 20 = 0.05 m/s, slower than WAKE_MPS: it still wakes the puck it
+    # reaches 5 mm away (after about 0.1 s) and pushes it along, where a
+    # sleeper would otherwise be a wall. In 0.5 s they move about 2 cm.
     from airtable.physics.forces import Pull
 
-    table = floor_table()
+    table = floor_table(xs=(3.0, 3.505))
     steps(table, 144)
-    table.step(DT_S, [Pull(row=0, anchor_m=(6.0, R_M), k_Npm=10.0, drag_Nspm=0.0)])
-    assert not table.asleep[0] and table.vel_mps[0, 0] > 0.0
+    assert table.asleep.all()
+    pull = [Pull(row=0, anchor_m=(4.0, R_M), k_Npm=1.0, drag_Nspm=20.0)]
+    table.step(DT_S, pull)
+    assert list(table.asleep) == [False, True]
+    steps(table, 120, pull)
+    assert not table.asleep.any()
+    assert table.vel_mps[0, 0] < sleep.WAKE_MPS
+    assert 3.505 + 0.005 < table.pos_m[1, 0] < 3.505 + 0.03
 
 
 @pytest.mark.parametrize("change", ["off", "stronger", "wider", "added"])

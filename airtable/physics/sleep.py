@@ -77,12 +77,15 @@ def island(pos, rows: np.ndarray, asleep, candidates) -> np.ndarray:
     return np.flatnonzero(woken)
 
 
-def near_movers(pos, vel, asleep, candidates, dt: float) -> np.ndarray:
-    """The sleepers (rows) within reach of an awake puck faster than WAKE_MPS: the sum of the radii,
-    plus what that puck moves in a step, plus WAKE_SKIN_M."""
+def near_movers(pos, vel, asleep, candidates, dt: float, pulled: np.ndarray = ()) -> np.ndarray:
+    """The sleepers (rows) within reach of an awake puck faster than WAKE_MPS, or pulled by a cursor
+    string (a slow drag pushes too): the sum of the radii, plus what that puck moves in a step, plus
+    WAKE_SKIN_M."""
     ci, cj, reach = candidates
     speed = vectors.lengths(vel)
-    mover = (speed > WAKE_MPS) & ~asleep
+    mover = speed > WAKE_MPS
+    mover[pulled] = True
+    mover &= ~asleep
     if not mover.any():
         return np.empty(0, dtype=np.intp)
     pick = np.flatnonzero((mover.take(ci) & asleep.take(cj)) | (mover.take(cj) & asleep.take(ci)))

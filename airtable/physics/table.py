@@ -495,7 +495,7 @@ class AirTable:
     def _world(self) -> str:
         """What sleepers depend on, as one value: a change in any of it wakes every puck."""
         g = self.gravity_mps2 if self.gravity_on else 0.0
-        sizes = f"{self.width_m!r} {self.height_m!r} {self._pucks.n} {self._springs.n}"
+        sizes = f"{self.width_m!r} {self.height_m!r} {self._pucks.n} {self._springs.n} {self.radius_m.sum()!r}"
         return f"{g!r} {sizes} {self.puck_correction} {self.puck_collisions}"
 
     def _wake(self, pulls: Sequence[Pull], dt: float) -> bool:
@@ -516,9 +516,9 @@ class AirTable:
         woken = sleep.written_from_outside(pos, vel, self.force_N, self._pucks.view("rest_pos"), sleepers)
         pulled = np.array([p.row for p in pulls], dtype=np.intp)
         self._set_awake(np.concatenate([woken, pulled]))
-        if len(sleepers) - len(woken) < self._pucks.n:  # someone is awake: is it coming near a sleeper?
+        if np.count_nonzero(asleep) < self._pucks.n:  # someone is awake: is it coming near a sleeper?
             candidates = self._neighbours.pairs(pos, self.radius_m)
-            self._set_awake(sleep.near_movers(pos, vel, asleep, candidates, dt))
+            self._set_awake(sleep.near_movers(pos, vel, asleep, candidates, dt, pulled))
         sleepers = np.flatnonzero(asleep)
         if len(sleepers) == self._pucks.n:
             return True
