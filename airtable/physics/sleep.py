@@ -13,14 +13,16 @@ while; we do the same, puck by puck (Box2D does it per island):
   puck stays still exactly anyway) and never a puck on a spring.
 * it wakes when anything touches or moves it: a velocity, position or force
   written from outside (a drag, a throw, reverse time, a restore), a cursor
-  string, a spring, an awake puck moving faster than WAKE_MPS coming within
-  reach, or a collision that gives it a velocity. Everything wakes when the
-  world changes: gravity, the table's size, a puck added or removed, the
-  correction mode.
+  string, an awake puck moving faster than WAKE_MPS (or pulled, however
+  slowly) coming within reach, or a collision that gives it a velocity; and
+  with it every sleeper joined to it by touching sleepers (its island, as
+  Box2D wakes islands), so that none stays up when what held it moves.
+  Everything wakes when the world changes: gravity, the table's size, a puck
+  or spring added or removed, a radius, the correction mode.
 
-The state of sleep is two columns of the pucks (`still` seconds, `asleep`)
-and the place each sleeper was put to sleep (`rest_pos`), so capture and
-restore keep it with the rest of a puck's row.
+The state of sleep is three columns of the pucks: `still` (seconds), `asleep`,
+and `rest_pos` (where a sleeper sleeps, or where an awake puck's still time
+began), so capture and restore keep it with the rest of a puck's row.
 """
 
 from __future__ import annotations
