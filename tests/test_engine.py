@@ -173,21 +173,7 @@ def test_the_pi_demo_counts_the_digits_of_pi_and_stops_the_pucks(demos) -> None:
         np.testing.assert_allclose(table.vel_mps, 0.0)  # stopped before the far wall
 
 
-def test_a_pile_dropped_into_a_box_comes_to_rest_without_sinking() -> None:
-    # 120 pucks of r = 0.1 m dropped into a 2.5 m wide box at up to 1 m/s,
-    # restitution 0.5: after 6 s nothing moves (a puck at 1 mm/s has
-    # 5e-9 J) and no two pucks overlap by more than 2 mm.
-    from airtable.bench_hard import pile_scene
-
-    table = AirTable(width_m=2.5, height_m=4.0)
-    pile_scene(table, n=120)
-    for _ in range(6 * 240):
-        table.step(1 / 240)
-    assert table.kinetic_energy_J() < 1e-4
-    d = table.pos_m[:, None, :] - table.pos_m[None, :, :]
-    gap = np.hypot(d[..., 0], d[..., 1]) + np.eye(120)
-    assert gap.min() > 0.2 - 2e-3
-    assert np.all(table.pos_m >= 0.1) and np.all(table.pos_m <= table.size_m - 0.1)
+# The 120-puck pile in a 2.5 m box: tests/test_sleep.py (it comes to rest exactly, asleep).
 
 
 def test_an_inelastic_cluster_does_not_collapse_into_endless_swept_hits():

@@ -71,6 +71,11 @@ MAX_PUSH_MPS = 0.5
 WALL_NORMALS = np.array([1.0, 1j, -1.0, -1j])
 
 
+def _same_rows(a: np.ndarray | None, b: np.ndarray | None) -> bool:
+    """Whether two optional row arrays are equal (None only equals None)."""
+    return (a is None and b is None) or (a is not None and b is not None and np.array_equal(a, b))
+
+
 @dataclass
 class _Contacts:
     """The contacts of one step: body a, body b (the row count for a wall), normal n from b to a."""
@@ -81,6 +86,9 @@ class _Contacts:
     gap: np.ndarray  # m, negative: overlap
     vn: np.ndarray  # relative normal velocity, negative: approaching
     keys: np.ndarray  # one integer per contact, the same from step to step
+
+
+_FIELDS = tuple(_Contacts.__dataclass_fields__)
 
 
 def _pair_contacts(pos, vel, ci, cj, reach, rest, held, margin) -> _Contacts:
@@ -173,6 +181,7 @@ class ContactSolver:
         self._impulses = np.empty((0, 2))
         self._rows = -1
         self._round_keys: np.ndarray | None = None  # the contacts the rounds are for, in their order
+        self._round_sleepers: np.ndarray | None = None  # and the sleepers they were coloured with
         self._key_order = np.empty(0, dtype=np.intp)  # argsort of _round_keys
         self._rounds: list[np.ndarray] = []  # bottom-up by bands: the first iteration
         self._free_rounds: list[np.ndarray] = []  # fewer rounds, in no order: the later iterations
@@ -211,30 +220,41 @@ class ContactSolver:
         """Drop the kept impulses (pucks were added, removed or moved by hand)."""
         self.__init__()
 
-    def solve(self, pos, vel, radius, mass, size_m, candidates, rest, dt) -> bool:
+    def solve(self, pos, vel, radius, mass, size_m, candidates, rest, dt, asleep=None) -> bool:
         """Solve the resting contacts in place; return whether there were any.
 
         candidates: (i, j, reach) pairs that may touch; rest: each puck's rest
-        speed (m/s): contacts approaching slower than it are resting.
+        speed (m/s): contacts approaching slower than it are resting; asleep:
+        which pucks sleep (sleep.py), or None: to the awake pucks a sleeper is
+        immovable, and its contacts with the walls and with other sleepers are
+        left out.
         """
         if len(pos) != self._rows:
             self.forget()
             self._rows = len(pos)
         ci, cj, reach = candidates
         margin = MARGIN_M + (2.0 * float(np.abs(vel).max()) + MAX_PUSH_MPS) * dt
+        if asleep is not None:
+            awake = np.flatnonzero(~(asleep.take(ci) & asleep.take(cj)))
+            ci, cj, reach = ci.take(awake), cj.take(awake), reach.take(awake)
         pc = _pair_contacts(pos, vel, ci, cj, reach, rest, self.held, margin)
         wc = _wall_contacts(pos, vel, radius, size_m, self.wall_rest(rest), margin)
-        c = _Contacts(*(np.concatenate([getattr(pc, f), getattr(wc, f)]) for f in _Contacts.__dataclass_fields__))
+        if asleep is not None:
+            wc = _Contacts(*(getattr(wc, f).take(np.flatnonzero(~asleep.take(wc.a))) for f in _FIELDS))
+        c = _Contacts(*(np.concatenate([getattr(pc, f), getattr(wc, f)]) for f in _FIELDS))
         self.count = len(c.a)
         if self.count == 0:
             self._keys, self._impulses = np.empty(0, dtype=np.int64), np.empty((0, 2))
             return False
         self._y, self._r_mean = pos[:, 1], float(radius.mean())
-        first, later = self._gather(c, mass, len(pc.a), dt)
+        inv = np.append(1.0 / mass, 0.0)  # the walls never move, nor do sleepers
+        if asleep is not None:
+            inv[:-1][asleep] = 0.0
+        first, later = self._gather(c, inv, len(pc.a), dt, asleep)
         w = np.zeros((len(pos) + 1, 2), dtype=complex)  # velocities and pseudo-velocities; the last row: walls
         w[:-1, 0] = _as_complex(vel)
         v0 = w[:-1, 0].copy()
-        w[:-1, 0] += _warm_push(c, mass, self._warm)  # warm start: last step's velocity impulses first
+        w[:-1, 0] += _warm_push(c, mass, self._warm, asleep)  # warm start: last step's velocity impulses first
         self.iterations, layout = _iterate(w, first, later)
         self._keep(c, layout)
         moved = (w[:-1, 0] - v0 + w[:-1, 1]) * dt
@@ -242,11 +262,11 @@ class ContactSolver:
         vel[:, 0], vel[:, 1] = w[:-1, 0].real, w[:-1, 0].imag
         return True
 
-    def _gather(self, c: _Contacts, mass, n_pairs: int, dt: float) -> tuple[_Layout, _Layout]:
-        """This step's targets, masses and warm-start impulses, filled into the layouts of the rounds
-        of the first iteration and of the later ones (colouring the contacts anew if they changed)."""
-        rows = len(mass)
-        inv = np.append(1.0 / mass, 0.0)  # the walls never move
+    def _gather(self, c: _Contacts, inv, n_pairs: int, dt: float, asleep=None) -> tuple[_Layout, _Layout]:
+        """This step's targets, inverse masses (inv, with the walls' 0 last) and warm-start impulses,
+        filled into the layouts of the rounds of the first iteration and of the later ones (colouring
+        the contacts anew if they changed)."""
+        rows = len(inv) - 1
         # Where the pair was at the start of the step, if it approached: the
         # velocity bound keeps it from closing more than that gap.
         s0 = c.gap - np.minimum(c.vn, 0.0) * dt
@@ -258,7 +278,9 @@ class ContactSolver:
         )
         impulse = np.zeros((len(c.keys), 2))  # pseudo-velocities start from nothing each step
         self._warm = impulse[:, 0]
+        sleepers = None if asleep is None else np.flatnonzero(asleep)
         same = self._round_keys is not None and np.array_equal(self._round_keys, c.keys)
+        same = same and _same_rows(self._round_sleepers, sleepers)
         if same and len(self._keys) == len(c.keys):
             # The contacts of the last step, in the same order (not a step with none
             # between): each finds its impulse where _keep sorted it.
@@ -268,12 +290,18 @@ class ContactSolver:
             hit = np.flatnonzero(self._keys.take(found) == c.keys)
             impulse[hit, 0] = self._impulses[found.take(hit), 0]
         if not same:
-            virtual = c.b.copy()
-            virtual[n_pairs:] = rows + 1 + np.arange(len(c.b) - n_pairs)  # each wall contact its own body
+            virtual_a, virtual_b = c.a.copy(), c.b.copy()
+            virtual_b[n_pairs:] = rows + 1 + np.arange(len(c.b) - n_pairs)  # each wall contact its own body
             bodies = rows + 1 + len(c.b) - n_pairs
-            self._rounds = colour_rounds(c.a, virtual, bodies, self._bands(c))
-            self._free_rounds = colour_rounds(c.a, virtual, bodies)
+            if asleep is not None:  # and each contact with a sleeper too: it never moves either
+                for v, real in ((virtual_a, c.a), (virtual_b, c.b)):
+                    on = np.flatnonzero(np.append(asleep, False).take(real))
+                    v[on] = bodies + np.arange(len(on))
+                    bodies += len(on)
+            self._rounds = colour_rounds(virtual_a, virtual_b, bodies, self._bands(c))
+            self._free_rounds = colour_rounds(virtual_a, virtual_b, bodies)
             self._round_keys = c.keys.copy()
+            self._round_sleepers = sleepers
             self._key_order = np.argsort(c.keys)
         if self._layouts is None or self._layouts[0].source is not self._rounds:
             self._layouts = (_Layout(self._rounds, c.a, c.b), _Layout(self._free_rounds, c.a, c.b))
@@ -376,13 +404,16 @@ class _Layout:
         return self
 
 
-def _warm_push(c: _Contacts, mass: np.ndarray, impulse: np.ndarray) -> np.ndarray:
+def _warm_push(c: _Contacts, mass: np.ndarray, impulse: np.ndarray, asleep=None) -> np.ndarray:
     """The velocity change (complex, per puck) from every contact's warm-start impulse at once:
-    a sum, so the order of the contacts does not matter."""
+    a sum, so the order of the contacts does not matter. Sleepers do not move."""
     rows = len(mass)
     push = impulse * c.n
     a = push / mass.take(c.a)
     b = push / np.append(mass, 1.0).take(c.b)  # the walls' row (b = rows) is dropped below
+    if asleep is not None:
+        a[asleep.take(c.a)] = 0.0
+        b[np.append(asleep, False).take(c.b)] = 0.0
     out = np.bincount(c.a, a.real, rows) - np.bincount(c.b, b.real, rows + 1)[:rows]
     return out + 1j * (np.bincount(c.a, a.imag, rows) - np.bincount(c.b, b.imag, rows + 1)[:rows])
 

@@ -71,7 +71,8 @@ PLAIN_TYPES = (bool, int, float, str, type(None))
 # the pucks were when they were formed, so they change results). The stage replaces these
 # arrays each step and never changes them in place, so a state keeps references.
 CONTACT_KEPT = (
-    "_keys", "_impulses", "_rows", "_round_keys", "_key_order", "_rounds", "_free_rounds", "count", "iterations"
+    "_keys", "_impulses", "_rows", "_round_keys", "_round_sleepers", "_key_order", "_rounds", "_free_rounds",
+    "count", "iterations",
 )  # fmt: skip
 # Worked out afresh at the start of every contact stage: nothing to keep.
 ROUND_LISTS = (CONTACT_KEPT.index("_rounds"), CONTACT_KEPT.index("_free_rounds"))  # lists of arrays, kept as tuples
@@ -259,6 +260,8 @@ def _contact_arrays(state: TableState) -> tuple:
         return ()
     kept = dict(zip(CONTACT_KEPT, state.contacts, strict=True))
     round_keys = () if kept["_round_keys"] is None else (kept["_round_keys"], kept["_key_order"])
+    if kept["_round_sleepers"] is not None:
+        round_keys += (kept["_round_sleepers"],)
     return (kept["_keys"], kept["_impulses"], *round_keys, *kept["_rounds"], *kept["_free_rounds"])
 
 

@@ -24,7 +24,15 @@ and the numpy work of each is in a module of its own:
    slower than the rest speed, held up together by impulses (contacts.py);
    stages 3 and 4 leave those to this one. Only when something presses:
    gravity, springs, pulls or a rest speed set by hand;
-6. walls again, since pushing pairs apart can push a puck into a wall.
+6. walls again, since pushing pairs apart can push a puck into a wall;
+7. sleeping (sleep.py): under gravity, a puck still for half a second, with
+   all its touching neighbours, falls asleep: velocity exactly 0, not moved,
+   its contacts with walls and other sleepers left out, immovable to the
+   awake pucks resting on it. At the start of a step (0b) a sleeper wakes if
+   anything touched it: a velocity, position or force written from outside,
+   a pull, an awake puck coming fast within reach; everything wakes when
+   gravity, the table's size, the pucks or springs or the correction mode
+   change. A pile at rest then costs almost nothing and shows no jitter.
 """
 
 from __future__ import annotations
@@ -37,7 +45,7 @@ from collections.abc import Callable, Sequence
 import numpy as np
 
 from airtable.colors import rgb
-from airtable.physics import broadphase, contacts, forces, pairs, sweep, vectors, walls
+from airtable.physics import broadphase, contacts, forces, pairs, sleep, sweep, vectors, walls
 from airtable.physics import implicit as implicit_solve
 from airtable.physics.bodies import Puck, Spring, as_vector
 from airtable.physics.forces import GRAVITY_MPS2, Pull
@@ -144,6 +152,9 @@ class _Columns:
 class AirTable:
     """A rectangular air table with walls at x = 0..width_m and y = 0..height_m."""
 
+    # Pucks at rest under gravity fall asleep (sleep.py); set False on a table to compare.
+    sleeping = True
+
     def __init__(self, width_m: float = TABLE_WIDTH_M, height_m: float = TABLE_HEIGHT_M) -> None:
         self.width_m = _positive(width_m, "width_m")
         self.height_m = _positive(height_m, "height_m")
@@ -154,6 +165,9 @@ class AirTable:
             radius=((), float),
             mass=((), float),
             color=((3,), np.uint8),
+            still=((), float),  # seconds the puck has been slower than sleep.SLEEP_MPS
+            asleep=((), bool),
+            rest_pos=((2,), float),  # where the puck sleeps, or where its still time began (sleep.py)
         )
         self._springs = _Columns(
             i=((), np.intp),
@@ -372,6 +386,8 @@ class AirTable:
         self.wall_collision_count = 0  # bounces off a wall since the start
         self._collision_records: list[pairs.Collisions] = []
         self._last_collisions: pairs.Collisions | None = None
+        self._world_key = ""  # what the sleepers fell asleep in (see _world): any change wakes them
+        self._sleepers: np.ndarray | None = None  # this step's sleeping rows (scratch)
 
     def schedule(self, t_s: float, fn: Callable[[AirTable], None]) -> None:
         """Run fn(table) at the start of the first step at or after simulation time t_s."""
@@ -439,28 +455,117 @@ class AirTable:
         """Advance the simulation by dt_s seconds, stage by stage (see the module docstring).
 
         `pulls` are the cursor strings acting during this step (forces.Pull).
+        Sleeping pucks (`asleep`) are not moved: the step first wakes those
+        something disturbed; when every puck sleeps, it only advances time.
         """
         dt = float(dt_s)
         if not (math.isfinite(dt) and dt >= 0.0):
             raise ValueError(f"dt_s must be zero or a positive number of seconds, not {dt_s!r}")
         self._run_due_events()
         self._collision_records, self._last_collisions = [], None
-        if self._pucks.n:
+        if self._pucks.n and not self._wake(pulls, dt):  # 0b. sleepers: wake those disturbed
             kick = None
             if dt > 0.0:
                 implicit = self._add_forces(pulls, dt)  # 1. forces
                 kick = self._integrate(implicit, dt)  # 2. semi-implicit Euler
                 self._sweep_fast(dt)  # 2b. fast pucks: their hits in time order, exactly
+                self._wake_hit()
             self.force_N[:] = 0.0  # the accumulators hold one step's forces
             rest = self._rest_speeds(kick, dt)  # below these speeds contacts rest, not bounce
             self._resolve_walls(rest=None if rest is None else self._contacts.wall_rest(rest))  # 3. walls
             moved = self._resolve_pairs(dt, rest) if self.puck_collisions else np.empty(0, dtype=np.intp)  # 4. pairs
+            self._wake_hit()
             if rest is not None and self._resolve_contacts(rest, dt):  # 5. resting contacts
                 self._resolve_walls(rest=self._contacts.wall_rest(rest), hold=True)  # 6. walls again
             elif len(moved):
                 self._resolve_walls(only=moved)  # 6. walls again, for the pucks the pairs moved
+            self._fall_asleep(pulls, dt)  # 7. pucks still for long enough fall asleep
         self.time_s += dt
         self.steps += 1
+
+    # ------------------------------------------------------------ sleeping (sleep.py)
+
+    @property
+    def asleep(self) -> np.ndarray:
+        """(N,) which pucks sleep (read-only): at rest, not moved by the step until disturbed."""
+        out = self._pucks.view("asleep").view()
+        out.flags.writeable = False
+        return out
+
+    def _world(self) -> str:
+        """What sleepers depend on, as one value: a change in any of it wakes every puck."""
+        g = self.gravity_mps2 if self.gravity_on else 0.0
+        sizes = f"{self.width_m!r} {self.height_m!r} {self._pucks.n} {self._springs.n} {self.radius_m.sum()!r}"
+        return f"{g!r} {sizes} {self.puck_correction} {self.puck_collisions}"
+
+    def _wake(self, pulls: Sequence[Pull], dt: float) -> bool:
+        """Wake the sleepers that must wake (sleep.py); return True if every puck still sleeps.
+
+        Sets `_sleepers` to the rows that sleep through this step (None: none).
+        """
+        asleep = self._pucks.view("asleep")
+        self._sleepers = None
+        world, self._world_key = self._world_key, self._world()
+        if not asleep.any():
+            return False
+        if world != self._world_key or not (self.sleeping and self.gravity_on):
+            self._set_awake(np.flatnonzero(asleep), island=False)
+            return False
+        pos, vel = self.pos_m, self.vel_mps
+        sleepers = np.flatnonzero(asleep)
+        woken = sleep.written_from_outside(pos, vel, self.force_N, self._pucks.view("rest_pos"), sleepers)
+        pulled = np.array([p.row for p in pulls], dtype=np.intp)
+        self._set_awake(np.concatenate([woken, pulled]))
+        if np.count_nonzero(asleep) < self._pucks.n:  # someone is awake: is it coming near a sleeper?
+            candidates = self._neighbours.pairs(pos, self.radius_m)
+            self._set_awake(sleep.near_movers(pos, vel, asleep, candidates, dt, pulled))
+        sleepers = np.flatnonzero(asleep)
+        if len(sleepers) == self._pucks.n:
+            return True
+        self._sleepers = sleepers if len(sleepers) else None
+        return False
+
+    def _set_awake(self, rows: np.ndarray, island: bool = True) -> None:
+        """Wake the pucks in `rows` (their still time starts again) and, with `island`, every
+        sleeper touching them, and every one touching those, and so on (sleep.island)."""
+        if len(rows) == 0:
+            return
+        asleep = self._pucks.view("asleep")
+        if island and len(rows) < self._pucks.n:
+            rows = sleep.island(self.pos_m, rows, asleep, self._neighbours.pairs(self.pos_m, self.radius_m))
+        asleep[rows] = False
+        self._pucks.view("still")[rows] = 0.0
+
+    def _wake_hit(self) -> None:
+        """Wake the sleepers a collision gave a velocity (this step's stages then move them)."""
+        if self._sleepers is None:
+            return
+        v = vectors.take(self.vel_mps, self._sleepers)
+        hit = self._sleepers.take(np.flatnonzero((v[:, 0] != 0.0) | (v[:, 1] != 0.0)))
+        if len(hit):
+            self._set_awake(hit)
+            keep = np.flatnonzero(self._pucks.view("asleep").take(self._sleepers))
+            self._sleepers = self._sleepers.take(keep) if len(keep) else None
+
+    def _fall_asleep(self, pulls: Sequence[Pull], dt: float) -> None:
+        """Put to sleep the pucks that have been still for long enough (sleep.ready_to_sleep)."""
+        self._sleepers = None
+        if not (self.sleeping and self.gravity_on):
+            return
+        asleep, pos, vel = self._pucks.view("asleep"), self.pos_m, self.vel_mps
+        free = np.ones(self._pucks.n, dtype=bool)
+        free[self._springs.view("i")] = False
+        free[self._springs.view("j")] = False
+        free[[p.row for p in pulls]] = False
+        still, anchor = self._pucks.view("still"), self._pucks.view("rest_pos")
+        ready = sleep.still_for_long(pos, vel, still, anchor, asleep, free, dt)
+        if ready is not None:
+            candidates = self._neighbours.pairs(pos, self.radius_m)
+            asleep[sleep.with_still_neighbours(pos, ready, asleep, candidates)] = True
+        sleepers = np.flatnonzero(asleep)
+        if len(sleepers):
+            vel[sleepers] = 0.0
+            self._pucks.view("rest_pos")[sleepers] = pos[sleepers]
 
     def _run_due_events(self) -> None:
         """Run the scheduled events whose time has come, in time order."""
@@ -504,6 +609,8 @@ class AirTable:
         elif self.gravity_on:
             vel[:, 1] -= self.gravity_mps2 * dt
             kick = self.gravity_mps2 * dt
+        if self._sleepers is not None:
+            vel[self._sleepers] = 0.0  # sleepers stay where they are
         # A last guard against runaway values; a cheap bound first: a speed
         # over the limit has a component over limit / sqrt(2).
         if np.abs(vel).max() > MAX_SPEED_MPS / math.sqrt(2.0):
@@ -568,8 +675,9 @@ class AirTable:
         else:
             none = np.empty(0, dtype=np.intp)
             candidates = (none, none, np.empty(0))
+        asleep = None if self._sleepers is None else self._pucks.view("asleep")
         return self._contacts.solve(
-            self.pos_m, self.vel_mps, self.radius_m, self.mass_kg, self.size_m, candidates, rest, dt
+            self.pos_m, self.vel_mps, self.radius_m, self.mass_kg, self.size_m, candidates, rest, dt, asleep
         )
 
     def _resolve_walls(self, only: np.ndarray | None = None, rest: np.ndarray | None = None, hold=False) -> None:

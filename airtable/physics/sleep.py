@@ -1,0 +1,128 @@
+"""Sleeping: pucks at rest in a pile are set aside until something disturbs them.
+
+A pile that has come to rest still costs a full contact solve every step, and
+an iterative solver never quite converges: the pucks keep a faint jitter.
+Box2D and Chipmunk put bodies to sleep once they have stayed still for a
+while; we do the same, puck by puck (Box2D does it per island):
+
+* a puck falls asleep once its speed has stayed under SLEEP_MPS for SLEEP_S
+  and every puck touching it has too (or sleeps already). Its velocity is
+  then exactly 0 and the step neither moves it nor solves its contacts with
+  the walls or with other sleepers: for the awake pucks resting on it, it is
+  an immovable body, like a wall. Only under gravity (without it a still
+  puck stays still exactly anyway) and never a puck on a spring.
+* it wakes when anything touches or moves it: a velocity, position or force
+  written from outside (a drag, a throw, reverse time, a restore), a cursor
+  string, an awake puck moving faster than WAKE_MPS (or pulled, however
+  slowly) coming within reach, or a collision that gives it a velocity; and
+  with it every sleeper joined to it by touching sleepers (its island, as
+  Box2D wakes islands), so that none stays up when what held it moves.
+  Everything wakes when the world changes: gravity, the table's size, a puck
+  or spring added or removed, a radius, the correction mode.
+
+The state of sleep is three columns of the pucks: `still` (seconds), `asleep`,
+and `rest_pos` (where a sleeper sleeps, or where an awake puck's still time
+began), so capture and restore keep it with the rest of a puck's row.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from airtable.physics import vectors
+
+# A puck slower than this (m/s) for SLEEP_S seconds, all the while within SLEEP_DRIFT_M of
+# where that time began, falls asleep (with its neighbours). Box2D's default threshold is
+# 0.05 m/s too: a pile's contacts, solved by a few iterations, leave about 0.02 m/s of jitter.
+SLEEP_MPS = 0.05
+SLEEP_DRIFT_M = 0.005
+SLEEP_S = 0.5
+# A sleeper wakes when an awake puck faster than this (m/s) comes within reach.
+WAKE_MPS = 0.1
+# Extra room (m) in "within reach": what a step moves a puck, plus this.
+WAKE_SKIN_M = 1e-3
+
+
+def written_from_outside(pos, vel, force, rest_pos, sleepers: np.ndarray) -> np.ndarray:
+    """The sleepers (rows) given a velocity, position or force since the last step."""
+    v, f = vectors.take(vel, sleepers), vectors.take(force, sleepers)
+    moved = vectors.take(pos, sleepers) != vectors.take(rest_pos, sleepers)
+    touched = (v != 0.0) | (f != 0.0) | moved
+    return sleepers.take(np.flatnonzero(touched[:, 0] | touched[:, 1]))
+
+
+def touching(pos, candidates) -> tuple[np.ndarray, np.ndarray]:
+    """The candidate pairs (i, j) that touch: closer than their reach plus WAKE_SKIN_M."""
+    ci, cj, reach = candidates
+    lim = reach + WAKE_SKIN_M
+    touch = np.flatnonzero(vectors.squared_lengths(vectors.take(pos, ci) - vectors.take(pos, cj)) < lim * lim)
+    return ci.take(touch), cj.take(touch)
+
+
+def island(pos, rows: np.ndarray, asleep, candidates) -> np.ndarray:
+    """`rows` and every sleeper joined to them by a chain of touching sleepers (Box2D wakes a
+    whole island): a sleeper must not stay up in the air when the puck it rests on wakes."""
+    i, j = touching(pos, candidates)
+    both = np.flatnonzero(asleep.take(i) & asleep.take(j))  # the chains run through sleepers
+    i, j = np.concatenate([i.take(both), j.take(both)]), np.concatenate([j.take(both), i.take(both)])
+    woken = np.zeros(len(pos), dtype=bool)
+    woken[rows] = True
+    new = woken & asleep
+    for _ in range(len(pos)):  # each pass reaches one more puck along the chains
+        reached = j.take(np.flatnonzero(new.take(i)))
+        new = np.zeros(len(pos), dtype=bool)
+        new[reached] = True
+        new &= ~woken
+        if not new.any():
+            break
+        woken |= new
+    return np.flatnonzero(woken)
+
+
+def near_movers(pos, vel, asleep, candidates, dt: float, pulled: np.ndarray = ()) -> np.ndarray:
+    """The sleepers (rows) within reach of an awake puck faster than WAKE_MPS, or pulled by a cursor
+    string (a slow drag pushes too): the sum of the radii, plus what that puck moves in a step, plus
+    WAKE_SKIN_M."""
+    ci, cj, reach = candidates
+    speed = vectors.lengths(vel)
+    mover = speed > WAKE_MPS
+    mover[pulled] = True
+    mover &= ~asleep
+    if not mover.any():
+        return np.empty(0, dtype=np.intp)
+    pick = np.flatnonzero((mover.take(ci) & asleep.take(cj)) | (mover.take(cj) & asleep.take(ci)))
+    i, j = ci.take(pick), cj.take(pick)
+    lim = reach.take(pick) + np.maximum(speed.take(i), speed.take(j)) * dt + WAKE_SKIN_M
+    close = np.flatnonzero(vectors.squared_lengths(vectors.take(pos, i) - vectors.take(pos, j)) < lim * lim)
+    i, j = i.take(close), j.take(close)
+    return np.unique(np.concatenate([i.take(np.flatnonzero(asleep.take(i))), j.take(np.flatnonzero(asleep.take(j)))]))
+
+
+def still_for_long(pos, vel, still, anchor, asleep, free, dt: float) -> np.ndarray | None:
+    """Count this step into each awake puck's still time; return the mask of pucks still for SLEEP_S
+    (`free` ones: no spring or pull), or None if none of them is awake.
+
+    A puck slower than SLEEP_MPS starts its still time (dt) at its position (`anchor`); it grows by
+    dt while the puck stays slow and within SLEEP_DRIFT_M of there, and is 0 otherwise. Moving
+    pucks keep 0 and their anchor: nothing changes in the columns, so a history of states shares them.
+    """
+    awake = ~asleep
+    slow = awake & (vectors.squared_lengths(vel) < SLEEP_MPS * SLEEP_MPS)
+    start = np.flatnonzero(slow & (still == 0.0))
+    near = vectors.squared_lengths(pos - anchor) < SLEEP_DRIFT_M * SLEEP_DRIFT_M
+    still[np.flatnonzero(slow & near & (still > 0.0))] += dt
+    still[np.flatnonzero(awake & ~(slow & near))] = 0.0
+    anchor[start] = pos[start]
+    still[start] = dt
+    ready = (still > SLEEP_S - 1e-9) & free  # a sum of dt: 120 steps of 1/240 s make 0.4999...
+    return ready if (ready & awake).any() else None
+
+
+def with_still_neighbours(pos, ready, asleep, candidates) -> np.ndarray:
+    """The awake `ready` pucks (rows) every touching neighbour of which is ready or asleep: they fall asleep."""
+    ok = ready | asleep  # a neighbour that lets a puck sleep
+    i, j = touching(pos, candidates)
+    blocked = np.zeros(len(pos), dtype=bool)
+    blocked[i.take(np.flatnonzero(~ok.take(j)))] = True
+    blocked[j.take(np.flatnonzero(~ok.take(i)))] = True
+    return np.flatnonzero(ready & ~asleep & ~blocked)
