@@ -51,3 +51,16 @@ def test_the_app_says_each_notice_once(demos, capsys) -> None:
         app.frame(FRAME_S)
     assert capsys.readouterr().err == ""  # not again while the scene lasts
     pygame.event.clear()
+
+
+def test_the_inspector_says_when_a_puck_sleeps() -> None:
+    # A puck laid on the floor under gravity, no bounce: still for 0.5 s, it falls asleep (physics/sleep.py).
+    table = AirTable()
+    table.gravity_on, table.cr_wall = True, 0.0
+    puck = table.add_puck(pos_m=(5.0, 0.25), radius_m=0.25)
+    table.step(1 / 240)
+    assert not any(line.startswith("asleep") for line in inspector_lines(table, puck))
+    for _ in range(240):
+        table.step(1 / 240)
+    assert table.asleep[puck.index]
+    assert inspector_lines(table, puck)[-1] == "asleep: the step skips it until something touches or moves it"
