@@ -63,4 +63,4 @@ def test_the_inspector_says_when_a_puck_sleeps() -> None:
     for _ in range(240):
         table.step(1 / 240)
     assert table.asleep[puck.index]
-    assert inspector_lines(table, puck)[-1] == "asleep: the step skips it until something touches or moves it"
+    assert inspector_lines(table, puck)[-1] == "asleep: the step skips it until disturbed"

@@ -53,7 +53,7 @@ def inspector_lines(table, puck) -> list[str]:
         f"kinetic energy {0.5 * puck.mass_kg * speed**2:.4g} J",
     ]
     if table.asleep[puck.index]:  # the engine's sleeping, made visible (physics/sleep.py)
-        lines.append("asleep: the step skips it until something touches or moves it")
+        lines.append("asleep: the step skips it until disturbed")
     for spring in table.springs_on(puck)[:MAX_INSPECTED_SPRINGS]:
         line = f"spring k {spring.k_Npm:.4g} N/m"
         if spring.k_effective_Npm != spring.k_Npm:
