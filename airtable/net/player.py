@@ -15,6 +15,7 @@ Two parts:
 from __future__ import annotations
 
 import argparse
+import contextlib
 import dataclasses
 import enum
 import math
@@ -108,6 +109,12 @@ class InputThrottle:
 
 def _empty_scene(width_m: float, height_m: float) -> Scene:
     return Scene(width_m, height_m, np.zeros((0, 2)), np.zeros(0), np.zeros((0, 3), np.uint8))
+
+
+def _shut(sock: socket.socket) -> None:
+    """Shut both directions, which wakes a thread blocked in recv(); a socket already gone is fine."""
+    with contextlib.suppress(OSError):
+        sock.shutdown(socket.SHUT_RDWR)
 
 
 class NetPlayer:
@@ -480,11 +487,7 @@ class NetPlayer:
             try:
                 sock.sendall(frame)
             except OSError:
-                # The reader thread notices too and starts reconnecting; wake it now.
-                try:
-                    sock.shutdown(socket.SHUT_RDWR)
-                except OSError:
-                    pass
+                _shut(sock)  # the reader thread notices too and starts reconnecting; wake it now
                 return False
             if on_sent is not None:
                 on_sent()
@@ -497,14 +500,9 @@ class NetPlayer:
             sock = self._sock
             if sock is not None:
                 if bye and self.state == PlayerState.CONNECTED:
-                    try:
+                    with contextlib.suppress(OSError):
                         sock.sendall(proto.encode_bye())
-                    except OSError:
-                        pass
-                try:
-                    sock.shutdown(socket.SHUT_RDWR)
-                except OSError:
-                    pass
+                _shut(sock)
         if self._thread is not None and self._thread is not threading.current_thread():
             self._thread.join(timeout=5.0)
         if self.state != PlayerState.FAILED:
