@@ -1,0 +1,50 @@
+"""A few pairs are resolved in plain floats (pairs._resolve_few); they give what the arrays give."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from airtable.physics import broadphase, pairs
+
+
+def _scene(seed: int, n: int):
+    """A handful of pucks heaped in a small square, some exactly on top of each other."""
+    rng = np.random.default_rng(seed)
+    radius = rng.uniform(0.1, 0.3, n)
+    mass = rng.uniform(0.1, 3.0, n) * math.pi * radius**2
+    pos = rng.uniform(0.0, 0.8, (n, 2))
+    pos[n - 1] = pos[0]
+    vel = rng.uniform(-3.0, 3.0, (n, 2))
+    return pos, vel, radius, mass
+
+
+def _resolve(few: int, scene, cr: float, mode: str, dt_s: float, monkeypatch):
+    pos, vel, radius, mass = (a.copy() for a in scene)
+    i, j = broadphase.brute_force_pairs(pos, radius)
+    monkeypatch.setattr(pairs, "FEW_PAIRS", few)
+    records = pairs.resolve_pairs(pos, vel, radius, mass, i, j, cr, mode, dt_s, in_time_order=True)
+    return pos, vel, pairs.Collisions.concatenate(records)
+
+
+@settings(max_examples=150, deadline=None, derandomize=True)
+@given(
+    st.integers(0, 2**32 - 1),
+    st.integers(2, 7),
+    st.sampled_from(pairs.CORRECTION_MODES),
+    st.sampled_from([0.0, 0.5, 1.0]) | st.floats(0.0, 1.0),
+    st.sampled_from([1 / 240, 1 / 60, 1 / 20]),
+)
+def test_floats_give_what_the_arrays_give(seed: int, n: int, mode: str, cr: float, dt_s: float) -> None:
+    scene = _scene(seed, n)
+    with pytest.MonkeyPatch.context() as mp:
+        arrays = _resolve(0, scene, cr, mode, dt_s, mp)  # every round with numpy
+        floats = _resolve(10**6, scene, cr, mode, dt_s, mp)  # every round in floats
+    for got, want in zip(floats[:2], arrays[:2], strict=True):
+        np.testing.assert_array_equal(got, want)
+    for field in pairs.Collisions.__dataclass_fields__:
+        np.testing.assert_array_equal(getattr(floats[2], field), getattr(arrays[2], field))
