@@ -46,7 +46,7 @@ REST_SPEED_MPS = 1e-9
 # floats (`_resolve_few`): a numpy call costs about a microsecond however few
 # rows it has, and a round makes some forty of them, while a gas mostly has
 # rounds of one to five pairs. The floats do the arrays' arithmetic in the
-# same order, so both paths give the same numbers (tests/test_pairs_few.py).
+# same order, so both paths give the same numbers (tests/test_few_in_floats.py).
 FEW_PAIRS = 8
 
 
@@ -125,17 +125,23 @@ def disjoint_rounds(i: np.ndarray, j: np.ndarray, n: int, since=None) -> list[np
     shared = np.flatnonzero((uses.take(i) > 1) | (uses.take(j) > 1))
     if since is not None:
         shared = shared.take(np.argsort(-since(shared), kind="stable"))  # the earliest contact first
-    busy_until: dict[int, int] = {}  # per puck: first level at which it is free again
-    levels = []
-    for a, b in zip(i.take(shared).tolist(), j.take(shared).tolist(), strict=True):
-        lvl = max(busy_until.get(a, 0), busy_until.get(b, 0))
-        levels.append(lvl)
-        busy_until[a] = busy_until[b] = lvl + 1
+    levels = _chain_levels(i.take(shared).tolist(), j.take(shared).tolist())
     level = np.zeros(m, dtype=np.intp)
     level[shared] = levels
     order = np.argsort(level, kind="stable")
     bounds = np.searchsorted(level.take(order), np.arange(max(levels) + 2))
     return [order[bounds[r] : bounds[r + 1]] for r in range(len(bounds) - 1)]
+
+
+def _chain_levels(i: list[int], j: list[int]) -> list[int]:
+    """For each pair in turn, how many earlier pairs form a chain into it (its round)."""
+    busy_until: dict[int, int] = {}  # per puck: first level at which it is free again
+    levels = []
+    for a, b in zip(i, j, strict=True):
+        lvl = max(busy_until.get(a, 0), busy_until.get(b, 0))
+        levels.append(lvl)
+        busy_until[a] = busy_until[b] = lvl + 1
+    return levels
 
 
 def since_contact(pos, vel, radius, i, j, dt_s: float) -> np.ndarray:
@@ -173,6 +179,10 @@ def resolve_pairs(
     def since(k):
         return since_contact(pos, vel, radius, i.take(k), j.take(k), dt_s)
 
+    if len(i) <= FEW_PAIRS:
+        order = _few_in_order(pos, vel, radius, i, j, dt_s if in_time_order else None)
+        c = _resolve_few(pos, vel, radius, mass, i.take(order), j.take(order), cr_puck, mode, dt_s)
+        return [] if c is None else [c]
     records = []
     for r in disjoint_rounds(i, j, len(pos), since if in_time_order else None):
         c = _resolve_round(pos, vel, radius, mass, i.take(r), j.take(r), cr_puck, mode, dt_s)
@@ -472,3 +482,33 @@ def _separate_floats(x1, x2, n, move: float, reach: float, share1: float, share2
         y1 = [y1[0] + left * share1 * m0, y1[1] + left * share1 * m1]
         y2 = [y2[0] - left * share2 * m0, y2[1] - left * share2 * m1]
     return y1, y2
+
+
+def _few_in_order(pos, vel, radius, i, j, dt_s: float | None) -> list[int]:
+    """The order in which `disjoint_rounds`' rounds would take the pairs (i, j): round by round,
+    in the given order within a round. With dt_s, pairs sharing a puck go as they met (since_contact)."""
+    il, jl = i.tolist(), j.tolist()
+    uses: dict[int, int] = {}
+    for p in il + jl:
+        uses[p] = uses.get(p, 0) + 1
+    shared = [k for k in range(len(il)) if uses[il[k]] > 1 or uses[jl[k]] > 1]
+    if not shared:
+        return list(range(len(il)))
+    if dt_s is not None:
+        since = {k: _since_floats(pos, vel, radius, il[k], jl[k], dt_s) for k in shared}
+        shared.sort(key=lambda k: -since[k])  # stable, as np.argsort(kind="stable")
+    level = [0] * len(il)
+    for k, lvl in zip(shared, _chain_levels([il[k] for k in shared], [jl[k] for k in shared]), strict=True):
+        level[k] = lvl
+    return sorted(range(len(il)), key=level.__getitem__)
+
+
+def _since_floats(pos, vel, radius, p: int, q: int, dt_s: float) -> float:
+    """`since_contact` for one pair."""
+    xi, xj, vi, vj = pos[p].tolist(), pos[q].tolist(), vel[p].tolist(), vel[q].tolist()
+    d0, d1, w0, w1 = xi[0] - xj[0], xi[1] - xj[1], vi[0] - vj[0], vi[1] - vj[1]
+    reach = radius.item(p) + radius.item(q)
+    ww, dw = w0 * w0 + w1 * w1, d0 * w0 + d1 * w1
+    disc = max(dw * dw - ww * ((d0 * d0 + d1 * d1) - reach * reach), 0.0)
+    back = (dw + math.sqrt(disc)) / (ww if ww > 0.0 else 1.0)
+    return back if ww > 0.0 and 0.0 <= back <= dt_s else dt_s

@@ -1,4 +1,5 @@
-"""A few pairs are resolved in plain floats (pairs._resolve_few); they give what the arrays give."""
+"""A few pairs (pairs._resolve_few) and a few pucks past a wall (walls._bounce_in_floats) are
+resolved in plain floats; they give, to the last bit, what the arrays give."""
 
 from __future__ import annotations
 
@@ -9,7 +10,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from airtable.physics import broadphase, pairs
+from airtable.physics import broadphase, pairs, walls
 
 
 def _scene(seed: int, n: int):
@@ -48,3 +49,27 @@ def test_floats_give_what_the_arrays_give(seed: int, n: int, mode: str, cr: floa
         np.testing.assert_array_equal(got, want)
     for field in pairs.Collisions.__dataclass_fields__:
         np.testing.assert_array_equal(getattr(floats[2], field), getattr(arrays[2], field))
+
+
+def _walls(few: int, pos, vel, radius, correction: bool, mp) -> tuple[np.ndarray, np.ndarray, int]:
+    pos, vel = pos.copy(), vel.copy()
+    mp.setattr(walls, "FEW_PUCKS", few)
+    count = walls.resolve_walls(pos, vel, radius, np.array([2.0, 1.5]), 0.7, correction)
+    return pos, vel, count
+
+
+@settings(max_examples=100, deadline=None, derandomize=True)
+@given(st.integers(0, 2**32 - 1), st.integers(1, 6), st.booleans())
+def test_walls_in_floats_give_what_the_arrays_give(seed: int, n: int, correction: bool) -> None:
+    # Pucks anywhere around a 2 x 1.5 m table, some far outside, one wider than the table.
+    rng = np.random.default_rng(seed)
+    pos = rng.uniform(-1.0, 3.0, (n, 2))
+    vel = rng.uniform(-3.0, 3.0, (n, 2))
+    radius = rng.uniform(0.05, 0.5, n)
+    radius[0] = 1.0 if seed % 3 == 0 else radius[0]
+    with pytest.MonkeyPatch.context() as mp:
+        arrays = _walls(0, pos, vel, radius, correction, mp)
+        floats = _walls(10**6, pos, vel, radius, correction, mp)
+    np.testing.assert_array_equal(floats[0], arrays[0])
+    np.testing.assert_array_equal(floats[1], arrays[1])
+    assert floats[2] == arrays[2]
