@@ -180,15 +180,32 @@ def resolve_pairs(
         return since_contact(pos, vel, radius, i.take(k), j.take(k), dt_s)
 
     if len(i) <= FEW_PAIRS:
-        order = _few_in_order(pos, vel, radius, i, j, dt_s if in_time_order else None)
-        c = _resolve_few(pos, vel, radius, mass, i.take(order), j.take(order), cr_puck, mode, dt_s)
-        return [] if c is None else [c]
+        return _resolve_few_in_order(pos, vel, radius, mass, i, j, cr_puck, mode, dt_s, in_time_order)
+    uses = np.bincount(np.concatenate([i, j]), minlength=len(pos))
+    shared = (uses.take(i) > 1) | (uses.take(j) > 1)
+    if np.count_nonzero(shared) <= FEW_PAIRS:
+        # A gas's usual case. The pairs whose pucks are in no other pair
+        # cannot change the others: one round for them, then the few that
+        # share a puck, one by one in floats, in their rounds' order.
+        alone, few = np.flatnonzero(~shared), np.flatnonzero(shared)
+        c = _resolve_round(pos, vel, radius, mass, i.take(alone), j.take(alone), cr_puck, mode, dt_s)
+        few_records = _resolve_few_in_order(
+            pos, vel, radius, mass, i.take(few), j.take(few), cr_puck, mode, dt_s, in_time_order
+        )
+        return ([] if c is None else [c]) + few_records
     records = []
     for r in disjoint_rounds(i, j, len(pos), since if in_time_order else None):
         c = _resolve_round(pos, vel, radius, mass, i.take(r), j.take(r), cr_puck, mode, dt_s)
         if c is not None:
             records.append(c)
     return records
+
+
+def _resolve_few_in_order(pos, vel, radius, mass, i, j, cr_puck, mode, dt_s, in_time_order) -> list[Collisions]:
+    """resolve_pairs for a few pairs, in floats: in the order of their rounds, one by one."""
+    order = _few_in_order(pos, vel, radius, i, j, dt_s if in_time_order else None)
+    c = _resolve_few(pos, vel, radius, mass, i.take(order), j.take(order), cr_puck, mode, dt_s)
+    return [] if c is None else [c]
 
 
 def push_apart(pos: np.ndarray, radius: np.ndarray, mass: np.ndarray, i: np.ndarray, j: np.ndarray) -> None:
