@@ -110,6 +110,13 @@ def overlapping_pairs(
     return i, j
 
 
+def pairs_with(rows: np.ndarray, i: np.ndarray, j: np.ndarray, n: int) -> np.ndarray:
+    """Indices k of the pairs (i, j) with a puck in `rows` (of n pucks)."""
+    marked = np.zeros(n, dtype=bool)
+    marked[rows] = True
+    return np.flatnonzero(marked.take(i) | marked.take(j))
+
+
 def _closer_than(pos: np.ndarray, i: np.ndarray, j: np.ndarray, reach: np.ndarray) -> np.ndarray:
     """Indices k of the pairs whose centres are less than reach[k] apart."""
     return np.flatnonzero(vectors.squared_lengths(vectors.take(pos, i) - vectors.take(pos, j)) < reach * reach)

@@ -721,9 +721,13 @@ class AirTable:
             if self.puck_correction == "off" or attempt == EXTRA_PASSES:
                 break  # with "off" overlaps stay: that is what it shows
             # Parting a pair can push one of its pucks into a third one that
-            # was already handled: look again among the same candidates,
-            # collide those pairs too, and at last just push apart what is left.
-            i, j = self._colliding(rest, *broadphase.overlapping_pairs(pos, ci, cj, reach - OVERLAP_SLOP_M, order))
+            # was already handled: look again among the same candidates (those
+            # of the pucks just moved: nothing else changed), collide those
+            # pairs too, and at last just push apart what is left.
+            k = broadphase.pairs_with(np.concatenate([i, j]), ci, cj, len(pos))
+            i, j = self._colliding(
+                rest, *broadphase.overlapping_pairs(pos, ci.take(k), cj.take(k), reach.take(k) - OVERLAP_SLOP_M)
+            )
         if not moved:
             return np.empty(0, dtype=np.intp)
         self._collision_records += records
