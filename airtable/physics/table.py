@@ -57,6 +57,9 @@ TABLE_HEIGHT_M = 8.7556
 # over the pairs the corrections pushed into overlap: collisions again, then a
 # last pass that only pushes apart.
 EXTRA_PASSES = 2
+# From this many candidate pairs on (a gas of some 3000 pucks), the second look for
+# overlaps checks only the pairs of the pucks the first pass moved.
+LOOK_AT_MOVED_MIN_PAIRS = 5000
 # Overlaps smaller than this (m) are left to the next step: round-off only.
 OVERLAP_SLOP_M = 1e-9
 # Said once (in `notices`) when springs are first solved implicitly.
@@ -724,15 +727,21 @@ class AirTable:
             # was already handled: look again among the same candidates (those
             # of the pucks just moved: nothing else changed), collide those
             # pairs too, and at last just push apart what is left.
-            k = broadphase.pairs_with(np.concatenate([i, j]), ci, cj, len(pos))
-            i, j = self._colliding(
-                rest, *broadphase.overlapping_pairs(pos, ci.take(k), cj.take(k), reach.take(k) - OVERLAP_SLOP_M)
-            )
+            ni, nj, near = self._candidates_of(np.concatenate([i, j]), ci, cj, reach)
+            i, j = self._colliding(rest, *broadphase.overlapping_pairs(pos, ni, nj, near - OVERLAP_SLOP_M))
         if not moved:
             return np.empty(0, dtype=np.intp)
         self._collision_records += records
         self.collision_count += sum(len(r) for r in records)
         return np.concatenate(moved)
+
+    def _candidates_of(self, rows: np.ndarray, ci: np.ndarray, cj: np.ndarray, reach: np.ndarray):
+        """(i, j, reach) of the candidate pairs with a puck in `rows`; all of them on a small table,
+        where picking them out costs more than checking them all."""
+        if len(ci) < LOOK_AT_MOVED_MIN_PAIRS:
+            return ci, cj, reach
+        k = broadphase.pairs_with(rows, ci, cj, self._pucks.n)
+        return ci.take(k), cj.take(k), reach.take(k)
 
     def _colliding(self, rest: np.ndarray | None, i: np.ndarray, j: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """The pairs (i, j) that collide: all of them if rest is None, else those that approach
