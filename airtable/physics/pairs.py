@@ -203,8 +203,9 @@ def resolve_pairs(
 
 def _resolve_few_in_order(pos, vel, radius, mass, i, j, cr_puck, mode, dt_s, in_time_order) -> list[Collisions]:
     """resolve_pairs for a few pairs, in floats: in the order of their rounds, one by one."""
-    order = _few_in_order(pos, vel, radius, i, j, dt_s if in_time_order else None)
-    c = _resolve_few(pos, vel, radius, mass, i.take(order), j.take(order), cr_puck, mode, dt_s)
+    il, jl = i.tolist(), j.tolist()
+    order = _few_in_order(pos, vel, radius, il, jl, dt_s if in_time_order else None)
+    c = _resolve_few(pos, vel, radius, mass, [il[k] for k in order], [jl[k] for k in order], cr_puck, mode, dt_s)
     return [] if c is None else [c]
 
 
@@ -389,7 +390,7 @@ def _resolve_round(pos, vel, radius, mass, a, b, cr, mode, dt_s) -> Collisions |
     Returns the record of the pairs that collided, None if none did.
     """
     if len(a) <= FEW_PAIRS:
-        return _resolve_few(pos, vel, radius, mass, a, b, cr, mode, dt_s)
+        return _resolve_few(pos, vel, radius, mass, a.tolist(), b.tolist(), cr, mode, dt_s)
     g = _gather(pos, vel, radius, mass, a, b)
     if g is None:
         return None
@@ -412,10 +413,10 @@ def _resolve_round(pos, vel, radius, mass, a, b, cr, mode, dt_s) -> Collisions |
 # ---------------------------------------------------------------- a few pairs, in floats
 
 
-def _resolve_few(pos, vel, radius, mass, a, b, cr, mode, dt_s) -> Collisions | None:
+def _resolve_few(pos, vel, radius, mass, a: list[int], b: list[int], cr, mode, dt_s) -> Collisions | None:
     """`_resolve_round` for a few pairs: the same steps, pair by pair, in Python floats."""
     rows, hit = [], []
-    for p, q in zip(a.tolist(), b.tolist(), strict=True):
+    for p, q in zip(a, b, strict=True):
         row = _pair_in_floats(pos, vel, radius, mass, p, q, cr, mode, dt_s)
         if row is not None:
             rows.append(row)
@@ -501,10 +502,9 @@ def _separate_floats(x1, x2, n, move: float, reach: float, share1: float, share2
     return y1, y2
 
 
-def _few_in_order(pos, vel, radius, i, j, dt_s: float | None) -> list[int]:
-    """The order in which `disjoint_rounds`' rounds would take the pairs (i, j): round by round,
+def _few_in_order(pos, vel, radius, il: list[int], jl: list[int], dt_s: float | None) -> list[int]:
+    """The order in which `disjoint_rounds`' rounds would take the pairs (il, jl): round by round,
     in the given order within a round. With dt_s, pairs sharing a puck go as they met (since_contact)."""
-    il, jl = i.tolist(), j.tolist()
     uses: dict[int, int] = {}
     for p in il + jl:
         uses[p] = uses.get(p, 0) + 1

@@ -508,9 +508,10 @@ class AirTable:
         """
         asleep = self._pucks.view("asleep")
         self._sleepers = None
-        world, self._world_key = self._world_key, self._world()
         if not asleep.any():
+            self._world_key = ""  # worked out when someone falls asleep (_fall_asleep)
             return False
+        world, self._world_key = self._world_key, self._world()
         if world != self._world_key or not (self.sleeping and self.gravity_on):
             self._set_awake(np.flatnonzero(asleep), island=False)
             return False
@@ -567,6 +568,7 @@ class AirTable:
             asleep[sleep.with_still_neighbours(pos, ready, asleep, candidates)] = True
         sleepers = np.flatnonzero(asleep)
         if len(sleepers):
+            self._world_key = self._world_key or self._world()
             vel[sleepers] = 0.0
             self._pucks.view("rest_pos")[sleepers] = pos[sleepers]
 

@@ -9,7 +9,7 @@ from airtable.physics import vectors
 # Up to this many pucks past a wall are bounced one at a time in plain floats
 # (`_bounce_in_floats`): in a gas one or two are, and a dozen numpy calls on
 # one or two rows cost more than the arithmetic (as pairs.FEW_PAIRS).
-FEW_PUCKS = 4
+FEW_PUCKS = 8
 
 
 def resolve_walls(
