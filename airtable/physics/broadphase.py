@@ -162,9 +162,17 @@ class NeighbourList:
     def _build(self, pos: np.ndarray, radius: np.ndarray) -> None:
         skin = SKIN_RADII * float(radius.mean()) if len(radius) else 0.0
         i, j = find_candidate_pairs(pos, radius, margin_m=skin)
+        # Keep the pairs closer than the largest reach plus the skin, then
+        # (unless all radii are equal) those closer than their own: the grid
+        # finds about three candidates for each one kept.
+        r_max = float(radius.max()) if len(radius) else 0.0
+        near = _closer_than(pos, i, j, 2.0 * r_max + skin)
+        i, j = i.take(near), j.take(near)
         reach = pair_reach(radius, i, j)
-        near = _closer_than(pos, i, j, reach + skin)
-        self._i, self._j, self._reach = i.take(near), j.take(near), reach.take(near)
+        if len(radius) and float(radius.min()) < r_max:
+            near = _closer_than(pos, i, j, reach + skin)
+            i, j, reach = i.take(near), j.take(near), reach.take(near)
+        self._i, self._j, self._reach = i, j, reach
         self._order: np.ndarray | None = None  # see sorted_order
         self._built_pos, self._built_radius = pos.copy(), radius.copy()
         self._half_skin_sq = (0.5 * skin) ** 2
