@@ -100,9 +100,9 @@ def overlapping_pairs(
     close = vectors.squared_lengths(d) < reach * reach
     if sorted_order is not None and np.count_nonzero(close) * SORTED_PICK_SHARE >= len(i):
         order = sorted_order()
-        hit = order.take(np.flatnonzero(close.take(order)))
+        hit = order.take(close.take(order).nonzero()[0])
         return i.take(hit), j.take(hit)
-    hit = np.flatnonzero(close)
+    hit = close.nonzero()[0]
     i, j = i.take(hit), j.take(hit)
     if len(i) > 1:
         by_pair = np.lexsort((j, i))
@@ -114,12 +114,12 @@ def pairs_with(rows: np.ndarray, i: np.ndarray, j: np.ndarray, n: int) -> np.nda
     """Indices k of the pairs (i, j) with a puck in `rows` (of n pucks)."""
     marked = np.zeros(n, dtype=bool)
     marked[rows] = True
-    return np.flatnonzero(marked.take(i) | marked.take(j))
+    return (marked.take(i) | marked.take(j)).nonzero()[0]
 
 
 def _closer_than(pos: np.ndarray, i: np.ndarray, j: np.ndarray, reach: np.ndarray) -> np.ndarray:
     """Indices k of the pairs whose centres are less than reach[k] apart."""
-    return np.flatnonzero(vectors.squared_lengths(vectors.take(pos, i) - vectors.take(pos, j)) < reach * reach)
+    return (vectors.squared_lengths(vectors.take(pos, i) - vectors.take(pos, j)) < reach * reach).nonzero()[0]
 
 
 class NeighbourList:

@@ -122,7 +122,7 @@ def disjoint_rounds(i: np.ndarray, j: np.ndarray, n: int, since=None) -> list[np
     # A pair whose pucks are in no other pair can go in any round: the first.
     # For the others, level[k] = how many earlier pairs form a chain into
     # pair k. One pass in Python over just those, a handful per step.
-    shared = np.flatnonzero((uses.take(i) > 1) | (uses.take(j) > 1))
+    shared = ((uses.take(i) > 1) | (uses.take(j) > 1)).nonzero()[0]
     if since is not None:
         shared = shared.take(np.argsort(-since(shared), kind="stable"))  # the earliest contact first
     levels = _chain_levels(i.take(shared).tolist(), j.take(shared).tolist())
@@ -187,7 +187,7 @@ def resolve_pairs(
         # A gas's usual case. The pairs whose pucks are in no other pair
         # cannot change the others: one round for them, then the few that
         # share a puck, one by one in floats, in their rounds' order.
-        alone, few = np.flatnonzero(~shared), np.flatnonzero(shared)
+        alone, few = (~shared).nonzero()[0], shared.nonzero()[0]
         c = _resolve_round(pos, vel, radius, mass, i.take(alone), j.take(alone), cr_puck, mode, dt_s)
         few_records = _resolve_few_in_order(
             pos, vel, radius, mass, i.take(few), j.take(few), cr_puck, mode, dt_s, in_time_order
@@ -269,7 +269,7 @@ def _gather(pos, vel, radius, mass, a, b) -> _Round | None:
     n, dist = vectors.unit_vectors(x1 - x2, a + b)
     overlap = reach - dist
     if np.count_nonzero(overlap > 0.0) < len(overlap):
-        keep = np.flatnonzero(overlap > 0.0)
+        keep = (overlap > 0.0).nonzero()[0]
         if len(keep) == 0:
             return None
         a, b, x1, x2, r2, reach, n, overlap = (v.take(keep, axis=0) for v in (a, b, x1, x2, r2, reach, n, overlap))
@@ -406,7 +406,7 @@ def _resolve_round(pos, vel, radius, mass, a, b, cr, mode, dt_s) -> Collisions |
     )
     if np.count_nonzero(out.approach) == len(out.approach):
         return record
-    hit = np.flatnonzero(out.approach)
+    hit = out.approach.nonzero()[0]
     return record.take(hit) if len(hit) else None
 
 

@@ -753,8 +753,8 @@ class AirTable:
         pos, vel = self.pos_m, self.vel_mps
         n, _ = vectors.unit_vectors(vectors.take(pos, i) - vectors.take(pos, j), i + j)
         vn = vectors.dot_rows(vectors.take(vel, i) - vectors.take(vel, j), n)
-        fast = np.flatnonzero(vn < -np.maximum(rest.take(i), rest.take(j)))  # few: look only these up
-        fast = fast.take(np.flatnonzero(~self._contacts.held(i.take(fast), j.take(fast))))
+        fast = (vn < -np.maximum(rest.take(i), rest.take(j))).nonzero()[0]  # few: look only these up
+        fast = fast.take((~self._contacts.held(i.take(fast), j.take(fast))).nonzero()[0])
         return i.take(fast), j.take(fast)
 
     def _spring_forces(

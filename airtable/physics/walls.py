@@ -47,14 +47,14 @@ def resolve_walls(
     room = np.minimum(np.minimum(x, y), np.minimum(width - x, height - y)) - r
     if room.min() >= 0.0:
         return 0  # the usual case: nobody is past a wall
-    out = np.flatnonzero(~(room >= 0.0))  # NaN counts as outside
+    out = (~(room >= 0.0)).nonzero()[0]  # NaN counts as outside
     if only is not None:
         out = only.take(out)
     if rest is not None:
         fast = _fast_ones(pos, vel, radius, size_m, rest, out)
         if hold_slow:
-            _hold(pos, vel, radius, size_m, out.take(np.flatnonzero(~fast)))
-        out = out.take(np.flatnonzero(fast))
+            _hold(pos, vel, radius, size_m, out.take((~fast).nonzero()[0]))
+        out = out.take(fast.nonzero()[0])
         if len(out) == 0:
             return 0  # a pile's usual case: every puck past a wall rests there
     if len(out) <= FEW_PUCKS:
