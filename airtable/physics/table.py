@@ -391,6 +391,7 @@ class AirTable:
         self._last_collisions: pairs.Collisions | None = None
         self._world_key = ""  # what the sleepers fell asleep in (see _world): any change wakes them
         self._sleepers: np.ndarray | None = None  # this step's sleeping rows (scratch)
+        self._top_component_mps = math.inf  # the step's largest |velocity component| (scratch, see _integrate)
 
     def schedule(self, t_s: float, fn: Callable[[AirTable], None]) -> None:
         """Run fn(table) at the start of the first step at or after simulation time t_s."""
@@ -508,7 +509,7 @@ class AirTable:
         """
         asleep = self._pucks.view("asleep")
         self._sleepers = None
-        if not asleep.any():
+        if not np.count_nonzero(asleep):
             self._world_key = ""  # worked out when someone falls asleep (_fall_asleep)
             return False
         world, self._world_key = self._world_key, self._world()
@@ -578,8 +579,10 @@ class AirTable:
             _, _, fn = heapq.heappop(self._events)
             fn(self)
 
-    def _add_forces(self, pulls: Sequence[Pull], dt: float) -> forces.Implicit:
-        """Add the pulls' and springs' forces to force_N; return what the step takes implicitly."""
+    def _add_forces(self, pulls: Sequence[Pull], dt: float) -> forces.Implicit | None:
+        """Add the pulls' and springs' forces to force_N; return what the step takes implicitly (None: nothing)."""
+        if not pulls and self._springs.n == 0:
+            return None  # a gas: nothing to add, and no (N, 2) arrays to make and check
         force = self.force_N
         implicit = forces.Implicit.empty(self._pucks.n)
         if pulls:
@@ -589,7 +592,7 @@ class AirTable:
             forces.add_spring_forces(force, a, b, f1)
         return implicit
 
-    def _integrate(self, implicit: forces.Implicit, dt: float) -> np.ndarray | float | None:
+    def _integrate(self, implicit: forces.Implicit | None, dt: float) -> np.ndarray | float | None:
         """Semi-implicit Euler: v += (F/m + g) dt (the implicit parts solved for), then x += v dt.
 
         Returns the speed the forces and gravity added to each puck (a number
@@ -598,7 +601,7 @@ class AirTable:
         """
         pos, vel, force, mass = self.pos_m, self.vel_mps, self.force_N, self.mass_kg
         kick = None
-        if implicit.any:
+        if implicit is not None and implicit.any:
             rhs = dt * (force + implicit.lag)
             if self.gravity_on:
                 rhs[:, 1] -= self.gravity_mps2 * dt * mass
@@ -618,9 +621,11 @@ class AirTable:
             vel[self._sleepers] = 0.0  # sleepers stay where they are
         # A last guard against runaway values; a cheap bound first: a speed
         # over the limit has a component over limit / sqrt(2).
-        if np.abs(vel).max() > MAX_SPEED_MPS / math.sqrt(2.0):
+        self._top_component_mps = float(np.abs(vel).max())  # _sweep_fast uses it too
+        if self._top_component_mps > MAX_SPEED_MPS / math.sqrt(2.0):
             speed = np.hypot(vel[:, 0], vel[:, 1])  # not lengths(): v^2 may overflow here
             vel *= np.minimum(1.0, MAX_SPEED_MPS / np.maximum(speed, 1e-300))[:, None]
+            self._top_component_mps = math.inf
         pos += vel * dt
         return kick
 
@@ -650,6 +655,11 @@ class AirTable:
 
     def _sweep_fast(self, dt: float) -> None:
         """Sweep the pucks that move a good part of their radius this step (sweep.py)."""
+        # No puck's speed is over sqrt(2) times the largest velocity component
+        # (_integrate's): below the limit, nobody is fast, and no speeds are needed.
+        top = self._top_component_mps
+        if 2.0 * top * top * dt * dt <= (sweep.FAST_FRACTION * float(self.radius_m.min())) ** 2:
+            return
         movers = sweep.fast_rows(self.vel_mps, self.radius_m, dt)
         if len(movers) == 0:
             return
