@@ -88,16 +88,18 @@ def overlapping_pairs(
     j: np.ndarray,
     reach: np.ndarray,
     sorted_order: Callable[[], np.ndarray] | None = None,
+    reach_sq: np.ndarray | None = None,
 ) -> tuple[np.ndarray, np.ndarray]:
     """The candidate pairs (i, j) closer than `reach`, sorted by (i, j).
 
     `sorted_order`, if given, returns the permutation that sorts the
     candidates by (i, j) (NeighbourList.sorted_order, worked out once per
     build): where many pairs overlap (a pile), they are picked in that order
-    instead of being sorted each time; the result is the same.
+    instead of being sorted each time; the result is the same. `reach_sq`,
+    if given, is reach * reach already worked out (NeighbourList.reach_squared).
     """
     d = vectors.take(pos, i) - vectors.take(pos, j)
-    close = vectors.squared_lengths(d) < reach * reach
+    close = vectors.squared_lengths(d) < (reach * reach if reach_sq is None else reach_sq)
     if sorted_order is not None and np.count_nonzero(close) * SORTED_PICK_SHARE >= len(i):
         order = sorted_order()
         hit = order.take(close.take(order).nonzero()[0])
@@ -151,6 +153,14 @@ class NeighbourList:
             self._order = np.lexsort((self._j, self._i))
         return self._order
 
+    def reach_squared(self, less_m: float = 0.0) -> np.ndarray:
+        """(reach - less_m)^2 for every pair, worked out once per build for each less_m."""
+        sq = self._squared.get(less_m)
+        if sq is None:
+            r = self._reach - less_m
+            sq = self._squared[less_m] = r * r
+        return sq
+
     def _still_valid(self, pos: np.ndarray, radius: np.ndarray) -> bool:
         if self._built_pos is None or len(pos) != len(self._built_pos) or len(pos) == 0:
             return False
@@ -174,6 +184,7 @@ class NeighbourList:
             i, j, reach = i.take(near), j.take(near), reach.take(near)
         self._i, self._j, self._reach = i, j, reach
         self._order: np.ndarray | None = None  # see sorted_order
+        self._squared: dict[float, np.ndarray] = {}  # see reach_squared
         self._built_pos, self._built_radius = pos.copy(), radius.copy()
         self._half_skin_sq = (0.5 * skin) ** 2
         self.builds += 1

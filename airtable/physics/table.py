@@ -721,7 +721,8 @@ class AirTable:
         pos, vel, radius, mass = self.pos_m, self.vel_mps, self.radius_m, self.mass_kg
         ci, cj, reach = self._neighbours.pairs(pos, radius)
         order = self._neighbours.sorted_order
-        i, j = self._colliding(rest, *broadphase.overlapping_pairs(pos, ci, cj, reach, order))
+        reach_sq = self._neighbours.reach_squared()
+        i, j = self._colliding(rest, *broadphase.overlapping_pairs(pos, ci, cj, reach, order, reach_sq))
         records, moved = [], []
         for attempt in range(1 + EXTRA_PASSES):
             if len(i) == 0:
@@ -739,21 +740,22 @@ class AirTable:
             # was already handled: look again among the same candidates (those
             # of the pucks just moved: nothing else changed), collide those
             # pairs too, and at last just push apart what is left.
-            ni, nj, near = self._candidates_of(np.concatenate([i, j]), ci, cj, reach)
-            i, j = self._colliding(rest, *broadphase.overlapping_pairs(pos, ni, nj, near - OVERLAP_SLOP_M))
+            ni, nj, near_sq = self._candidates_of(np.concatenate([i, j]), ci, cj)
+            i, j = self._colliding(rest, *broadphase.overlapping_pairs(pos, ni, nj, None, reach_sq=near_sq))
         if not moved:
             return np.empty(0, dtype=np.intp)
         self._collision_records += records
         self.collision_count += sum(len(r) for r in records)
         return np.concatenate(moved)
 
-    def _candidates_of(self, rows: np.ndarray, ci: np.ndarray, cj: np.ndarray, reach: np.ndarray):
-        """(i, j, reach) of the candidate pairs with a puck in `rows`; all of them on a small table,
-        where picking them out costs more than checking them all."""
+    def _candidates_of(self, rows: np.ndarray, ci: np.ndarray, cj: np.ndarray):
+        """(i, j, (reach - OVERLAP_SLOP_M)^2) of the candidate pairs with a puck in `rows`; all of
+        them on a small table, where picking them out costs more than checking them all."""
+        reach_sq = self._neighbours.reach_squared(OVERLAP_SLOP_M)
         if len(ci) < LOOK_AT_MOVED_MIN_PAIRS:
-            return ci, cj, reach
+            return ci, cj, reach_sq
         k = broadphase.pairs_with(rows, ci, cj, self._pucks.n)
-        return ci.take(k), cj.take(k), reach.take(k)
+        return ci.take(k), cj.take(k), reach_sq.take(k)
 
     def _colliding(self, rest: np.ndarray | None, i: np.ndarray, j: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """The pairs (i, j) that collide: all of them if rest is None, else those that approach
