@@ -40,8 +40,12 @@ def find_overlapping_pairs(pos: np.ndarray, radius: np.ndarray) -> tuple[np.ndar
     return overlapping_pairs(pos, i, j, pair_reach(radius, i, j))
 
 
-def find_candidate_pairs(pos: np.ndarray, radius: np.ndarray, margin_m: float = 0.0) -> tuple[np.ndarray, np.ndarray]:
+def find_candidate_pairs(
+    pos: np.ndarray, radius: np.ndarray, margin_m: float = 0.0, closer: bool = False
+) -> tuple[np.ndarray, np.ndarray]:
     """Pairs (i < j) that may be closer than their reach plus margin_m, each once.
+
+    With `closer`, only those closer than the largest reach plus margin_m.
 
     Uses a uniform grid with cells as wide as the largest ordinary pair's
     reach plus the margin. Each puck is compared with the pucks in its own
@@ -52,7 +56,11 @@ def find_candidate_pairs(pos: np.ndarray, radius: np.ndarray, margin_m: float = 
     """
     n = len(pos)
     if n <= BRUTE_FORCE_MAX_PUCKS:
-        return np.triu_indices(n, k=1)
+        i, j = np.triu_indices(n, k=1)
+        if closer and n:
+            near = _closer_than(pos, i, j, 2.0 * float(radius.max()) + margin_m)
+            i, j = i.take(near), j.take(near)
+        return i, j
     r_max = float(radius.max())
     # No puck can be twice the mean while the largest is within twice the smallest.
     big = radius > 2.0 * radius.mean() if r_max > 2.0 * float(radius.min()) else None
@@ -67,8 +75,11 @@ def find_candidate_pairs(pos: np.ndarray, radius: np.ndarray, margin_m: float = 
             i_parts.append(np.full(len(others), b))
             j_parts.append(others)
         i, j = np.concatenate(i_parts), np.concatenate(j_parts)
+        if closer:
+            near = _closer_than(pos, i, j, 2.0 * r_max + margin_m)
+            i, j = i.take(near), j.take(near)
     else:
-        i, j = _grid_candidates(pos, 2.0 * r_max + margin_m)
+        i, j = _grid_candidates(pos, 2.0 * r_max + margin_m, closer)
     return np.minimum(i, j), np.maximum(i, j)
 
 
@@ -171,15 +182,12 @@ class NeighbourList:
 
     def _build(self, pos: np.ndarray, radius: np.ndarray) -> None:
         skin = SKIN_RADII * float(radius.mean()) if len(radius) else 0.0
-        i, j = find_candidate_pairs(pos, radius, margin_m=skin)
-        # Keep the pairs closer than the largest reach plus the skin, then
-        # (unless all radii are equal) those closer than their own: the grid
-        # finds about three candidates for each one kept.
-        r_max = float(radius.max()) if len(radius) else 0.0
-        near = _closer_than(pos, i, j, 2.0 * r_max + skin)
-        i, j = i.take(near), j.take(near)
+        # The pairs closer than the largest reach plus the skin, then (unless
+        # all radii are equal) those closer than their own: the grid finds
+        # about three candidates for each one kept.
+        i, j = find_candidate_pairs(pos, radius, margin_m=skin, closer=True)
         reach = pair_reach(radius, i, j)
-        if len(radius) and float(radius.min()) < r_max:
+        if len(radius) and float(radius.min()) < float(radius.max()):
             near = _closer_than(pos, i, j, reach + skin)
             i, j, reach = i.take(near), j.take(near), reach.take(near)
         self._i, self._j, self._reach = i, j, reach
@@ -190,8 +198,10 @@ class NeighbourList:
         self.builds += 1
 
 
-def _grid_candidates(pos: np.ndarray, cell: float) -> tuple[np.ndarray, np.ndarray]:
-    """Candidate pairs of pucks whose cells touch (indices into `pos`)."""
+def _grid_candidates(pos: np.ndarray, cell: float, closer: bool = False) -> tuple[np.ndarray, np.ndarray]:
+    """Candidate pairs of pucks whose cells touch (indices into `pos`); with `closer`, only
+    those whose centres are closer than `cell`."""
+    within = cell
     n = len(pos)
     if n < 2:
         empty = np.empty(0, dtype=np.intp)
@@ -228,7 +238,10 @@ def _grid_candidates(pos: np.ndarray, cell: float) -> tuple[np.ndarray, np.ndarr
     first = start[skey + np.array([[0], [ny - 1]])]
     first[0] = idx + 1
     stop = start[skey + np.array([[2], [ny + 2]])]
-    a, b = _expand_ranges(np.tile(idx, 2), first.ravel(), (stop - first).ravel())
+    a, b = _expand_ranges(np.concatenate([idx, idx]), first.ravel(), (stop - first).ravel())
+    if closer:  # checked in sorted order, where neighbours sit close together in memory
+        near = _closer_than(vectors.take(pos, order), a, b, within)
+        a, b = a.take(near), b.take(near)
     return order.take(a), order.take(b)
 
 
