@@ -333,6 +333,17 @@ def test_broadphase_with_a_margin_finds_every_pair_within_it(pucks: tuple[np.nda
     assert pairs_closer_than(pos, radius, margin) <= set(zip(i.tolist(), j.tolist(), strict=True))
 
 
+@settings(max_examples=60, deadline=None, derandomize=True)
+@given(puck_sets(), st.floats(0.0, 1.0))
+def test_closer_candidates_are_the_candidates_closer_than_the_largest_reach(pucks, margin: float):
+    # The grid checks distances in its own sorted order; the pairs and their order are those of checking after.
+    pos, radius = pucks
+    i, j = broadphase.find_candidate_pairs(pos, radius, margin_m=margin)
+    near = broadphase._closer_than(pos, i, j, 2.0 * float(radius.max(initial=0.0)) + margin)
+    ci, cj = broadphase.find_candidate_pairs(pos, radius, margin_m=margin, closer=True)
+    assert np.array_equal(ci, i.take(near)) and np.array_equal(cj, j.take(near))
+
+
 def test_neighbour_list_finds_every_overlap_as_pucks_drift_jump_and_grow() -> None:
     rng = np.random.default_rng(7)
     n, r = 400, 0.1

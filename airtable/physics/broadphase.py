@@ -40,8 +40,12 @@ def find_overlapping_pairs(pos: np.ndarray, radius: np.ndarray) -> tuple[np.ndar
     return overlapping_pairs(pos, i, j, pair_reach(radius, i, j))
 
 
-def find_candidate_pairs(pos: np.ndarray, radius: np.ndarray, margin_m: float = 0.0) -> tuple[np.ndarray, np.ndarray]:
+def find_candidate_pairs(
+    pos: np.ndarray, radius: np.ndarray, margin_m: float = 0.0, closer: bool = False
+) -> tuple[np.ndarray, np.ndarray]:
     """Pairs (i < j) that may be closer than their reach plus margin_m, each once.
+
+    With `closer`, only those closer than the largest reach plus margin_m.
 
     Uses a uniform grid with cells as wide as the largest ordinary pair's
     reach plus the margin. Each puck is compared with the pucks in its own
@@ -52,7 +56,11 @@ def find_candidate_pairs(pos: np.ndarray, radius: np.ndarray, margin_m: float = 
     """
     n = len(pos)
     if n <= BRUTE_FORCE_MAX_PUCKS:
-        return np.triu_indices(n, k=1)
+        i, j = np.triu_indices(n, k=1)
+        if closer and n:
+            near = _closer_than(pos, i, j, 2.0 * float(radius.max()) + margin_m)
+            i, j = i.take(near), j.take(near)
+        return i, j
     r_max = float(radius.max())
     # No puck can be twice the mean while the largest is within twice the smallest.
     big = radius > 2.0 * radius.mean() if r_max > 2.0 * float(radius.min()) else None
@@ -67,8 +75,11 @@ def find_candidate_pairs(pos: np.ndarray, radius: np.ndarray, margin_m: float = 
             i_parts.append(np.full(len(others), b))
             j_parts.append(others)
         i, j = np.concatenate(i_parts), np.concatenate(j_parts)
+        if closer:
+            near = _closer_than(pos, i, j, 2.0 * r_max + margin_m)
+            i, j = i.take(near), j.take(near)
     else:
-        i, j = _grid_candidates(pos, 2.0 * r_max + margin_m)
+        i, j = _grid_candidates(pos, 2.0 * r_max + margin_m, closer)
     return np.minimum(i, j), np.maximum(i, j)
 
 
@@ -88,21 +99,23 @@ def overlapping_pairs(
     j: np.ndarray,
     reach: np.ndarray,
     sorted_order: Callable[[], np.ndarray] | None = None,
+    reach_sq: np.ndarray | None = None,
 ) -> tuple[np.ndarray, np.ndarray]:
     """The candidate pairs (i, j) closer than `reach`, sorted by (i, j).
 
     `sorted_order`, if given, returns the permutation that sorts the
     candidates by (i, j) (NeighbourList.sorted_order, worked out once per
     build): where many pairs overlap (a pile), they are picked in that order
-    instead of being sorted each time; the result is the same.
+    instead of being sorted each time; the result is the same. `reach_sq`,
+    if given, is reach * reach already worked out (NeighbourList.reach_squared).
     """
     d = vectors.take(pos, i) - vectors.take(pos, j)
-    close = vectors.squared_lengths(d) < reach * reach
+    close = vectors.squared_lengths(d) < (reach * reach if reach_sq is None else reach_sq)
     if sorted_order is not None and np.count_nonzero(close) * SORTED_PICK_SHARE >= len(i):
         order = sorted_order()
-        hit = order.take(np.flatnonzero(close.take(order)))
+        hit = order.take(close.take(order).nonzero()[0])
         return i.take(hit), j.take(hit)
-    hit = np.flatnonzero(close)
+    hit = close.nonzero()[0]
     i, j = i.take(hit), j.take(hit)
     if len(i) > 1:
         by_pair = np.lexsort((j, i))
@@ -110,9 +123,16 @@ def overlapping_pairs(
     return i, j
 
 
+def pairs_with(rows: np.ndarray, i: np.ndarray, j: np.ndarray, n: int) -> np.ndarray:
+    """Indices k of the pairs (i, j) with a puck in `rows` (of n pucks)."""
+    marked = np.zeros(n, dtype=bool)
+    marked[rows] = True
+    return (marked.take(i) | marked.take(j)).nonzero()[0]
+
+
 def _closer_than(pos: np.ndarray, i: np.ndarray, j: np.ndarray, reach: np.ndarray) -> np.ndarray:
     """Indices k of the pairs whose centres are less than reach[k] apart."""
-    return np.flatnonzero(vectors.squared_lengths(vectors.take(pos, i) - vectors.take(pos, j)) < reach * reach)
+    return (vectors.squared_lengths(vectors.take(pos, i) - vectors.take(pos, j)) < reach * reach).nonzero()[0]
 
 
 class NeighbourList:
@@ -144,6 +164,14 @@ class NeighbourList:
             self._order = np.lexsort((self._j, self._i))
         return self._order
 
+    def reach_squared(self, less_m: float = 0.0) -> np.ndarray:
+        """(reach - less_m)^2 for every pair, worked out once per build for each less_m."""
+        sq = self._squared.get(less_m)
+        if sq is None:
+            r = self._reach - less_m
+            sq = self._squared[less_m] = r * r
+        return sq
+
     def _still_valid(self, pos: np.ndarray, radius: np.ndarray) -> bool:
         if self._built_pos is None or len(pos) != len(self._built_pos) or len(pos) == 0:
             return False
@@ -154,18 +182,26 @@ class NeighbourList:
 
     def _build(self, pos: np.ndarray, radius: np.ndarray) -> None:
         skin = SKIN_RADII * float(radius.mean()) if len(radius) else 0.0
-        i, j = find_candidate_pairs(pos, radius, margin_m=skin)
+        # The pairs closer than the largest reach plus the skin, then (unless
+        # all radii are equal) those closer than their own: the grid finds
+        # about three candidates for each one kept.
+        i, j = find_candidate_pairs(pos, radius, margin_m=skin, closer=True)
         reach = pair_reach(radius, i, j)
-        near = _closer_than(pos, i, j, reach + skin)
-        self._i, self._j, self._reach = i.take(near), j.take(near), reach.take(near)
+        if len(radius) and float(radius.min()) < float(radius.max()):
+            near = _closer_than(pos, i, j, reach + skin)
+            i, j, reach = i.take(near), j.take(near), reach.take(near)
+        self._i, self._j, self._reach = i, j, reach
         self._order: np.ndarray | None = None  # see sorted_order
+        self._squared: dict[float, np.ndarray] = {}  # see reach_squared
         self._built_pos, self._built_radius = pos.copy(), radius.copy()
         self._half_skin_sq = (0.5 * skin) ** 2
         self.builds += 1
 
 
-def _grid_candidates(pos: np.ndarray, cell: float) -> tuple[np.ndarray, np.ndarray]:
-    """Candidate pairs of pucks whose cells touch (indices into `pos`)."""
+def _grid_candidates(pos: np.ndarray, cell: float, closer: bool = False) -> tuple[np.ndarray, np.ndarray]:
+    """Candidate pairs of pucks whose cells touch (indices into `pos`); with `closer`, only
+    those whose centres are closer than `cell`."""
+    within = cell
     n = len(pos)
     if n < 2:
         empty = np.empty(0, dtype=np.intp)
@@ -202,7 +238,10 @@ def _grid_candidates(pos: np.ndarray, cell: float) -> tuple[np.ndarray, np.ndarr
     first = start[skey + np.array([[0], [ny - 1]])]
     first[0] = idx + 1
     stop = start[skey + np.array([[2], [ny + 2]])]
-    a, b = _expand_ranges(np.tile(idx, 2), first.ravel(), (stop - first).ravel())
+    a, b = _expand_ranges(np.concatenate([idx, idx]), first.ravel(), (stop - first).ravel())
+    if closer:  # checked in sorted order, where neighbours sit close together in memory
+        near = _closer_than(vectors.take(pos, order), a, b, within)
+        a, b = a.take(near), b.take(near)
     return order.take(a), order.take(b)
 
 

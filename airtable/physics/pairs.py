@@ -29,6 +29,7 @@ equation; the tests check the two agree.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable
 from dataclasses import dataclass
 
@@ -41,6 +42,12 @@ CORRECTION_MODES = ("off", "two-step", "perfect-kiss")
 # A relative normal speed smaller than this (m/s) counts as "not moving": such
 # an overlap cannot be explained by the last step's motion.
 REST_SPEED_MPS = 1e-9
+# Rounds of at most this many pairs are resolved one pair at a time in plain
+# floats (`_resolve_few`): a numpy call costs about a microsecond however few
+# rows it has, and a round makes some forty of them, while a gas mostly has
+# rounds of one to five pairs. The floats do the arrays' arithmetic in the
+# same order, so both paths give the same numbers (tests/test_few_in_floats.py).
+FEW_PAIRS = 8
 
 
 @dataclass
@@ -115,20 +122,26 @@ def disjoint_rounds(i: np.ndarray, j: np.ndarray, n: int, since=None) -> list[np
     # A pair whose pucks are in no other pair can go in any round: the first.
     # For the others, level[k] = how many earlier pairs form a chain into
     # pair k. One pass in Python over just those, a handful per step.
-    shared = np.flatnonzero((uses.take(i) > 1) | (uses.take(j) > 1))
+    shared = ((uses.take(i) > 1) | (uses.take(j) > 1)).nonzero()[0]
     if since is not None:
         shared = shared.take(np.argsort(-since(shared), kind="stable"))  # the earliest contact first
-    busy_until: dict[int, int] = {}  # per puck: first level at which it is free again
-    levels = []
-    for a, b in zip(i.take(shared).tolist(), j.take(shared).tolist(), strict=True):
-        lvl = max(busy_until.get(a, 0), busy_until.get(b, 0))
-        levels.append(lvl)
-        busy_until[a] = busy_until[b] = lvl + 1
+    levels = _chain_levels(i.take(shared).tolist(), j.take(shared).tolist())
     level = np.zeros(m, dtype=np.intp)
     level[shared] = levels
     order = np.argsort(level, kind="stable")
     bounds = np.searchsorted(level.take(order), np.arange(max(levels) + 2))
     return [order[bounds[r] : bounds[r + 1]] for r in range(len(bounds) - 1)]
+
+
+def _chain_levels(i: list[int], j: list[int]) -> list[int]:
+    """For each pair in turn, how many earlier pairs form a chain into it (its round)."""
+    busy_until: dict[int, int] = {}  # per puck: first level at which it is free again
+    levels = []
+    for a, b in zip(i, j, strict=True):
+        lvl = max(busy_until.get(a, 0), busy_until.get(b, 0))
+        levels.append(lvl)
+        busy_until[a] = busy_until[b] = lvl + 1
+    return levels
 
 
 def since_contact(pos, vel, radius, i, j, dt_s: float) -> np.ndarray:
@@ -166,12 +179,34 @@ def resolve_pairs(
     def since(k):
         return since_contact(pos, vel, radius, i.take(k), j.take(k), dt_s)
 
+    if len(i) <= FEW_PAIRS:
+        return _resolve_few_in_order(pos, vel, radius, mass, i, j, cr_puck, mode, dt_s, in_time_order)
+    uses = np.bincount(np.concatenate([i, j]), minlength=len(pos))
+    shared = (uses.take(i) > 1) | (uses.take(j) > 1)
+    if np.count_nonzero(shared) <= FEW_PAIRS:
+        # A gas's usual case. The pairs whose pucks are in no other pair
+        # cannot change the others: one round for them, then the few that
+        # share a puck, one by one in floats, in their rounds' order.
+        alone, few = (~shared).nonzero()[0], shared.nonzero()[0]
+        c = _resolve_round(pos, vel, radius, mass, i.take(alone), j.take(alone), cr_puck, mode, dt_s)
+        few_records = _resolve_few_in_order(
+            pos, vel, radius, mass, i.take(few), j.take(few), cr_puck, mode, dt_s, in_time_order
+        )
+        return ([] if c is None else [c]) + few_records
     records = []
     for r in disjoint_rounds(i, j, len(pos), since if in_time_order else None):
         c = _resolve_round(pos, vel, radius, mass, i.take(r), j.take(r), cr_puck, mode, dt_s)
         if c is not None:
             records.append(c)
     return records
+
+
+def _resolve_few_in_order(pos, vel, radius, mass, i, j, cr_puck, mode, dt_s, in_time_order) -> list[Collisions]:
+    """resolve_pairs for a few pairs, in floats: in the order of their rounds, one by one."""
+    il, jl = i.tolist(), j.tolist()
+    order = _few_in_order(pos, vel, radius, il, jl, dt_s if in_time_order else None)
+    c = _resolve_few(pos, vel, radius, mass, [il[k] for k in order], [jl[k] for k in order], cr_puck, mode, dt_s)
+    return [] if c is None else [c]
 
 
 def push_apart(pos: np.ndarray, radius: np.ndarray, mass: np.ndarray, i: np.ndarray, j: np.ndarray) -> None:
@@ -234,7 +269,7 @@ def _gather(pos, vel, radius, mass, a, b) -> _Round | None:
     n, dist = vectors.unit_vectors(x1 - x2, a + b)
     overlap = reach - dist
     if np.count_nonzero(overlap > 0.0) < len(overlap):
-        keep = np.flatnonzero(overlap > 0.0)
+        keep = (overlap > 0.0).nonzero()[0]
         if len(keep) == 0:
             return None
         a, b, x1, x2, r2, reach, n, overlap = (v.take(keep, axis=0) for v in (a, b, x1, x2, r2, reach, n, overlap))
@@ -354,6 +389,8 @@ def _resolve_round(pos, vel, radius, mass, a, b, cr, mode, dt_s) -> Collisions |
 
     Returns the record of the pairs that collided, None if none did.
     """
+    if len(a) <= FEW_PAIRS:
+        return _resolve_few(pos, vel, radius, mass, a.tolist(), b.tolist(), cr, mode, dt_s)
     g = _gather(pos, vel, radius, mass, a, b)
     if g is None:
         return None
@@ -369,5 +406,126 @@ def _resolve_round(pos, vel, radius, mass, a, b, cr, mode, dt_s) -> Collisions |
     )
     if np.count_nonzero(out.approach) == len(out.approach):
         return record
-    hit = np.flatnonzero(out.approach)
+    hit = out.approach.nonzero()[0]
     return record.take(hit) if len(hit) else None
+
+
+# ---------------------------------------------------------------- a few pairs, in floats
+
+
+def _resolve_few(pos, vel, radius, mass, a: list[int], b: list[int], cr, mode, dt_s) -> Collisions | None:
+    """`_resolve_round` for a few pairs: the same steps, pair by pair, in Python floats."""
+    rows, hit = [], []
+    for p, q in zip(a, b, strict=True):
+        row = _pair_in_floats(pos, vel, radius, mass, p, q, cr, mode, dt_s)
+        if row is not None:
+            rows.append(row)
+            hit.append((p, q))
+    if not rows:
+        return None
+    ij, f = np.array(hit, dtype=np.intp), np.array(rows)
+    two = [f[:, k : k + 2] for k in range(2, 22, 2)]  # normal, contact, then 8 positions and velocities
+    return Collisions(ij[:, 0], ij[:, 1], two[0], two[1], f[:, 0], f[:, 1], *two[2:])
+
+
+def _unit_floats(d0: float, d1: float, key: int) -> tuple[float, float, float]:
+    """vectors.unit_vectors for one row: (n0, n1, length)."""
+    dist = math.sqrt(d0 * d0 + d1 * d1)
+    if dist != 0.0:
+        return d0 / dist, d1 / dist, dist
+    n0, n1 = vectors.fallback_directions(np.array([key]))[0].tolist()
+    return n0, n1, dist
+
+
+def _kiss_time(x1, x2, vrel, reach: float, dt_s: float) -> float | None:
+    """`_time_since_contact` for one pair: the time back to first contact, None if the step cannot explain it."""
+    d0, d1 = x1[0] - x2[0], x1[1] - x2[1]
+    vv = vrel[0] * vrel[0] + vrel[1] * vrel[1]
+    dv = d0 * vrel[0] + d1 * vrel[1]
+    disc = max(dv * dv - vv * ((d0 * d0 + d1 * d1) - reach * reach), 0.0)
+    if not vv > REST_SPEED_MPS**2:
+        return None
+    t_back = (dv + math.sqrt(disc)) / vv
+    return t_back if 0.0 <= t_back <= dt_s * (1.0 + 1e-9) + 1e-15 else None
+
+
+def _pair_in_floats(pos, vel, radius, mass, p, q, cr, mode, dt_s) -> list[float] | None:
+    """Collide and part the pair (p, q) in place, as `_gather`, the mode's round function and
+    `separate` would; return its record row (see _resolve_few), None if it did not collide."""
+    x1, x2 = pos[p].tolist(), pos[q].tolist()
+    r2 = radius.item(q)
+    reach = radius.item(p) + r2
+    n0, n1, dist = _unit_floats(x1[0] - x2[0], x1[1] - x2[1], p + q)
+    overlap = reach - dist
+    if not overlap > 0.0:
+        return None
+    v1, v2 = vel[p].tolist(), vel[q].tolist()
+    m1, m2 = mass.item(p), mass.item(q)
+    m_sum = m1 + m2
+    share1, share2 = m2 / m_sum, m1 / m_sum
+    vrel = (v1[0] - v2[0], v1[1] - v2[1])
+    vn = vrel[0] * n0 + vrel[1] * n1
+    t_b = _kiss_time(x1, x2, vrel, reach, dt_s) if mode == "perfect-kiss" else None
+    if t_b is None:  # as _round_two_step (and _round_off, which does not use `move`)
+        approach = vn < -REST_SPEED_MPS
+        move = (1.0 + cr) * min(overlap, -vn * dt_s)
+        c = x2
+    else:  # as _round_perfect_kiss
+        c = [x2[0] - v2[0] * t_b, x2[1] - v2[1] * t_b]
+        n0, n1, _ = _unit_floats((x1[0] - v1[0] * t_b) - c[0], (x1[1] - v1[1] * t_b) - c[1], p + q)
+        vn = vrel[0] * n0 + vrel[1] * n1
+        approach = vn < 0.0
+        move = -(1.0 + cr) * vn * t_b
+    jn = -(1.0 + cr) * vn if approach else 0.0  # collide_along_normal
+    w1 = [v1[0] + jn * share1 * n0, v1[1] + jn * share1 * n1]
+    w2 = [v2[0] - jn * share2 * n0, v2[1] - jn * share2 * n1]
+    vel[p], vel[q] = w1, w2
+    y1, y2 = x1, x2
+    if mode != "off":
+        y1, y2 = _separate_floats(x1, x2, (n0, n1), move if approach else 0.0, reach, share1, share2, p + q)
+        pos[p], pos[q] = y1, y2
+    if not approach:
+        return None
+    return [overlap, reach, n0, n1, c[0] + n0 * r2, c[1] + n1 * r2, *x1, *x2, *y1, *y2, *v1, *v2, *w1, *w2]
+
+
+def _separate_floats(x1, x2, n, move: float, reach: float, share1: float, share2: float, key: int):
+    """`separate` for one pair: move it `move` apart along n, then push apart what still overlaps."""
+    y1 = [x1[0] + move * share1 * n[0], x1[1] + move * share1 * n[1]]
+    y2 = [x2[0] - move * share2 * n[0], x2[1] - move * share2 * n[1]]
+    d0, d1 = y1[0] - y2[0], y1[1] - y2[1]
+    if d0 * d0 + d1 * d1 < reach * reach:
+        m0, m1, dist = _unit_floats(d0, d1, key)
+        left = max(reach - dist, 0.0)
+        y1 = [y1[0] + left * share1 * m0, y1[1] + left * share1 * m1]
+        y2 = [y2[0] - left * share2 * m0, y2[1] - left * share2 * m1]
+    return y1, y2
+
+
+def _few_in_order(pos, vel, radius, il: list[int], jl: list[int], dt_s: float | None) -> list[int]:
+    """The order in which `disjoint_rounds`' rounds would take the pairs (il, jl): round by round,
+    in the given order within a round. With dt_s, pairs sharing a puck go as they met (since_contact)."""
+    uses: dict[int, int] = {}
+    for p in il + jl:
+        uses[p] = uses.get(p, 0) + 1
+    shared = [k for k in range(len(il)) if uses[il[k]] > 1 or uses[jl[k]] > 1]
+    if not shared:
+        return list(range(len(il)))
+    if dt_s is not None:
+        since = {k: _since_floats(pos, vel, radius, il[k], jl[k], dt_s) for k in shared}
+        shared.sort(key=lambda k: -since[k])  # stable, as np.argsort(kind="stable")
+    level = [0] * len(il)
+    for k, lvl in zip(shared, _chain_levels([il[k] for k in shared], [jl[k] for k in shared]), strict=True):
+        level[k] = lvl
+    return sorted(range(len(il)), key=level.__getitem__)
+
+
+def _since_floats(pos, vel, radius, p: int, q: int, dt_s: float) -> float:
+    """`since_contact` for one pair."""
+    xi, xj, vi, vj = pos[p].tolist(), pos[q].tolist(), vel[p].tolist(), vel[q].tolist()
+    d0, d1, w0, w1 = xi[0] - xj[0], xi[1] - xj[1], vi[0] - vj[0], vi[1] - vj[1]
+    reach = radius.item(p) + radius.item(q)
+    ww, dw = w0 * w0 + w1 * w1, d0 * w0 + d1 * w1
+    disc = max(dw * dw - ww * ((d0 * d0 + d1 * d1) - reach * reach), 0.0)
+    back = (dw + math.sqrt(disc)) / (ww if ww > 0.0 else 1.0)
+    return back if ww > 0.0 and 0.0 <= back <= dt_s else dt_s

@@ -57,6 +57,9 @@ TABLE_HEIGHT_M = 8.7556
 # over the pairs the corrections pushed into overlap: collisions again, then a
 # last pass that only pushes apart.
 EXTRA_PASSES = 2
+# From this many candidate pairs on (a gas of some 3000 pucks), the second look for
+# overlaps checks only the pairs of the pucks the first pass moved.
+LOOK_AT_MOVED_MIN_PAIRS = 5000
 # Overlaps smaller than this (m) are left to the next step: round-off only.
 OVERLAP_SLOP_M = 1e-9
 # Said once (in `notices`) when springs are first solved implicitly.
@@ -388,6 +391,7 @@ class AirTable:
         self._last_collisions: pairs.Collisions | None = None
         self._world_key = ""  # what the sleepers fell asleep in (see _world): any change wakes them
         self._sleepers: np.ndarray | None = None  # this step's sleeping rows (scratch)
+        self._top_component_mps = math.inf  # the step's largest |velocity component| (scratch, see _integrate)
 
     def schedule(self, t_s: float, fn: Callable[[AirTable], None]) -> None:
         """Run fn(table) at the start of the first step at or after simulation time t_s."""
@@ -505,9 +509,10 @@ class AirTable:
         """
         asleep = self._pucks.view("asleep")
         self._sleepers = None
-        world, self._world_key = self._world_key, self._world()
-        if not asleep.any():
+        if not np.count_nonzero(asleep):
+            self._world_key = ""  # worked out when someone falls asleep (_fall_asleep)
             return False
+        world, self._world_key = self._world_key, self._world()
         if world != self._world_key or not (self.sleeping and self.gravity_on):
             self._set_awake(np.flatnonzero(asleep), island=False)
             return False
@@ -564,6 +569,7 @@ class AirTable:
             asleep[sleep.with_still_neighbours(pos, ready, asleep, candidates)] = True
         sleepers = np.flatnonzero(asleep)
         if len(sleepers):
+            self._world_key = self._world_key or self._world()
             vel[sleepers] = 0.0
             self._pucks.view("rest_pos")[sleepers] = pos[sleepers]
 
@@ -573,8 +579,10 @@ class AirTable:
             _, _, fn = heapq.heappop(self._events)
             fn(self)
 
-    def _add_forces(self, pulls: Sequence[Pull], dt: float) -> forces.Implicit:
-        """Add the pulls' and springs' forces to force_N; return what the step takes implicitly."""
+    def _add_forces(self, pulls: Sequence[Pull], dt: float) -> forces.Implicit | None:
+        """Add the pulls' and springs' forces to force_N; return what the step takes implicitly (None: nothing)."""
+        if not pulls and self._springs.n == 0:
+            return None  # a gas: nothing to add, and no (N, 2) arrays to make and check
         force = self.force_N
         implicit = forces.Implicit.empty(self._pucks.n)
         if pulls:
@@ -584,7 +592,7 @@ class AirTable:
             forces.add_spring_forces(force, a, b, f1)
         return implicit
 
-    def _integrate(self, implicit: forces.Implicit, dt: float) -> np.ndarray | float | None:
+    def _integrate(self, implicit: forces.Implicit | None, dt: float) -> np.ndarray | float | None:
         """Semi-implicit Euler: v += (F/m + g) dt (the implicit parts solved for), then x += v dt.
 
         Returns the speed the forces and gravity added to each puck (a number
@@ -593,7 +601,7 @@ class AirTable:
         """
         pos, vel, force, mass = self.pos_m, self.vel_mps, self.force_N, self.mass_kg
         kick = None
-        if implicit.any:
+        if implicit is not None and implicit.any:
             rhs = dt * (force + implicit.lag)
             if self.gravity_on:
                 rhs[:, 1] -= self.gravity_mps2 * dt * mass
@@ -613,9 +621,11 @@ class AirTable:
             vel[self._sleepers] = 0.0  # sleepers stay where they are
         # A last guard against runaway values; a cheap bound first: a speed
         # over the limit has a component over limit / sqrt(2).
-        if np.abs(vel).max() > MAX_SPEED_MPS / math.sqrt(2.0):
+        self._top_component_mps = float(np.abs(vel).max())  # _sweep_fast uses it too
+        if self._top_component_mps > MAX_SPEED_MPS / math.sqrt(2.0):
             speed = np.hypot(vel[:, 0], vel[:, 1])  # not lengths(): v^2 may overflow here
             vel *= np.minimum(1.0, MAX_SPEED_MPS / np.maximum(speed, 1e-300))[:, None]
+            self._top_component_mps = math.inf
         pos += vel * dt
         return kick
 
@@ -645,6 +655,11 @@ class AirTable:
 
     def _sweep_fast(self, dt: float) -> None:
         """Sweep the pucks that move a good part of their radius this step (sweep.py)."""
+        # No puck's speed is over sqrt(2) times the largest velocity component
+        # (_integrate's): below the limit, nobody is fast, and no speeds are needed.
+        top = self._top_component_mps
+        if 2.0 * top * top * dt * dt <= (sweep.FAST_FRACTION * float(self.radius_m.min())) ** 2:
+            return
         movers = sweep.fast_rows(self.vel_mps, self.radius_m, dt)
         if len(movers) == 0:
             return
@@ -706,7 +721,8 @@ class AirTable:
         pos, vel, radius, mass = self.pos_m, self.vel_mps, self.radius_m, self.mass_kg
         ci, cj, reach = self._neighbours.pairs(pos, radius)
         order = self._neighbours.sorted_order
-        i, j = self._colliding(rest, *broadphase.overlapping_pairs(pos, ci, cj, reach, order))
+        reach_sq = self._neighbours.reach_squared()
+        i, j = self._colliding(rest, *broadphase.overlapping_pairs(pos, ci, cj, reach, order, reach_sq))
         records, moved = [], []
         for attempt in range(1 + EXTRA_PASSES):
             if len(i) == 0:
@@ -721,14 +737,25 @@ class AirTable:
             if self.puck_correction == "off" or attempt == EXTRA_PASSES:
                 break  # with "off" overlaps stay: that is what it shows
             # Parting a pair can push one of its pucks into a third one that
-            # was already handled: look again among the same candidates,
-            # collide those pairs too, and at last just push apart what is left.
-            i, j = self._colliding(rest, *broadphase.overlapping_pairs(pos, ci, cj, reach - OVERLAP_SLOP_M, order))
+            # was already handled: look again among the same candidates (those
+            # of the pucks just moved: nothing else changed), collide those
+            # pairs too, and at last just push apart what is left.
+            ni, nj, near_sq = self._candidates_of(np.concatenate([i, j]), ci, cj)
+            i, j = self._colliding(rest, *broadphase.overlapping_pairs(pos, ni, nj, None, reach_sq=near_sq))
         if not moved:
             return np.empty(0, dtype=np.intp)
         self._collision_records += records
         self.collision_count += sum(len(r) for r in records)
         return np.concatenate(moved)
+
+    def _candidates_of(self, rows: np.ndarray, ci: np.ndarray, cj: np.ndarray):
+        """(i, j, (reach - OVERLAP_SLOP_M)^2) of the candidate pairs with a puck in `rows`; all of
+        them on a small table, where picking them out costs more than checking them all."""
+        reach_sq = self._neighbours.reach_squared(OVERLAP_SLOP_M)
+        if len(ci) < LOOK_AT_MOVED_MIN_PAIRS:
+            return ci, cj, reach_sq
+        k = broadphase.pairs_with(rows, ci, cj, self._pucks.n)
+        return ci.take(k), cj.take(k), reach_sq.take(k)
 
     def _colliding(self, rest: np.ndarray | None, i: np.ndarray, j: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """The pairs (i, j) that collide: all of them if rest is None, else those that approach
@@ -738,8 +765,8 @@ class AirTable:
         pos, vel = self.pos_m, self.vel_mps
         n, _ = vectors.unit_vectors(vectors.take(pos, i) - vectors.take(pos, j), i + j)
         vn = vectors.dot_rows(vectors.take(vel, i) - vectors.take(vel, j), n)
-        fast = np.flatnonzero(vn < -np.maximum(rest.take(i), rest.take(j)))  # few: look only these up
-        fast = fast.take(np.flatnonzero(~self._contacts.held(i.take(fast), j.take(fast))))
+        fast = (vn < -np.maximum(rest.take(i), rest.take(j))).nonzero()[0]  # few: look only these up
+        fast = fast.take((~self._contacts.held(i.take(fast), j.take(fast))).nonzero()[0])
         return i.take(fast), j.take(fast)
 
     def _spring_forces(

@@ -12,6 +12,10 @@ instead: `take` gathers with `ndarray.take`, and `put` and `add_at` see each
 row of two float64 numbers as one complex number, which turns the array into a
 1-D one without copying (so the target must be C-contiguous float64, as the
 table's columns are). The results are exactly those of plain indexing.
+
+Likewise the step finds the true entries of a 1-D mask with
+`mask.nonzero()[0]`, not `np.flatnonzero(mask)`: the same indices, without
+the wrapper that costs twice the work on a few thousand pairs.
 """
 
 from __future__ import annotations

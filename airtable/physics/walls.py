@@ -6,6 +6,11 @@ import numpy as np
 
 from airtable.physics import vectors
 
+# Up to this many pucks past a wall are bounced one at a time in plain floats
+# (`_bounce_in_floats`): in a gas one or two are, and a dozen numpy calls on
+# one or two rows cost more than the arithmetic (as pairs.FEW_PAIRS).
+FEW_PUCKS = 8
+
 
 def resolve_walls(
     pos: np.ndarray,
@@ -42,16 +47,18 @@ def resolve_walls(
     room = np.minimum(np.minimum(x, y), np.minimum(width - x, height - y)) - r
     if room.min() >= 0.0:
         return 0  # the usual case: nobody is past a wall
-    out = np.flatnonzero(~(room >= 0.0))  # NaN counts as outside
+    out = (~(room >= 0.0)).nonzero()[0]  # NaN counts as outside
     if only is not None:
         out = only.take(out)
     if rest is not None:
         fast = _fast_ones(pos, vel, radius, size_m, rest, out)
         if hold_slow:
-            _hold(pos, vel, radius, size_m, out.take(np.flatnonzero(~fast)))
-        out = out.take(np.flatnonzero(fast))
+            _hold(pos, vel, radius, size_m, out.take((~fast).nonzero()[0]))
+        out = out.take(fast.nonzero()[0])
         if len(out) == 0:
             return 0  # a pile's usual case: every puck past a wall rests there
+    if len(out) <= FEW_PUCKS:
+        return sum(_bounce_in_floats(pos, vel, radius, size_m, cr_wall, correction, k) for k in out.tolist())
     p, v = vectors.take(pos, out), vectors.take(vel, out)
     lo = radius.take(out)[:, None]
     hi = size_m - lo
@@ -65,6 +72,23 @@ def resolve_walls(
     half = 0.5 * size_m
     vectors.put(pos, out, np.minimum(np.maximum(target, np.minimum(lo, half)), np.maximum(hi, half)))
     return int(np.count_nonzero(into))
+
+
+def _bounce_in_floats(pos, vel, radius, size_m, cr_wall: float, correction: bool, k: int) -> int:
+    """What the arrays above do, for the one puck k, in plain floats; return how many walls it bounced off."""
+    p, v, lo = pos[k].tolist(), vel[k].tolist(), radius.item(k)
+    bounced = 0
+    for axis, size in enumerate(size_m.tolist()):
+        hi, half = size - lo, 0.5 * size
+        below, above = p[axis] < lo, p[axis] > hi
+        if (below and v[axis] < 0.0) or (above and v[axis] > 0.0):
+            v[axis] = -cr_wall * v[axis]
+            bounced += 1
+        if correction and (below or above):
+            p[axis] = 2.0 * lo - p[axis] if below else 2.0 * hi - p[axis]
+        p[axis] = min(max(p[axis], min(lo, half)), max(hi, half))
+    pos[k], vel[k] = p, v
+    return bounced
 
 
 def _fast_ones(pos, vel, radius, size_m, rest, out: np.ndarray) -> np.ndarray:

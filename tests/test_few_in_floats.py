@@ -1,0 +1,102 @@
+"""A few pairs (pairs._resolve_few) and a few pucks past a wall (walls._bounce_in_floats) are
+resolved in plain floats; they give, to the last bit, what the arrays give."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from airtable.physics import broadphase, pairs, walls
+from airtable.physics import table as table_module
+
+
+def _scene(seed: int, n: int):
+    """A handful of pucks heaped in a small square, some exactly on top of each other."""
+    rng = np.random.default_rng(seed)
+    radius = rng.uniform(0.1, 0.3, n)
+    mass = rng.uniform(0.1, 3.0, n) * math.pi * radius**2
+    pos = rng.uniform(0.0, 0.8, (n, 2))
+    pos[n - 1] = pos[0]
+    vel = rng.uniform(-3.0, 3.0, (n, 2))
+    return pos, vel, radius, mass
+
+
+def _resolve(few: int, scene, cr: float, mode: str, dt_s: float, monkeypatch):
+    pos, vel, radius, mass = (a.copy() for a in scene)
+    i, j = broadphase.brute_force_pairs(pos, radius)
+    monkeypatch.setattr(pairs, "FEW_PAIRS", few)
+    records = pairs.resolve_pairs(pos, vel, radius, mass, i, j, cr, mode, dt_s, in_time_order=True)
+    return pos, vel, pairs.Collisions.concatenate(records)
+
+
+@settings(max_examples=150, deadline=None, derandomize=True)
+@given(
+    st.integers(0, 2**32 - 1),
+    st.integers(2, 7),
+    st.sampled_from(pairs.CORRECTION_MODES),
+    st.sampled_from([0.0, 0.5, 1.0]) | st.floats(0.0, 1.0),
+    st.sampled_from([1 / 240, 1 / 60, 1 / 20]),
+)
+def test_floats_give_what_the_arrays_give(seed: int, n: int, mode: str, cr: float, dt_s: float) -> None:
+    scene = _scene(seed, n)
+    with pytest.MonkeyPatch.context() as mp:
+        arrays = _resolve(0, scene, cr, mode, dt_s, mp)  # every round with numpy
+        mixed = _resolve(2, scene, cr, mode, dt_s, mp)  # the pairs sharing a puck in floats, if few
+        floats = _resolve(10**6, scene, cr, mode, dt_s, mp)  # every pair in floats
+    for other in (mixed, floats):
+        for got, want in zip(other[:2], arrays[:2], strict=True):
+            np.testing.assert_array_equal(got, want)
+        # The same collisions; the mixed path records the pairs alone first.
+        got, want = (c.take(np.lexsort((c.j, c.i))) for c in (other[2], arrays[2]))
+        for field in pairs.Collisions.__dataclass_fields__:
+            np.testing.assert_array_equal(getattr(got, field), getattr(want, field))
+
+
+def _walls(few: int, pos, vel, radius, correction: bool, mp) -> tuple[np.ndarray, np.ndarray, int]:
+    pos, vel = pos.copy(), vel.copy()
+    mp.setattr(walls, "FEW_PUCKS", few)
+    count = walls.resolve_walls(pos, vel, radius, np.array([2.0, 1.5]), 0.7, correction)
+    return pos, vel, count
+
+
+@settings(max_examples=100, deadline=None, derandomize=True)
+@given(st.integers(0, 2**32 - 1), st.integers(1, 6), st.booleans())
+def test_walls_in_floats_give_what_the_arrays_give(seed: int, n: int, correction: bool) -> None:
+    # Pucks anywhere around a 2 x 1.5 m table, some far outside, one wider than the table.
+    rng = np.random.default_rng(seed)
+    pos = rng.uniform(-1.0, 3.0, (n, 2))
+    vel = rng.uniform(-3.0, 3.0, (n, 2))
+    radius = rng.uniform(0.05, 0.5, n)
+    radius[0] = 1.0 if seed % 3 == 0 else radius[0]
+    with pytest.MonkeyPatch.context() as mp:
+        arrays = _walls(0, pos, vel, radius, correction, mp)
+        floats = _walls(10**6, pos, vel, radius, correction, mp)
+    np.testing.assert_array_equal(floats[0], arrays[0])
+    np.testing.assert_array_equal(floats[1], arrays[1])
+    assert floats[2] == arrays[2]
+
+
+def _crowd(gravity: bool, seed: int, steps: int = 40):
+    """A crowded table, stepped: pairs parted in one pass often push into others."""
+    rng = np.random.default_rng(seed)
+    table = table_module.AirTable(width_m=2.0, height_m=2.0)
+    table.gravity_on = gravity
+    for _ in range(70):
+        table.add_puck(rng.uniform(0.1, 1.9, 2), radius_m=rng.uniform(0.05, 0.12), vel_mps=rng.uniform(-4, 4, 2))
+    for _ in range(steps):
+        table.step(1 / 120)
+    return table.pos_m.copy(), table.vel_mps.copy()
+
+
+@pytest.mark.parametrize("gravity", [False, True])
+def test_second_look_at_the_moved_pucks_only_finds_what_a_look_at_all_finds(gravity: bool, monkeypatch) -> None:
+    monkeypatch.setattr(table_module, "LOOK_AT_MOVED_MIN_PAIRS", 0)
+    moved_only = _crowd(gravity, seed=3)
+    monkeypatch.setattr(table_module, "LOOK_AT_MOVED_MIN_PAIRS", 10**9)
+    every = _crowd(gravity, seed=3)
+    np.testing.assert_array_equal(moved_only[0], every[0])
+    np.testing.assert_array_equal(moved_only[1], every[1])
