@@ -203,14 +203,19 @@ def test_three_students_predict_over_real_sockets_then_the_reveal_sums_them_up(s
             s.close()
 
 
+def open_round_for(app: App, net: NetPlayer) -> None:
+    """Join `net` to the app's table, then open a round (F6) and wait until the student has the ROUND."""
+    net.connect()
+    frames_until(app, lambda: app.student_count() == 1 and net.latest() is not None, "the student to join")
+    press(app, pygame.K_F6)
+    wait_until(lambda: net.round is not None and net.round.state == "open", what="the ROUND at the student")
+
+
 def test_a_player_window_drags_an_arrow_and_sends_predict(server, tmp_path):
     app = head_on_app(tmp_path, server)
     net = NetPlayer("127.0.0.1", server.port, name="Dee")
-    net.connect()
     try:
-        frames_until(app, lambda: app.student_count() == 1 and net.latest() is not None, "the student to join")
-        press(app, pygame.K_F6)
-        wait_until(lambda: net.round is not None and net.round.state == "open", what="the ROUND at the student")
+        open_round_for(app, net)
         guesses = StudentGuesses()
         scene = net.latest()
         assert not guesses.press(net.round, (8.0, 1.0), scene.radius_m)  # not on a puck: the cursor as usual
@@ -227,11 +232,8 @@ def test_a_player_window_drags_an_arrow_and_sends_predict(server, tmp_path):
 def test_a_student_window_turns_a_mouse_drag_on_a_puck_into_predict(server, tmp_path):
     app = head_on_app(tmp_path, server)
     net = NetPlayer("127.0.0.1", server.port, name="Eve")
-    net.connect()
     try:
-        frames_until(app, lambda: app.student_count() == 1 and net.latest() is not None, "the student to join")
-        press(app, pygame.K_F6)
-        wait_until(lambda: net.round is not None and net.round.state == "open", what="the ROUND at the student")
+        open_round_for(app, net)
         window = PlayerApp(net, headless=True)
         env = Environment(DEFAULT_SIZE_PX, width_m=app.table.width_m)  # the student's view as it opens
         puck = tuple(float(v) for v in env.to_screen(np.array(net.round.from_m[1])))
