@@ -91,9 +91,11 @@ class Collisions:
         return len(self.i)
 
     @classmethod
-    def concatenate(cls, parts: list[Collisions]) -> Collisions:
+    def concatenate(cls, parts: list[Recorded]) -> Collisions:
+        """One record of all the parts (each a Collisions, or a round's record made into one now)."""
         if not parts:
             return cls.empty()
+        parts = [p if isinstance(p, Collisions) else p.collisions() for p in parts]
         if len(parts) == 1:
             return parts[0]
         return cls(*(np.concatenate([getattr(p, f) for p in parts]) for f in cls.__dataclass_fields__))
@@ -166,7 +168,7 @@ def resolve_pairs(
     mode: str,
     dt_s: float,
     in_time_order: bool = False,
-) -> list[Collisions]:
+) -> list[Recorded]:
     """Collide the overlapping pairs (i, j) in order, in place (see the module docstring).
 
     in_time_order: pairs that share a puck go in the order they met during
@@ -201,7 +203,7 @@ def resolve_pairs(
     return records
 
 
-def _resolve_few_in_order(pos, vel, radius, mass, i, j, cr_puck, mode, dt_s, in_time_order) -> list[Collisions]:
+def _resolve_few_in_order(pos, vel, radius, mass, i, j, cr_puck, mode, dt_s, in_time_order) -> list[Recorded]:
     """resolve_pairs for a few pairs, in floats: in the order of their rounds, one by one."""
     il, jl = i.tolist(), j.tolist()
     order = _few_in_order(pos, vel, radius, il, jl, dt_s if in_time_order else None)
@@ -234,6 +236,7 @@ class _Round:
 
     a: np.ndarray
     b: np.ndarray
+    ab: np.ndarray  # a then b: the rows the round writes back, in one scatter each for pos and vel
     x1: np.ndarray
     x2: np.ndarray
     v1: np.ndarray
@@ -262,23 +265,30 @@ class _Outcome:
 
 
 def _gather(pos, vel, radius, mass, a, b) -> _Round | None:
-    """The pairs (a, b) that still overlap (an earlier round may have parted some); None if none do."""
-    x1, x2 = vectors.take(pos, a), vectors.take(pos, b)
-    r2 = radius.take(b)
-    reach = radius.take(a) + r2
+    """The pairs (a, b) that still overlap (an earlier round may have parted some); None if none do.
+
+    Rows a and b are gathered together (one `take` per column, split into
+    halves): on a few dozen pairs a numpy call costs more than its rows.
+    """
+    k = len(a)
+    ab = np.concatenate((a, b))
+    x, r = vectors.take(pos, ab), radius.take(ab)
+    x1, x2, r2 = x[:k], x[k:], r[k:]
+    reach = r[:k] + r2
     n, dist = vectors.unit_vectors(x1 - x2, a + b)
     overlap = reach - dist
-    if np.count_nonzero(overlap > 0.0) < len(overlap):
+    if np.count_nonzero(overlap > 0.0) < k:
         keep = (overlap > 0.0).nonzero()[0]
         if len(keep) == 0:
             return None
         a, b, x1, x2, r2, reach, n, overlap = (v.take(keep, axis=0) for v in (a, b, x1, x2, r2, reach, n, overlap))
-    v1, v2 = vectors.take(vel, a), vectors.take(vel, b)
-    m1, m2 = mass.take(a), mass.take(b)
+        k, ab = len(a), np.concatenate((a, b))
+    v, m = vectors.take(vel, ab), mass.take(ab)
+    v1, v2, m1, m2 = v[:k], v[k:], m[:k], m[k:]
     m_sum = m1 + m2
     vrel = v1 - v2
     vn = vectors.dot_rows(vrel, n)
-    return _Round(a, b, x1, x2, v1, v2, r2, reach, n, overlap, vrel, vn, m2 / m_sum, m1 / m_sum)
+    return _Round(a, b, ab, x1, x2, v1, v2, r2, reach, n, overlap, vrel, vn, m2 / m_sum, m1 / m_sum)
 
 
 def collide_along_normal(g: _Round, n: np.ndarray, vn: np.ndarray, approach: np.ndarray, cr: float):
@@ -384,7 +394,7 @@ _ROUND_BY_MODE: dict[str, Callable[[_Round, float, float], _Outcome]] = {
 }
 
 
-def _resolve_round(pos, vel, radius, mass, a, b, cr, mode, dt_s) -> Collisions | None:
+def _resolve_round(pos, vel, radius, mass, a, b, cr, mode, dt_s) -> Recorded | None:
     """Resolve pairs that share no puck, all at once, in place (see `disjoint_rounds`).
 
     Returns the record of the pairs that collided, None if none did.
@@ -395,25 +405,39 @@ def _resolve_round(pos, vel, radius, mass, a, b, cr, mode, dt_s) -> Collisions |
     if g is None:
         return None
     out = _ROUND_BY_MODE[mode](g, cr, dt_s)
-    vectors.put(vel, g.a, out.v1)
-    vectors.put(vel, g.b, out.v2)
+    # No row repeats within a round, so one scatter of a then b writes each once.
+    vectors.put(vel, g.ab, np.concatenate((out.v1, out.v2)))
     if mode != "off":
-        vectors.put(pos, g.a, out.x1)
-        vectors.put(pos, g.b, out.x2)
-    contact = out.contact_from + out.n * g.r2[:, None]
-    record = Collisions(
-        g.a, g.b, out.n, contact, g.overlap, g.reach, g.x1, g.x2, out.x1, out.x2, g.v1, g.v2, out.v1, out.v2
-    )
-    if np.count_nonzero(out.approach) == len(out.approach):
-        return record
-    hit = out.approach.nonzero()[0]
-    return record.take(hit) if len(hit) else None
+        vectors.put(pos, g.ab, np.concatenate((out.x1, out.x2)))
+    count = np.count_nonzero(out.approach)
+    return _RoundRecord(g, out, count) if count else None
+
+
+@dataclass
+class _RoundRecord:
+    """A round's collisions, kept as the round left them: made into `Collisions` only when read
+    (most steps nobody reads them)."""
+
+    g: _Round
+    out: _Outcome
+    count: int  # how many pairs collided
+
+    def __len__(self) -> int:
+        return self.count
+
+    def collisions(self) -> Collisions:
+        g, out = self.g, self.out
+        contact = out.contact_from + out.n * g.r2[:, None]
+        record = Collisions(
+            g.a, g.b, out.n, contact, g.overlap, g.reach, g.x1, g.x2, out.x1, out.x2, g.v1, g.v2, out.v1, out.v2
+        )
+        return record if self.count == len(g.a) else record.take(out.approach.nonzero()[0])
 
 
 # ---------------------------------------------------------------- a few pairs, in floats
 
 
-def _resolve_few(pos, vel, radius, mass, a: list[int], b: list[int], cr, mode, dt_s) -> Collisions | None:
+def _resolve_few(pos, vel, radius, mass, a: list[int], b: list[int], cr, mode, dt_s) -> Recorded | None:
     """`_resolve_round` for a few pairs: the same steps, pair by pair, in Python floats."""
     rows, hit = [], []
     for p, q in zip(a, b, strict=True):
@@ -421,11 +445,27 @@ def _resolve_few(pos, vel, radius, mass, a: list[int], b: list[int], cr, mode, d
         if row is not None:
             rows.append(row)
             hit.append((p, q))
-    if not rows:
-        return None
-    ij, f = np.array(hit, dtype=np.intp), np.array(rows)
-    two = [f[:, k : k + 2] for k in range(2, 22, 2)]  # normal, contact, then 8 positions and velocities
-    return Collisions(ij[:, 0], ij[:, 1], two[0], two[1], f[:, 0], f[:, 1], *two[2:])
+    return _FewRecord(hit, rows) if rows else None
+
+
+@dataclass
+class _FewRecord:
+    """The record rows of `_resolve_few`, made into `Collisions` only when read."""
+
+    hit: list[tuple[int, int]]
+    rows: list[list[float]]  # overlap, reach, then normal, contact and 8 positions and velocities as (x, y)
+
+    def __len__(self) -> int:
+        return len(self.rows)
+
+    def collisions(self) -> Collisions:
+        ij, f = np.array(self.hit, dtype=np.intp), np.array(self.rows)
+        two = [f[:, k : k + 2] for k in range(2, 22, 2)]
+        return Collisions(ij[:, 0], ij[:, 1], two[0], two[1], f[:, 0], f[:, 1], *two[2:])
+
+
+# What a round or a few pairs record: `Collisions`, or what makes them when read.
+Recorded = Collisions | _RoundRecord | _FewRecord
 
 
 def _unit_floats(d0: float, d1: float, key: int) -> tuple[float, float, float]:

@@ -387,7 +387,7 @@ class AirTable:
         self.steps = 0
         self.collision_count = 0  # puck-puck collisions since the start
         self.wall_collision_count = 0  # bounces off a wall since the start
-        self._collision_records: list[pairs.Collisions] = []
+        self._collision_records: list[pairs.Recorded] = []
         self._last_collisions: pairs.Collisions | None = None
         self._world_key = ""  # what the sleepers fell asleep in (see _world): any change wakes them
         self._sleepers: np.ndarray | None = None  # this step's sleeping rows (scratch)
