@@ -183,7 +183,7 @@ def resolve_pairs(
 
     if len(i) <= FEW_PAIRS:
         return _resolve_few_in_order(pos, vel, radius, mass, i, j, cr_puck, mode, dt_s, in_time_order)
-    uses = np.bincount(np.concatenate([i, j]), minlength=len(pos))
+    uses = np.bincount(np.concatenate([i, j]))  # as long as the largest row in a pair, no longer
     shared = (uses.take(i) > 1) | (uses.take(j) > 1)
     if np.count_nonzero(shared) <= FEW_PAIRS:
         # A gas's usual case. The pairs whose pucks are in no other pair
@@ -545,6 +545,8 @@ def _separate_floats(x1, x2, n, move: float, reach: float, share1: float, share2
 def _few_in_order(pos, vel, radius, il: list[int], jl: list[int], dt_s: float | None) -> list[int]:
     """The order in which `disjoint_rounds`' rounds would take the pairs (il, jl): round by round,
     in the given order within a round. With dt_s, pairs sharing a puck go as they met (since_contact)."""
+    if len(set(il + jl)) == 2 * len(il):
+        return list(range(len(il)))  # the usual case: no puck in two pairs, one round
     uses: dict[int, int] = {}
     for p in il + jl:
         uses[p] = uses.get(p, 0) + 1

@@ -43,7 +43,7 @@ def resolve_walls(
     # Room between each puck's edge and the nearest wall, column by column:
     # numpy broadcasts an (N, 1) radius against (N, 2) rows several times slower.
     x, y = p[:, 0], p[:, 1]
-    width, height = size_m
+    width, height = size_m.tolist()
     room = np.minimum(np.minimum(x, y), np.minimum(width - x, height - y)) - r
     if room.min() >= 0.0:
         return 0  # the usual case: nobody is past a wall
