@@ -740,7 +740,7 @@ class AirTable:
             # was already handled: look again among the same candidates (those
             # of the pucks just moved: nothing else changed), collide those
             # pairs too, and at last just push apart what is left.
-            ni, nj, near_sq = self._candidates_of(np.concatenate([i, j]), ci, cj)
+            ni, nj, near_sq = self._candidates_of(i, j, ci, cj)
             i, j = self._colliding(rest, *broadphase.overlapping_pairs(pos, ni, nj, None, reach_sq=near_sq))
         if not moved:
             return np.empty(0, dtype=np.intp)
@@ -748,13 +748,13 @@ class AirTable:
         self.collision_count += sum(len(r) for r in records)
         return np.concatenate(moved)
 
-    def _candidates_of(self, rows: np.ndarray, ci: np.ndarray, cj: np.ndarray):
-        """(i, j, (reach - OVERLAP_SLOP_M)^2) of the candidate pairs with a puck in `rows`; all of
-        them on a small table, where picking them out costs more than checking them all."""
+    def _candidates_of(self, i: np.ndarray, j: np.ndarray, ci: np.ndarray, cj: np.ndarray):
+        """(i, j, (reach - OVERLAP_SLOP_M)^2) of the candidate pairs with a puck of a pair (i, j);
+        all of them on a small table, where picking them out costs more than checking them all."""
         reach_sq = self._neighbours.reach_squared(OVERLAP_SLOP_M)
         if len(ci) < LOOK_AT_MOVED_MIN_PAIRS:
             return ci, cj, reach_sq
-        k = broadphase.pairs_with(rows, ci, cj, self._pucks.n)
+        k = broadphase.pairs_with(np.concatenate([i, j]), ci, cj, self._pucks.n)
         return ci.take(k), cj.take(k), reach_sq.take(k)
 
     def _colliding(self, rest: np.ndarray | None, i: np.ndarray, j: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
