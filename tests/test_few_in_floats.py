@@ -59,7 +59,7 @@ def test_floats_give_what_the_arrays_give(seed: int, n: int, mode: str, cr: floa
 def _walls(few: int, pos, vel, radius, correction: bool, mp) -> tuple[np.ndarray, np.ndarray, int]:
     pos, vel = pos.copy(), vel.copy()
     mp.setattr(walls, "FEW_PUCKS", few)
-    count = walls.resolve_walls(pos, vel, radius, np.array([2.0, 1.5]), 0.7, correction)
+    count, _ = walls.resolve_walls(pos, vel, radius, np.array([2.0, 1.5]), 0.7, correction)
     return pos, vel, count
 
 
@@ -100,3 +100,71 @@ def test_second_look_at_the_moved_pucks_only_finds_what_a_look_at_all_finds(grav
     every = _crowd(gravity, seed=3)
     np.testing.assert_array_equal(moved_only[0], every[0])
     np.testing.assert_array_equal(moved_only[1], every[1])
+
+
+def _crowd_changed_by_hand() -> tuple[np.ndarray, np.ndarray, int]:
+    """_crowd, then the table shrunk under the pucks, a puck grown and one moved by hand."""
+    rng = np.random.default_rng(5)
+    table = table_module.AirTable(width_m=2.0, height_m=2.0)
+    table.gravity_on = False
+    for _ in range(70):
+        table.add_puck(rng.uniform(0.1, 1.9, 2), radius_m=rng.uniform(0.05, 0.12), vel_mps=rng.uniform(-4, 4, 2))
+    for k in range(240):
+        if k == 60:
+            table.width_m = 1.7  # the right-hand pucks are now past the wall
+        if k == 120:
+            table.radius_m[3] = 0.3
+        if k == 180:
+            table.pos_m[7] = (0.01, 0.01)  # into the corner, past both walls
+        table.step(1 / 120)
+    return table.pos_m.copy(), table.vel_mps.copy(), table.wall_collision_count
+
+
+def test_walls_near_the_list_find_what_a_pass_over_every_puck_finds(monkeypatch) -> None:
+    bands = []
+    near_walls = broadphase.NeighbourList.near_walls
+    monkeypatch.setattr(
+        broadphase.NeighbourList, "near_walls", lambda nl, size: bands.append(1) or near_walls(nl, size)
+    )
+    monkeypatch.setattr(table_module, "WALL_BAND_MIN_PUCKS", 0)
+    near_only = _crowd_changed_by_hand()
+    assert len(bands) == 240  # every step checked only the pucks near a wall
+    monkeypatch.setattr(table_module, "WALL_BAND_MIN_PUCKS", 10**9)
+    every = _crowd_changed_by_hand()
+    assert len(bands) == 240
+    np.testing.assert_array_equal(near_only[0], every[0])
+    np.testing.assert_array_equal(near_only[1], every[1])
+    assert near_only[2] == every[2] > 100  # the same bounces, and plenty of them
+    x, y = every[0][:, 0], every[0][:, 1]
+    assert x.max() < 1.7 and y.min() > 0.0  # everyone back inside the shrunk table
+
+
+def test_near_walls_are_the_pucks_within_a_skin_of_a_wall() -> None:
+    r = 0.1
+    skin = broadphase.SKIN_RADII * r  # all radii equal: the skin is SKIN_RADII radii
+    # Room (edge to nearest wall of the 2 x 2 m table): 0.9, skin + 0.01, skin - 0.01 (left),
+    # skin + 0.01, skin - 0.01 (top).
+    x_near, y_near = r + skin - 0.01, 2.0 - r - skin + 0.01
+    pos = np.array([[1.0, 1.0], [r + skin + 0.01, 1.0], [x_near, 1.0], [1.0, y_near - 0.02], [1.0, y_near]])
+    nl = broadphase.NeighbourList()
+    nl.pairs(pos, np.full(len(pos), r))
+    assert nl.near_walls(np.array([2.0, 2.0])).tolist() == [2, 4]
+    # A table 1.2 m wide puts x = 1.0 a radius from the right-hand wall: near as well.
+    assert nl.near_walls(np.array([1.2, 2.0])).tolist() == [0, 2, 3, 4]
+
+
+def test_a_row_said_to_have_moved_past_half_the_skin_rebuilds_the_list() -> None:
+    r = 0.1
+    pos = np.array([[0.5, 0.5], [1.0, 0.5], [1.4, 0.5]])  # 0.4 m apart: more than reach + skin (0.35 m)
+    radius = np.full(3, r)
+    nl = broadphase.NeighbourList()
+    i, _, _ = nl.pairs(pos, radius)
+    assert len(i) == 0
+    half_skin = 0.5 * broadphase.SKIN_RADII * r
+    pos[2, 0] -= 0.9 * half_skin
+    nl.pairs(pos, radius, moved=np.array([2]))
+    assert nl.builds == 1  # still within half a skin: the list holds
+    pos[2, 0] -= 0.2 * half_skin
+    i, j, _ = nl.pairs(pos, radius, moved=np.array([2]))
+    assert nl.builds == 2
+    assert (1, 2) in zip(i.tolist(), j.tolist(), strict=True)  # now 0.32 m apart: within reach + skin

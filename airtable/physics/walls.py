@@ -22,8 +22,9 @@ def resolve_walls(
     only: np.ndarray | None = None,
     rest: np.ndarray | None = None,
     hold_slow: bool = False,
-) -> int:
-    """Keep every puck inside the box [0, size_m], in place; return how many bounced.
+) -> tuple[int, np.ndarray]:
+    """Keep every puck inside the box [0, size_m], in place; return (how many bounced, the rows
+    that were past a wall: moved, or left for the contact stage).
 
     `only`, if given, limits the check to those rows (the pucks that moved).
     A puck past a wall is moved back: mirrored by its penetration when
@@ -38,27 +39,33 @@ def resolve_walls(
     instead: a resting contact never bounces.
     """
     if len(pos) == 0:
-        return 0
+        return 0, np.empty(0, dtype=np.intp)
     p, r = (pos, radius) if only is None else (vectors.take(pos, only), radius.take(only))
     # Room between each puck's edge and the nearest wall, column by column:
     # numpy broadcasts an (N, 1) radius against (N, 2) rows several times slower.
     x, y = p[:, 0], p[:, 1]
     width, height = size_m.tolist()
     room = np.minimum(np.minimum(x, y), np.minimum(width - x, height - y)) - r
-    if room.min() >= 0.0:
-        return 0  # the usual case: nobody is past a wall
+    if len(room) == 0 or room.min() >= 0.0:
+        return 0, np.empty(0, dtype=np.intp)  # the usual case: nobody is past a wall
     out = (~(room >= 0.0)).nonzero()[0]  # NaN counts as outside
     if only is not None:
         out = only.take(out)
+    past = out
     if rest is not None:
         fast = _fast_ones(pos, vel, radius, size_m, rest, out)
         if hold_slow:
             _hold(pos, vel, radius, size_m, out.take((~fast).nonzero()[0]))
         out = out.take(fast.nonzero()[0])
         if len(out) == 0:
-            return 0  # a pile's usual case: every puck past a wall rests there
+            return 0, past  # a pile's usual case: every puck past a wall rests there
     if len(out) <= FEW_PUCKS:
-        return sum(_bounce_in_floats(pos, vel, radius, size_m, cr_wall, correction, k) for k in out.tolist())
+        return sum(_bounce_in_floats(pos, vel, radius, size_m, cr_wall, correction, k) for k in out.tolist()), past
+    return _bounce_rows(pos, vel, radius, size_m, cr_wall, correction, out), past
+
+
+def _bounce_rows(pos, vel, radius, size_m, cr_wall: float, correction: bool, out: np.ndarray) -> int:
+    """Bounce the rows `out` (past a wall) back inside, in place; return how many walls they bounced off."""
     p, v = vectors.take(pos, out), vectors.take(vel, out)
     lo = radius.take(out)[:, None]
     hi = size_m - lo
@@ -75,7 +82,7 @@ def resolve_walls(
 
 
 def _bounce_in_floats(pos, vel, radius, size_m, cr_wall: float, correction: bool, k: int) -> int:
-    """What the arrays above do, for the one puck k, in plain floats; return how many walls it bounced off."""
+    """What `_bounce_rows` does, for the one puck k, in plain floats; return how many walls it bounced off."""
     p, v, lo = pos[k].tolist(), vel[k].tolist(), radius.item(k)
     bounced = 0
     for axis, size in enumerate(size_m.tolist()):
