@@ -397,7 +397,7 @@ def pair_lists(draw) -> tuple[np.ndarray, np.ndarray, int]:
 @given(pair_lists())
 def test_disjoint_rounds_keep_order_and_never_repeat_a_puck(pair_list: tuple[np.ndarray, np.ndarray, int]) -> None:
     i, j, n = pair_list
-    rounds = pairs.disjoint_rounds(i, j, n)
+    rounds = pairs.disjoint_rounds(i, j)
     round_of = np.full(len(i), -1)
     for number, members in enumerate(rounds):
         pucks = np.concatenate([i[members], j[members]])

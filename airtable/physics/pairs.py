@@ -105,7 +105,13 @@ class Collisions:
         return Collisions(*(getattr(self, f).take(k, axis=0) for f in self.__dataclass_fields__))
 
 
-def disjoint_rounds(i: np.ndarray, j: np.ndarray, n: int, since=None) -> list[np.ndarray]:
+def sharing_pairs(i: np.ndarray, j: np.ndarray) -> np.ndarray:
+    """Indices k of the pairs (i, j) that share a puck with another pair."""
+    uses = np.bincount(np.concatenate([i, j]))  # as long as the largest row in a pair, no longer
+    return ((uses.take(i) > 1) | (uses.take(j) > 1)).nonzero()[0]
+
+
+def disjoint_rounds(i: np.ndarray, j: np.ndarray, since=None, shared: np.ndarray | None = None) -> list[np.ndarray]:
     """Split pairs into rounds in which no puck appears twice.
 
     Keeps the pairs' order: a pair goes into the first round after every
@@ -113,18 +119,19 @@ def disjoint_rounds(i: np.ndarray, j: np.ndarray, n: int, since=None) -> list[np
     therefore the same as resolving the pairs one by one in the given order.
     since(k), if given, says how long ago the pairs k met: then the pairs
     that share a puck are taken in the order they met (events in time order)
-    instead of the given one.
+    instead of the given one. `shared`: sharing_pairs(i, j), if the caller
+    has it already.
     """
     m = len(i)
     if m == 0:
         return []
-    uses = np.bincount(np.concatenate([i, j]), minlength=n)
-    if uses.max() == 1:
+    if shared is None:
+        shared = sharing_pairs(i, j)
+    if len(shared) == 0:
         return [np.arange(m)]  # the common case: no puck in two pairs
     # A pair whose pucks are in no other pair can go in any round: the first.
     # For the others, level[k] = how many earlier pairs form a chain into
     # pair k. One pass in Python over just those, a handful per step.
-    shared = ((uses.take(i) > 1) | (uses.take(j) > 1)).nonzero()[0]
     if since is not None:
         shared = shared.take(np.argsort(-since(shared), kind="stable"))  # the earliest contact first
     levels = _chain_levels(i.take(shared).tolist(), j.take(shared).tolist())
@@ -183,20 +190,21 @@ def resolve_pairs(
 
     if len(i) <= FEW_PAIRS:
         return _resolve_few_in_order(pos, vel, radius, mass, i, j, cr_puck, mode, dt_s, in_time_order)
-    uses = np.bincount(np.concatenate([i, j]))  # as long as the largest row in a pair, no longer
-    shared = (uses.take(i) > 1) | (uses.take(j) > 1)
-    if np.count_nonzero(shared) <= FEW_PAIRS:
+    shared = sharing_pairs(i, j)
+    if len(shared) <= FEW_PAIRS:
         # A gas's usual case. The pairs whose pucks are in no other pair
         # cannot change the others: one round for them, then the few that
         # share a puck, one by one in floats, in their rounds' order.
-        alone, few = (~shared).nonzero()[0], shared.nonzero()[0]
+        alone = np.ones(len(i), dtype=bool)
+        alone[shared] = False
+        alone, few = alone.nonzero()[0], shared
         c = _resolve_round(pos, vel, radius, mass, i.take(alone), j.take(alone), cr_puck, mode, dt_s)
         few_records = _resolve_few_in_order(
             pos, vel, radius, mass, i.take(few), j.take(few), cr_puck, mode, dt_s, in_time_order
         )
         return ([] if c is None else [c]) + few_records
     records = []
-    for r in disjoint_rounds(i, j, len(pos), since if in_time_order else None):
+    for r in disjoint_rounds(i, j, since if in_time_order else None, shared):
         c = _resolve_round(pos, vel, radius, mass, i.take(r), j.take(r), cr_puck, mode, dt_s)
         if c is not None:
             records.append(c)
