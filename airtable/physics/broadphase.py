@@ -26,6 +26,8 @@ BRUTE_FORCE_MAX_PUCKS = 48
 # pucks near 3 m/s) 1.5 radii lasts about four steps and was the fastest of
 # 0.5, 1, 1.5 and 2.
 SKIN_RADII = 1.5
+# Rows of grid cells per cell width (see _grid_candidates).
+ROWS_PER_CELL = 4
 
 
 def brute_force_pairs(pos: np.ndarray, radius: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -217,10 +219,12 @@ class NeighbourList:
         # all radii are equal) those closer than their own: the grid finds
         # about three candidates for each one kept.
         i, j = find_candidate_pairs(pos, radius, margin_m=skin, closer=True)
-        reach = pair_reach(radius, i, j)
         if len(radius) and float(radius.min()) < float(radius.max()):
+            reach = pair_reach(radius, i, j)
             near = _closer_than(pos, i, j, reach + skin)
             i, j, reach = i.take(near), j.take(near), reach.take(near)
+        else:  # the same numbers as pair_reach, without looking them up
+            reach = np.full(len(i), 2.0 * float(radius[0]) if len(radius) else 0.0)
         self._i, self._j, self._reach = i, j, reach
         self._order: np.ndarray | None = None  # see sorted_order
         self._squared: dict[float, np.ndarray] = {}  # see reach_squared
@@ -231,7 +235,7 @@ class NeighbourList:
 
 
 def _grid_candidates(pos: np.ndarray, cell: float, closer: bool = False) -> tuple[np.ndarray, np.ndarray]:
-    """Candidate pairs of pucks whose cells touch (indices into `pos`); with `closer`, only
+    """Candidate pairs of pucks whose cells are near (indices into `pos`); with `closer`, only
     those whose centres are closer than `cell`."""
     within = cell
     n = len(pos)
@@ -242,51 +246,77 @@ def _grid_candidates(pos: np.ndarray, cell: float, closer: bool = False) -> tupl
     x, y = pos[:, 0], pos[:, 1]
     x0, y0 = float(x.min()), float(y.min())
     span_x, span_y = float(x.max()) - x0, float(y.max()) - y0
+    rows = ROWS_PER_CELL
     # Far more cells than pucks only costs memory: widen the cells instead.
-    cell = max(cell, (span_x * span_y / (4.0 * n)) ** 0.5)
+    cell = max(cell, (span_x * span_y * rows / (4.0 * n)) ** 0.5)
     # A hair wider than the largest reach: two pucks exactly one reach apart
     # can count as overlapping after rounding, and their cell indices must
     # then not round two cells apart.
     inv = 1.0 / (cell * (1.0 + 1e-9))
     cx = ((x - x0) * inv).astype(np.intp)
-    cy = ((y - y0) * inv).astype(np.intp)
+    cy = ((y - y0) * (inv * rows)).astype(np.intp)
     # Size the grid from the cells actually used, not span / cell: the two can
     # round differently (0.6 * (1 / 0.2) is 3.0 but 0.6 / 0.2 is 2.999...), and
     # a grid one cell short sends the neighbour look-ups out of bounds.
-    # One margin cell on each side for the neighbours.
-    nx, ny = int(cx.max()) + 3, int(cy.max()) + 3
-    n_cells = nx * ny
-    key = cx * ny + cy + (ny + 1)  # column-major cell number, shifted past the margin
-    order = _argsort_cells(key, n_cells)
+    # `rows` spare rows below and above, and a spare column on the right, so
+    # that every look-up stays inside its column and inside the grid.
+    nx, ny = int(cx.max()) + 2, int(cy.max()) + 1 + 2 * rows
+    key = cx * ny + cy + rows  # column-major cell number
+    order = _argsort_cells(key, nx * ny)
     skey = key.take(order)
-    # start[c]: where cell c begins in sorted order; one extra cell as the end.
-    count = np.bincount(skey, minlength=n_cells + 1)
-    start = np.cumsum(count) - count
+    # ends[c]: where cell c ends in sorted order (and cell c + 1 begins).
+    ends = np.cumsum(np.bincount(skey, minlength=nx * ny))
     # Each puck (at sorted position p, in cell c) looks at two runs of the
-    # sorted order: the pucks after it in its own cell together with cell
-    # c + 1 (the next one up), and the three cells of the next column
-    # c + ny - 1 .. c + ny + 1. The other four neighbours see it from their side.
-    idx = np.arange(n)
-    first = start[skey + np.array([[0], [ny - 1]])]
-    first[0] = idx + 1
-    stop = start[skey + np.array([[2], [ny + 2]])]
-    a, b = _expand_ranges(np.concatenate([idx, idx]), first.ravel(), (stop - first).ravel())
+    # sorted order: the pucks after it in its own cell and in the `rows` cells
+    # above it (c + 1 .. c + rows), and the 2 rows + 1 cells of the next column
+    # beside it (c + ny - rows .. c + ny + rows). The other side sees it from theirs.
+    first, stop = np.empty((2, n), dtype=np.intp), np.empty((2, n), dtype=np.intp)
+    first[0] = np.arange(1, n + 1)
+    ends[rows:].take(skey, out=stop[0])  # ends[c + rows], without adding rows to every c
+    ends[ny - rows - 1 :].take(skey, out=first[1])
+    ends[ny + rows :].take(skey, out=stop[1])
+    a, b = _expand_ranges(first, stop)
     if closer:  # checked in sorted order, where neighbours sit close together in memory
-        near = _closer_than(vectors.take(pos, order), a, b, within)
+        near = _closer_in_order(vectors.take(pos, order), a, b, within)
         a, b = a.take(near), b.take(near)
     return order.take(a), order.take(b)
 
 
-def _expand_ranges(owner: np.ndarray, first: np.ndarray, count: np.ndarray):
-    """For each k, pair owner[k] with first[k], first[k]+1, ..., first[k]+count[k]-1."""
-    total = int(count.sum())
+def _closer_in_order(pos: np.ndarray, a: np.ndarray, b: np.ndarray, within: float) -> np.ndarray:
+    """_closer_than(pos, a, b, within) for many pairs: the same sums, with fewer passes."""
+    z = pos.view(np.complex128).reshape(-1)  # (x, y) as one number: a 1-D take
+    d = z.take(a)
+    d -= z.take(b)
+    dd = d.view(np.float64)
+    dd *= dd
+    return (dd[0::2] + dd[1::2] < within * within).nonzero()[0]
+
+
+def _expand_ranges(first: np.ndarray, stop: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Pair each p with every q in [first[k, p], stop[k, p]), for each k (rows of first and stop).
+
+    np.repeat would do, but it takes a branch per run that the CPU cannot
+    predict; here both outputs are running sums (cumsum), which have none.
+    """
+    n = first.shape[1]
+    count = (stop - first).reshape(-1)  # the runs in order: row 0 of all p, then row 1...
+    ends = np.cumsum(count)
+    total = int(ends[-1])
     if total == 0:
         empty = np.empty(0, dtype=np.intp)
         return empty, empty
-    offset = np.cumsum(count) - count
-    a = np.repeat(owner, count)
-    b = np.repeat(first - offset, count) + np.arange(total)
-    return a, b
+    begins = ends[:-1]  # where runs 1, 2, ... begin
+    # b counts up by one inside a run and jumps from the last run's stop - 1 to
+    # this run's first; an empty run adds first - stop = 0 of its own. p goes
+    # up by one where each run begins and back to 0 where a row of runs does.
+    # Both running sums are taken at once: p in the high 32 bits, b in the low.
+    jump = first.reshape(-1)[1:] - stop.reshape(-1)[:-1] + (1 << 32)
+    jump[n - 1 :: n] -= n << 32
+    step = np.ones(total + 1, dtype=np.intp)
+    step[0] = first[0, 0]
+    np.add.at(step, begins, jump)
+    both = np.cumsum(step[:total])
+    return both >> 32, both & 0xFFFFFFFF
 
 
 def _argsort_cells(key: np.ndarray, n_cells: int) -> np.ndarray:
