@@ -317,6 +317,34 @@ def test_broadphase_lattice_of_touching_pucks(r: float) -> None:
     assert np.array_equal(i, bi) and np.array_equal(j, bj)
 
 
+@pytest.mark.parametrize("r", np.linspace(0.01, 0.3, 30))
+def test_grid_finds_pairs_exactly_one_reach_apart_across_cell_edges(r: float) -> None:
+    # Columns are one reach (2 r + skin) wide and cells a quarter of that tall.
+    # Lattices in steps of a fifth and a quarter of the reach put pucks on the
+    # cell edges and pairs exactly one reach apart: side by side, one above the
+    # other, and across corners (3, 4, 5). After rounding some are a hair
+    # closer: the grid must find those, and nothing else.
+    skin = broadphase.SKIN_RADII * r
+    reach = 2.0 * r + skin
+    fifths = np.stack(np.meshgrid(np.arange(11), np.arange(11)), axis=-1).reshape(-1, 2) * (0.2 * reach)
+    quarters = np.stack(np.meshgrid(np.arange(9), np.arange(9)), axis=-1).reshape(-1, 2) * (0.25 * reach)
+    pos = np.concatenate([fifths, quarters + 0.1 * reach])
+    radius = np.full(len(pos), r)
+    i, j = broadphase.find_candidate_pairs(pos, radius, margin_m=skin, closer=True)
+    bi, bj = np.triu_indices(len(pos), k=1)
+    near = broadphase._closer_than(pos, bi, bj, reach)
+    assert np.all(i < j)
+    assert sorted(zip(i.tolist(), j.tolist(), strict=True)) == list(zip(bi[near].tolist(), bj[near].tolist()))
+
+
+def test_expand_ranges_pairs_each_row_with_its_ranges_in_order() -> None:
+    first = np.array([[1, 2, 5], [3, 9, 7]])
+    stop = np.array([[3, 2, 6], [3, 11, 9]])  # two empty ranges: [2, 2) and [3, 3)
+    a, b = broadphase._expand_ranges(first, stop)
+    assert a.dtype == b.dtype == np.intp
+    assert list(zip(a.tolist(), b.tolist(), strict=True)) == [(0, 1), (0, 2), (2, 5), (1, 9), (1, 10), (2, 7), (2, 8)]
+
+
 def pairs_closer_than(pos: np.ndarray, radius: np.ndarray, margin_m: float) -> set[tuple[int, int]]:
     """Every pair (i < j) closer than its reach plus margin_m: all n^2 distances, no grid."""
     d = np.hypot(*(pos[:, None, :] - pos[None, :, :]).transpose(2, 0, 1))
