@@ -3,8 +3,8 @@
 A uniform grid finds the candidate pairs in O(N) work: each puck is binned
 into a column as wide as the largest pair's reach, cut into cells a quarter
 as tall; the cell numbers are sorted (a radix sort), and each puck is paired
-with the pucks of the cells within one reach of its own. Pucks too big for the grid are checked against everyone,
-and small tables use brute force alone. `NeighbourList` keeps the grid's
+with the pucks of the cells within one reach of its own. Pucks too big for
+the grid are checked against everyone, and small tables use brute force alone. `NeighbourList` keeps the grid's
 pairs, widened by a skin, for as many steps as they stay valid (a Verlet
 list), so the grid is rebuilt only every few steps. `overlapping_pairs` then
 keeps the candidates that really overlap, sorted by (i, j).
@@ -117,7 +117,7 @@ def overlapping_pairs(
     instead of being sorted each time; the result is the same. `reach_sq`,
     if given, is reach * reach already worked out (NeighbourList.reach_squared).
     """
-    close = squared_distances(pos, i, j) < (reach * reach if reach_sq is None else reach_sq)
+    close = _squared_distances(pos, i, j) < (reach * reach if reach_sq is None else reach_sq)
     if sorted_order is not None and np.count_nonzero(close) * SORTED_PICK_SHARE >= len(i):
         order = sorted_order()
         hit = order.take(close.take(order).nonzero()[0])
@@ -137,7 +137,7 @@ def pairs_with(rows: np.ndarray, i: np.ndarray, j: np.ndarray, n: int) -> np.nda
     return (marked.take(i) | marked.take(j)).nonzero()[0]
 
 
-def squared_distances(pos: np.ndarray, i: np.ndarray, j: np.ndarray) -> np.ndarray:
+def _squared_distances(pos: np.ndarray, i: np.ndarray, j: np.ndarray) -> np.ndarray:
     """|pos[i] - pos[j]|^2 for each pair: the sums of vectors.squared_lengths, in fewer passes."""
     # A puck's (x, y) as one complex number: two 1-D takes instead of 2-D ones.
     z = np.ascontiguousarray(pos, dtype=np.float64).view(np.complex128).reshape(-1)
@@ -150,7 +150,7 @@ def squared_distances(pos: np.ndarray, i: np.ndarray, j: np.ndarray) -> np.ndarr
 
 def _closer_than(pos: np.ndarray, i: np.ndarray, j: np.ndarray, reach: np.ndarray) -> np.ndarray:
     """Indices k of the pairs whose centres are less than reach[k] apart."""
-    return (squared_distances(pos, i, j) < reach * reach).nonzero()[0]
+    return (_squared_distances(pos, i, j) < reach * reach).nonzero()[0]
 
 
 class NeighbourList:
@@ -237,12 +237,14 @@ class NeighbourList:
         # all radii are equal) those closer than their own: the grid finds
         # about 2.4 candidates for each one kept.
         i, j = find_candidate_pairs(pos, radius, margin_m=skin, closer=True)
-        if len(radius) and float(radius.min()) < float(radius.max()):
+        r_min, r_max = (float(radius.min()), float(radius.max())) if len(radius) else (0.0, 0.0)
+        if r_min == r_max:  # pair_reach's sums, without looking them up
+            reach = np.full(len(i), r_min + r_max)
+        else:
             reach = pair_reach(radius, i, j)
-            near = _closer_than(pos, i, j, reach + skin)
-            i, j, reach = i.take(near), j.take(near), reach.take(near)
-        else:  # the same numbers as pair_reach, without looking them up
-            reach = np.full(len(i), 2.0 * float(radius[0]) if len(radius) else 0.0)
+            if r_min < r_max:  # (False for a NaN radius)
+                near = _closer_than(pos, i, j, reach + skin)
+                i, j, reach = i.take(near), j.take(near), reach.take(near)
         self._i, self._j, self._reach = i, j, reach
         self._order: np.ndarray | None = None  # see sorted_order
         self._squared: dict[float, np.ndarray] = {}  # see reach_squared
@@ -291,8 +293,9 @@ def _sort_into_cells(pos: np.ndarray, cell: float) -> tuple[np.ndarray, np.ndarr
     x0, y0 = float(x.min()), float(y.min())
     span_x, span_y = float(x.max()) - x0, float(y.max()) - y0
     rows = ROWS_PER_CELL
-    # Far more cells than pucks only costs memory: widen the cells instead.
-    cell = max(cell, (span_x * span_y * rows / (4.0 * len(pos))) ** 0.5)
+    # Far more cells than pucks only costs memory: widen the cells instead
+    # (to at most 4 squares of a column's width per puck, so 4 * rows cells).
+    cell = max(cell, (span_x * span_y / (4.0 * len(pos))) ** 0.5)
     # A hair wider than the largest reach: two pucks exactly one reach apart
     # can count as overlapping after rounding, and their column (or row)
     # numbers must then not round one column (or `rows` rows) too far apart.
@@ -315,7 +318,8 @@ def _expand_ranges(first: np.ndarray, stop: np.ndarray) -> tuple[np.ndarray, np.
     """(a, b): each p paired with every q in [first[k, p], stop[k, p]), for each k, in that order.
 
     np.repeat could do it, but it takes a branch per range that the CPU cannot
-    predict (that cost 2x here); a running sum (cumsum) has none.
+    predict: with new positions at every build that cost twice as much as
+    this running sum (cumsum), which has none.
     """
     n = first.shape[1]
     count = (stop - first).reshape(-1)  # the ranges in order: those of row k = 0 for every p, then k = 1...
@@ -325,14 +329,15 @@ def _expand_ranges(first: np.ndarray, stop: np.ndarray) -> tuple[np.ndarray, np.
         empty = np.empty(0, dtype=np.intp)
         return empty, empty
     # b goes up by one inside a range and jumps from the last range's stop - 1
-    # to this range's first (an empty range adds first - stop = 0 of its own);
-    # a goes up by one where each range begins, and back to 0 where a row k
-    # does. Both running sums are taken at once: a in the high 32 bits, b in the low.
+    # to this range's first (an empty range adds first - stop = 0 of its own).
+    # a goes up by one where each range begins (from p to p + 1), and from
+    # n - 1 back to 0 where the ranges of the next k begin. Both running sums
+    # are taken at once: a in the high 32 bits, b in the low ones.
     jump = np.subtract(first.reshape(-1)[1:], stop.reshape(-1)[:-1], dtype=np.int64)
     jump += 1 << 32
     jump[n - 1 :: n] -= n << 32
     step = np.ones(total + 1, dtype=np.int64)  # the spare entry: ranges that begin at the very end
-    step[0] = first[0, 0]
+    step[0] = first[0, 0]  # a = 0, b = the first range's first
     np.add.at(step, ends[:-1], jump)
     both = np.cumsum(step[:total])
     return (both >> 32).astype(np.intp, copy=False), (both & 0xFFFFFFFF).astype(np.intp, copy=False)
