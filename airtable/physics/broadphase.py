@@ -297,8 +297,8 @@ def _sort_into_cells(pos: np.ndarray, cell: float) -> tuple[np.ndarray, np.ndarr
     # (to at most 4 squares of a column's width per puck, so 4 * rows cells).
     cell = max(cell, (span_x * span_y / (4.0 * len(pos))) ** 0.5)
     # A hair wider than the largest reach: two pucks exactly one reach apart
-    # can count as overlapping after rounding, and their column (or row)
-    # numbers must then not round one column (or `rows` rows) too far apart.
+    # can count as overlapping after rounding, and their column numbers must
+    # then still differ by at most one, their row numbers by at most `rows`.
     inv = 1.0 / (cell * (1.0 + 1e-9))
     cx = ((x - x0) * inv).astype(np.intp)
     cy = ((y - y0) * (inv * rows)).astype(np.intp)
@@ -332,7 +332,7 @@ def _expand_ranges(first: np.ndarray, stop: np.ndarray) -> tuple[np.ndarray, np.
     # to this range's first (an empty range adds first - stop = 0 of its own).
     # a goes up by one where each range begins (from p to p + 1), and from
     # n - 1 back to 0 where the ranges of the next k begin. Both running sums
-    # are taken at once: a in the high 32 bits, b in the low ones.
+    # are taken at once: a in the high 32 bits, b (a row, far below 2^32) in the low ones.
     jump = np.subtract(first.reshape(-1)[1:], stop.reshape(-1)[:-1], dtype=np.int64)
     jump += 1 << 32
     jump[n - 1 :: n] -= n << 32
