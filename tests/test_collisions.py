@@ -305,6 +305,23 @@ def test_broadphase_grid_span_an_exact_multiple_of_the_cell() -> None:
     assert np.array_equal(i, bi) and np.array_equal(j, bj)
 
 
+@pytest.mark.parametrize("along", [0, 1])
+def test_pucks_along_a_long_line_keep_the_grid_small(along: int, monkeypatch) -> None:
+    # 60 pucks spread along a 1000 km line cover no area: the grid may not
+    # grow with the line's length (cells of 0.2 m would be 5 million columns).
+    cells = []
+    argsort_cells = broadphase._argsort_cells
+    monkeypatch.setattr(broadphase, "_argsort_cells", lambda key, n: cells.append(n) or argsort_cells(key, n))
+    rng = np.random.default_rng(4)
+    pos = np.zeros((60, 2))
+    pos[:, along] = np.sort(rng.uniform(0.0, 1e6, 60))
+    pos[1, along] = pos[0, along] + 0.15  # one overlapping pair
+    radius = np.full(60, 0.1)
+    i, j = broadphase.find_overlapping_pairs(pos, radius)
+    assert list(zip(i.tolist(), j.tolist(), strict=True)) == [(0, 1)]
+    assert cells and max(cells) <= 4 * 60 * broadphase.ROWS_PER_CELL * 3
+
+
 @pytest.mark.parametrize("r", np.linspace(0.01, 0.3, 59))
 def test_broadphase_lattice_of_touching_pucks(r: float) -> None:
     # Neighbours exactly one diameter (= one grid cell) apart: rounding makes

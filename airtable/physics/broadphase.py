@@ -4,10 +4,11 @@ A uniform grid finds the candidate pairs in O(N) work: each puck is binned
 into a column as wide as the largest pair's reach, cut into cells a quarter
 as tall; the cell numbers are sorted (a radix sort), and each puck is paired
 with the pucks of the cells within one reach of its own. Pucks too big for
-the grid are checked against everyone, and small tables use brute force alone. `NeighbourList` keeps the grid's
-pairs, widened by a skin, for as many steps as they stay valid (a Verlet
-list), so the grid is rebuilt only every few steps. `overlapping_pairs` then
-keeps the candidates that really overlap, sorted by (i, j).
+the grid are checked against everyone, and small tables use brute force
+alone. `NeighbourList` keeps the grid's pairs, widened by a skin, for as many
+steps as they stay valid (a Verlet list), so the grid is rebuilt only every
+few steps. `overlapping_pairs` then keeps the candidates that really overlap,
+sorted by (i, j).
 """
 
 from __future__ import annotations
@@ -293,9 +294,12 @@ def _sort_into_cells(pos: np.ndarray, cell: float) -> tuple[np.ndarray, np.ndarr
     x0, y0 = float(x.min()), float(y.min())
     span_x, span_y = float(x.max()) - x0, float(y.max()) - y0
     rows = ROWS_PER_CELL
-    # Far more cells than pucks only costs memory: widen the cells instead
-    # (to at most 4 squares of a column's width per puck, so 4 * rows cells).
-    cell = max(cell, (span_x * span_y / (4.0 * len(pos))) ** 0.5)
+    # Far more cells than pucks only costs memory: widen the cells instead, to
+    # at most 4 squares of a column's width per puck (so 4 * rows cells), and
+    # at most 4 columns (or squares up a column) per puck where the pucks lie
+    # along a line and cover no area.
+    n4 = 4.0 * len(pos)
+    cell = max(cell, (span_x * span_y / n4) ** 0.5, max(span_x, span_y) / n4)
     # A hair wider than the largest reach: two pucks exactly one reach apart
     # can count as overlapping after rounding, and their column numbers must
     # then still differ by at most one, their row numbers by at most `rows`.

@@ -64,6 +64,11 @@ LOOK_AT_MOVED_MIN_PAIRS = 5000
 # wall: on 10000 a pass over every puck costs 20 us, the few hundred near a wall 6 us. On
 # fewer, picking them out and checking the list first cost as much as they save.
 WALL_BAND_MIN_PUCKS = 4000
+# A pressed contact (one whose pucks this step's forces push: gravity, springs, pulls)
+# approaching slower than this (m/s) rests instead of bouncing: the speed of a 2 mm fall.
+# Without it a pile's pucks, shaken at a few cm/s by their neighbours, bounce off each
+# other at restitution cr_puck and keep each other shaking; Box2D's threshold is 1 m/s.
+PRESSED_REST_MPS = 0.2
 # Overlaps smaller than this (m) are left to the next step: round-off only.
 OVERLAP_SLOP_M = 1e-9
 # Said once (in `notices`) when springs are first solved implicitly.
@@ -205,9 +210,10 @@ class AirTable:
         self.wall_correction = True
         self.puck_correction = "perfect-kiss"  # the accurate mode; two-step is taught in demo 2p
         self.puck_collisions = True
-        # Contacts approaching slower than this (m/s), or than twice what the
-        # step's forces add to a puck's speed (2 g dt under gravity), are
-        # resting: held up by the contact stage, with no bounce.
+        # Contacts approaching slower than this (m/s) are resting: held up by
+        # the contact stage, with no bounce. Where forces press a puck, its
+        # contacts also rest below PRESSED_REST_MPS and twice what the step's
+        # forces add to its speed (2 g dt under gravity).
         self.rest_speed_mps = 0.0
 
     @property
@@ -682,13 +688,15 @@ class AirTable:
             self.collision_count += len(s.i)
 
     def _rest_speeds(self, kick: np.ndarray | float | None, dt: float) -> np.ndarray | None:
-        """Each puck's rest speed: rest_speed_mps or twice its kick from this step's forces; None: all zero."""
+        """Each puck's rest speed: rest_speed_mps, and where this step's forces gave it a kick,
+        PRESSED_REST_MPS and twice the kick; None: all zero."""
         floor = _non_negative(self.rest_speed_mps, "rest_speed_mps")
         if kick is None and floor == 0.0:
             return None  # nothing presses: every contact is a collision, as in the course's model
         rest = np.full(self._pucks.n, floor)
         if kick is not None:
-            np.maximum(rest, 2.0 * np.asarray(kick), out=rest)
+            pressed = np.maximum(2.0 * np.asarray(kick), PRESSED_REST_MPS)
+            np.maximum(rest, np.where(np.asarray(kick) > 0.0, pressed, 0.0), out=rest)
         return rest
 
     def _resolve_contacts(self, rest: np.ndarray, dt: float) -> bool:
