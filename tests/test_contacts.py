@@ -2,10 +2,15 @@
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 import pytest
 
 from airtable.physics import broadphase, contacts
+from airtable.physics import table as table_module
+from airtable.physics.forces import GRAVITY_MPS2
+from airtable.physics.table import AirTable
 
 
 def _small_pile() -> tuple[np.ndarray, ...]:
@@ -93,3 +98,30 @@ def test_a_puck_resting_on_the_floor_converges_at_once() -> None:
     assert solver.count == 1 and solver.iterations == 2 < contacts.ITERATIONS
     assert vel[0, 1] == 0.0 and vel[0, 0] == 0.0
     assert pos[0, 1] == pytest.approx(0.1, abs=1e-15)  # back where it rests, and no overlap to push out
+
+
+@pytest.mark.parametrize("drop_mm", [1.0, 10.0])
+def test_a_fall_under_the_pressed_rest_speed_rests_and_a_faster_one_bounces(drop_mm: float) -> None:
+    # Dropped from h onto the floor, a puck lands at sqrt(2 g h). From 1 mm that is 0.14 m/s,
+    # under PRESSED_REST_MPS = 0.2: it rests at once. From 10 mm (0.44 m/s) it bounces at
+    # cr_wall = 0.9, back up to 0.81 h = 8.1 mm (to within what steps of 1/240 s see), and
+    # so on until it lands slower than 0.2 m/s, from 2.04 mm or less: then it rests.
+    assert math.sqrt(2 * GRAVITY_MPS2 * 1e-3) < table_module.PRESSED_REST_MPS < math.sqrt(2 * GRAVITY_MPS2 * 1e-2)
+    table = AirTable()
+    table.gravity_on, table.sleeping, table.cr_wall = True, False, 0.9
+    puck = table.add_puck(pos_m=(5.0, 0.1 + 1e-3 * drop_mm), radius_m=0.1)
+    tops, rising = [], False  # the height of each rebound (mm)
+    for _ in range(240):  # 1 s
+        table.step(1 / 240)
+        if rising and puck.vel_mps[1] <= 0.0:
+            tops.append(1e3 * (puck.pos_m[1] - 0.1))
+        rising = puck.vel_mps[1] > 1e-9
+    if drop_mm == 1.0:
+        assert table.wall_collision_count == 0 and tops == []
+    else:
+        assert tops[0] == pytest.approx(8.1, abs=1.0)
+        assert table.wall_collision_count == len(tops) > 3
+        # It came to rest falling from the last rise, about 2.04 mm high; it bounced from those before.
+        assert tops[-1] == pytest.approx(2.04, abs=0.3) and tops[-2] > 2.04
+    assert puck.pos_m[1] == pytest.approx(0.1, abs=1e-9)  # at rest on the floor
+    assert puck.vel_mps[1] == pytest.approx(0.0, abs=1e-9)
