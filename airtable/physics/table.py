@@ -487,7 +487,7 @@ class AirTable:
             self.force_N[:] = 0.0  # the accumulators hold one step's forces
             rest = self._rest_speeds(kick, dt)  # below these speeds contacts rest, not bounce
             wall_rest = None if rest is None else self._contacts.wall_rest(rest)
-            near = self._near_walls() if rest is None else None  # (the contact stage reads the list as built)
+            near = self._near_walls()
             past = self._resolve_walls(near, wall_rest)  # 3. walls
             moved = np.empty(0, dtype=np.intp)
             if self.puck_collisions:  # 4. pairs (told what the walls moved if the list was just checked)
@@ -716,10 +716,7 @@ class AirTable:
 
         Where pucks collide, the pair stage needs the neighbour list anyway;
         checking it here, before the walls move anyone, lets the wall stage
-        skip the pucks it knows are far from every wall. Not where contacts
-        rest: the contact stage takes the list's pairs in the order built, so
-        a list built before the walls instead of after would change its
-        round-off.
+        skip the pucks it knows are far from every wall.
         """
         if not self.puck_collisions or self._pucks.n < WALL_BAND_MIN_PUCKS:
             return None
