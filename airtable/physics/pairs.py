@@ -236,27 +236,43 @@ def push_apart(pos: np.ndarray, radius: np.ndarray, mass: np.ndarray, i: np.ndar
 
 
 # ---------------------------------------------------------------- one round
+#
+# A round's arrays hold both pucks of each pair stacked: rows 0..k-1 for the
+# k pairs' first pucks (table rows a), rows k..2k-1 for their second pucks
+# (rows b). One numpy operation then moves both pucks, and the round writes
+# back with one scatter each for positions and velocities. On a few dozen
+# pairs a numpy call costs more than its rows: fewer calls is what counts.
 
 
 @dataclass
 class _Round:
-    """The overlapping pairs of one round, gathered: puck 1 is row a, puck 2 row b."""
+    """The overlapping pairs of one round, gathered: puck 1 is row a, puck 2 row b.
+
+    x, v and share are stacked (puck 1 of every pair, then puck 2); the other
+    arrays have one row per pair.
+    """
 
     a: np.ndarray
     b: np.ndarray
-    ab: np.ndarray  # a then b: the rows the round writes back, in one scatter each for pos and vel
-    x1: np.ndarray
-    x2: np.ndarray
-    v1: np.ndarray
-    v2: np.ndarray
+    ab: np.ndarray  # a then b: the table rows of x, v and share
+    x: np.ndarray  # positions
+    v: np.ndarray  # velocities
+    share: np.ndarray  # a puck's part of a change in relative motion: m2 / (m1 + m2) for puck 1, m1 / (m1 + m2) for 2
     r2: np.ndarray
     reach: np.ndarray  # r1 + r2
+    d: np.ndarray  # x1 - x2
     n: np.ndarray  # unit normal from puck 2 to puck 1, along the line of centres
     overlap: np.ndarray
     vrel: np.ndarray  # v1 - v2
     vn: np.ndarray  # relative normal speed, negative when approaching
-    share1: np.ndarray  # puck 1's part of a change in relative motion: m2 / (m1 + m2)
-    share2: np.ndarray  # m1 / (m1 + m2)
+
+    def keys(self) -> np.ndarray:
+        """a + b: one key per pair for `vectors.unit_vectors`, made only where a distance is 0."""
+        return self.a + self.b
+
+    @property
+    def x2(self) -> np.ndarray:
+        return self.x[len(self.a) :]
 
 
 @dataclass
@@ -266,77 +282,91 @@ class _Outcome:
     n: np.ndarray  # the normal the pair collided along
     contact_from: np.ndarray  # centre of puck 2 when they touched
     approach: np.ndarray  # which pairs collided
-    v1: np.ndarray
-    v2: np.ndarray
-    x1: np.ndarray
-    x2: np.ndarray
+    count: int  # how many
+    v: np.ndarray  # velocities after, stacked as _Round.v
+    x: np.ndarray  # positions after
+
+
+def _both(per_pair: np.ndarray) -> np.ndarray:
+    """A number per pair, stacked as _Round.x: once for puck 1, once for puck 2."""
+    return np.concatenate((per_pair, per_pair))
+
+
+def _apart(n: np.ndarray) -> np.ndarray:
+    """Each puck's direction away from the other, stacked as _Round.x: n for puck 1, -n for puck 2."""
+    return np.concatenate((n, -n))
+
+
+def _approaching(approach: np.ndarray) -> tuple[int, np.ndarray | None]:
+    """(how many pairs approach, the mask to apply to them): None when all do, as they mostly do."""
+    count = np.count_nonzero(approach)
+    return count, (None if count == len(approach) else approach)
 
 
 def _gather(pos, vel, radius, mass, a, b) -> _Round | None:
-    """The pairs (a, b) that still overlap (an earlier round may have parted some); None if none do.
-
-    Rows a and b are gathered together (one `take` per column, split into
-    halves): on a few dozen pairs a numpy call costs more than its rows.
-    """
+    """The pairs (a, b) that still overlap (an earlier round may have parted some); None if none do."""
     k = len(a)
     ab = np.concatenate((a, b))
     x, r = vectors.take(pos, ab), radius.take(ab)
-    x1, x2, r2 = x[:k], x[k:], r[k:]
+    d, r2 = x[:k] - x[k:], r[k:]
     reach = r[:k] + r2
-    n, dist = vectors.unit_vectors(x1 - x2, a + b)
+    n, dist = vectors.unit_vectors(d, lambda: a + b)
     overlap = reach - dist
     if np.count_nonzero(overlap > 0.0) < k:
         keep = (overlap > 0.0).nonzero()[0]
         if len(keep) == 0:
             return None
-        a, b, x1, x2, r2, reach, n, overlap = (v.take(keep, axis=0) for v in (a, b, x1, x2, r2, reach, n, overlap))
+        a, b, d, r2, reach, n, overlap = (v.take(keep, axis=0) for v in (a, b, d, r2, reach, n, overlap))
         k, ab = len(a), np.concatenate((a, b))
+        x = vectors.take(pos, ab)
     v, m = vectors.take(vel, ab), mass.take(ab)
-    v1, v2, m1, m2 = v[:k], v[k:], m[:k], m[k:]
-    m_sum = m1 + m2
-    vrel = v1 - v2
-    vn = vectors.dot_rows(vrel, n)
-    return _Round(a, b, ab, x1, x2, v1, v2, r2, reach, n, overlap, vrel, vn, m2 / m_sum, m1 / m_sum)
+    m_sum = m[:k] + m[k:]
+    share = np.empty(2 * k)
+    np.divide(m[k:], m_sum, out=share[:k])  # each puck's share is the other's mass over the pair's
+    np.divide(m[:k], m_sum, out=share[k:])
+    vrel = v[:k] - v[k:]
+    return _Round(a, b, ab, x, v, share, r2, reach, d, n, overlap, vrel, vectors.dot_rows(vrel, n))
 
 
-def collide_along_normal(g: _Round, n: np.ndarray, vn: np.ndarray, approach: np.ndarray, cr: float):
-    """Velocities (v1, v2) after the 1D collision with restitution cr along n, for the approaching pairs.
+def collide_along_normal(g: _Round, apart: np.ndarray, vn: np.ndarray, only: np.ndarray | None, cr: float):
+    """Velocities (stacked) after the 1D collision with restitution cr along the normal.
 
+    apart: `_apart` of the normal; only: which pairs collide, None for all.
     The relative normal speed vn becomes -cr vn, shared so that momentum is
     kept (the lighter puck takes more of the change); the tangential
     velocities are untouched.
     """
     jn = -(1.0 + cr) * vn  # change of relative normal speed
-    if np.count_nonzero(approach) < len(approach):
-        jn = np.where(approach, jn, 0.0)
-    return g.v1 + (jn * g.share1)[:, None] * n, g.v2 - (jn * g.share2)[:, None] * n
+    if only is not None:
+        jn = np.where(only, jn, 0.0)
+    return g.v + vectors.per_row(_both(jn) * g.share) * apart
 
 
-def separate(g: _Round, n: np.ndarray, move: np.ndarray, approach: np.ndarray):
-    """Positions (x1, x2) after moving each approaching pair `move` apart along n.
+def separate(g: _Round, apart: np.ndarray, move: np.ndarray, only: np.ndarray | None):
+    """Positions (stacked) after moving each pair (only those in `only`, if given) `move` apart.
 
-    Each puck moves its mass share. Whatever still overlaps (separating,
-    resting, created on top of each other, or capped) is then pushed apart
-    along its line of centres, by the same shares.
+    Each puck moves its share along `apart`. Whatever still overlaps
+    (separating, resting, created on top of each other, or capped) is then
+    pushed apart along its line of centres, by the same shares.
     """
-    if np.count_nonzero(approach) < len(approach):
-        move = np.where(approach, move, 0.0)
-    x1 = g.x1 + (move * g.share1)[:, None] * n
-    x2 = g.x2 - (move * g.share2)[:, None] * n
-    d = x1 - x2
+    if only is not None:
+        move = np.where(only, move, 0.0)
+    x = g.x + vectors.per_row(_both(move) * g.share) * apart
+    k = len(g.a)
+    d = x[:k] - x[k:]
     if np.count_nonzero(vectors.squared_lengths(d) < g.reach * g.reach):
-        n_now, dist_now = vectors.unit_vectors(d, g.a + g.b)
+        n_now, dist_now = vectors.unit_vectors(d, g.keys)
         left = np.maximum(g.reach - dist_now, 0.0)
-        x1 = x1 + (left * g.share1)[:, None] * n_now
-        x2 = x2 - (left * g.share2)[:, None] * n_now
-    return x1, x2
+        x = x + vectors.per_row(_both(left) * g.share) * _apart(n_now)
+    return x
 
 
 def _round_off(g: _Round, cr: float, dt_s: float) -> _Outcome:
     """Velocities only: the overlap stays, which is what this mode shows."""
     approach = g.vn < -REST_SPEED_MPS
-    v1, v2 = collide_along_normal(g, g.n, g.vn, approach, cr)
-    return _Outcome(g.n, g.x2, approach, v1, v2, g.x1, g.x2)
+    count, only = _approaching(approach)
+    v = collide_along_normal(g, _apart(g.n), g.vn, only, cr)
+    return _Outcome(g.n, g.x2, approach, count, v, g.x)
 
 
 def _two_step_move(g: _Round, cr: float, dt_s: float) -> np.ndarray:
@@ -348,14 +378,16 @@ def _two_step_move(g: _Round, cr: float, dt_s: float) -> np.ndarray:
     overlap deeper than one step of approach can explain is capped there;
     `separate` pushes the rest apart.
     """
-    return (1.0 + cr) * np.minimum(g.overlap, -g.vn * dt_s)
+    return (1.0 + cr) * np.minimum(g.overlap, g.vn * -dt_s)
 
 
 def _round_two_step(g: _Round, cr: float, dt_s: float) -> _Outcome:
     approach = g.vn < -REST_SPEED_MPS
-    v1, v2 = collide_along_normal(g, g.n, g.vn, approach, cr)
-    x1, x2 = separate(g, g.n, _two_step_move(g, cr, dt_s), approach)
-    return _Outcome(g.n, g.x2, approach, v1, v2, x1, x2)
+    count, only = _approaching(approach)
+    apart = _apart(g.n)
+    v = collide_along_normal(g, apart, g.vn, only, cr)
+    x = separate(g, apart, _two_step_move(g, cr, dt_s), only)
+    return _Outcome(g.n, g.x2, approach, count, v, x)
 
 
 def _time_since_contact(g: _Round, dt_s: float) -> tuple[np.ndarray, np.ndarray]:
@@ -363,12 +395,12 @@ def _time_since_contact(g: _Round, dt_s: float) -> tuple[np.ndarray, np.ndarray]
 
     Solves |d - vrel t| = reach for the larger root t, with d = x1 - x2.
     """
-    d = g.x1 - g.x2
     vv = vectors.squared_lengths(g.vrel)
-    dv = vectors.dot_rows(d, g.vrel)
-    disc = np.maximum(dv * dv - vv * (vectors.squared_lengths(d) - g.reach * g.reach), 0.0)
+    dv = vectors.dot_rows(g.d, g.vrel)
+    disc = np.maximum(dv * dv - vv * (vectors.squared_lengths(g.d) - g.reach * g.reach), 0.0)
     moving = vv > REST_SPEED_MPS**2
-    t_back = (dv + np.sqrt(disc)) / np.where(moving, vv, 1.0)
+    all_moving = np.count_nonzero(moving) == len(vv)  # as they mostly are; the count costs a quarter of np.where
+    t_back = (dv + np.sqrt(disc)) / (vv if all_moving else np.where(moving, vv, 1.0))
     ok = moving & (t_back >= 0.0) & (t_back <= dt_s * (1.0 + 1e-9) + 1e-15)
     return t_back, ok
 
@@ -376,23 +408,29 @@ def _time_since_contact(g: _Round, dt_s: float) -> tuple[np.ndarray, np.ndarray]
 def _round_perfect_kiss(g: _Round, cr: float, dt_s: float) -> _Outcome:
     """Collide at first contact; pairs whose overlap this step cannot explain get the two-step correction."""
     t_back, kiss = _time_since_contact(g, dt_s)
-    if not kiss.any():
+    kissing = np.count_nonzero(kiss)
+    if not kissing:
         return _round_two_step(g, cr, dt_s)
-    t_b = np.where(kiss, t_back, 0.0)[:, None]
-    c2 = g.x2 - g.v2 * t_b  # both centres at first contact
-    n_kiss, _ = vectors.unit_vectors(g.x1 - g.v1 * t_b - c2, g.a + g.b)
-    vn_kiss = vectors.dot_rows(g.vrel, n_kiss)
-    kiss2 = kiss[:, None]
-    n = np.where(kiss2, n_kiss, g.n)
-    vn = np.where(kiss, vn_kiss, g.vn)
+    t_b = t_back if kissing == len(kiss) else np.where(kiss, t_back, 0.0)
+    c = g.x - g.v * vectors.per_row(_both(t_b))  # both centres at first contact
+    k = len(g.a)
+    n, _ = vectors.unit_vectors(c[:k] - c[k:], g.keys)
+    vn = vectors.dot_rows(g.vrel, n)
     # Approaching is judged at the contact time: a fast pair is often caught
     # after its closest approach. Going forward t_b with the new velocities
     # parts the pair by (1 + cr) |vn| t_b.
-    approach = np.where(kiss, vn_kiss < 0.0, g.vn < -REST_SPEED_MPS)
-    move = np.where(kiss, -(1.0 + cr) * vn_kiss * t_b[:, 0], _two_step_move(g, cr, dt_s))
-    v1, v2 = collide_along_normal(g, n, vn, approach, cr)
-    x1, x2 = separate(g, n, move, approach)
-    return _Outcome(n, np.where(kiss2, c2, g.x2), approach, v1, v2, x1, x2)
+    contact_from, approach, move = c[k:], vn < 0.0, -(1.0 + cr) * vn * t_b
+    if kissing < len(kiss):  # the others: the two-step's normal, speed and move
+        kiss2 = kiss[:, None]
+        n, contact_from = np.where(kiss2, n, g.n), np.where(kiss2, contact_from, g.x2)
+        vn = np.where(kiss, vn, g.vn)
+        approach = np.where(kiss, approach, g.vn < -REST_SPEED_MPS)
+        move = np.where(kiss, move, _two_step_move(g, cr, dt_s))
+    count, only = _approaching(approach)
+    apart = _apart(n)
+    v = collide_along_normal(g, apart, vn, only, cr)
+    x = separate(g, apart, move, only)
+    return _Outcome(n, contact_from, approach, count, v, x)
 
 
 _ROUND_BY_MODE: dict[str, Callable[[_Round, float, float], _Outcome]] = {
@@ -414,11 +452,10 @@ def _resolve_round(pos, vel, radius, mass, a, b, cr, mode, dt_s) -> Recorded | N
         return None
     out = _ROUND_BY_MODE[mode](g, cr, dt_s)
     # No row repeats within a round, so one scatter of a then b writes each once.
-    vectors.put(vel, g.ab, np.concatenate((out.v1, out.v2)))
+    vectors.put(vel, g.ab, out.v)
     if mode != "off":
-        vectors.put(pos, g.ab, np.concatenate((out.x1, out.x2)))
-    count = np.count_nonzero(out.approach)
-    return _RoundRecord(g, out, count) if count else None
+        vectors.put(pos, g.ab, out.x)
+    return _RoundRecord(g, out) if out.count else None
 
 
 @dataclass
@@ -428,18 +465,19 @@ class _RoundRecord:
 
     g: _Round
     out: _Outcome
-    count: int  # how many pairs collided
 
     def __len__(self) -> int:
-        return self.count
+        return self.out.count
 
     def collisions(self) -> Collisions:
-        g, out = self.g, self.out
+        g, out, k = self.g, self.out, len(self.g.a)
         contact = out.contact_from + out.n * g.r2[:, None]
+        x, v, x_after, v_after = g.x, g.v, out.x, out.v
         record = Collisions(
-            g.a, g.b, out.n, contact, g.overlap, g.reach, g.x1, g.x2, out.x1, out.x2, g.v1, g.v2, out.v1, out.v2
-        )
-        return record if self.count == len(g.a) else record.take(out.approach.nonzero()[0])
+            g.a, g.b, out.n, contact, g.overlap, g.reach,
+            x[:k], x[k:], x_after[:k], x_after[k:], v[:k], v[k:], v_after[:k], v_after[k:],
+        )  # fmt: skip
+        return record if out.count == k else record.take(out.approach.nonzero()[0])
 
 
 # ---------------------------------------------------------------- a few pairs, in floats
@@ -516,7 +554,7 @@ def _pair_in_floats(pos, vel, radius, mass, p, q, cr, mode, dt_s) -> list[float]
     t_b = _kiss_time(x1, x2, vrel, reach, dt_s) if mode == "perfect-kiss" else None
     if t_b is None:  # as _round_two_step (and _round_off, which does not use `move`)
         approach = vn < -REST_SPEED_MPS
-        move = (1.0 + cr) * min(overlap, -vn * dt_s)
+        move = (1.0 + cr) * min(overlap, vn * -dt_s)
         c = x2
     else:  # as _round_perfect_kiss
         c = [x2[0] - v2[0] * t_b, x2[1] - v2[1] * t_b]
