@@ -6,7 +6,8 @@ os.environ.setdefault("SDL_VIDEODRIVER", "dummy")
 os.environ.setdefault("SDL_AUDIODRIVER", "dummy")
 os.environ.setdefault("PYGAME_HIDE_SUPPORT_PROMPT", "1")
 
-import time  # noqa: E402  (after the SDL settings above, which must come first)
+import contextlib  # noqa: E402  (after the SDL settings above, which must come first)
+import time  # noqa: E402
 from collections.abc import Callable  # noqa: E402
 
 import pytest  # noqa: E402
@@ -23,6 +24,30 @@ def demos():
     found, errors = discover([BUILTIN_DIR])
     assert not errors
     return found
+
+
+@contextlib.contextmanager
+def teacher_and_student(demos, demo_key: str):
+    """A headless teacher's App on `demo_key`, serving on a free port of 127.0.0.1, and one student
+    (Ann) joined over a real socket: yields (teacher, net). Closes the socket and the server after."""
+    import pygame
+
+    from airtable.app.app import App
+    from airtable.net.player import NetPlayer
+    from airtable.net.server import GameServer
+
+    server = GameServer(host="127.0.0.1", port=0)
+    server.start()
+    teacher = App(demos, demo_key=demo_key, headless=True, server=server)
+    pygame.event.clear()
+    net = NetPlayer("127.0.0.1", server.port, name="Ann", max_backoff_s=0.3)
+    net.connect()
+    try:
+        yield teacher, net
+    finally:
+        net.close()
+        server.stop()
+        pygame.event.clear()
 
 
 def post_key(key: int, down: bool = True, mod: int = 0, unicode: str = "") -> None:

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pygame
 import pytest
-from conftest import FRAME_S, post_key, server_frames
+from conftest import FRAME_S, post_key, server_frames, teacher_and_student
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
@@ -19,7 +19,6 @@ from airtable.net.bench_aids import frame_sizes, measure
 from airtable.net.codec import SnapshotDecoder, SnapshotEncoder, Viewer
 from airtable.net.player import NetPlayer, PlayerApp
 from airtable.net.protocol import AIDS, LAYOUT, SNAPSHOT, ProtocolError
-from airtable.net.server import GameServer
 
 
 def _scene(n: int = 3, aids_: SharedAids | None = None, t: float = 0.0) -> Scene:
@@ -232,18 +231,8 @@ def test_byte_figures_for_demo_4_and_shift_1_with_a_v_c_on():
 
 @pytest.fixture
 def classroom(demos):
-    from airtable.app.app import App
-
-    server = GameServer(host="127.0.0.1", port=0)
-    server.start()
-    teacher = App(demos, demo_key="1p", headless=True, server=server)
-    pygame.event.clear()
-    net = NetPlayer("127.0.0.1", server.port, name="Ann", max_backoff_s=0.3)
-    net.connect()
-    yield teacher, net
-    net.close()
-    server.stop()
-    pygame.event.clear()
+    with teacher_and_student(demos, "1p") as pair:
+        yield pair
 
 
 def _run_student(teacher, net, until, keys=()):

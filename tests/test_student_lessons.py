@@ -10,7 +10,7 @@ from pathlib import Path
 import numpy as np
 import pygame
 import pytest
-from conftest import FRAME_S, WAIT_S, press, server_frames, wait_until
+from conftest import FRAME_S, WAIT_S, press, server_frames, teacher_and_student, wait_until
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
@@ -28,7 +28,6 @@ from airtable.net import aids_wire
 from airtable.net.aids_wire import AidsDecoder, AidsEncoder, AidsViewer, SharedAids, SharedLessons
 from airtable.net.player import NetPlayer, PlayerApp
 from airtable.net.protocol import AIDS, ProtocolError
-from airtable.net.server import GameServer
 
 # Puck 0 (1 m/s) hits puck 1 (at rest) head on after 0.1 s; puck 2 drifts far away. With SIX more
 # pucks at rest in a row at the bottom, the table has nine: more than FEW_PUCKS.
@@ -186,16 +185,8 @@ def test_many_collided_pucks_draw_the_forty_whose_momentum_changed_most():
 @pytest.fixture
 def classroom(tmp_path: Path):
     (tmp_path / "head_on.py").write_text(DEMO + VARIATIONS)
-    server = GameServer(host="127.0.0.1", port=0)
-    server.start()
-    teacher = App(DemoShelf([BUILTIN_DIR, tmp_path]), demo_key="5", headless=True, server=server)
-    pygame.event.clear()
-    net = NetPlayer("127.0.0.1", server.port, name="Ann", max_backoff_s=0.3)
-    net.connect()
-    yield teacher, net
-    net.close()
-    server.stop()
-    pygame.event.clear()
+    with teacher_and_student(DemoShelf([BUILTIN_DIR, tmp_path]), "5") as pair:
+        yield pair
 
 
 def _student(teacher: App, net: NetPlayer, until) -> PlayerApp:
