@@ -17,7 +17,7 @@ from collections.abc import Callable
 
 import numpy as np
 
-from airtable.physics import vectors
+from airtable.physics import vectors, walls
 
 # Below this many pucks, checking every pair with one numpy expression is
 # cheaper than building a grid.
@@ -197,8 +197,7 @@ class NeighbourList:
         key = (float(size_m[0]), float(size_m[1]))
         rows = self._near_walls.get(key)
         if rows is None:
-            x, y = self._built_pos[:, 0], self._built_pos[:, 1]
-            room = np.minimum(np.minimum(x, y), np.minimum(key[0] - x, key[1] - y)) - self._built_radius
+            room = walls.room_to_walls(self._built_pos, self._built_radius, key)
             rows = self._near_walls[key] = (~(room >= self._skin)).nonzero()[0]  # NaN counts as near
         return rows
 

@@ -591,14 +591,12 @@ def _separate_floats(x1, x2, n, move: float, reach: float, share1: float, share2
 def _few_in_order(pos, vel, radius, il: list[int], jl: list[int], dt_s: float | None) -> list[int]:
     """The order in which `disjoint_rounds`' rounds would take the pairs (il, jl): round by round,
     in the given order within a round. With dt_s, pairs sharing a puck go as they met (since_contact)."""
-    if len(set(il + jl)) == 2 * len(il):
-        return list(range(len(il)))  # the usual case: no puck in two pairs, one round
     uses: dict[int, int] = {}
     for p in il + jl:
         uses[p] = uses.get(p, 0) + 1
     shared = [k for k in range(len(il)) if uses[il[k]] > 1 or uses[jl[k]] > 1]
     if not shared:
-        return list(range(len(il)))
+        return list(range(len(il)))  # the usual case: no puck in two pairs, one round
     if dt_s is not None:
         since = {k: _since_floats(pos, vel, radius, il[k], jl[k], dt_s) for k in shared}
         shared.sort(key=lambda k: -since[k])  # stable, as np.argsort(kind="stable")

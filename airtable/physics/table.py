@@ -695,8 +695,8 @@ class AirTable:
             return None  # nothing presses: every contact is a collision, as in the course's model
         rest = np.full(self._pucks.n, floor)
         if kick is not None:
-            pressed = np.maximum(2.0 * np.asarray(kick), PRESSED_REST_MPS)
-            np.maximum(rest, np.where(np.asarray(kick) > 0.0, pressed, 0.0), out=rest)
+            kick = np.asarray(kick)
+            np.maximum(rest, np.where(kick > 0.0, np.maximum(2.0 * kick, PRESSED_REST_MPS), 0.0), out=rest)
         return rest
 
     def _resolve_contacts(self, rest: np.ndarray, dt: float) -> bool:

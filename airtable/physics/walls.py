@@ -41,11 +41,7 @@ def resolve_walls(
     if len(pos) == 0:
         return 0, np.empty(0, dtype=np.intp)
     p, r = (pos, radius) if only is None else (vectors.take(pos, only), radius.take(only))
-    # Room between each puck's edge and the nearest wall, column by column:
-    # numpy broadcasts an (N, 1) radius against (N, 2) rows several times slower.
-    x, y = p[:, 0], p[:, 1]
-    width, height = size_m.tolist()
-    room = np.minimum(np.minimum(x, y), np.minimum(width - x, height - y)) - r
+    room = room_to_walls(p, r, size_m)
     if len(room) == 0 or room.min() >= 0.0:
         return 0, np.empty(0, dtype=np.intp)  # the usual case: nobody is past a wall
     out = (~(room >= 0.0)).nonzero()[0]  # NaN counts as outside
@@ -62,6 +58,15 @@ def resolve_walls(
     if len(out) <= FEW_PUCKS:
         return sum(_bounce_in_floats(pos, vel, radius, size_m, cr_wall, correction, k) for k in out.tolist()), past
     return _bounce_rows(pos, vel, radius, size_m, cr_wall, correction, out), past
+
+
+def room_to_walls(pos: np.ndarray, radius: np.ndarray, size_m) -> np.ndarray:
+    """Each puck's room between its edge and the nearest wall of the box [0, size_m] (m; negative:
+    past it, NaN for a NaN position)."""
+    # Column by column: numpy broadcasts an (N, 1) radius against (N, 2) rows several times slower.
+    x, y = pos[:, 0], pos[:, 1]
+    width, height = (float(size_m[0]), float(size_m[1]))
+    return np.minimum(np.minimum(x, y), np.minimum(width - x, height - y)) - radius
 
 
 def _bounce_rows(pos, vel, radius, size_m, cr_wall: float, correction: bool, out: np.ndarray) -> int:
