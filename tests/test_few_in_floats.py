@@ -168,3 +168,15 @@ def test_a_row_said_to_have_moved_past_half_the_skin_rebuilds_the_list() -> None
     i, j, _ = nl.pairs(pos, radius, moved=np.array([2]))
     assert nl.builds == 2
     assert (1, 2) in zip(i.tolist(), j.tolist(), strict=True)  # now 0.32 m apart: within reach + skin
+
+
+@pytest.mark.parametrize("few", [0, 100])
+def test_a_row_named_twice_bounces_once(few: int, monkeypatch) -> None:
+    # The wall pass after the pairs gets the rows they moved, and a row may be in two pairs.
+    monkeypatch.setattr(walls, "FEW_PUCKS", few)
+    pos, vel, radius = np.array([[-0.02, 1.0], [1.0, 1.0]]), np.array([[-2.0, 0.5], [0.0, 0.0]]), np.full(2, 0.1)
+    count, past = walls.resolve_walls(pos, vel, radius, np.array([2.0, 2.0]), 0.5, True, only=np.array([0, 1, 0]))
+    assert count == 1 and past.tolist() == [0, 0]
+    # Mirrored by its 0.12 m penetration to x = 0.22 m, moving out at 0.5 * 2 m/s.
+    np.testing.assert_allclose(pos[0], [0.22, 1.0])
+    np.testing.assert_allclose(vel[0], [1.0, 0.5])

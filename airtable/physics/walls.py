@@ -57,7 +57,8 @@ def resolve_walls(
             return 0, past  # a pile's usual case: every puck past a wall rests there
     if len(out) <= FEW_PUCKS:
         return sum(_bounce_in_floats(pos, vel, radius, size_m, cr_wall, correction, k) for k in out.tolist()), past
-    return _bounce_rows(pos, vel, radius, size_m, cr_wall, correction, out), past
+    # `only` may name a row twice (the rows the pairs moved): bounced, and counted, once.
+    return _bounce_rows(pos, vel, radius, size_m, cr_wall, correction, np.unique(out)), past
 
 
 def room_to_walls(pos: np.ndarray, radius: np.ndarray, size_m) -> np.ndarray:
