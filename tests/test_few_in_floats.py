@@ -180,3 +180,15 @@ def test_a_row_named_twice_bounces_once(few: int, monkeypatch) -> None:
     # Mirrored by its 0.12 m penetration to x = 0.22 m, moving out at 0.5 * 2 m/s.
     np.testing.assert_allclose(pos[0], [0.22, 1.0])
     np.testing.assert_allclose(vel[0], [1.0, 0.5])
+
+
+def test_the_squared_reach_is_one_number_when_every_radius_is_equal() -> None:
+    pos = np.array([[0.5, 0.5], [0.8, 0.5], [2.0, 2.0]])
+    nl = broadphase.NeighbourList()
+    nl.pairs(pos, np.full(3, 0.1))
+    assert nl.reach_squared(0.05) == pytest.approx(0.15**2)  # (0.1 + 0.1 - 0.05)^2, one number
+    assert isinstance(nl.reach_squared(), float)
+    nl.pairs(pos, np.array([0.1, 0.2, 0.1]))  # a radius changed: the list is built again
+    i, j, _ = nl.pairs(pos, np.array([0.1, 0.2, 0.1]))
+    assert (i.tolist(), j.tolist()) == ([0], [1])
+    np.testing.assert_allclose(nl.reach_squared(0.05), [0.25**2])  # (0.1 + 0.2 - 0.05)^2, per pair
