@@ -38,14 +38,16 @@ def teacher_and_student(demos, demo_key: str):
 
     server = GameServer(host="127.0.0.1", port=0)
     server.start()
-    teacher = App(demos, demo_key=demo_key, headless=True, server=server)
-    pygame.event.clear()
-    net = NetPlayer("127.0.0.1", server.port, name="Ann", max_backoff_s=0.3)
-    net.connect()
-    try:
+    net = None
+    try:  # the server stops even if the App or the join fails
+        teacher = App(demos, demo_key=demo_key, headless=True, server=server)
+        pygame.event.clear()
+        net = NetPlayer("127.0.0.1", server.port, name="Ann", max_backoff_s=0.3)
+        net.connect()
         yield teacher, net
     finally:
-        net.close()
+        if net is not None:
+            net.close()
         server.stop()
         pygame.event.clear()
 

@@ -188,7 +188,8 @@ def test_the_squared_reach_is_one_number_when_every_radius_is_equal() -> None:
     nl.pairs(pos, np.full(3, 0.1))
     assert nl.reach_squared(0.05) == pytest.approx(0.15**2)  # (0.1 + 0.1 - 0.05)^2, one number
     assert isinstance(nl.reach_squared(), float)
-    nl.pairs(pos, np.array([0.1, 0.2, 0.1]))  # a radius changed: the list is built again
-    i, j, _ = nl.pairs(pos, np.array([0.1, 0.2, 0.1]))
+    assert nl.reach_squared_of(np.array([0, 0]), 0.05) == nl.reach_squared(0.05)
+    i, j, _ = nl.pairs(pos, np.array([0.1, 0.2, 0.1]))  # a radius changed: the list is built again
     assert (i.tolist(), j.tolist()) == ([0], [1])
     np.testing.assert_allclose(nl.reach_squared(0.05), [0.25**2])  # (0.1 + 0.2 - 0.05)^2, per pair
+    np.testing.assert_allclose(nl.reach_squared_of(np.array([0, 0]), 0.05), [0.25**2, 0.25**2])

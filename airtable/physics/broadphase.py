@@ -219,6 +219,11 @@ class NeighbourList:
             sq = self._squared[less_m] = r * r
         return sq
 
+    def reach_squared_of(self, k: np.ndarray, less_m: float = 0.0) -> np.ndarray | float:
+        """reach_squared(less_m) of the pairs k only (the one number, where it is one)."""
+        sq = self.reach_squared(less_m)
+        return sq if self._one_reach is not None else sq.take(k)
+
     def _still_valid(self, pos: np.ndarray, radius: np.ndarray, rows: np.ndarray | None = None) -> bool:
         """Whether no puck moved half a skin since the build (`rows`: pos and radius are just those rows)."""
         if self._built_pos is None or len(pos) == 0:
@@ -242,9 +247,10 @@ class NeighbourList:
         # about 2.4 candidates for each one kept.
         i, j = find_candidate_pairs(pos, radius, margin_m=skin, closer=True)
         r_min, r_max = (float(radius.min()), float(radius.max())) if len(radius) else (0.0, 0.0)
-        self._one_reach = r_min + r_max if r_min == r_max else None  # see reach_squared
+        self._one_reach = None  # see reach_squared
         if r_min == r_max:  # pair_reach's sums, without looking them up
-            reach = np.full(len(i), r_min + r_max)
+            self._one_reach = r_min + r_max
+            reach = np.full(len(i), self._one_reach)
         else:
             reach = pair_reach(radius, i, j)
             if r_min < r_max:  # (False for a NaN radius)

@@ -782,14 +782,13 @@ class AirTable:
         return np.concatenate(moved)
 
     def _candidates_of(self, i: np.ndarray, j: np.ndarray, ci: np.ndarray, cj: np.ndarray):
-        """(i, j, (reach - OVERLAP_SLOP_M)^2) of the candidate pairs with a puck of a pair (i, j) (the
-        last one number if all radii are equal, see NeighbourList.reach_squared); all of them on a
-        small table, where picking them out costs more than checking them all."""
-        reach_sq = self._neighbours.reach_squared(OVERLAP_SLOP_M)
+        """(i, j, (reach - OVERLAP_SLOP_M)^2) of the candidate pairs with a puck of a pair (i, j)
+        (NeighbourList.reach_squared); all of them on a small table, where picking them out costs
+        more than checking them all."""
         if len(ci) < LOOK_AT_MOVED_MIN_PAIRS:
-            return ci, cj, reach_sq
+            return ci, cj, self._neighbours.reach_squared(OVERLAP_SLOP_M)
         k = broadphase.pairs_with(np.concatenate([i, j]), ci, cj, self._pucks.n)
-        return ci.take(k), cj.take(k), (reach_sq.take(k) if isinstance(reach_sq, np.ndarray) else reach_sq)
+        return ci.take(k), cj.take(k), self._neighbours.reach_squared_of(k, OVERLAP_SLOP_M)
 
     def _colliding(self, rest: np.ndarray | None, i: np.ndarray, j: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """The pairs (i, j) that collide: all of them if rest is None, else those that approach
