@@ -237,27 +237,28 @@ def push_apart(pos: np.ndarray, radius: np.ndarray, mass: np.ndarray, i: np.ndar
 
 # ---------------------------------------------------------------- one round
 #
-# A round's arrays hold both pucks of each pair stacked: rows 0..k-1 for the
-# k pairs' first pucks (table rows a), rows k..2k-1 for their second pucks
-# (rows b). One numpy operation then moves both pucks, and the round writes
-# back with one scatter each for positions and velocities. On a few dozen
-# pairs a numpy call costs more than its rows: fewer calls is what counts.
+# A round holds its vectors as complex numbers x + iy (vectors.as_complex: views of the
+# table's rows, no copies), one array for the first pucks of the pairs (table rows a) and one
+# for the second (rows b). Gathering, moving and scattering a round are then one 1-D numpy
+# operation per array, and each line reads as the course's formula for one pair: on a few
+# dozen pairs a numpy call costs more than its rows, so fewer calls is what counts.
 
 
 @dataclass
 class _Round:
     """The overlapping pairs of one round, gathered: puck 1 is row a, puck 2 row b.
 
-    x, v and share are stacked (puck 1 of every pair, then puck 2); the other
-    arrays have one row per pair.
+    Vectors are complex (x + iy), one per pair.
     """
 
     a: np.ndarray
     b: np.ndarray
-    ab: np.ndarray  # a then b: the table rows of x, v and share
-    x: np.ndarray  # positions
-    v: np.ndarray  # velocities
-    share: np.ndarray  # a puck's part of a change in relative motion: m2 / (m1 + m2) for puck 1, m1 / (m1 + m2) for 2
+    x1: np.ndarray  # positions
+    x2: np.ndarray
+    v1: np.ndarray  # velocities
+    v2: np.ndarray
+    share1: np.ndarray  # a puck's part of a change in relative motion: m2 / (m1 + m2) for puck 1,
+    share2: np.ndarray  # m1 / (m1 + m2) for puck 2 (the lighter one moves more)
     r2: np.ndarray
     reach: np.ndarray  # r1 + r2
     d: np.ndarray  # x1 - x2
@@ -267,34 +268,22 @@ class _Round:
     vn: np.ndarray  # relative normal speed, negative when approaching
 
     def keys(self) -> np.ndarray:
-        """a + b: one key per pair for `vectors.unit_vectors`, made only where a distance is 0."""
+        """a + b: one key per pair for `vectors.units`, made only where a distance is 0."""
         return self.a + self.b
-
-    @property
-    def x2(self) -> np.ndarray:
-        return self.x[len(self.a) :]
 
 
 @dataclass
 class _Outcome:
-    """What a correction mode did to a round."""
+    """What a correction mode did to a round (vectors complex, as in _Round)."""
 
     n: np.ndarray  # the normal the pair collided along
     contact_from: np.ndarray  # centre of puck 2 when they touched
     approach: np.ndarray  # which pairs collided
     count: int  # how many
-    v: np.ndarray  # velocities after, stacked as _Round.v
-    x: np.ndarray  # positions after
-
-
-def _both(per_pair: np.ndarray) -> np.ndarray:
-    """A number per pair, stacked as _Round.x: once for puck 1, once for puck 2."""
-    return np.concatenate((per_pair, per_pair))
-
-
-def _apart(n: np.ndarray) -> np.ndarray:
-    """Each puck's direction away from the other, stacked as _Round.x: n for puck 1, -n for puck 2."""
-    return np.concatenate((n, -n))
+    v1: np.ndarray  # velocities after
+    v2: np.ndarray
+    x1: np.ndarray  # positions after
+    x2: np.ndarray
 
 
 def _approaching(approach: np.ndarray) -> tuple[int, np.ndarray | None]:
@@ -303,70 +292,65 @@ def _approaching(approach: np.ndarray) -> tuple[int, np.ndarray | None]:
     return count, (None if count == len(approach) else approach)
 
 
-def _gather(pos, vel, radius, mass, a, b) -> _Round | None:
-    """The pairs (a, b) that still overlap (an earlier round may have parted some); None if none do."""
-    k = len(a)
-    ab = np.concatenate((a, b))
-    x, r = vectors.take(pos, ab), radius.take(ab)
-    d, r2 = x[:k] - x[k:], r[k:]
-    reach = r[:k] + r2
-    n, dist = vectors.unit_vectors(d, lambda: a + b)
+def _gather(zpos, zvel, radius, mass, a, b) -> _Round | None:
+    """The pairs (a, b) that still overlap (an earlier round may have parted some); None if none do.
+
+    zpos, zvel: the table's positions and velocities as complex numbers.
+    """
+    x1, x2 = zpos.take(a), zpos.take(b)
+    d, r2 = x1 - x2, radius.take(b)
+    reach = radius.take(a) + r2
+    n, dist = vectors.units(d, lambda: a + b)
     overlap = reach - dist
-    if np.count_nonzero(overlap > 0.0) < k:
+    if np.count_nonzero(overlap > 0.0) < len(a):
         keep = (overlap > 0.0).nonzero()[0]
         if len(keep) == 0:
             return None
-        a, b, d, r2, reach, n, overlap = (v.take(keep, axis=0) for v in (a, b, d, r2, reach, n, overlap))
-        k, ab = len(a), np.concatenate((a, b))
-        x = vectors.take(pos, ab)
-    v, m = vectors.take(vel, ab), mass.take(ab)
-    m_sum = m[:k] + m[k:]
-    share = np.empty(2 * k)
-    np.divide(m[k:], m_sum, out=share[:k])  # each puck's share is the other's mass over the pair's
-    np.divide(m[:k], m_sum, out=share[k:])
-    vrel = v[:k] - v[k:]
-    return _Round(a, b, ab, x, v, share, r2, reach, d, n, overlap, vrel, vectors.dot_rows(vrel, n))
+        a, b, x1, x2, d, r2, reach, n, overlap = (v.take(keep) for v in (a, b, x1, x2, d, r2, reach, n, overlap))
+    v1, v2 = zvel.take(a), zvel.take(b)
+    m1, m2 = mass.take(a), mass.take(b)
+    m_sum = m1 + m2
+    vrel = v1 - v2
+    return _Round(a, b, x1, x2, v1, v2, m2 / m_sum, m1 / m_sum, r2, reach, d, n, overlap, vrel, vectors.dot(vrel, n))
 
 
-def collide_along_normal(g: _Round, apart: np.ndarray, vn: np.ndarray, only: np.ndarray | None, cr: float):
-    """Velocities (stacked) after the 1D collision with restitution cr along the normal.
+def collide_along_normal(g: _Round, n: np.ndarray, vn: np.ndarray, only: np.ndarray | None, cr: float):
+    """(v1, v2) after the 1D collision with restitution cr along the normal n.
 
-    apart: `_apart` of the normal; only: which pairs collide, None for all.
-    The relative normal speed vn becomes -cr vn, shared so that momentum is
-    kept (the lighter puck takes more of the change); the tangential
-    velocities are untouched.
+    only: which pairs collide, None for all. The relative normal speed vn
+    becomes -cr vn, shared so that momentum is kept (the lighter puck takes
+    more of the change); the tangential velocities are untouched.
     """
     jn = -(1.0 + cr) * vn  # change of relative normal speed
     if only is not None:
         jn = np.where(only, jn, 0.0)
-    return g.v + vectors.per_row(_both(jn) * g.share) * apart
+    return g.v1 + (jn * g.share1) * n, g.v2 - (jn * g.share2) * n
 
 
-def separate(g: _Round, apart: np.ndarray, move: np.ndarray, only: np.ndarray | None):
-    """Positions (stacked) after moving each pair (only those in `only`, if given) `move` apart.
+def separate(g: _Round, n: np.ndarray, move: np.ndarray, only: np.ndarray | None):
+    """(x1, x2) after moving each pair (only those in `only`, if given) `move` apart along n.
 
-    Each puck moves its share along `apart`. Whatever still overlaps
-    (separating, resting, created on top of each other, or capped) is then
-    pushed apart along its line of centres, by the same shares.
+    Each puck moves its share. Whatever still overlaps (separating, resting,
+    created on top of each other, or capped) is then pushed apart along its
+    line of centres, by the same shares.
     """
     if only is not None:
         move = np.where(only, move, 0.0)
-    x = g.x + vectors.per_row(_both(move) * g.share) * apart
-    k = len(g.a)
-    d = x[:k] - x[k:]
-    if np.count_nonzero(vectors.squared_lengths(d) < g.reach * g.reach):
-        n_now, dist_now = vectors.unit_vectors(d, g.keys)
+    x1, x2 = g.x1 + (move * g.share1) * n, g.x2 - (move * g.share2) * n
+    d = x1 - x2
+    if np.count_nonzero(vectors.squared_abs(d) < g.reach * g.reach):
+        n_now, dist_now = vectors.units(d, g.keys)
         left = np.maximum(g.reach - dist_now, 0.0)
-        x = x + vectors.per_row(_both(left) * g.share) * _apart(n_now)
-    return x
+        x1, x2 = x1 + (left * g.share1) * n_now, x2 - (left * g.share2) * n_now
+    return x1, x2
 
 
 def _round_off(g: _Round, cr: float, dt_s: float) -> _Outcome:
     """Velocities only: the overlap stays, which is what this mode shows."""
     approach = g.vn < -REST_SPEED_MPS
     count, only = _approaching(approach)
-    v = collide_along_normal(g, _apart(g.n), g.vn, only, cr)
-    return _Outcome(g.n, g.x2, approach, count, v, g.x)
+    v1, v2 = collide_along_normal(g, g.n, g.vn, only, cr)
+    return _Outcome(g.n, g.x2, approach, count, v1, v2, g.x1, g.x2)
 
 
 def _two_step_move(g: _Round, cr: float, dt_s: float) -> np.ndarray:
@@ -384,10 +368,9 @@ def _two_step_move(g: _Round, cr: float, dt_s: float) -> np.ndarray:
 def _round_two_step(g: _Round, cr: float, dt_s: float) -> _Outcome:
     approach = g.vn < -REST_SPEED_MPS
     count, only = _approaching(approach)
-    apart = _apart(g.n)
-    v = collide_along_normal(g, apart, g.vn, only, cr)
-    x = separate(g, apart, _two_step_move(g, cr, dt_s), only)
-    return _Outcome(g.n, g.x2, approach, count, v, x)
+    v1, v2 = collide_along_normal(g, g.n, g.vn, only, cr)
+    x1, x2 = separate(g, g.n, _two_step_move(g, cr, dt_s), only)
+    return _Outcome(g.n, g.x2, approach, count, v1, v2, x1, x2)
 
 
 def _time_since_contact(g: _Round, dt_s: float) -> tuple[np.ndarray, np.ndarray]:
@@ -395,9 +378,9 @@ def _time_since_contact(g: _Round, dt_s: float) -> tuple[np.ndarray, np.ndarray]
 
     Solves |d - vrel t| = reach for the larger root t, with d = x1 - x2.
     """
-    vv = vectors.squared_lengths(g.vrel)
-    dv = vectors.dot_rows(g.d, g.vrel)
-    disc = np.maximum(dv * dv - vv * (vectors.squared_lengths(g.d) - g.reach * g.reach), 0.0)
+    vv = vectors.squared_abs(g.vrel)
+    dv = vectors.dot(g.d, g.vrel)
+    disc = np.maximum(dv * dv - vv * (vectors.squared_abs(g.d) - g.reach * g.reach), 0.0)
     moving = vv > REST_SPEED_MPS**2
     all_moving = np.count_nonzero(moving) == len(vv)  # as they mostly are; the count costs a quarter of np.where
     t_back = (dv + np.sqrt(disc)) / (vv if all_moving else np.where(moving, vv, 1.0))
@@ -412,25 +395,22 @@ def _round_perfect_kiss(g: _Round, cr: float, dt_s: float) -> _Outcome:
     if not kissing:
         return _round_two_step(g, cr, dt_s)
     t_b = t_back if kissing == len(kiss) else np.where(kiss, t_back, 0.0)
-    c = g.x - g.v * vectors.per_row(_both(t_b))  # both centres at first contact
-    k = len(g.a)
-    n, _ = vectors.unit_vectors(c[:k] - c[k:], g.keys)
-    vn = vectors.dot_rows(g.vrel, n)
+    c1, c2 = g.x1 - t_b * g.v1, g.x2 - t_b * g.v2  # both centres at first contact
+    n, _ = vectors.units(c1 - c2, g.keys)
+    vn = vectors.dot(g.vrel, n)
     # Approaching is judged at the contact time: a fast pair is often caught
     # after its closest approach. Going forward t_b with the new velocities
     # parts the pair by (1 + cr) |vn| t_b.
-    contact_from, approach, move = c[k:], vn < 0.0, -(1.0 + cr) * vn * t_b
+    contact_from, approach, move = c2, vn < 0.0, -(1.0 + cr) * vn * t_b
     if kissing < len(kiss):  # the others: the two-step's normal, speed and move
-        kiss2 = kiss[:, None]
-        n, contact_from = np.where(kiss2, n, g.n), np.where(kiss2, contact_from, g.x2)
+        n, contact_from = np.where(kiss, n, g.n), np.where(kiss, contact_from, g.x2)
         vn = np.where(kiss, vn, g.vn)
         approach = np.where(kiss, approach, g.vn < -REST_SPEED_MPS)
         move = np.where(kiss, move, _two_step_move(g, cr, dt_s))
     count, only = _approaching(approach)
-    apart = _apart(n)
-    v = collide_along_normal(g, apart, vn, only, cr)
-    x = separate(g, apart, move, only)
-    return _Outcome(n, contact_from, approach, count, v, x)
+    v1, v2 = collide_along_normal(g, n, vn, only, cr)
+    x1, x2 = separate(g, n, move, only)
+    return _Outcome(n, contact_from, approach, count, v1, v2, x1, x2)
 
 
 _ROUND_BY_MODE: dict[str, Callable[[_Round, float, float], _Outcome]] = {
@@ -447,15 +427,21 @@ def _resolve_round(pos, vel, radius, mass, a, b, cr, mode, dt_s) -> Recorded | N
     """
     if len(a) <= FEW_PAIRS:
         return _resolve_few(pos, vel, radius, mass, a.tolist(), b.tolist(), cr, mode, dt_s)
-    g = _gather(pos, vel, radius, mass, a, b)
+    zpos, zvel = vectors.as_complex(pos), vectors.as_complex(vel)
+    g = _gather(zpos, zvel, radius, mass, a, b)
     if g is None:
         return None
     out = _ROUND_BY_MODE[mode](g, cr, dt_s)
-    # No row repeats within a round, so one scatter of a then b writes each once.
-    vectors.put(vel, g.ab, out.v)
+    # No row repeats within a round, so each scatter writes each row once.
+    zvel[g.a], zvel[g.b] = out.v1, out.v2
     if mode != "off":
-        vectors.put(pos, g.ab, out.x)
+        zpos[g.a], zpos[g.b] = out.x1, out.x2
     return _RoundRecord(g, out) if out.count else None
+
+
+def _rows(z: np.ndarray) -> np.ndarray:
+    """Complex vectors as (N, 2) float rows."""
+    return z.view(np.float64).reshape(-1, 2)
 
 
 @dataclass
@@ -470,14 +456,13 @@ class _RoundRecord:
         return self.out.count
 
     def collisions(self) -> Collisions:
-        g, out, k = self.g, self.out, len(self.g.a)
-        contact = out.contact_from + out.n * g.r2[:, None]
-        x, v, x_after, v_after = g.x, g.v, out.x, out.v
+        g, out = self.g, self.out
+        contact = out.contact_from + g.r2 * out.n
         record = Collisions(
-            g.a, g.b, out.n, contact, g.overlap, g.reach,
-            x[:k], x[k:], x_after[:k], x_after[k:], v[:k], v[k:], v_after[:k], v_after[k:],
+            g.a, g.b, _rows(out.n), _rows(contact), g.overlap, g.reach,
+            *(_rows(z) for z in (g.x1, g.x2, out.x1, out.x2, g.v1, g.v2, out.v1, out.v2)),
         )  # fmt: skip
-        return record if out.count == k else record.take(out.approach.nonzero()[0])
+        return record if out.count == len(g.a) else record.take(out.approach.nonzero()[0])
 
 
 # ---------------------------------------------------------------- a few pairs, in floats

@@ -89,16 +89,53 @@ def take(a: np.ndarray, idx: np.ndarray) -> np.ndarray:
     return a.take(idx, axis=0)
 
 
-def _as_complex(a: np.ndarray) -> np.ndarray:
-    """The (N,) complex128 view of a C-contiguous (N, 2) float64 array."""
+def as_complex(a: np.ndarray) -> np.ndarray:
+    """The (N,) complex128 view of a C-contiguous (N, 2) float64 array: row (x, y) is x + iy."""
     return a.view(np.complex128).ravel()  # a view, as reshape(-1) gives, for half the cost
 
 
 def put(a: np.ndarray, idx: np.ndarray, values: np.ndarray) -> None:
     """a[idx] = values for an (N, 2) float64 array, in place (the last write wins where idx repeats)."""
-    _as_complex(a)[idx] = _as_complex(np.ascontiguousarray(values, dtype=np.float64))
+    as_complex(a)[idx] = as_complex(np.ascontiguousarray(values, dtype=np.float64))
 
 
 def add_at(a: np.ndarray, idx: np.ndarray, values: np.ndarray) -> None:
     """np.add.at(a, idx, values) for an (N, 2) float64 array, in place: repeated rows add up."""
-    np.add.at(_as_complex(a), idx, _as_complex(np.ascontiguousarray(values, dtype=np.float64)))
+    np.add.at(as_complex(a), idx, as_complex(np.ascontiguousarray(values, dtype=np.float64)))
+
+
+# ---------------------------------------------------------------- vectors as complex numbers
+#
+# The pair rounds (pairs.py) hold each vector as one complex number x + iy, gathered from the
+# table with as_complex: a pair's two pucks are then two 1-D arrays, and adding, subtracting,
+# gathering and scattering vectors is one numpy operation each, with no (N, 2) shapes to
+# broadcast. Only operations that are exact per part are used on them: adding, subtracting,
+# and scaling by a real array (s * z is (s x) + i (s y), bit for bit); dot products and
+# lengths below work on the x, y, x, y... floats behind them. So every result is bit for bit
+# what the same formula gives in plain Python floats, part by part.
+
+
+def squared_abs(z: np.ndarray) -> np.ndarray:
+    """x^2 + y^2 of each complex z = x + iy: the squared length of the vector (x, y)."""
+    xy = z.view(np.float64)
+    xy = xy * xy
+    return xy[0::2] + xy[1::2]
+
+
+def dot(z: np.ndarray, w: np.ndarray) -> np.ndarray:
+    """The dot product of the vectors z and w (complex, one per row): zx wx + zy wy."""
+    xy = z.view(np.float64) * w.view(np.float64)
+    return xy[0::2] + xy[1::2]
+
+
+def units(z: np.ndarray, keys) -> tuple[np.ndarray, np.ndarray]:
+    """unit_vectors for complex z: (z / |z|, |z|), each part divided by the length.
+
+    A zero z gets `fallback_directions` of its key; keys may be a function
+    that makes them, called only if some z is zero.
+    """
+    dist = np.sqrt(squared_abs(z))
+    if np.count_nonzero(dist) == len(dist):
+        return (z.view(np.float64) / dist.repeat(2)).view(np.complex128), dist
+    n, _ = unit_vectors(z.view(np.float64).reshape(-1, 2), keys)
+    return as_complex(n), dist
