@@ -469,10 +469,11 @@ class _RoundRecord:
 
 
 def _resolve_few(pos, vel, radius, mass, a: list[int], b: list[int], cr, mode, dt_s) -> Recorded | None:
-    """`_resolve_round` for a few pairs: the same steps, pair by pair, in Python floats."""
+    """`_resolve_round` for a few pairs: the same steps, pair by pair, in Python numbers."""
+    zpos, zvel = vectors.as_complex(pos), vectors.as_complex(vel)
     rows, hit = [], []
     for p, q in zip(a, b, strict=True):
-        row = _pair_in_floats(pos, vel, radius, mass, p, q, cr, mode, dt_s)
+        row = _pair_in_floats(zpos, zvel, radius, mass, p, q, cr, mode, dt_s)
         if row is not None:
             rows.append(row)
             hit.append((p, q))
@@ -484,92 +485,95 @@ class _FewRecord:
     """The record rows of `_resolve_few`, made into `Collisions` only when read."""
 
     hit: list[tuple[int, int]]
-    rows: list[list[float]]  # overlap, reach, then normal, contact and 8 positions and velocities as (x, y)
+    rows: list[tuple]  # overlap, reach, then normal, contact and 8 positions and velocities, as complex x + iy
 
     def __len__(self) -> int:
         return len(self.rows)
 
     def collisions(self) -> Collisions:
-        ij, f = np.array(self.hit, dtype=np.intp), np.array(self.rows)
-        two = [f[:, k : k + 2] for k in range(2, 22, 2)]
-        return Collisions(ij[:, 0], ij[:, 1], two[0], two[1], f[:, 0], f[:, 1], *two[2:])
+        ij = np.array(self.hit, dtype=np.intp)
+        overlap, reach, n, contact, *states = (np.array(column) for column in zip(*self.rows, strict=True))
+        return Collisions(ij[:, 0], ij[:, 1], _rows(n), _rows(contact), overlap, reach, *(_rows(z) for z in states))
 
 
 # What a round or a few pairs record: `Collisions`, or what makes them when read.
 Recorded = Collisions | _RoundRecord | _FewRecord
 
 
-def _unit_floats(d0: float, d1: float, key: int) -> tuple[float, float, float]:
-    """vectors.unit_vectors for one row: (n0, n1, length)."""
-    dist = math.sqrt(d0 * d0 + d1 * d1)
+def _unit_floats(d: complex, key: int) -> tuple[complex, float]:
+    """vectors.units for one vector: (d / |d|, |d|), each part divided by the length."""
+    dx, dy = d.real, d.imag
+    dist = math.sqrt(dx * dx + dy * dy)
     if dist != 0.0:
-        return d0 / dist, d1 / dist, dist
+        return complex(dx / dist, dy / dist), dist
     n0, n1 = vectors.fallback_directions(np.array([key]))[0].tolist()
-    return n0, n1, dist
+    return complex(n0, n1), dist
 
 
-def _kiss_time(x1, x2, vrel, reach: float, dt_s: float) -> float | None:
+def _dot(z: complex, w: complex) -> float:
+    """vectors.dot for one pair of vectors."""
+    return z.real * w.real + z.imag * w.imag
+
+
+def _kiss_time(d: complex, vrel: complex, reach: float, dt_s: float) -> float | None:
     """`_time_since_contact` for one pair: the time back to first contact, None if the step cannot explain it."""
-    d0, d1 = x1[0] - x2[0], x1[1] - x2[1]
-    vv = vrel[0] * vrel[0] + vrel[1] * vrel[1]
-    dv = d0 * vrel[0] + d1 * vrel[1]
-    disc = max(dv * dv - vv * ((d0 * d0 + d1 * d1) - reach * reach), 0.0)
+    vv, dv = _dot(vrel, vrel), _dot(d, vrel)
+    disc = max(dv * dv - vv * (_dot(d, d) - reach * reach), 0.0)
     if not vv > REST_SPEED_MPS**2:
         return None
     t_back = (dv + math.sqrt(disc)) / vv
     return t_back if 0.0 <= t_back <= dt_s * (1.0 + 1e-9) + 1e-15 else None
 
 
-def _pair_in_floats(pos, vel, radius, mass, p, q, cr, mode, dt_s) -> list[float] | None:
+def _pair_in_floats(zpos, zvel, radius, mass, p, q, cr, mode, dt_s) -> tuple | None:
     """Collide and part the pair (p, q) in place, as `_gather`, the mode's round function and
-    `separate` would; return its record row (see _resolve_few), None if it did not collide."""
-    x1, x2 = pos[p].tolist(), pos[q].tolist()
+    `separate` would, on the table's complex views zpos and zvel; return its record row (see
+    _FewRecord), None if it did not collide."""
+    x1, x2 = zpos.item(p), zpos.item(q)
     r2 = radius.item(q)
     reach = radius.item(p) + r2
-    n0, n1, dist = _unit_floats(x1[0] - x2[0], x1[1] - x2[1], p + q)
+    d = x1 - x2
+    n, dist = _unit_floats(d, p + q)
     overlap = reach - dist
     if not overlap > 0.0:
         return None
-    v1, v2 = vel[p].tolist(), vel[q].tolist()
+    v1, v2 = zvel.item(p), zvel.item(q)
     m1, m2 = mass.item(p), mass.item(q)
     m_sum = m1 + m2
     share1, share2 = m2 / m_sum, m1 / m_sum
-    vrel = (v1[0] - v2[0], v1[1] - v2[1])
-    vn = vrel[0] * n0 + vrel[1] * n1
-    t_b = _kiss_time(x1, x2, vrel, reach, dt_s) if mode == "perfect-kiss" else None
+    vrel = v1 - v2
+    vn = _dot(vrel, n)
+    t_b = _kiss_time(d, vrel, reach, dt_s) if mode == "perfect-kiss" else None
     if t_b is None:  # as _round_two_step (and _round_off, which does not use `move`)
         approach = vn < -REST_SPEED_MPS
         move = (1.0 + cr) * min(overlap, vn * -dt_s)
         c = x2
     else:  # as _round_perfect_kiss
-        c = [x2[0] - v2[0] * t_b, x2[1] - v2[1] * t_b]
-        n0, n1, _ = _unit_floats((x1[0] - v1[0] * t_b) - c[0], (x1[1] - v1[1] * t_b) - c[1], p + q)
-        vn = vrel[0] * n0 + vrel[1] * n1
+        c = x2 - t_b * v2
+        n, _ = _unit_floats((x1 - t_b * v1) - c, p + q)
+        vn = _dot(vrel, n)
         approach = vn < 0.0
         move = -(1.0 + cr) * vn * t_b
     jn = -(1.0 + cr) * vn if approach else 0.0  # collide_along_normal
-    w1 = [v1[0] + jn * share1 * n0, v1[1] + jn * share1 * n1]
-    w2 = [v2[0] - jn * share2 * n0, v2[1] - jn * share2 * n1]
-    vel[p], vel[q] = w1, w2
+    w1, w2 = v1 + (jn * share1) * n, v2 - (jn * share2) * n
+    zvel[p], zvel[q] = w1, w2
     y1, y2 = x1, x2
     if mode != "off":
-        y1, y2 = _separate_floats(x1, x2, (n0, n1), move if approach else 0.0, reach, share1, share2, p + q)
-        pos[p], pos[q] = y1, y2
+        y1, y2 = _separate_floats(x1, x2, n, move if approach else 0.0, reach, share1, share2, p + q)
+        zpos[p], zpos[q] = y1, y2
     if not approach:
         return None
-    return [overlap, reach, n0, n1, c[0] + n0 * r2, c[1] + n1 * r2, *x1, *x2, *y1, *y2, *v1, *v2, *w1, *w2]
+    return overlap, reach, n, c + r2 * n, x1, x2, y1, y2, v1, v2, w1, w2
 
 
-def _separate_floats(x1, x2, n, move: float, reach: float, share1: float, share2: float, key: int):
+def _separate_floats(x1, x2, n: complex, move: float, reach: float, share1: float, share2: float, key: int):
     """`separate` for one pair: move it `move` apart along n, then push apart what still overlaps."""
-    y1 = [x1[0] + move * share1 * n[0], x1[1] + move * share1 * n[1]]
-    y2 = [x2[0] - move * share2 * n[0], x2[1] - move * share2 * n[1]]
-    d0, d1 = y1[0] - y2[0], y1[1] - y2[1]
-    if d0 * d0 + d1 * d1 < reach * reach:
-        m0, m1, dist = _unit_floats(d0, d1, key)
+    y1, y2 = x1 + (move * share1) * n, x2 - (move * share2) * n
+    d = y1 - y2
+    if _dot(d, d) < reach * reach:
+        n_now, dist = _unit_floats(d, key)
         left = max(reach - dist, 0.0)
-        y1 = [y1[0] + left * share1 * m0, y1[1] + left * share1 * m1]
-        y2 = [y2[0] - left * share2 * m0, y2[1] - left * share2 * m1]
+        y1, y2 = y1 + (left * share1) * n_now, y2 - (left * share2) * n_now
     return y1, y2
 
 
