@@ -108,17 +108,27 @@ def overlapping_pairs(
     j: np.ndarray,
     reach: np.ndarray,
     sorted_order: Callable[[], np.ndarray] | None = None,
-    reach_sq: np.ndarray | None = None,
+    reach_sq: np.ndarray | float | None = None,
 ) -> tuple[np.ndarray, np.ndarray]:
     """The candidate pairs (i, j) closer than `reach`, sorted by (i, j).
 
+    `reach_sq`, if given, is reach * reach already worked out (NeighbourList.reach_squared).
+    `sorted_order`: see `pairs_where`.
+    """
+    close = squared_distances(pos, i, j) < (reach * reach if reach_sq is None else reach_sq)
+    return pairs_where(close, i, j, len(pos), sorted_order)
+
+
+def pairs_where(
+    close: np.ndarray, i: np.ndarray, j: np.ndarray, n: int, sorted_order: Callable[[], np.ndarray] | None = None
+) -> tuple[np.ndarray, np.ndarray]:
+    """The pairs (i, j) (of n pucks) where `close` is True, sorted by (i, j).
+
     `sorted_order`, if given, returns the permutation that sorts the
     candidates by (i, j) (NeighbourList.sorted_order, worked out once per
-    build): where many pairs overlap (a pile), they are picked in that order
-    instead of being sorted each time; the result is the same. `reach_sq`,
-    if given, is reach * reach already worked out (NeighbourList.reach_squared).
+    build): where many pairs are close (a pile), they are picked in that order
+    instead of being sorted each time; the result is the same.
     """
-    close = _squared_distances(pos, i, j) < (reach * reach if reach_sq is None else reach_sq)
     if sorted_order is not None and np.count_nonzero(close) * SORTED_PICK_SHARE >= len(i):
         order = sorted_order()
         hit = order.take(close.take(order).nonzero()[0])
@@ -126,19 +136,12 @@ def overlapping_pairs(
     hit = close.nonzero()[0]
     i, j = i.take(hit), j.take(hit)
     if len(i) > 1:  # one key i * n + j sorts as (i, j) does, twice as fast as lexsort on a few hundred
-        by_pair = np.argsort(i * len(pos) + j, kind="stable")
+        by_pair = np.argsort(i * n + j, kind="stable")
         i, j = i.take(by_pair), j.take(by_pair)
     return i, j
 
 
-def pairs_with(rows: np.ndarray, i: np.ndarray, j: np.ndarray, n: int) -> np.ndarray:
-    """Indices k of the pairs (i, j) with a puck in `rows` (of n pucks)."""
-    marked = np.zeros(n, dtype=bool)
-    marked[rows] = True
-    return (marked.take(i) | marked.take(j)).nonzero()[0]
-
-
-def _squared_distances(pos: np.ndarray, i: np.ndarray, j: np.ndarray) -> np.ndarray:
+def squared_distances(pos: np.ndarray, i: np.ndarray, j: np.ndarray) -> np.ndarray:
     """|pos[i] - pos[j]|^2 for each pair: the sums of vectors.squared_lengths, in fewer passes."""
     # A puck's (x, y) as one complex number: two 1-D takes instead of 2-D ones.
     z = np.ascontiguousarray(pos, dtype=np.float64).view(np.complex128).reshape(-1)
@@ -151,7 +154,7 @@ def _squared_distances(pos: np.ndarray, i: np.ndarray, j: np.ndarray) -> np.ndar
 
 def _closer_than(pos: np.ndarray, i: np.ndarray, j: np.ndarray, reach: np.ndarray) -> np.ndarray:
     """Indices k of the pairs whose centres are less than reach[k] apart."""
-    return (_squared_distances(pos, i, j) < reach * reach).nonzero()[0]
+    return (squared_distances(pos, i, j) < reach * reach).nonzero()[0]
 
 
 class NeighbourList:
@@ -223,6 +226,12 @@ class NeighbourList:
         """reach_squared(less_m) of the pairs k only (the one number, where it is one)."""
         sq = self.reach_squared(less_m)
         return sq if self._one_reach is not None else sq.take(k)
+
+    def within(self, dsq: np.ndarray, extra_m: float) -> np.ndarray:
+        """Indices k of the pairs whose squared distance dsq[k] (one per pair of the list) is
+        under (reach + extra_m)^2."""
+        r = (self._reach if self._one_reach is None else self._one_reach) + extra_m
+        return (dsq < r * r).nonzero()[0]
 
     def _still_valid(self, pos: np.ndarray, radius: np.ndarray, rows: np.ndarray | None = None) -> bool:
         """Whether no puck moved half a skin since the build (`rows`: pos and radius are just those rows)."""

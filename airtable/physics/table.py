@@ -113,6 +113,12 @@ def _swept_record(s: sweep.Swept, radius: np.ndarray) -> pairs.Collisions:
     return pairs.Collisions(i, j, n, contact, np.zeros(len(i)), reach, xi, xj, xi, xj, vi0, vj0, vi1, vj1)
 
 
+def _farthest_move(pos: np.ndarray, before: np.ndarray, i: np.ndarray, j: np.ndarray) -> float:
+    """The farthest any puck of the pairs (i, j) is now from where it was (`before`, the rows of i
+    then j)."""
+    return math.sqrt(float(vectors.squared_lengths(vectors.take(pos, np.concatenate([i, j])) - before).max()))
+
+
 class _Columns:
     """Growable numpy arrays sharing one row count (amortised O(1) append)."""
 
@@ -752,14 +758,17 @@ class AirTable:
         list was last checked (NeighbourList.pairs).
         """
         pos, vel, radius, mass = self.pos_m, self.vel_mps, self.radius_m, self.mass_kg
-        ci, cj, reach = self._neighbours.pairs(pos, radius, moved)
-        order = self._neighbours.sorted_order
-        reach_sq = self._neighbours.reach_squared()
-        i, j = self._colliding(rest, *broadphase.overlapping_pairs(pos, ci, cj, reach, order, reach_sq))
-        records, moved = [], []
+        ci, cj, _ = self._neighbours.pairs(pos, radius, moved)
+        dsq = broadphase.squared_distances(pos, ci, cj)  # kept: later looks pick their candidates by it
+        close = dsq < self._neighbours.reach_squared()
+        i, j = self._colliding(rest, *broadphase.pairs_where(close, ci, cj, len(pos), self._neighbours.sorted_order))
+        records, moved, drift = [], [], 0.0
         for attempt in range(1 + EXTRA_PASSES):
             if len(i) == 0:
                 break
+            look_again = self.puck_correction != "off" and attempt < EXTRA_PASSES
+            near_only = look_again and len(ci) >= LOOK_AT_MOVED_MIN_PAIRS  # see _candidates_of
+            before = vectors.take(pos, np.concatenate([i, j])) if near_only else None
             if attempt < EXTRA_PASSES:
                 records += pairs.resolve_pairs(
                     pos, vel, radius, mass, i, j, self.cr_puck, self.puck_correction, dt, in_time_order=True
@@ -767,13 +776,15 @@ class AirTable:
             else:
                 pairs.push_apart(pos, radius, mass, i, j)
             moved += [i, j]
-            if self.puck_correction == "off" or attempt == EXTRA_PASSES:
+            if not look_again:
                 break  # with "off" overlaps stay: that is what it shows
             # Parting a pair can push one of its pucks into a third one that
             # was already handled: look again among the same candidates (those
-            # of the pucks just moved: nothing else changed), collide those
-            # pairs too, and at last just push apart what is left.
-            ni, nj, near_sq = self._candidates_of(i, j, ci, cj)
+            # that may have come within reach: nothing else changed), collide
+            # those pairs too, and at last just push apart what is left.
+            if near_only:
+                drift += _farthest_move(pos, before, i, j)
+            ni, nj, near_sq = self._candidates_of(ci, cj, dsq, drift)
             i, j = self._colliding(rest, *broadphase.overlapping_pairs(pos, ni, nj, None, reach_sq=near_sq))
         if not moved:
             return np.empty(0, dtype=np.intp)
@@ -781,13 +792,16 @@ class AirTable:
         self.collision_count += sum(len(r) for r in records)
         return np.concatenate(moved)
 
-    def _candidates_of(self, i: np.ndarray, j: np.ndarray, ci: np.ndarray, cj: np.ndarray):
-        """(i, j, (reach - OVERLAP_SLOP_M)^2) of the candidate pairs with a puck of a pair (i, j)
-        (NeighbourList.reach_squared); all of them on a small table, where picking them out costs
-        more than checking them all."""
+    def _candidates_of(self, ci: np.ndarray, cj: np.ndarray, dsq: np.ndarray, drift: float):
+        """(i, j, (reach - OVERLAP_SLOP_M)^2) of the candidate pairs that may overlap now, `dsq`
+        being their squared distances when the pair stage began and `drift` the farthest any
+        puck has moved since (NeighbourList.within): on a small table all of them, where
+        picking them out costs more than checking them all."""
         if len(ci) < LOOK_AT_MOVED_MIN_PAIRS:
             return ci, cj, self._neighbours.reach_squared(OVERLAP_SLOP_M)
-        k = broadphase.pairs_with(np.concatenate([i, j]), ci, cj, self._pucks.n)
+        # Two pucks that each moved at most `drift` came at most 2 drift closer (a
+        # micrometre more against rounding): pairs farther apart than that cannot touch.
+        k = self._neighbours.within(dsq, 2.0 * drift + 1e-6)
         return ci.take(k), cj.take(k), self._neighbours.reach_squared_of(k, OVERLAP_SLOP_M)
 
     def _colliding(self, rest: np.ndarray | None, i: np.ndarray, j: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
