@@ -188,8 +188,9 @@ def resolve_pairs(
     def since(k):
         return since_contact(pos, vel, radius, i.take(k), j.take(k), dt_s)
 
+    zpos, zvel = vectors.as_complex(pos), vectors.as_complex(vel)  # the rounds' vectors (see _Round)
     if len(i) <= FEW_PAIRS:
-        return _resolve_few_in_order(pos, vel, radius, mass, i, j, cr_puck, mode, dt_s, in_time_order)
+        return _resolve_few_in_order(zpos, zvel, radius, mass, i, j, cr_puck, mode, dt_s, in_time_order)
     shared = sharing_pairs(i, j)
     if len(shared) <= FEW_PAIRS:
         # A gas's usual case. The pairs whose pucks are in no other pair
@@ -198,24 +199,26 @@ def resolve_pairs(
         alone = np.ones(len(i), dtype=bool)
         alone[shared] = False
         alone, few = alone.nonzero()[0], shared
-        c = _resolve_round(pos, vel, radius, mass, i.take(alone), j.take(alone), cr_puck, mode, dt_s)
+        c = _resolve_round(zpos, zvel, radius, mass, i.take(alone), j.take(alone), cr_puck, mode, dt_s)
         few_records = _resolve_few_in_order(
-            pos, vel, radius, mass, i.take(few), j.take(few), cr_puck, mode, dt_s, in_time_order
+            zpos, zvel, radius, mass, i.take(few), j.take(few), cr_puck, mode, dt_s, in_time_order
         )
         return ([] if c is None else [c]) + few_records
     records = []
     for r in disjoint_rounds(i, j, since if in_time_order else None, shared):
-        c = _resolve_round(pos, vel, radius, mass, i.take(r), j.take(r), cr_puck, mode, dt_s)
+        c = _resolve_round(zpos, zvel, radius, mass, i.take(r), j.take(r), cr_puck, mode, dt_s)
         if c is not None:
             records.append(c)
     return records
 
 
-def _resolve_few_in_order(pos, vel, radius, mass, i, j, cr_puck, mode, dt_s, in_time_order) -> list[Recorded]:
+def _resolve_few_in_order(zpos, zvel, radius, mass, i, j, cr_puck, mode, dt_s, in_time_order) -> list[Recorded]:
     """resolve_pairs for a few pairs, in floats: in the order of their rounds, one by one."""
     il, jl = i.tolist(), j.tolist()
-    order = _few_in_order(pos, vel, radius, il, jl, dt_s if in_time_order else None)
-    c = _resolve_few(pos, vel, radius, mass, [il[k] for k in order], [jl[k] for k in order], cr_puck, mode, dt_s)
+    order = _few_in_order(zpos, zvel, radius, il, jl, dt_s if in_time_order else None)
+    if order is not None:
+        il, jl = [il[k] for k in order], [jl[k] for k in order]
+    c = _resolve_few(zpos, zvel, radius, mass, il, jl, cr_puck, mode, dt_s)
     return [] if c is None else [c]
 
 
@@ -420,14 +423,14 @@ _ROUND_BY_MODE: dict[str, Callable[[_Round, float, float], _Outcome]] = {
 }
 
 
-def _resolve_round(pos, vel, radius, mass, a, b, cr, mode, dt_s) -> Recorded | None:
-    """Resolve pairs that share no puck, all at once, in place (see `disjoint_rounds`).
+def _resolve_round(zpos, zvel, radius, mass, a, b, cr, mode, dt_s) -> Recorded | None:
+    """Resolve pairs that share no puck, all at once, in place (see `disjoint_rounds`), on the
+    table's positions and velocities as complex numbers (vectors.as_complex).
 
     Returns the record of the pairs that collided, None if none did.
     """
     if len(a) <= FEW_PAIRS:
-        return _resolve_few(pos, vel, radius, mass, a.tolist(), b.tolist(), cr, mode, dt_s)
-    zpos, zvel = vectors.as_complex(pos), vectors.as_complex(vel)
+        return _resolve_few(zpos, zvel, radius, mass, a.tolist(), b.tolist(), cr, mode, dt_s)
     g = _gather(zpos, zvel, radius, mass, a, b)
     if g is None:
         return None
@@ -468,9 +471,8 @@ class _RoundRecord:
 # ---------------------------------------------------------------- a few pairs, in floats
 
 
-def _resolve_few(pos, vel, radius, mass, a: list[int], b: list[int], cr, mode, dt_s) -> Recorded | None:
+def _resolve_few(zpos, zvel, radius, mass, a: list[int], b: list[int], cr, mode, dt_s) -> Recorded | None:
     """`_resolve_round` for a few pairs: the same steps, pair by pair, in Python numbers."""
-    zpos, zvel = vectors.as_complex(pos), vectors.as_complex(vel)
     rows, hit = [], []
     for p, q in zip(a, b, strict=True):
         row = _pair_in_floats(zpos, zvel, radius, mass, p, q, cr, mode, dt_s)
@@ -577,17 +579,18 @@ def _separate_floats(x1, x2, n: complex, move: float, reach: float, share1: floa
     return y1, y2
 
 
-def _few_in_order(pos, vel, radius, il: list[int], jl: list[int], dt_s: float | None) -> list[int]:
+def _few_in_order(zpos, zvel, radius, il: list[int], jl: list[int], dt_s: float | None) -> list[int] | None:
     """The order in which `disjoint_rounds`' rounds would take the pairs (il, jl): round by round,
-    in the given order within a round. With dt_s, pairs sharing a puck go as they met (since_contact)."""
+    in the given order within a round (None: the given order). With dt_s, pairs sharing a puck
+    go as they met (since_contact)."""
+    if len(set(il + jl)) == 2 * len(il):
+        return None  # the usual case: no puck in two pairs, one round in the given order
     uses: dict[int, int] = {}
     for p in il + jl:
         uses[p] = uses.get(p, 0) + 1
     shared = [k for k in range(len(il)) if uses[il[k]] > 1 or uses[jl[k]] > 1]
-    if not shared:
-        return list(range(len(il)))  # the usual case: no puck in two pairs, one round
     if dt_s is not None:
-        since = {k: _since_floats(pos, vel, radius, il[k], jl[k], dt_s) for k in shared}
+        since = {k: _since_floats(zpos, zvel, radius, il[k], jl[k], dt_s) for k in shared}
         shared.sort(key=lambda k: -since[k])  # stable, as np.argsort(kind="stable")
     level = [0] * len(il)
     for k, lvl in zip(shared, _chain_levels([il[k] for k in shared], [jl[k] for k in shared]), strict=True):
@@ -595,12 +598,11 @@ def _few_in_order(pos, vel, radius, il: list[int], jl: list[int], dt_s: float | 
     return sorted(range(len(il)), key=level.__getitem__)
 
 
-def _since_floats(pos, vel, radius, p: int, q: int, dt_s: float) -> float:
+def _since_floats(zpos, zvel, radius, p: int, q: int, dt_s: float) -> float:
     """`since_contact` for one pair."""
-    xi, xj, vi, vj = pos[p].tolist(), pos[q].tolist(), vel[p].tolist(), vel[q].tolist()
-    d0, d1, w0, w1 = xi[0] - xj[0], xi[1] - xj[1], vi[0] - vj[0], vi[1] - vj[1]
+    d, w = zpos.item(p) - zpos.item(q), zvel.item(p) - zvel.item(q)
     reach = radius.item(p) + radius.item(q)
-    ww, dw = w0 * w0 + w1 * w1, d0 * w0 + d1 * w1
-    disc = max(dw * dw - ww * ((d0 * d0 + d1 * d1) - reach * reach), 0.0)
+    ww, dw = _dot(w, w), _dot(d, w)
+    disc = max(dw * dw - ww * (_dot(d, d) - reach * reach), 0.0)
     back = (dw + math.sqrt(disc)) / (ww if ww > 0.0 else 1.0)
     return back if ww > 0.0 and 0.0 <= back <= dt_s else dt_s
