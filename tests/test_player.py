@@ -125,6 +125,33 @@ def test_own_cursor_is_drawn_at_the_live_mouse_position_with_its_string():
     assert own_cursor_live((mine, other), welcome.client, (2.5, 2.25), 0, focused=False) == ((other, mine), False)
 
 
+def test_a_still_table_lets_the_window_draw_less_often_until_something_moves():
+    app = PlayerApp(NetPlayer("127.0.0.1", 1), headless=True)  # never connected: only the bookkeeping
+    pucks = np.array([[1.0, 1.0], [2.0, 1.0]])
+    other = CursorView("C1", (255, 52, 179), (1.0, 1.0), 0, -1)
+
+    def scene(pos, cursors=(other,)):
+        return Scene(10.0, 8.7556, pos, np.full(len(pos), 0.25), np.zeros((len(pos), 3), np.uint8), cursors=cursors)
+
+    here = np.array([5.0, 5.0])
+    app.note_motion(scene(pucks), here, now_s=10.0)
+    assert not app.still(10.5)
+    app.note_motion(scene(pucks.copy()), here.copy(), now_s=10.9)  # the same picture: not a change
+    assert app.still(11.0)  # idle IDLE_AFTER_S = 1 s after the last change
+    moved = pucks.copy()
+    moved[1, 0] += 1e-6  # a puck moves, however little
+    app.note_motion(scene(moved), here, now_s=12.0)
+    assert not app.still(12.5) and app.still(13.0)
+    walked = CursorView("C1", (255, 52, 179), (1.5, 1.0), 0, -1)  # another student's cursor
+    app.note_motion(scene(moved, (walked,)), here, now_s=14.0)
+    assert not app.still(14.5) and app.still(15.0)
+    app.note_motion(scene(moved, (walked,)), np.array([5.0, 5.1]), now_s=16.0)  # our own mouse
+    assert not app.still(16.5)
+    app.button = 1  # our button, with the mouse still
+    app.note_motion(scene(moved, (walked,)), np.array([5.0, 5.1]), now_s=17.5)
+    assert not app.still(18.0) and app.still(18.5)
+
+
 # ---------------------------------------------------------------- NetPlayer
 
 

@@ -45,6 +45,11 @@ HEARTBEAT_S = 1.0
 FIRST_BACKOFF_S = 0.25
 FIRST_FULL_BACKOFF_S = 1.0  # the table is full: ask again after this, then less and less often
 MAX_BACKOFF_S = 4.0
+# Once nothing has moved on the table (pucks, cursors) and this window had no input for
+# IDLE_AFTER_S, it draws IDLE_FPS frames a second instead of its full rate, waking at once on
+# input: a still table leaves a student's laptop quiet, and motion shows within 1 / IDLE_FPS.
+IDLE_FPS = 20.0
+IDLE_AFTER_S = 1.0
 # Drawing budgets for one frame (see fit_drawing_budget).
 MAX_PUCK_AREA_SCREENS = 40.0
 MAX_PUCK_LOOKS = 1024
@@ -512,6 +517,16 @@ class NetPlayer:
 # -------------------------------------------------------------------- the window
 
 
+def _wait_for_input(seconds: float) -> None:
+    """Sleep up to `seconds`, waking early when an event (input, the window) comes in; the
+    event stays in the queue for the next frame."""
+    import pygame
+
+    event = pygame.event.wait(max(1, int(seconds * 1000)))
+    if event.type != pygame.NOEVENT:
+        pygame.event.post(event)
+
+
 class PlayerApp:
     """The pygame window of a player: the server's table from snapshots, our cursor drawn locally."""
 
@@ -533,6 +548,8 @@ class PlayerApp:
         self._drawn_from: tuple = ()  # the restarts and view the trails were drawn in
         self._welcome: proto.Welcome | None = None
         self.predicting = StudentGuesses()  # our arrows in a prediction round
+        self._motion: tuple = ()  # what moves, as the last frame showed it (see note_motion)
+        self._moved_s = -math.inf  # when it last changed
 
     def run(
         self, seconds: float | None = None, screenshot: str | None = None, until: Callable[[], bool] | None = None
@@ -559,7 +576,10 @@ class PlayerApp:
                     break
                 if until is not None and until():
                     break
-                clock.tick(self.fps)
+                if self.still(time.monotonic()) and not self.headless:
+                    _wait_for_input(1.0 / IDLE_FPS)
+                else:
+                    clock.tick(self.fps)
         except KeyboardInterrupt:
             pass
         finally:
@@ -567,6 +587,16 @@ class PlayerApp:
                 self.window.save_screenshot(screenshot)
             self.net.close(bye=True)
         return status
+
+    def note_motion(self, scene: Scene, cursor_m: np.ndarray, now_s: float) -> None:
+        """Remember what moves in this frame: the pucks, every cursor, our own input."""
+        motion = (scene.pos_m.tobytes(), scene.cursors, tuple(cursor_m.tolist()), self.button, frozenset(self.keys))
+        if motion != self._motion:
+            self._motion, self._moved_s = motion, now_s
+
+    def still(self, now_s: float) -> bool:
+        """Nothing has moved, and no input came, for IDLE_AFTER_S: the window may draw less often."""
+        return now_s - self._moved_s >= IDLE_AFTER_S
 
     def _open_window(self) -> None:
         import pygame
@@ -684,6 +714,7 @@ class PlayerApp:
         env.origin_m = np.array(scene.origin_m, dtype=float)
         cursor_m = env.to_world(np.array(pygame.mouse.get_pos(), dtype=float))
         net.update_input(cursor_m, self.button, self.keys)
+        self.note_motion(scene, cursor_m, time.monotonic())
         self.states_seen.add(net.state)
         self.frames += 1
         try:
