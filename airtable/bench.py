@@ -31,6 +31,7 @@ import numpy as np
 from airtable import bench_hard
 from airtable.bench_cpu import cpu_section
 from airtable.bench_frames import window_section
+from airtable.bench_instructions import instructions_section
 from airtable.bench_net_sections import link_section, snapshot_section
 from airtable.memory import keep_freed_memory
 from airtable.physics import broadphase, vectors
@@ -481,6 +482,7 @@ SECTIONS: dict[str, Callable[[argparse.Namespace], bool]] = {
     "snapshots": snapshot_section,
     "link": link_section,
     "hard": bench_hard.hard_section,
+    "instructions": instructions_section,
 }
 
 
