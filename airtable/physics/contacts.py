@@ -104,7 +104,7 @@ def _pair_contacts(pos, vel, ci, cj, reach, rest, held, margin) -> _Contacts:
     slow[fast] = held(i.take(fast), j.take(fast))
     slow = np.flatnonzero(slow)
     i, j = i.take(slow), j.take(slow)
-    nc = _as_complex(vectors.take(n, slow))
+    nc = vectors.as_complex(vectors.take(n, slow))
     count = len(pos)
     keys = i.astype(np.int64) * (count + 4) + j
     return _Contacts(i, j, nc, dist.take(slow) - reach.take(near).take(slow), vn.take(slow), keys)
@@ -128,11 +128,6 @@ def _wall_contacts(pos, vel, radius, size_m, rest, margin) -> _Contacts:
     keys = a.astype(np.int64) * (count + 4) + count + w
     b = np.full(len(a), count)
     return _Contacts(a, b, WALL_NORMALS.take(w), np.concatenate(gap), np.concatenate(vn), keys)
-
-
-def _as_complex(rows: np.ndarray) -> np.ndarray:
-    """(N, 2) float rows as N complex numbers x + iy (a matrix product with (1, i) is many times slower)."""
-    return np.ascontiguousarray(rows, dtype=np.float64).view(np.complex128).reshape(-1)
 
 
 def colour_rounds(a: np.ndarray, b: np.ndarray, n_bodies: int, prio: np.ndarray | None = None) -> list[np.ndarray]:
@@ -252,7 +247,7 @@ class ContactSolver:
             inv[:-1][asleep] = 0.0
         first, later = self._gather(c, inv, len(pc.a), dt, asleep)
         w = np.zeros((len(pos) + 1, 2), dtype=complex)  # velocities and pseudo-velocities; the last row: walls
-        w[:-1, 0] = _as_complex(vel)
+        w[:-1, 0] = vectors.as_complex(np.ascontiguousarray(vel))
         v0 = w[:-1, 0].copy()
         w[:-1, 0] += _warm_push(c, mass, self._warm, asleep)  # warm start: last step's velocity impulses first
         self.iterations, layout = _iterate(w, first, later)

@@ -57,8 +57,9 @@ TABLE_HEIGHT_M = 8.7556
 # over the pairs the corrections pushed into overlap: collisions again, then a
 # last pass that only pushes apart.
 EXTRA_PASSES = 2
-# From this many candidate pairs on (a gas of some 3000 pucks), the second look for
-# overlaps checks only the pairs of the pucks the first pass moved.
+# From this many candidate pairs on (a gas of some 3000 pucks), the second and third
+# looks for overlaps check only the pairs the passes' moves may have brought within reach
+# (see AirTable._candidates_of); on fewer, picking them out costs more than it saves.
 LOOK_AT_MOVED_MIN_PAIRS = 5000
 # From this many pucks on, the wall stage checks only those the neighbour list keeps near a
 # wall: on 10000 a pass over every puck costs 20 us, the few hundred near a wall 6 us. On
@@ -113,10 +114,9 @@ def _swept_record(s: sweep.Swept, radius: np.ndarray) -> pairs.Collisions:
     return pairs.Collisions(i, j, n, contact, np.zeros(len(i)), reach, xi, xj, xi, xj, vi0, vj0, vi1, vj1)
 
 
-def _farthest_move(pos: np.ndarray, before: np.ndarray, i: np.ndarray, j: np.ndarray) -> float:
-    """The farthest any puck of the pairs (i, j) is now from where it was (`before`, the rows of i
-    then j)."""
-    return math.sqrt(float(vectors.squared_lengths(vectors.take(pos, np.concatenate([i, j])) - before).max()))
+def _farthest_move(pos: np.ndarray, rows: np.ndarray, before: np.ndarray) -> float:
+    """The farthest any of the pucks `rows` is now from where it was (`before`: their positions then)."""
+    return math.sqrt(float(vectors.squared_lengths(vectors.take(pos, rows) - before).max()))
 
 
 class _Columns:
@@ -768,7 +768,8 @@ class AirTable:
                 break
             look_again = self.puck_correction != "off" and attempt < EXTRA_PASSES
             near_only = look_again and len(ci) >= LOOK_AT_MOVED_MIN_PAIRS  # see _candidates_of
-            before = vectors.take(pos, np.concatenate([i, j])) if near_only else None
+            rows = np.concatenate([i, j]) if near_only else None
+            before = vectors.take(pos, rows) if near_only else None
             if attempt < EXTRA_PASSES:
                 records += pairs.resolve_pairs(
                     pos, vel, radius, mass, i, j, self.cr_puck, self.puck_correction, dt, in_time_order=True
@@ -777,13 +778,13 @@ class AirTable:
                 pairs.push_apart(pos, radius, mass, i, j)
             moved += [i, j]
             if not look_again:
-                break  # with "off" overlaps stay: that is what it shows
+                break  # the last pass; or "off", where overlaps stay: that is what it shows
             # Parting a pair can push one of its pucks into a third one that
             # was already handled: look again among the same candidates (those
             # that may have come within reach: nothing else changed), collide
             # those pairs too, and at last just push apart what is left.
             if near_only:
-                drift += _farthest_move(pos, before, i, j)
+                drift += _farthest_move(pos, rows, before)
             ni, nj, near_sq = self._candidates_of(ci, cj, dsq, drift)
             i, j = self._colliding(rest, *broadphase.overlapping_pairs(pos, ni, nj, None, reach_sq=near_sq))
         if not moved:
