@@ -149,7 +149,7 @@ def test_ctrl_drag_pans(app):
     pygame.event.post(pygame.event.Event(pygame.MOUSEMOTION, pos=(490, 400), rel=(90, 0), buttons=(1, 0, 0)))
     pygame.event.post(pygame.event.Event(pygame.MOUSEBUTTONUP, pos=(490, 400), button=1))
     app.frame(FRAME_S)
-    assert app.env.origin_m[0] == pytest.approx(-1.0)  # 90 px = 1 m dragged right
+    assert app.env.origin_m[0] == pytest.approx(-90.0 / app.env.px_per_m)  # the world follows 90 px right
     assert app.local.held is None
 
 

@@ -118,6 +118,23 @@ def test_the_table_fits_any_window_centred_with_its_aspect_kept(size: tuple[int,
     assert x0 == pytest.approx(w - x1) and y0 == pytest.approx(h - y1)  # centred
 
 
+@settings(max_examples=100, deadline=None, derandomize=True)
+@given(sizes_px, st.integers(0, 120))
+def test_the_table_fits_above_the_band_kept_for_the_status_line(size: tuple[int, int], band: int) -> None:
+    env = Environment(width_m=10.0, height_m=8.7556)
+    env.resize(size, bottom_px=band)
+    w, h = size
+    room = h - min(band, h / 2)  # a band of at most half the window
+    (x0, y0), (x1, y1) = env.to_screen([(0.0, 8.7556), (10.0, 0.0)])  # top-left, bottom-right corners
+    assert -1e-6 <= x0 and x1 <= w + 1e-6 and -1e-6 <= y0 and y1 <= room + 1e-6  # all of it, above the band
+    assert (x1 - x0) / (y1 - y0) == pytest.approx(10.0 / 8.7556)  # not stretched
+    assert min(x0, y0) == pytest.approx(0.0, abs=1e-6)  # it fills one direction
+    assert x0 == pytest.approx(w - x1) and y0 == pytest.approx(room - y1)  # centred in the room left
+    np.testing.assert_allclose(env.table_rect_px, (x0, y0, x1 - x0, y1 - y0), atol=1e-6)
+    points = np.array([[0.0, 0.0], [3.3, 7.1], [10.0, 8.7556]])
+    np.testing.assert_allclose(env.to_world(env.to_screen(points)), points, rtol=1e-9, atol=1e-9)
+
+
 def test_zoom_and_pan_survive_a_resize() -> None:
     env = Environment(width_m=10.0, height_m=8.7556)
     env.zoom_about((300, 200), 3.0)

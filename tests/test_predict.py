@@ -19,6 +19,7 @@ from airtable.app.environment import DEFAULT_SIZE_PX, Environment
 from airtable.app.predict import FROZEN_NOTICE, StudentGuesses, angle_deg, puck_summary, summarize
 from airtable.app.predict_view import draw_predict
 from airtable.app.rewind import timeline_shown
+from airtable.app.window import GameWindow
 from airtable.net import protocol as proto
 from airtable.net.player import NetPlayer, PlayerApp, PlayerState
 from airtable.net.predictions import (
@@ -235,7 +236,8 @@ def test_a_student_window_turns_a_mouse_drag_on_a_puck_into_predict(server, tmp_
     try:
         open_round_for(app, net)
         window = PlayerApp(net, headless=True)
-        env = Environment(DEFAULT_SIZE_PX, width_m=app.table.width_m)  # the student's view as it opens
+        # The student's view as it opens: the table fitted above the window's status bar.
+        env = GameWindow(Environment(DEFAULT_SIZE_PX, width_m=app.table.width_m), headless=True).env
         puck = tuple(float(v) for v in env.to_screen(np.array(net.round.from_m[1])))
         tip = tuple(float(v) for v in env.to_screen(np.array(net.round.from_m[1]) + np.array([0.0, 1.5])))
         pygame.event.clear()

@@ -47,6 +47,24 @@ def test_text_scales_with_the_height_and_is_never_small(size) -> None:
         assert win.line_px(2) == 6
 
 
+@pytest.mark.parametrize("size", [(900, 788), (1280, 720), (3840, 2160)])
+def test_a_puck_resting_on_the_floor_shows_whole_above_the_status_line(size) -> None:
+    win = window(size)
+    w, h = size
+    # An orange puck of 0.5 m resting on the floor, in the middle of the table.
+    win.draw(scene(pos_m=np.array([[5.0, 0.5], [2.0, 2.0]]), status="t = 3.00 s   gravity on   54 pucks"))
+    bar = win.status_bar_px
+    assert 0 < bar < 0.08 * h and win.status_top_px == h - bar
+    left, top, width, height = win.env.table_rect_px
+    assert top + height == pytest.approx(h - bar)  # the floor sits on the status line
+    assert height == pytest.approx(h - bar) or width == pytest.approx(w)  # and the table is as big as fits
+    x, floor_y = win.env.to_screen(np.array([5.0, 0.0]))
+    img = pixels(win)
+    lowest_fill = int(floor_y - 0.25 * win.env.px_per_m)  # inside the puck, a quarter radius above the floor
+    assert tuple(img[int(x), lowest_fill]) == tuple(core_color((255, 165, 0)))  # not dimmed by the bar
+    assert tuple(img[int(x), int(h - bar / 2)]) != tuple(core_color((255, 165, 0)))  # the bar is below it
+
+
 def test_a_resize_event_refits_the_table() -> None:
     win = window((900, 788))
     pygame.event.post(pygame.event.Event(pygame.VIDEORESIZE, size=(1600, 700), w=1600, h=700))
@@ -55,11 +73,13 @@ def test_a_resize_event_refits_the_table() -> None:
     assert win.surface.get_size() == (1600, 700) and win.env.size_px == (1600, 700)
     win.draw(scene())
     img = pixels(win)
-    # The table is 700 px tall, 799 px wide, centred: walls at x = 400 and 1199, margins outside.
-    x0 = round((1600 - 700 * TABLE[0] / TABLE[1]) / 2)
-    assert tuple(img[x0 + 1, 350]) == (255, 69, 0)
-    assert tuple(img[1600 - x0 - 2, 350]) == (255, 69, 0)
-    assert tuple(img[x0 - 20, 350]) != (0, 0, 0) or tuple(img[x0 + 20, 350]) == (0, 0, 0)
+    # The table is 700 px tall less the status bar, centred: walls near x = 415 and 1184, margins outside.
+    table_h = 700 - win.status_bar_px
+    x0 = round((1600 - table_h * TABLE[0] / TABLE[1]) / 2)
+    y = table_h // 2
+    assert tuple(img[x0 + 1, y]) == (255, 69, 0)
+    assert tuple(img[1600 - x0 - 2, y]) == (255, 69, 0)
+    assert tuple(img[x0 - 20, y]) != (0, 0, 0) or tuple(img[x0 + 20, y]) == (0, 0, 0)
 
 
 def test_status_line_never_overflows_and_drops_the_least_important_parts() -> None:

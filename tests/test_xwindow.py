@@ -138,14 +138,24 @@ def wall_columns(image: np.ndarray, row: int) -> np.ndarray:
     return np.flatnonzero(np.all(image[:, row] == WALL, axis=1))
 
 
+def status_bar_px(size: tuple[int, int]) -> int:
+    """The status bar's height in a window of `size` (the app fits the table above it)."""
+    from airtable.app.environment import Environment
+    from airtable.app.window import GameWindow
+
+    return GameWindow(Environment(size), headless=True).status_bar_px
+
+
 def assert_table_fills_the_height(shot, size: tuple[int, int]) -> np.ndarray:
-    """The screenshot is `size`, and the table fills its height, centred, with its aspect kept."""
+    """The screenshot is `size`, and the table fills its height above the status bar, centred,
+    with its aspect kept."""
     pygame.display.init()
     image = pygame.surfarray.array3d(pygame.image.load(str(shot)))
     (w, h) = size
     assert image.shape[:2] == size
-    left = round((w - h * TABLE_ASPECT) / 2)
-    xs = wall_columns(image, h // 2)
+    table_h = h - status_bar_px(size)
+    left = round((w - table_h * TABLE_ASPECT) / 2)
+    xs = wall_columns(image, table_h // 2)
     assert abs(xs.min() - left) <= 2 and abs(xs.max() - (w - 1 - left)) <= 2
     return image
 
@@ -186,10 +196,11 @@ def test_the_table_follows_a_resize_of_the_window(display, tmp_path):
         xdotool(display, "windowsize", "--sync", wid, "1000", "500")
         wait_for(lambda: window_size(display, wid) == (1000, 500), what="the new size")
         quit_with_escape(display, wid, app)
-    # The 500 px tall table is 571 px wide and centred: walls near x = 214 and 785, not at the old edges.
+    # The table, 500 px less the status bar tall, is centred: walls near x = 230 and 769, not at the old edges.
     image = assert_table_fills_the_height(shot, (1000, 500))
     ys = np.flatnonzero(np.all(image[500] == WALL, axis=1))
-    assert ys.min() <= 2 and ys.max() >= 497  # top and bottom walls at the window's edges
+    bottom = 499 - status_bar_px((1000, 500))
+    assert ys.min() <= 2 and abs(ys.max() - bottom) <= 2  # the top wall at the window's edge, the floor above the bar
 
 
 FULLSCREEN_DRIVER = """

@@ -5,8 +5,10 @@ down and the origin at the top-left of the window. One transform serves both
 directions and stays in floats; only the drawing code rounds to pixels.
 
 The table (width_m x height_m) is fitted into the window with its aspect
-ratio kept and centred: that box, the "viewport", is `fit_px_per_m` pixels per
-metre, with `offset_px` of empty margin left and right or above and below.
+ratio kept and centred, above a band kept for the status line (`resize`'s
+bottom_px): that box, the "viewport", is `fit_px_per_m` pixels per metre;
+`offset_px` is how far its left edge is from the window's and its bottom edge
+from the window's (margins, and the band).
 The view inside it is a zoom and `origin_m`, the world point at the
 viewport's bottom-left corner:
 
@@ -61,18 +63,24 @@ class Environment:
         self.zoom = 1.0
         self.origin_m = np.zeros(2)
 
-    def resize(self, size_px: Sequence[int]) -> None:
-        """A new window size: the table is fitted again; zoom and pan are kept."""
+    def resize(self, size_px: Sequence[int], bottom_px: float = 0.0) -> None:
+        """A new window size: the table is fitted again; zoom and pan are kept.
+
+        `bottom_px`: a band along the bottom of the window kept clear of the table (the
+        status bar's), so that nothing resting on the floor is hidden under it.
+        """
         w, h = _checked_size(size_px)
         self.size_px = (w, h)
+        band = min(max(0.0, float(bottom_px)), 0.5 * h)
+        room = h - band
         # A window within 0.01 % of the table's shape counts as that shape, so 900 x 788
         # is 90 px per metre across the 10 x 8.7556 m table (8.7556 being 788 / 90 rounded).
-        if w / self.width_m <= h / self.height_m * (1 + 1e-4):  # the width fits: margins above and below
+        if w / self.width_m <= room / self.height_m * (1 + 1e-4):  # the width fits: margins above and below
             self.fit_px_per_m = w / self.width_m
-            self.offset_px = (0.0, 0.5 * max(0.0, h - self.height_m * self.fit_px_per_m))
+            self.offset_px = (0.0, band + 0.5 * max(0.0, room - self.height_m * self.fit_px_per_m))
         else:
-            self.fit_px_per_m = h / self.height_m
-            self.offset_px = (0.5 * max(0.0, w - self.width_m * self.fit_px_per_m), 0.0)
+            self.fit_px_per_m = room / self.height_m
+            self.offset_px = (0.5 * max(0.0, w - self.width_m * self.fit_px_per_m), band)
 
     @property
     def zoom(self) -> float:
@@ -101,7 +109,8 @@ class Environment:
     @property
     def table_rect_px(self) -> tuple[float, float, float, float]:
         """(left, top, width, height) of the viewport: where the whole table shows at zoom 1."""
-        return (*self.offset_px, self.width_m * self.fit_px_per_m, self.height_m * self.fit_px_per_m)
+        width, height = self.width_m * self.fit_px_per_m, self.height_m * self.fit_px_per_m
+        return (self.offset_px[0], self.size_px[1] - self.offset_px[1] - height, width, height)
 
     # ------------------------------------------------------------ transform
 

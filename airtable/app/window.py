@@ -171,18 +171,28 @@ class GameWindow:
             self._open(False)
         self._sized()
 
+    def set_env(self, env: Environment) -> None:
+        """Show another table (a student's window, when the teacher restarts with another size)."""
+        self.env = env
+        self._sized()
+
     def _sized(self) -> None:
-        """After any change of size: the transform, the type and the layers follow."""
-        self.env.resize(self.surface.get_size())
+        """After any change of size: the type, the transform and the layers follow."""
         self.unit = self.surface.get_height() / REFERENCE_HEIGHT_PX
         self.label_font = self._font("label")
         self.font = self._font("text")
         self.big_font = self._font("big")
         self.huge_font = self._font("huge")
+        self.env.resize(self.surface.get_size(), bottom_px=self.status_bar_px)
         self._trail_layer = None
         self._status_bar = None
         self._labels.clear()
         self._panels.clear()
+
+    @property
+    def status_bar_px(self) -> int:
+        """The status bar's height: the table is fitted above it (Environment.resize)."""
+        return self.font.get_linesize() + self.font.get_height() // 2
 
     def _size_px(self, role: str) -> int:
         size, floor = FONT_SIZES[role]
@@ -414,10 +424,11 @@ class GameWindow:
         parts = [p.strip() for p in scene.status_parts]
         paused = PAUSED in parts
         parts = [p for p in parts if p != PAUSED]
-        bar_h = line_h + pad
+        bar_h = self.status_bar_px
         self.status_top_px = h - bar_h if parts else h
         if parts:
-            # See-through, so pucks resting on the bottom wall stay visible.
+            # The table is fitted above the bar (Environment.resize); see-through for a
+            # zoomed or panned view, which can pass under it.
             if self._status_bar is None or self._status_bar.get_size() != (w, bar_h):
                 self._status_bar = pygame.Surface((w, bar_h), pygame.SRCALPHA)
                 self._status_bar.fill((0, 0, 0, 150))

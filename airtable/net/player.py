@@ -699,7 +699,7 @@ class PlayerApp:
         self._welcome = welcome
         self.window.set_caption(self._caption())
         if welcome.width_m != old_width:  # the teacher restarted with another table
-            self.window.env = self._new_env()
+            self.window.set_env(self._new_env())
 
     def _frame(self) -> None:
         import pygame
