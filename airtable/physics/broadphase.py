@@ -144,7 +144,7 @@ def pairs_where(
 def squared_distances(pos: np.ndarray, i: np.ndarray, j: np.ndarray) -> np.ndarray:
     """|pos[i] - pos[j]|^2 for each pair: the sums of vectors.squared_lengths, in fewer passes."""
     # A puck's (x, y) as one complex number: two 1-D takes instead of 2-D ones.
-    z = np.ascontiguousarray(pos, dtype=np.float64).view(np.complex128).reshape(-1)
+    z = vectors.as_complex(np.ascontiguousarray(pos, dtype=np.float64))
     d = z.take(i)
     d -= z.take(j)
     dd = d.view(np.float64)  # back to x, y, x, y...

@@ -442,11 +442,6 @@ def _resolve_round(zpos, zvel, radius, mass, a, b, cr, mode, dt_s) -> Recorded |
     return _RoundRecord(g, out) if out.count else None
 
 
-def _rows(z: np.ndarray) -> np.ndarray:
-    """Complex vectors as (N, 2) float rows."""
-    return z.view(np.float64).reshape(-1, 2)
-
-
 @dataclass
 class _RoundRecord:
     """A round's collisions, kept as the round left them: made into `Collisions` only when read
@@ -462,8 +457,8 @@ class _RoundRecord:
         g, out = self.g, self.out
         contact = out.contact_from + g.r2 * out.n
         record = Collisions(
-            g.a, g.b, _rows(out.n), _rows(contact), g.overlap, g.reach,
-            *(_rows(z) for z in (g.x1, g.x2, out.x1, out.x2, g.v1, g.v2, out.v1, out.v2)),
+            g.a, g.b, vectors.as_rows(out.n), vectors.as_rows(contact), g.overlap, g.reach,
+            *(vectors.as_rows(z) for z in (g.x1, g.x2, out.x1, out.x2, g.v1, g.v2, out.v1, out.v2)),
         )  # fmt: skip
         return record if out.count == len(g.a) else record.take(out.approach.nonzero()[0])
 
@@ -495,7 +490,8 @@ class _FewRecord:
     def collisions(self) -> Collisions:
         ij = np.array(self.hit, dtype=np.intp)
         overlap, reach, n, contact, *states = (np.array(column) for column in zip(*self.rows, strict=True))
-        return Collisions(ij[:, 0], ij[:, 1], _rows(n), _rows(contact), overlap, reach, *(_rows(z) for z in states))
+        n, contact, *states = (vectors.as_rows(z) for z in (n, contact, *states))
+        return Collisions(ij[:, 0], ij[:, 1], n, contact, overlap, reach, *states)
 
 
 # What a round or a few pairs record: `Collisions`, or what makes them when read.

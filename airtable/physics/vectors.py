@@ -94,6 +94,11 @@ def as_complex(a: np.ndarray) -> np.ndarray:
     return a.view(np.complex128).ravel()  # a view, as reshape(-1) gives, for half the cost
 
 
+def as_rows(z: np.ndarray) -> np.ndarray:
+    """The (N, 2) float64 view of a contiguous (N,) complex128 array: as_complex undone."""
+    return z.view(np.float64).reshape(-1, 2)
+
+
 def put(a: np.ndarray, idx: np.ndarray, values: np.ndarray) -> None:
     """a[idx] = values for an (N, 2) float64 array, in place (the last write wins where idx repeats)."""
     as_complex(a)[idx] = as_complex(np.ascontiguousarray(values, dtype=np.float64))
@@ -137,5 +142,5 @@ def units(z: np.ndarray, keys) -> tuple[np.ndarray, np.ndarray]:
     dist = np.sqrt(squared_abs(z))
     if np.count_nonzero(dist) == len(dist):
         return (z.view(np.float64) / dist.repeat(2)).view(np.complex128), dist
-    n, _ = unit_vectors(z.view(np.float64).reshape(-1, 2), keys)
+    n, _ = unit_vectors(as_rows(z), keys)
     return as_complex(n), dist
