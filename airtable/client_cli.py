@@ -17,3 +17,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     from airtable.net.player import main as play
 
     return play(argv)
+
+
+if __name__ == "__main__":  # python -m airtable.client_cli, as the installed command
+    raise SystemExit(main())

@@ -42,11 +42,11 @@ from airtable.net.protocol import (
     MAX_DRAWN_PUCKS,
     MAX_DRAWN_SPRINGS,
     MAX_DRAWN_TEXT_CHARS,
+    MAX_VIEW_ORIGIN_M,
     MAX_VIEW_ZOOM,
     MIN_VIEW_ZOOM,
     SNAPSHOT,
     ProtocolError,
-    cursor_limits,
     encode_frame,
     printable,
     table_size_problem,
@@ -559,7 +559,7 @@ class SnapshotEncoder:
             self._epoch += 1  # a restart or another demo: players snap instead of smearing
         self._seq += 1
         fps = float(scene.fps) if math.isfinite(scene.fps) else 0.0
-        view = (float(scene.zoom), float(scene.origin_m[0]), float(scene.origin_m[1]))
+        view = shareable_view(scene.zoom, *scene.origin_m)
         tick = Tick(
             seq=self._seq,
             layout=layout,
@@ -637,6 +637,9 @@ class SnapshotDecoder:
     last: Tick | None = None
     prev: Tick | None = None
     _clock_s: float = 0.0
+    shown_view: tuple[float, float, float] = (1.0, 0.0, 0.0)  # the newest usable view
+    # A field this client could not use and left out (a sentence), until the player reads it.
+    problem: str | None = None
 
     def feed_layout(self, payload: bytes) -> None:
         self.layout = decode_layout(payload)
@@ -661,7 +664,10 @@ class SnapshotDecoder:
         view = _VIEW.unpack(r.take(_VIEW.size)) if flags & HAS_VIEW else (b1.view if b1 else None)
         if view is None:
             raise _bad("a keyframe without the view")
-        _check_view(view, layout)
+        if usable_view(view):
+            self.shown_view = view
+        else:
+            self.problem = f"a view of zoom {view[0]:g} at ({view[1]:g}, {view[2]:g}) m; left out, the previous view kept"
         if flags & HAS_STATUS:
             status = _apply_text_delta("" if flags & KEYFRAME else b1.status, r)
         elif b1 is not None:
@@ -677,12 +683,14 @@ class SnapshotDecoder:
             if len(b1.values) != count:
                 raise _bad("a delta on a tick with another number of pucks or cursors")
             values = predict(time_us, 2 * n + 2 * c, b1, b2) + residuals
-        _check_values(values, layout)
+        shown, problem = _shown_values(values, layout)
+        if problem is not None:
+            self.problem = f"{problem}; left out"
         tick = Tick(seq, layout, epoch, time_us, clock_ms, centi_fps, view, status, values)
         if self.last is not None:  # unwrap the 32-bit millisecond clock
             self._clock_s += ((clock_ms - self.last.clock_ms) & 0xFFFFFFFF) / 1e3
         self.prev, self.last = b1, tick
-        return Decoded(self._scene(tick), seq, epoch, time_us / 1e6, self._clock_s)
+        return Decoded(self._scene(tick, shown), seq, epoch, time_us / 1e6, self._clock_s)
 
     def _bases(self, flags: int, seq: int, gap1: int, gap2: int) -> tuple[Tick | None, Tick | None]:
         if flags & KEYFRAME:
@@ -698,10 +706,10 @@ class SnapshotDecoder:
             raise _bad(f"a delta on tick {last.seq - gap2}, which this client does not hold")
         return last, prev
 
-    def _scene(self, tick: Tick) -> Scene:
+    def _scene(self, tick: Tick, v: np.ndarray) -> Scene:
+        """The Scene of `tick`, drawn from its values `v` as cleaned for showing."""
         layout = tick.layout
         n, _, c = layout.sizes
-        v = tick.values
         pos = np.column_stack([v[:n], v[n : 2 * n]]) / UNITS_PER_M
         cur = np.column_stack([v[2 * n : 2 * n + c], v[2 * n + c : 2 * n + 2 * c]]) / UNITS_PER_M
         buttons = v[2 * n + 2 * c : 2 * n + 3 * c]
@@ -733,30 +741,51 @@ class SnapshotDecoder:
             puck_correction=layout.puck_correction,
             time_s=tick.time_us / 1e6,
             fps=tick.centi_fps / 100,
-            zoom=tick.view[0],
-            origin_m=(tick.view[1], tick.view[2]),
+            zoom=self.shown_view[0],
+            origin_m=(self.shown_view[1], self.shown_view[2]),
         )
 
 
-def _check_view(view: tuple[float, float, float], layout: Layout) -> None:
+def shareable_view(zoom: float, origin_x_m: float, origin_y_m: float) -> tuple[float, float, float]:
+    """The server's view as players accept it: finite, the zoom and the origin within bounds."""
+    view = (float(zoom), float(origin_x_m), float(origin_y_m))
+    if not all(math.isfinite(x) for x in view):
+        return (1.0, 0.0, 0.0)
+    limit = MAX_VIEW_ORIGIN_M
+    return (
+        min(max(view[0], MIN_VIEW_ZOOM), MAX_VIEW_ZOOM),
+        min(max(view[1], -limit), limit),
+        min(max(view[2], -limit), limit),
+    )
+
+
+def usable_view(view: tuple[float, float, float]) -> bool:
+    """Finite numbers of bounded size: where the view points is the teacher's business."""
     zoom, ox, oy = view
-    if not all(math.isfinite(x) for x in view) or not MIN_VIEW_ZOOM <= zoom <= MAX_VIEW_ZOOM:
-        raise _bad(f"a zoom of {zoom:g}, outside {MIN_VIEW_ZOOM:g} to {MAX_VIEW_ZOOM:g}")
-    x0, y0, x1, y1 = cursor_limits(layout.width_m, layout.height_m)
-    if not (x0 <= ox <= x1 and y0 <= oy <= y1):
-        raise _bad(f"a view origin ({ox:g}, {oy:g}) far off the table")
+    return (
+        all(math.isfinite(x) for x in view)
+        and MIN_VIEW_ZOOM <= zoom <= MAX_VIEW_ZOOM
+        and abs(ox) <= MAX_VIEW_ORIGIN_M
+        and abs(oy) <= MAX_VIEW_ORIGIN_M
+    )
 
 
-def _check_values(values: np.ndarray, layout: Layout) -> None:
-    """Positions near the table (as cursors may be), buttons 0-3, held rows of real pucks."""
+def _shown_values(values: np.ndarray, layout: Layout) -> tuple[np.ndarray, str | None]:
+    """`values` as a player can draw them, and what had to be cleaned (None: nothing).
+
+    Positions beyond the coder's range are pulled to its edge; a bad button reads as
+    none pressed, a held puck that is not there as none held. The tick keeps the
+    values as sent: they are the base of the next delta."""
     n, _, c = layout.sizes
     moving = 2 * n + 2 * c
-    x0, y0, x1, y1 = (round(v * UNITS_PER_M) for v in cursor_limits(layout.width_m, layout.height_m))
-    xs = np.concatenate([values[:n], values[2 * n : 2 * n + c]])
-    ys = np.concatenate([values[n : 2 * n], values[2 * n + c : moving]])
-    if len(xs) and (xs.min() < x0 or xs.max() > x1 or ys.min() < y0 or ys.max() > y1):
-        raise _bad("a position that is far off the table")
-    buttons = values[moving : moving + c]
-    held = values[moving + c :]
-    if c and (buttons.min() < 0 or buttons.max() > 3 or held.min() < 0 or held.max() > n):
-        raise _bad("a cursor with a bad button or held puck")
+    problems = []
+    values = values.copy()
+    if np.abs(values[:moving]).max(initial=0) > MAX_Q:
+        np.clip(values[:moving], -MAX_Q, MAX_Q, out=values[:moving])
+        problems.append("a position beyond 268 km")
+    buttons, held = values[moving : moving + c], values[moving + c :]
+    bad_buttons, bad_held = (buttons < 0) | (buttons > 3), (held < 0) | (held > n)
+    if bad_buttons.any() or bad_held.any():
+        buttons[bad_buttons], held[bad_held] = 0, 0
+        problems.append("a cursor with a bad button or held puck")
+    return values, (" and ".join(problems) if problems else None)

@@ -181,6 +181,8 @@ class NetPlayer:
         self._thread: threading.Thread | None = None
         self._throttle = InputThrottle()
         self.round: RoundInfo | None = None  # the newest prediction round the server announced
+        self.problems = 0  # things from the server left out (see skipped)
+        self._said: set[str] = set()
 
     @property
     def address(self) -> str:
@@ -378,49 +380,68 @@ class NetPlayer:
             raise _ConnectionEndedError()
         try:
             return reader.feed(data)
-        except proto.ProtocolError as e:
-            raise _ConnectionEndedError(f"{self.address} sent something that is not airtable protocol ({e})") from None
+        except proto.ProtocolError as e:  # the stream lost its frames: start afresh on a new connection
+            self.skipped(f"{self.address} sent a frame this client cannot read ({e}); connecting again")
+            raise _ConnectionEndedError() from None
+
+    def skipped(self, sentence: str) -> None:
+        """Something from the server this client could not use, and left out: said once, on stderr.
+
+        Data from the server never ends the session; only its ERROR can (see _take)."""
+        self.problems += 1
+        if sentence not in self._said:
+            self._said.add(sentence)
+            print(f"airtable-client: {sentence}", file=sys.stderr, flush=True)
 
     def _take(self, frames: list, now: float) -> None:
         for frame_type, payload in frames:
             if frame_type in (proto.SNAPSHOT, proto.LAYOUT):
-                try:
-                    scene = self._feed.feed(frame_type, payload, now)
-                except proto.ProtocolError as e:
-                    raise _ConnectionEndedError(str(e)) from None
-                if scene is None:
-                    continue  # a LAYOUT: what the next snapshots need
-                self._scene = scene  # one reference swap: readers see the old or the new scene
-                self.aids.snapshot(scene)
-                self.snapshots += 1
-                if self.on_snapshot is not None:
-                    self.on_snapshot(scene, now)
+                self._take_snapshot(frame_type, payload, now)
             elif frame_type == proto.AIDS:
                 self._take_aids(payload, now)
             elif frame_type == proto.ROUND:
                 try:
                     self.round = parse_round(payload)
                 except proto.ProtocolError as e:
-                    raise _ConnectionEndedError(str(e)) from None
+                    self.skipped(f"left out a prediction round this client cannot use ({e})")
             elif frame_type == proto.ERROR:
                 sentence, retry = proto.parse_error_message(payload)
                 raise _ConnectionEndedError(None if retry else sentence)
             elif frame_type == proto.BYE:
                 raise _ConnectionEndedError()
-            else:
-                raise _ConnectionEndedError(
-                    f"{self.address} sent an unexpected {proto.FRAME_NAMES[frame_type]} message"
-                )
+            else:  # a newer server's message: not for this client
+                self.skipped(f"left out {proto.FRAME_NAMES[frame_type]} messages, which this client does not use")
+
+    def _take_snapshot(self, frame_type: int, payload: bytes, now: float) -> None:
+        """A LAYOUT or SNAPSHOT. One that cannot be decoded breaks the chain of deltas after it:
+        the client says so and connects again, keeping its seat, for a fresh keyframe."""
+        decoder = self._feed.decoder
+        try:
+            scene = self._feed.feed(frame_type, payload, now)
+        except proto.ProtocolError as e:
+            self.skipped(f"left out a snapshot this client cannot use ({e}); connecting again")
+            raise _ConnectionEndedError() from None
+        if decoder.problem is not None:
+            self.skipped(f"the snapshot has {decoder.problem}")
+            decoder.problem = None
+        if scene is None:
+            return  # a LAYOUT: what the next snapshots need
+        self._scene = scene  # one reference swap: readers see the old or the new scene
+        self.aids.snapshot(scene)
+        self.snapshots += 1
+        if self.on_snapshot is not None:
+            self.on_snapshot(scene, now)
 
     def _take_aids(self, payload: bytes, now: float) -> None:
-        """An AIDS frame: the teacher's aids at the tick just decoded."""
+        """An AIDS frame: the teacher's aids at the tick just decoded (left out if unusable)."""
         last = self._feed.decoder.last
-        if last is None:
-            raise _ConnectionEndedError(f"{self.address} sent aids before any snapshot")
         try:
+            if last is None:
+                raise proto.ProtocolError("aids before any snapshot")
             frame = self._aids.feed(payload, last.seq, last.layout.sizes[0], last.time_us / 1e6)
         except proto.ProtocolError as e:
-            raise _ConnectionEndedError(str(e)) from None
+            self.skipped(f"left out the teacher's aids for a moment ({e})")
+            return
         self.aids.take(frame, now)
 
     def _reconnect(self) -> tuple | None:

@@ -80,6 +80,7 @@ MAX_DRAWN_SPRINGS = 10_000
 MAX_DRAWN_CURSORS = 1_000
 MIN_VIEW_ZOOM = 0.01
 MAX_VIEW_ZOOM = 1000.0
+MAX_VIEW_ORIGIN_M = 1e6  # the teacher may pan anywhere; the view travels clamped to 1000 km
 MAX_DRAWN_TEXT_CHARS = 300  # a title or status line longer than this is cut, not drawn a mile wide
 
 _HEADER = struct.Struct(">IB")
