@@ -232,7 +232,9 @@ def test_screenshot_key_saves_a_png(app, tmp_path, monkeypatch):
     assert str(files[0].resolve()) in app.message
 
 
-def test_escape_quits(app):
+def test_escape_asks_then_a_second_escape_quits(app):
+    press(app, pygame.K_ESCAPE)
+    assert app.running and app.panel() == "quit"
     press(app, pygame.K_ESCAPE)
     assert not app.running
 

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import dataclasses
 import os
 import socket
 import struct
@@ -348,16 +347,24 @@ def test_headless_app_survives_a_server_restart(cleanup):
     assert net.reconnects == 1
 
 
-def test_escape_sends_bye_and_quits(cleanup):
+def test_escape_asks_then_a_second_escape_sends_bye_and_quits(cleanup):
     server, _ = start_table(cleanup)
     net = player(cleanup, server.port)
     net.connect()
     cleanup(pygame.quit)
     app = PlayerApp(net, headless=True)
 
+    def escape():
+        pygame.event.post(pygame.event.Event(pygame.KEYDOWN, key=pygame.K_ESCAPE, mod=0, unicode="\x1b", scancode=41))
+
     def press_escape():
         wait_until(lambda: app.frames > 2, what="the window")
-        pygame.event.post(pygame.event.Event(pygame.KEYDOWN, key=pygame.K_ESCAPE, mod=0, unicode="\x1b", scancode=41))
+        escape()  # asks
+        wait_until(lambda: app.leave_asked_until > time.monotonic(), what="the question")
+        frames = app.frames
+        wait_until(lambda: app.frames > frames + 2, what="a few frames asking")
+        assert net.state == PlayerState.CONNECTED
+        escape()
 
     t = threading.Thread(target=press_escape)
     t.start()

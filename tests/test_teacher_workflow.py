@@ -178,6 +178,8 @@ def test_esc_closes_an_open_panel_first(demos, opener):
     press(app, pygame.K_ESCAPE)
     assert app.panel() is None and app.running
     press(app, pygame.K_ESCAPE)
+    assert app.panel() == "quit" and app.running
+    press(app, pygame.K_ESCAPE)
     assert not app.running
 
 

@@ -28,6 +28,7 @@ from airtable.app.lessons import Lessons
 from airtable.app.lessons_view import draw_lessons
 from airtable.app.loop import FixedStep, FpsCounter, FrameLoop
 from airtable.app.menu import DemoMenu
+from airtable.app.overlays import OverlayFlag, Overlays
 from airtable.app.predict_view import draw_predict
 from airtable.app.roster_view import draw_alert, draw_roster
 from airtable.app.scene import STATUS_SEPARATOR, Scene
@@ -36,7 +37,9 @@ from airtable.app.window import AidsPainter, GameWindow, TimelinePainter
 from airtable.physics.table import TABLE_HEIGHT_M, TABLE_WIDTH_M, AirTable
 
 MESSAGE_S = 4.0
-QUIT_CONFIRM_S = 4.0  # a second Esc within this time quits while students are connected
+QUIT_CONFIRM_S = 4.0  # the quit question waits this long for a second Esc (or window close)
+# Closing the window asks first when leaving would lose at least this much recording.
+UNEXPORTED_ASK_S = 2.0
 DEFAULT_FPS = 60.0  # when the display does not say its refresh rate
 MAX_FPS = 240.0
 # A still table (paused, or nothing moving) with nobody at it redraws this often,
@@ -75,6 +78,11 @@ def unused_path(folder: Path, stem: str, suffix: str = ".png") -> Path:
 class App:
     """The teacher's table: one AirTable, its clients, a window and the loop."""
 
+    # What shows over the table lives in one stack, `overlays` (overlays.py).
+    show_help = OverlayFlag("help")
+    show_notes = OverlayFlag("notes")
+    show_chart = OverlayFlag("chart")
+
     def __init__(
         self,
         demos: dict[str, Demo] | DemoShelf,
@@ -106,28 +114,28 @@ class App:
         self.errors: list[DemoError] = []  # every error reported, in order
         for error in [*demo_errors, *self.shelf.errors]:
             self.report(error)
-        self.notice: list[str] = [f"could not load {e}" for e in self.errors]
+        self.notice = [f"could not load {e}" for e in self.errors]
         self.start_demo(demo_key if demo_key in self.demos else next(iter(self.demos)), variation)
 
     def _init_state(self) -> None:
+        self.overlays = Overlays()
         self.running = True
         self.paused = False
         self.trails = False
         self.speed = 1.0
-        self.show_help = False
         self.help_page, self.help_pages = 0, 1
-        self.show_notes = False
         self.show_annotations = False
-        self.show_chart = False
         self.vectors = 0  # 0 off, 1 velocity, 2 momentum
         self.inspecting = False
         self._notices_seen = 0  # how many of table.notices were said
-        self.menu: DemoMenu | None = None
+        self._menu: DemoMenu | None = None
+        self._notice: list[str] = []
+        self._build_error: DemoError | None = None
         self.quit_armed_until = -1.0  # clock_s until which a second Esc quits
         self.collision_log = aids.CollisionLog()
         self.chart = aids.EnergyChart()
-        self.lessons = Lessons()  # recording, momenta, saving the moment (lessons.py)
-        self.room = room.Room()  # the roster, hands off, the floor, anonymous names (room.py)
+        self.lessons = Lessons(overlays=self.overlays)  # recording, momenta, saving the moment (lessons.py)
+        self.room = room.Room(overlays=self.overlays)  # the roster, hands off, the floor, anonymous names (room.py)
         self.history = History()  # the table's recent moments, for rewinding (history.py, rewind.py)
         self.predict = predict.PredictRound()  # predict, then reveal (predict.py)
         self.keys_down: set[int] = set()
@@ -146,7 +154,6 @@ class App:
         self.loop: FrameLoop | None = None  # while run() runs
         self.demo_key = ""
         self.demo_path: Path | None = None
-        self.build_error: DemoError | None = None  # shown instead of the demo while set
 
     # ------------------------------------------------------------ demos
 
@@ -243,42 +250,49 @@ class App:
         items = [(key, demo.title) for key, demo in self.demos.items()]
         self.menu = DemoMenu(items, current=self.demo_key)
 
+    # The menu, the demo error and the notice are objects; each is shown while it is set.
+
+    @property
+    def menu(self) -> DemoMenu | None:
+        return self._menu if self.overlays.shown("menu") else None
+
+    @menu.setter
+    def menu(self, menu: DemoMenu | None) -> None:
+        self._menu = menu
+        self.overlays.set("menu", menu is not None)
+
+    @property
+    def build_error(self) -> DemoError | None:
+        """The demo's error, shown instead of the demo while set."""
+        return self._build_error if self.overlays.shown("error") else None
+
+    @build_error.setter
+    def build_error(self, error: DemoError | None) -> None:
+        self._build_error = error
+        self.overlays.set("error", error is not None)
+
+    @property
+    def notice(self) -> list[str]:
+        return self._notice if self.overlays.shown("notice") else []
+
+    @notice.setter
+    def notice(self, lines: list[str]) -> None:
+        self._notice = list(lines)
+        self.overlays.set("notice", bool(lines))
+
     def panel(self) -> str | None:
-        """Which panel is on top of the table now, if any."""
-        if self.clock_s < self.quit_armed_until:
-            return "quit"
-        if self.menu is not None:
-            return "menu"
-        if self.build_error is not None:
-            return "error"
-        if self.notice:
-            return "notice"
-        if self.show_help:
-            return "help"
-        if self.show_notes:
-            return "notes"
-        if self.room.show_roster:
-            return "roster"
-        return None
+        """Which panel is in the middle of the window now, if any (the quit question lapses)."""
+        if self.overlays.shown("quit") and self.clock_s >= self.quit_armed_until:
+            self.overlays.close("quit")
+        return self.overlays.panel()
 
     def close_panel(self) -> bool:
-        """Close the panel on top; False if none was open."""
-        closing = self.panel()
-        if closing == "quit":
-            self.quit_armed_until = -1.0
-        elif closing == "menu":
-            self.menu = None
-        elif closing == "error":
-            self.build_error = None
-        elif closing == "notice":
-            self.notice = []
-        elif closing == "help":
-            self.show_help = False
-        elif closing == "notes":
-            self.show_notes = False
-        elif closing == "roster":
-            self.room.show_roster = False
-        return closing is not None
+        """Close what is on top (a panel, else the chart, values or momenta); False if nothing was open."""
+        self.panel()  # a lapsed quit question first
+        closing = self.overlays.top()
+        if closing == "help":
+            self.help_page = 0
+        return closing is not None and self.overlays.close(closing)
 
     def take_key_for_overlay(self, event: pygame.event.Event) -> bool:
         """A panel that waits for a key takes it first; True if it did."""
@@ -300,15 +314,34 @@ class App:
         return len(self.clients) - 1
 
     def escape(self) -> None:
-        """Esc: close the panel on top; else quit, asking twice while students are connected."""
+        """Esc: close what is on top; with nothing open, ask; Esc again while asked quits."""
         if self.panel() == "quit":
             self.running = False
-        elif self.close_panel():
-            pass
-        elif self.student_count() > 0:
-            self.quit_armed_until = self.clock_s + QUIT_CONFIRM_S
-        else:
+        elif not self.close_panel():
+            self.ask_to_quit()
+
+    def close_window(self) -> None:
+        """The window's close button: quit, asking first while leaving would drop students or
+        lose recording; closing again (or Esc) while asked quits."""
+        if self.panel() == "quit" or not self.quit_would_lose():
             self.running = False
+        else:
+            self.ask_to_quit()
+
+    def ask_to_quit(self) -> None:
+        self.quit_armed_until = self.clock_s + QUIT_CONFIRM_S
+        self.overlays.open("quit")
+
+    def quit_would_lose(self) -> list[str]:
+        """What quitting now drops, one sentence each (empty: nothing)."""
+        lost = []
+        n = self.student_count()
+        if n:
+            lost.append(f"{n} student{'' if n == 1 else 's'} will be dropped.")
+        unexported = self.lessons.unexported_s()
+        if unexported >= UNEXPORTED_ASK_S:
+            lost.append(f"{unexported:.0f} s of recording not exported (x exports it).")
+        return lost
 
     def zoom(self, factor: float) -> None:
         self.env.zoom_about(self.mouse_px, factor)
@@ -463,14 +496,7 @@ class App:
     def _draw_panel(self) -> None:
         panel, w = self.panel(), self.window
         if panel == "quit":
-            n = self.student_count()
-            w.draw_panel(
-                "Quit?",
-                [
-                    f"{n} student{'' if n == 1 else 's'} will be dropped.",
-                    "Press Esc again to quit, any other key to stay.",
-                ],
-            )
+            w.draw_panel("Quit?", [*self.quit_would_lose(), "Esc again to quit; any other key to stay."])
         elif panel == "menu":
             w.draw_panel("Demos", [*self.menu.rows(), self.menu.footer()])
         elif panel == "error":

@@ -135,6 +135,7 @@ def toggle_help(app: App) -> None:
     else:
         app.help_page += 1
         app.show_help = app.help_page < app.help_pages
+        app.help_page = app.help_page if app.show_help else 0
 
 
 def toggle_fullscreen(app: App) -> None:
@@ -376,7 +377,7 @@ MOUSE_EVENTS = (pygame.MOUSEMOTION, pygame.MOUSEBUTTONDOWN, pygame.MOUSEBUTTONUP
 
 def handle_event(app: App, event: pygame.event.Event) -> None:
     if event.type == pygame.QUIT:
-        app.running = False
+        app.close_window()
     elif event.type == pygame.KEYDOWN:
         handle_key(app, event)
     elif event.type == pygame.KEYUP:

@@ -14,6 +14,7 @@ from typing import TYPE_CHECKING
 
 from airtable.app.demo_loader import BUILTIN_DIR
 from airtable.app.momenta import MomentaLog
+from airtable.app.overlays import OverlayFlag, Overlays
 from airtable.app.recorder import DEFAULT_BUDGET_BYTES, Recorder, free_csv_pair
 from airtable.app.saved_demo import demo_source, free_key, save_folder, write_demo
 from airtable.physics.table import AirTable
@@ -27,17 +28,21 @@ RECORDINGS_DIR = Path("recordings")  # where the export key writes, created on d
 class Lessons:
     """The state of the lesson tools: the recording, the latest collision's momenta, which panels show."""
 
-    def __init__(self, budget_bytes: int = DEFAULT_BUDGET_BYTES) -> None:
+    show_momenta = OverlayFlag("momenta")  # the momenta diagram (d)
+    show_values = OverlayFlag("values")  # the values panel (t)
+
+    def __init__(self, budget_bytes: int = DEFAULT_BUDGET_BYTES, overlays: Overlays | None = None) -> None:
+        self.overlays = Overlays() if overlays is None else overlays  # the app's, where its panels live
         self.recorder = Recorder(budget_bytes)
+        self.exported_to_s = -1.0  # the recording's time up to which it was exported
         self.momenta = MomentaLog()
-        self.show_momenta = False  # the momenta diagram (d)
-        self.show_values = False  # the values panel (t)
         self.painter = None  # the LessonsPainter, made on the first draw (lessons_view.py)
 
     def start(self, table: AirTable) -> None:
         """A demo (re)started: a new recording from its first moment, no collision seen yet."""
         self.recorder.clear()
         self.recorder.sample(table)
+        self.exported_to_s = table.time_s
         self.momenta.clear()
         if self.painter is not None:
             self.painter.new_demo()
@@ -47,6 +52,13 @@ class Lessons:
         self.recorder.drop_after(t_s)
         if self.momenta.latest is not None and self.momenta.latest.t_s > t_s:
             self.momenta.clear()
+
+    def unexported_s(self) -> float:
+        """Seconds of the recording that quitting now would lose (not exported with x)."""
+        samples = self.recorder.samples
+        if not samples:
+            return 0.0
+        return max(0.0, samples[-1].t_s - max(samples[0].t_s, self.exported_to_s))
 
     def after_step(self, table: AirTable) -> None:
         self.recorder.sample(table)
@@ -71,6 +83,7 @@ def export_recording(app: App) -> None:
     except OSError as exc:
         app.say(f"could not write the recording: {exc}")
         return
+    app.lessons.exported_to_s = app.table.time_s
     app.say(f"recorded {app.lessons.recorder.summary()} to {pucks.resolve()} and {energy.name}")
 
 

@@ -16,6 +16,7 @@ import dataclasses
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING
 
+from airtable.app.overlays import OverlayFlag, Overlays
 from airtable.app.scene import Scene
 
 if TYPE_CHECKING:
@@ -54,7 +55,8 @@ def anonymous_label(name: str) -> str:
 class Room:
     """The teacher's side of running the room."""
 
-    show_roster: bool = False
+    show_roster = OverlayFlag("roster")  # not a field: the flag lives in `overlays`
+    overlays: Overlays = field(default_factory=Overlays)
     selected: int = 0  # row of the roster panel
     anonymous: bool = False  # names hidden on the projector (colours stay)
     remove_armed: tuple[int, float] | None = None  # (player number, clock_s until which Delete removes)

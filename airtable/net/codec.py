@@ -667,7 +667,9 @@ class SnapshotDecoder:
         if usable_view(view):
             self.shown_view = view
         else:
-            self.problem = f"a view of zoom {view[0]:g} at ({view[1]:g}, {view[2]:g}) m; left out, the previous view kept"
+            self.problem = (
+                f"a view of zoom {view[0]:g} at ({view[1]:g}, {view[2]:g}) m; left out, the previous view kept"
+            )
         if flags & HAS_STATUS:
             status = _apply_text_delta("" if flags & KEYFRAME else b1.status, r)
         elif b1 is not None:

@@ -50,6 +50,8 @@ MAX_BACKOFF_S = 4.0
 # input: a still table leaves a student's laptop quiet, and motion shows within 1 / IDLE_FPS.
 IDLE_FPS = 20.0
 IDLE_AFTER_S = 1.0
+LEAVE_CONFIRM_S = 4.0  # a second Esc within this time leaves the table
+LEAVE_QUESTION = "Esc again to leave the table; any other key to stay"
 # Drawing budgets for one frame (see fit_drawing_budget).
 MAX_PUCK_AREA_SCREENS = 40.0
 MAX_PUCK_LOOKS = 1024
@@ -563,6 +565,7 @@ class PlayerApp:
         self.button = 0
         self.keys: set[str] = set()
         self.show_help = False  # F1: the keys of this window
+        self.leave_asked_until = -math.inf  # time.monotonic() until which a second Esc leaves
         self.painter = None  # the AidsPainter, once the window is open
         self.lessons_painter = None  # the LessonsPainter (momenta, values) and
         self.timeline_painter = None  # the TimelinePainter, likewise
@@ -652,11 +655,12 @@ class PlayerApp:
         import pygame
 
         for event in events:
-            if event.type == pygame.KEYDOWN and event.key == pygame.K_ESCAPE and self.show_help:
-                self.show_help = False
-                continue
-            if event.type == pygame.QUIT or (event.type == pygame.KEYDOWN and event.key == pygame.K_ESCAPE):
+            if event.type == pygame.QUIT:
+                return False  # the window's close button: the student meant it
+            if event.type == pygame.KEYDOWN and not self._answer_leave(event.key == pygame.K_ESCAPE):
                 return False
+            if event.type == pygame.KEYDOWN and event.key == pygame.K_ESCAPE:
+                continue
             if event.type == pygame.KEYDOWN and self._local_key(pygame.key.name(event.key)):
                 continue  # this window's own toggles: the server never hears of them
             if self._predict_event(event):
@@ -670,6 +674,23 @@ class PlayerApp:
             elif event.type == pygame.MOUSEBUTTONUP and event.button == self.button:
                 held = pygame.mouse.get_pressed(3)
                 self.button = next((b for b in (1, 2, 3) if held[b - 1]), 0)
+        return True
+
+    def _answer_leave(self, escape: bool) -> bool:
+        """A key while the window may be asking whether to leave; False to leave now.
+
+        Esc closes the help if it is open, else asks; Esc again while asked leaves.
+        Any other key while asked: stay."""
+        asked, now = self.leave_asked_until > time.monotonic(), time.monotonic()
+        self.leave_asked_until = -math.inf
+        if not escape:
+            return True
+        if self.show_help:
+            self.show_help = False
+        elif asked:
+            return False
+        else:
+            self.leave_asked_until = now + LEAVE_CONFIRM_S
         return True
 
     def _local_key(self, name: str) -> bool:
@@ -765,7 +786,9 @@ class PlayerApp:
         if extra and me:  # not in the snapshots yet: the arrow alone
             win.draw_cursor(me, color, cursor_m)
         self._draw_round(color)
-        if self.show_help:
+        if self.leave_asked_until > time.monotonic():
+            win.draw_panel("Leave the table?", [LEAVE_QUESTION])
+        elif self.show_help:
             win.draw_panel("Keys", list(STUDENT_KEYS))
         elif net.aids.teacher & NOTES and net.aids.notes is not None:
             win.draw_panel(scene.title, [net.aids.notes], large=True)
