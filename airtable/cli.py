@@ -153,13 +153,11 @@ def write_starter_demo(path: Path) -> Path:
 
 
 def start_server(args):
-    """Start the network server, or explain on stderr why students cannot join."""
-    try:
-        from airtable.app.glyphs import NameCheck, drawable_characters
-        from airtable.net.identity import load_key
-        from airtable.net.server import GameServer
-    except ImportError:
-        return None
+    """Start the network server: (server, None), or (None, why students cannot join), also said on stderr."""
+    from airtable.app.glyphs import NameCheck, drawable_characters
+    from airtable.net.identity import load_key
+    from airtable.net.server import GameServer
+
     server = GameServer(
         host=args.host,
         port=args.port,
@@ -172,11 +170,12 @@ def start_server(args):
     try:
         server.start()
     except OSError as exc:
-        print(f"airtable: students cannot join: {exc}", file=sys.stderr)
-        return None
+        problem = f"students cannot join: {exc.strerror or exc}"
+        print(f"airtable: {problem}", file=sys.stderr)
+        return None, problem
     for line in server.join_lines():
         print(line)
-    return server
+    return server, None
 
 
 def screenshot_path(text: str) -> Path:
@@ -308,7 +307,7 @@ def run_app(args: argparse.Namespace, shelf: DemoShelf, shot: Path | None) -> in
 
     # The server logs who joins and who is dropped (and why) for the teacher.
     logging.basicConfig(level=logging.INFO, format="%(message)s")
-    server = None if args.no_server else start_server(args)
+    server, server_problem = (None, None) if args.no_server else start_server(args)
     # A timed headless run with nobody to serve simulates its time: it takes as long as the machine needs.
     simulated = args.headless and server is None and args.seconds is not None
     frame_dt_s = HEADLESS_FRAME_S if simulated else None
@@ -320,6 +319,7 @@ def run_app(args: argparse.Namespace, shelf: DemoShelf, shot: Path | None) -> in
             variation=args.variation,
             headless=args.headless,
             server=server,
+            server_problem=server_problem,
             fullscreen=args.fullscreen,
         )
         app.run(seconds=args.seconds, frame_dt_s=frame_dt_s)

@@ -91,6 +91,7 @@ class App:
         variation: int = 0,
         headless: bool = False,
         server=None,
+        server_problem: str | None = None,
         demo_errors=(),
         window_size_px: tuple[int, int] | None = None,
         fullscreen: bool = False,
@@ -109,6 +110,7 @@ class App:
         if not headless:
             pygame.mouse.set_visible(False)  # the local client's arrow is the pointer
         self.server = server
+        self.server_problem = server_problem  # why students cannot join, when the server did not start
         self.stats = RunStats()  # frames, steps and their cost, for --stats
         self._init_state()
         self.errors: list[DemoError] = []  # every error reported, in order

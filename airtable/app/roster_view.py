@@ -89,9 +89,14 @@ def _draw_row(surf: pygame.Surface, font: pygame.font.Font, seat: Seat, label: s
         surf.blit(font.render(panel_view.shorten(font, text, max(0, right - x)), True, color), (x, y))
 
 
+def room_alert(app: App) -> str | None:
+    """Why students cannot join, if they cannot: the server did not start, or its thread failed."""
+    return app.server.failure if app.server is not None else app.server_problem
+
+
 def draw_alert(app: App) -> None:
-    """`server.failure` in red under the HUD, wrapped to the window: students can no longer join."""
-    failure = app.server.failure if app.server is not None else None
+    """`room_alert` in red under the HUD, wrapped to the window, so the projector says it."""
+    failure = room_alert(app)
     if not failure:
         return
     w = app.window

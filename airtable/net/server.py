@@ -185,6 +185,18 @@ def _open_file_limit() -> int | None:
     return None if soft == resource.RLIM_INFINITY else int(soft)
 
 
+def free_port_after(host: str, port: int, tries: int = 20) -> int | None:
+    """The first port after `port` that `host` can listen on now (None if none of `tries` is free):
+    what the teacher can start with instead of a busy one."""
+    for candidate in range(port + 1, min(port + 1 + tries, 65536)):
+        try:
+            with socket.create_server((host, candidate)):
+                return candidate
+        except OSError:
+            continue
+    return None
+
+
 class GameServer:
     """The table's network server; see the module docstring for how the game loop uses it."""
 
@@ -316,10 +328,9 @@ class GameServer:
 
     def _bind_sentence(self, e: OSError, host: str) -> str:
         if e.errno in (errno.EADDRINUSE, getattr(errno, "WSAEADDRINUSE", -1)):
-            return (
-                f"port {self.port} is already in use on {host}: is another airtable server running? "
-                "Stop it or pick another port with --port"
-            )
+            other = free_port_after(host, self.port)
+            instead = f"start with --port {other}" if other else "pick another port with --port"
+            return f"port {self.port} is already in use (another airtable?); {instead}"
         if e.errno in (errno.EACCES, errno.EPERM):
             return f"not allowed to listen on {host}:{self.port}; use a port above 1023 with --port"
         if e.errno == errno.EADDRNOTAVAIL:
@@ -370,10 +381,12 @@ class GameServer:
         host = self.host or "0.0.0.0"
         hosts = lan_addresses() if host in ("0.0.0.0", "::", "") else [host]
         lines = []
+        # The password itself never goes on the projector: the teacher says it.
+        password = " --password (ask the teacher)" if self.password else ""
         for h in hosts:
             if self.port != proto.DEFAULT_PORT:
                 h = f"[{h}]:{self.port}" if ":" in h else f"{h}:{self.port}"
-            lines.append(f"join with: airtable-client {h}")
+            lines.append(f"join with: airtable-client {h}{password}")
         return lines
 
     # ---------------------------------------------------------------- the teacher's view
