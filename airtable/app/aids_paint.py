@@ -294,12 +294,11 @@ class AidsPainter:
         )
 
     def energy_chart(self, series: dict[str, np.ndarray], latest: dict[str, float], note: str | None) -> None:
-        """Strip chart of energies (left scale) and |momentum| (right scale) in a corner panel."""
+        """Strip chart of energies (left scale) and |momentum| (right scale) in an opaque corner panel;
+        the key beside the plot, or under it where the panel is narrow (a side margin)."""
         box = self.chart_rect()
         surf, font = self.w.surface, self.w.label_font
-        panel = pygame.Surface(box.size, pygame.SRCALPHA)
-        panel.fill((0, 0, 0, 215))
-        surf.blit(panel, box)
+        pygame.draw.rect(surf, (0, 0, 0), box)
         pygame.draw.rect(surf, DIM_TEXT, box, 1)
         self._taken.append(box)
         line_h = font.get_linesize()
@@ -311,10 +310,11 @@ class AidsPainter:
         # Sized for the widest value the format gives, so the plot does not jitter.
         widest = max(font.size(f"{CHART_LABELS[k]} -8.88e-88 N s")[0] for k in CHART_COLORS)
         key_w = widest + 5 * pad
+        stacked = box.width < 2 * key_w
         notes = _wrap(font, note, box.width - 20)[:2] if note and not self.chart_small else []
-        plot = pygame.Rect(
-            box.x + pad, box.y + pad, box.width - key_w - 3 * pad, box.height - 2 * pad - line_h * len(notes)
-        )
+        below = line_h * (len(notes) + (len(legend) if stacked else 0))
+        plot_w = box.width - 2 * pad if stacked else box.width - key_w - 3 * pad
+        plot = pygame.Rect(box.x + pad, box.y + pad, plot_w, box.height - 2 * pad - below)
         pygame.draw.rect(surf, (60, 60, 60), plot, 1)
         t = series["time_s"]
         if len(t) >= 2 and plot.width > 10 and plot.height > 10:
@@ -322,14 +322,14 @@ class AidsPainter:
             top_e = max(float(np.max(series["total_J"])), 1e-12) * 1.1
             self._text(f"{top_e:.3g} J", (plot.x + 2, plot.y + 2), DIM_TEXT)
             self._text(f"last {max(t[-1] - t[0], 0.0):.1f} s", (plot.x + 2, plot.bottom - line_h), DIM_TEXT)
-        y = box.y + pad
+        x, y = (box.x + pad, plot.bottom) if stacked else (plot.right + pad, box.y + pad)
         for text, color in legend:
             mid = y + line_h // 2
-            pygame.draw.line(surf, color, (plot.right + pad, mid), (plot.right + 3 * pad, mid), self.w.line_px(3))
-            self._text(text, (plot.right + 3 * pad + 4, y), color)
-            y += line_h + (pad // 2 if not self.chart_small else 0)
+            pygame.draw.line(surf, color, (x, mid), (x + 2 * pad, mid), self.w.line_px(3))
+            self._text(text, (x + 2 * pad + 4, y), color)
+            y += line_h + (pad // 2 if not (self.chart_small or stacked) else 0)
         for k, line in enumerate(notes):
-            self._text(line, (box.x + pad, plot.bottom + k * line_h), DIM_TEXT)
+            self._text(line, (box.x + pad, box.bottom - pad - (len(notes) - k) * line_h), DIM_TEXT)
 
     def _chart_lines(self, series: dict[str, np.ndarray], plot: pygame.Rect) -> None:
         t = series["time_s"]
@@ -356,9 +356,12 @@ class AidsPainter:
 
 
 def place_in_corner(window, rect: pygame.Rect, corner: int) -> pygame.Rect:
-    """`rect` moved into CHART_CORNERS[corner]: under the HUD or above the status bar, a margin from the side."""
+    """`rect` moved into CHART_CORNERS[corner]: under the HUD or above the status bar, a margin from the side;
+    where the window has side margins, inside them (no wider than they are), clear of the table."""
     pad = window.line_px(4)
     name = CHART_CORNERS[corner]
+    if window.layout.side_px:
+        rect.width = min(rect.width, window.layout.side_px - 2 * pad)
     if name.startswith("top"):
         rect.top = window.hud_bottom_px + pad
     else:

@@ -30,7 +30,7 @@ from airtable.app.loop import FixedStep, FpsCounter, FrameLoop
 from airtable.app.menu import DemoMenu
 from airtable.app.overlays import OverlayFlag, Overlays
 from airtable.app.predict_view import draw_predict
-from airtable.app.roster_view import draw_alert, draw_roster
+from airtable.app.roster_view import ALERT_COLOR, draw_roster, room_alert
 from airtable.app.scene import STATUS_SEPARATOR, Scene
 from airtable.app.stats import RunStats
 from airtable.app.window import AidsPainter, GameWindow, TimelinePainter
@@ -468,8 +468,11 @@ class App:
     def status_line(self) -> str:
         return STATUS_SEPARATOR.join(self.status_parts())
 
-    def hud_lines(self) -> list[str]:
-        lines = []
+    def hud_lines(self) -> list:
+        """The heads-up lines under the title: why students cannot join (in red), the join line,
+        the student count, then the newest message."""
+        alert = room_alert(self)
+        lines: list = [(alert, ALERT_COLOR)] if alert else []
         if self.server is not None:
             lines.extend(self.server.join_lines())
             lines.extend(room.hud_lines(self))
@@ -481,7 +484,6 @@ class App:
         """Draw `scene` (by default the table as it is now), the aids and the panel on top."""
         projected = self.room.projected(scene or self.scene())  # names hidden if anonymous
         self.window.draw(projected, trails=self.trails, hud=self.hud_lines())
-        draw_alert(self)  # the network thread failed: students can no longer join
         self._draw_timeline()  # first: the lesson panels then stand clear of it
         draw_lessons(self)  # before the aids: their labels then place themselves around its panels
         draw_aids(self)
