@@ -15,7 +15,7 @@ import pygame
 ACCENT = (255, 220, 120)
 TEXT_COLOR = (230, 230, 230)
 DIM_TEXT = (150, 150, 150)
-PANEL_COLOR = (10, 10, 30, 242)
+PANEL_COLOR = (10, 10, 30, 255)  # opaque: nothing shows through the text
 COLUMN_EMS = 20  # a column is at least this many font sizes wide (about 50 characters)
 
 Row = tuple[str, str] | str

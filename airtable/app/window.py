@@ -325,23 +325,34 @@ class GameWindow:
         right, bottom = int(round(np.clip(x1, -2, w + 2))), int(round(np.clip(y1, -2, h + 2)))
         return pygame.Rect(left, top, max(0, right - left), max(0, bottom - top))
 
-    def _draw_walls(self, scene: Scene) -> None:
-        # The wall line sits just inside the table's edge, so it shows even
-        # when the table exactly fills the window.
+    def wall_rects(self, size_m: Sequence[float] | None = None) -> list[pygame.Rect]:
+        """The four walls' lines on screen for a table of `size_m` (default: the view's), clipped near
+        the window (none when the table is out of view).
+
+        The wall line sits just inside the table's edge, so it shows even when the table
+        exactly fills the window."""
+        width_m, height_m = size_m if size_m is not None else (self.env.width_m, self.env.height_m)
         width = max(self.line_px(2), int(round(self.env.length_to_px(0.03))))
         width = min(width, 4 * self.line_px(2))
-        (x0, y0), (x1, y1) = self.env.to_screen(np.array([[0.0, scene.height_m], [scene.width_m, 0.0]]))
+        (x0, y0), (x1, y1) = self.env.to_screen(np.array([[0.0, height_m], [width_m, 0.0]]))
         w, h = self.surface.get_size()
-        if x0 < w and x1 > 0 and y0 < h and y1 > 0:  # each edge drawn alone, clipped to the window
-            top, bottom = max(y0, -width), min(y1, h + width)
-            left, right = max(x0, -width), min(x1, w + width)
+        if not (x0 < w and x1 > 0 and y0 < h and y1 > 0):
+            return []
+        top, bottom = max(y0, -width), min(y1, h + width)
+        left, right = max(x0, -width), min(x1, w + width)
+        return [
+            pygame.Rect(*(int(round(v)) for v in rect))
             for rect in (
                 (left, y0, right - left, width),
                 (left, y1 - width, right - left, width),
                 (x0, top, width, bottom - top),
                 (x1 - width, top, width, bottom - top),
-            ):
-                self.surface.fill(WALL_COLOR, pygame.Rect(*(int(round(v)) for v in rect)))
+            )
+        ]
+
+    def _draw_walls(self, scene: Scene) -> None:
+        for rect in self.wall_rects((scene.width_m, scene.height_m)):
+            self.surface.fill(WALL_COLOR, rect)
 
     def _draw_pucks(self, target: pygame.Surface, scene: Scene) -> None:
         if len(scene.pos_m) == 0:
