@@ -46,6 +46,7 @@ MAX_FPS = 240.0
 # and wakes at once on input: a laptop projecting all lesson stays quiet.
 IDLE_FPS = 12.0
 IDLE_AFTER_S = 1.0  # input this recent keeps the full frame rate
+STILL_PX_PER_S = 0.5  # slower than this on screen, nothing visibly moves: the table idles
 ERROR_TITLES = {
     "load": "Demo {key} could not be loaded",
     "build": "Demo {key} could not be built",
@@ -531,7 +532,14 @@ class App:
             self._students_seen, self.last_input_s = students, self.clock_s
         if self.keys_down or self.mouse_button or self.clock_s - self.last_input_s < IDLE_AFTER_S:
             return False
-        return self.paused or not np.any(self.table.vel_mps)
+        return self.paused or self.motion_px_per_s() < STILL_PX_PER_S
+
+    def motion_px_per_s(self) -> float:
+        """How fast the fastest puck crosses the screen: a settled demo's round-off is far below a pixel."""
+        v = self.table.vel_mps
+        if not len(v):
+            return 0.0
+        return float(np.sqrt(np.max(np.einsum("ij,ij->i", v, v)))) * self.env.px_per_m
 
     def run(self, seconds: float | None = None, max_frames: int | None = None, frame_dt_s: float | None = None) -> int:
         """Run until Esc / window close, `seconds` or `max_frames` frames; returns the frames run.
