@@ -322,7 +322,13 @@ def run_app(args: argparse.Namespace, shelf: DemoShelf, shot: Path | None) -> in
             server_problem=server_problem,
             fullscreen=args.fullscreen,
         )
-        app.run(seconds=args.seconds, frame_dt_s=frame_dt_s)
+        started = None
+        if args.headless and args.seconds is None:  # no window to close: say how it ends
+
+            def started():
+                print("airtable: running without a window; Ctrl+C (or kill) stops it", flush=True)
+
+        app.run(seconds=args.seconds, frame_dt_s=frame_dt_s, started=started)
         if shot is not None:
             try:
                 print(f"screenshot saved to {app.window.save_screenshot(shot)}")

@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import sys
 import time
+from collections.abc import Callable
 from pathlib import Path
 
 import numpy as np
@@ -26,7 +27,7 @@ from airtable.app.environment import Environment
 from airtable.app.history import History
 from airtable.app.lessons import Lessons
 from airtable.app.lessons_view import draw_lessons
-from airtable.app.loop import FixedStep, FpsCounter, FrameLoop
+from airtable.app.loop import FixedStep, FpsCounter, FrameLoop, signals_end_the_run
 from airtable.app.menu import DemoMenu
 from airtable.app.overlays import OverlayFlag, Overlays
 from airtable.app.predict_view import draw_predict
@@ -53,6 +54,9 @@ ERROR_TITLES = {
     "event": "Demo {key}: a timed event failed",
 }
 
+MODIFIER_KEYS = frozenset(
+    getattr(pygame, f"K_{side}{name}") for side in "LR" for name in ("SHIFT", "CTRL", "ALT", "META", "SUPER")
+)
 # Kept importable from here: the key table lives in controls.py.
 BINDINGS = controls.BINDINGS
 
@@ -302,6 +306,8 @@ class App:
         panel = self.panel()
         if event.key == pygame.K_ESCAPE or panel not in ("quit", "menu", "notice"):
             return False
+        if event.key in MODIFIER_KEYS:
+            return True  # Shift or Ctrl alone answers nothing: it starts a key
         if panel == "menu" and event.key == pygame.K_TAB:
             self.menu = None
         elif panel == "menu":
@@ -541,21 +547,34 @@ class App:
             return 0.0
         return float(np.sqrt(np.max(np.einsum("ij,ij->i", v, v)))) * self.env.px_per_m
 
-    def run(self, seconds: float | None = None, max_frames: int | None = None, frame_dt_s: float | None = None) -> int:
+    def run(
+        self,
+        seconds: float | None = None,
+        max_frames: int | None = None,
+        frame_dt_s: float | None = None,
+        started: Callable[[], None] | None = None,
+    ) -> int:
         """Run until Esc / window close, `seconds` or `max_frames` frames; returns the frames run.
 
         With `frame_dt_s` every frame is that long and nothing sleeps: `seconds`
         is then simulated time (tests and headless runs use it, so they never
         depend on timing). Without it, frames follow the clock, at most at the
         display's refresh rate, sleeping in between; a still table runs at
-        IDLE_FPS and wakes on input.
+        IDLE_FPS and wakes on input. `started` is called once signals end the run (see loop.py).
         """
         self._full_period_s = 1.0 / display_rate_hz()
         self.loop = FrameLoop(fps=1.0 / self._full_period_s, fixed_dt_s=frame_dt_s, sleep=self._sleep)
         try:
-            return self.loop.run(self._frame_running, max_frames=max_frames, max_time_s=seconds)
+            with signals_end_the_run(self.stop):
+                if started is not None:
+                    started()
+                return self.loop.run(self._frame_running, max_frames=max_frames, max_time_s=seconds)
         finally:
             self.loop = None
+
+    def stop(self) -> None:
+        """End the run after this frame, asking nothing (a signal, not a person at the window)."""
+        self.running = False
 
     def _frame_running(self, dt_s: float) -> bool:
         self.frame(dt_s)
