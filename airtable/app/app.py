@@ -100,6 +100,7 @@ class App:
         demo_errors=(),
         window_size_px: tuple[int, int] | None = None,
         fullscreen: bool = False,
+        show_fps: bool = False,
     ) -> None:
         self.shelf = demos if isinstance(demos, DemoShelf) else DemoShelf.from_demos(demos)
         if not self.shelf.demos:
@@ -110,6 +111,7 @@ class App:
         # The loop owns the clients (index 0 is the local user); the server adds the students.
         self.clients: list[Client] = [self.local]
         self.window = GameWindow(self.env, headless=headless, size_px=window_size_px, fullscreen=fullscreen)
+        self.window.show_fps = show_fps  # --stats: the frame rate in a corner too
         self.painter = AidsPainter(self.window)
         self.timeline_painter = TimelinePainter(self.window)
         if not headless:
@@ -509,7 +511,8 @@ class App:
         if panel == "quit":
             w.draw_panel("Quit?", [*self.quit_would_lose(), "Esc again to quit; any other key to stay."])
         elif panel == "menu":
-            w.draw_panel("Demos", [*self.menu.rows(), self.menu.footer()])
+            rows = self.menu.rows(visible=w.panel_rows() - 2, label=key_label)  # the footer under them
+            w.draw_panel("Demos", [*rows, self.menu.footer()])
         elif panel == "error":
             error = self.build_error
             title = ERROR_TITLES[error.stage].format(key=key_label(self.demo_key))

@@ -97,19 +97,22 @@ def draw_hud(
     style: HudStyle,
     title: str,
     lines: Sequence[HudLine],
-    fps: float,
+    fps: float | None,
     paused: bool,
 ) -> tuple[list[pygame.Rect], int]:
-    """The title, heads-up lines, frame rate and PAUSED in their places; returns the boxes drawn
-    (for the aids to keep clear of) and how far down the window the text goes."""
+    """The title, heads-up lines, frame rate (None: not shown) and PAUSED in their places; returns
+    the boxes drawn (for the aids to keep clear of) and how far down the window the text goes."""
     if layout.side_px:
         return _draw_in_margins(surface, layout, style, title, lines, fps, paused)
     return _draw_in_band(surface, layout, style, title, lines, fps, paused)
 
 
-def _fps_box(surface, style: HudStyle, fps: float, topright) -> pygame.Rect:
+def _fps_box(surface, style: HudStyle, fps: float | None, topright) -> pygame.Rect:
+    """The frame rate in a box at `topright`; with none to show, an empty box of no width there."""
     font = style.font
     pad = font.get_height() // 2
+    if fps is None:
+        return pygame.Rect(topright[0], topright[1], 0, font.get_linesize())
     label = font.render(f"{fps:5.1f} fps", True, style.text)
     box = label.get_rect(topright=topright).inflate(pad, pad // 4)
     box.topright = topright
@@ -164,6 +167,7 @@ def _draw_in_margins(surface, layout, style, title, lines, fps, paused) -> tuple
             y += line_h
         y += pad // 2
     right = [_fps_box(surface, style, fps, (w - pad, pad // 2))]
+    right = [box for box in right if box.width] or [pygame.Rect(w - pad, 0, 0, pad // 2)]
     if paused:
         big = style.big_font
         right.append(_paused_box(surface, style, big, (w - pad, right[0].bottom + pad), column))

@@ -111,6 +111,7 @@ class GameWindow:
         self._status_bar: pygame.Surface | None = None
         self.hud_bottom_px = 0  # below the title and HUD lines: panels start under it
         self.layout = TextLayout(0, 0)  # where the text goes (hud_view.py)
+        self.show_fps = False  # the frame rate in a corner (--stats): not for the room
         self.label_boxes: list[pygame.Rect] = []  # text drawn this frame; the aids place labels around it
         self.status_top_px = 0
         if headless:
@@ -419,7 +420,8 @@ class GameWindow:
         paused = PAUSED in parts
         parts = [p for p in parts if p != PAUSED]
         style = HudStyle(self.font, self.big_font, TEXT_COLOR, DIM_TEXT, PAUSED_COLOR, self.line_px(3))
-        boxes, self.hud_bottom_px = draw_hud(self.surface, self.layout, style, scene.title, hud, scene.fps, paused)
+        fps = scene.fps if self.show_fps else None
+        boxes, self.hud_bottom_px = draw_hud(self.surface, self.layout, style, scene.title, hud, fps, paused)
         self.label_boxes.extend(boxes)
         bar_h = self.status_bar_px
         self.status_top_px = h - bar_h if parts else h
@@ -451,6 +453,12 @@ class GameWindow:
         left = max(pad, w // 40, self.layout.side_px)  # the left margin's text stays in view
         right = w - max(pad, w // 40)
         return pygame.Rect(left, top, right - left, max(4 * self.font.get_linesize(), bottom - top))
+
+    def panel_rows(self) -> int:
+        """How many one-line rows a panel holds on one page at the smallest readable type."""
+        font = self._font_px(FONT_SIZES["label"][1])
+        body = panel_view.body_rect(self.panel_rect().size, font, self.big_font, self.label_font)
+        return max(3, body.height // font.get_linesize())
 
     def draw_panel(
         self,
