@@ -446,3 +446,16 @@ def test_the_summary_wraps_to_a_students_window(size):
         assert any(t.strip().startswith("speeds within 20 %") for t, _ in placed)
     Net.round = RoundInfo(4, "open", 2, 17, 28, from_m=info.from_m)
     _check_fits(student._draw_round((0, 255, 0)), size[0], ("17 of 28 predicted",))
+
+
+def test_the_students_status_line_has_no_teacher_keys(demos):
+    from conftest import teacher_and_student
+
+    with teacher_and_student(demos, "8") as (teacher, net):
+        frames_until(teacher, lambda: teacher.student_count() == 1, "the student to join")
+        press(teacher, pygame.K_F6)
+        assert "F6 reveals" in teacher.status_line()
+        scene = frames_until(
+            teacher, lambda: (s := net.latest()) is not None and "PREDICT" in s.status and s, "the round's status"
+        )
+        assert "F6" not in scene.status and "PREDICT: 0 of 1 predicted" in scene.status

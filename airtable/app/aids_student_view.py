@@ -28,6 +28,7 @@ STUDENT_KEYS = (
     ("i", "inspect the puck under your cursor, on or off"),
     ("e", "trails on your window, on or off"),
     ("F1", "this help (again: close it)"),
+    ("F11", "fullscreen on / off"),
     ("Esc", "close this help; else leave the table (Esc twice)"),
 )
 

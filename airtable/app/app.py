@@ -10,6 +10,7 @@ opened and closed here.
 
 from __future__ import annotations
 
+import dataclasses
 import sys
 import time
 from collections.abc import Callable
@@ -412,8 +413,9 @@ class App:
         self.fps = self._fps_counter.tick(self.clock_s)
         scene = self.scene()
         if self.server is not None:
-            scene.aids = shared_aids(self)  # the students see the teacher's aids too
-            self.server.publish(scene)
+            shared = dataclasses.replace(scene, status=STATUS_SEPARATOR.join(self.status_parts(for_students=True)))
+            shared.aids = shared_aids(self)  # the students see the teacher's aids too
+            self.server.publish(shared)
         self.draw(scene)
         self.stats.frame()
 
@@ -449,20 +451,21 @@ class App:
             origin_m=(float(self.env.origin_m[0]), float(self.env.origin_m[1])),
         )
 
-    def status_parts(self) -> list[str]:
-        """The status line in parts, most important first (a narrow window drops the last)."""
+    def status_parts(self, for_students: bool = False) -> list[str]:
+        """The status line in parts, most important first (a narrow window drops the last);
+        `for_students`: as the students' windows show it, without the teacher's keys."""
         t = self.table
         parts = ["PAUSED"] if self.paused else []
         parts.extend(room.status_parts(self))  # hands off, the floor
         if self.predict.active:
-            parts.append(predict.status_text(self))
+            parts.append(predict.status_text(self, for_students))
         timeline = self.history.timeline() if self.history.in_past else None
         if timeline is not None:
             parts.append(f"rewound {timeline.newest_s - timeline.view_s:.2f} s")
         if self.speed != 1.0:
             parts.append(f"slow motion x1/{round(1 / self.speed)}")
         parts.append(f"t = {t.time_s:.2f} s")
-        parts.append("F1: help")
+        parts.append("F1: help")  # the students' windows have their own F1
         parts.append(world.gravity_label(t))
         parts.append(f"correction: {t.puck_correction}")
         n, hits = len(t.pos_m), t.collision_count

@@ -566,6 +566,7 @@ class PlayerApp:
         self.keys: set[str] = set()
         self.show_help = False  # F1: the keys of this window
         self.leave_asked_until = -math.inf  # time.monotonic() until which a second Esc leaves
+        self.ended: str | None = None  # why the session ended for good, shown until a key is pressed
         self.painter = None  # the AidsPainter, once the window is open
         self.lessons_painter = None  # the LessonsPainter (momenta, values) and
         self.timeline_painter = None  # the TimelinePainter, likewise
@@ -591,10 +592,11 @@ class PlayerApp:
         status = 0
         try:
             while self._handle_events(pygame.event.get()):
-                if self.net.state == PlayerState.FAILED:
+                if self.net.state == PlayerState.FAILED and self.ended is None:
                     print(f"airtable-client: {self.net.error}", file=sys.stderr)
-                    status = 1
-                    break
+                    status, self.ended = 1, self.net.error or "the session ended"
+                    if self.headless:
+                        break  # nobody to read it: the line above says it
                 self._frame()
                 if seconds is not None and time.monotonic() - start >= seconds:
                     break
@@ -657,6 +659,10 @@ class PlayerApp:
         for event in events:
             if event.type == pygame.QUIT:
                 return False  # the window's close button: the student meant it
+            if self.window.handle_event(event):
+                continue  # a resize, or F11: fullscreen on or off
+            if event.type == pygame.KEYDOWN and self.ended is not None:
+                return False  # the session ended and the student has read why
             if event.type == pygame.KEYDOWN and not self._answer_leave(event.key == pygame.K_ESCAPE):
                 return False
             if event.type == pygame.KEYDOWN and event.key == pygame.K_ESCAPE:
@@ -786,7 +792,9 @@ class PlayerApp:
         if extra and me:  # not in the snapshots yet: the arrow alone
             win.draw_cursor(me, color, cursor_m)
         self._draw_round(color)
-        if self.leave_asked_until > time.monotonic():
+        if self.ended is not None:
+            win.draw_panel("The session has ended", [self.ended, "Press any key to close this window."])
+        elif self.leave_asked_until > time.monotonic():
             win.draw_panel("Leave the table?", [LEAVE_QUESTION])
         elif self.show_help:
             win.draw_panel("Keys", list(STUDENT_KEYS))
@@ -905,7 +913,7 @@ def _parse_args(argv: Sequence[str] | None) -> argparse.Namespace:
     parser = argparse.ArgumentParser(
         prog="airtable-client",
         description="Join a teacher's air table: your mouse pulls pucks on the shared table "
-        "(buttons 1, 2, 3 are the medium, soft and stiff cursor strings; Esc quits).",
+        "(buttons 1, 2, 3 are the medium, soft and stiff cursor strings; Esc twice leaves; F11 fullscreen).",
     )
     parser.add_argument("server", metavar="HOST[:PORT]", help="the address from the teacher's 'join with:' line")
     parser.add_argument("--name", help=f"a name shown next to your cursor (up to {proto.MAX_NAME_CHARS} characters)")
