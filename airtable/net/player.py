@@ -661,26 +661,36 @@ class PlayerApp:
                 return False  # the window's close button: the student meant it
             if self.window.handle_event(event):
                 continue  # a resize, or F11: fullscreen on or off
-            if event.type == pygame.KEYDOWN and self.ended is not None:
-                return False  # the session ended and the student has read why
-            if event.type == pygame.KEYDOWN and not self._answer_leave(event.key == pygame.K_ESCAPE):
+            if event.type == pygame.KEYDOWN and not self._window_key(event.key):
                 return False
-            if event.type == pygame.KEYDOWN and event.key == pygame.K_ESCAPE:
-                continue
-            if event.type == pygame.KEYDOWN and self._local_key(pygame.key.name(event.key)):
-                continue  # this window's own toggles: the server never hears of them
-            if self._predict_event(event):
-                continue
-            if event.type == pygame.KEYDOWN:
-                self.keys.add(pygame.key.name(event.key))
-            elif event.type == pygame.KEYUP:
-                self.keys.discard(pygame.key.name(event.key))
-            elif event.type == pygame.MOUSEBUTTONDOWN and event.button in (1, 2, 3):
-                self.button = event.button
-            elif event.type == pygame.MOUSEBUTTONUP and event.button == self.button:
-                held = pygame.mouse.get_pressed(3)
-                self.button = next((b for b in (1, 2, 3) if held[b - 1]), 0)
+            if event.type == pygame.KEYDOWN and (event.key == pygame.K_ESCAPE or self._local_key(event.key)):
+                continue  # this window's own keys: the server never hears of them
+            if not self._predict_event(event):
+                self._table_input(event)
         return True
+
+    def _window_key(self, key: int) -> bool:
+        """A key for the window itself first: False to close it (the session ended and was read,
+        or Esc twice)."""
+        import pygame
+
+        if self.ended is not None:
+            return False
+        return self._answer_leave(key == pygame.K_ESCAPE)
+
+    def _table_input(self, event) -> None:
+        """Keys held and the mouse button: what the server hears."""
+        import pygame
+
+        if event.type == pygame.KEYDOWN:
+            self.keys.add(pygame.key.name(event.key))
+        elif event.type == pygame.KEYUP:
+            self.keys.discard(pygame.key.name(event.key))
+        elif event.type == pygame.MOUSEBUTTONDOWN and event.button in (1, 2, 3):
+            self.button = event.button
+        elif event.type == pygame.MOUSEBUTTONUP and event.button == self.button:
+            held = pygame.mouse.get_pressed(3)
+            self.button = next((b for b in (1, 2, 3) if held[b - 1]), 0)
 
     def _answer_leave(self, escape: bool) -> bool:
         """A key while the window may be asking whether to leave; False to leave now.
@@ -699,8 +709,11 @@ class PlayerApp:
             self.leave_asked_until = now + LEAVE_CONFIRM_S
         return True
 
-    def _local_key(self, name: str) -> bool:
-        """F1 and the aids a student turns on or off for their own window; True if `name` was one."""
+    def _local_key(self, key: int) -> bool:
+        """F1 and the aids a student turns on or off for their own window; True if `key` was one."""
+        import pygame
+
+        name = pygame.key.name(key)
         if name == "f1":
             self.show_help = not self.show_help
         elif name in LOCAL_KEYS:
