@@ -4,8 +4,8 @@
 pygame; the window lives in `airtable.app.window`.
 """
 
-from airtable.app.client import Client
 from airtable.app.environment import Environment
+from airtable.model.client import Client
 from airtable.physics.bodies import Puck, Spring
 from airtable.physics.table import AirTable
 

@@ -9,10 +9,10 @@ import pygame
 import pytest
 from conftest import FRAME_S, frames_until, post_key, press
 
-from airtable.app import aids
 from airtable.app.app import App
 from airtable.app.demo_loader import BUILTIN_DIR, discover
 from airtable.cli import main
+from airtable.model import aids
 from airtable.physics.table import AirTable
 
 

@@ -12,7 +12,7 @@ from hypothesis import strategies as st
 from hypothesis.extra import numpy as hnp
 
 from airtable import AirTable, Client
-from airtable.app.scene import CursorView, Scene
+from airtable.model.scene import CursorView, Scene
 from airtable.net import bench_net
 from airtable.net.codec import (
     LAYOUT,

@@ -11,7 +11,9 @@ from conftest import FRAME_S, press
 
 from airtable.app.app import App
 from airtable.app.lessons_paint import TOTAL_COLOR, fitting, momenta_scale, total_texts
-from airtable.app.momenta import (
+from airtable.app.panel_view import ACCENT
+from airtable.app.rewind import timeline_shown
+from airtable.model.momenta import (
     MomentaLog,
     MomentaView,
     every_puck_values,
@@ -20,8 +22,6 @@ from airtable.app.momenta import (
     tip_to_tail,
     values_for,
 )
-from airtable.app.panel_view import ACCENT
-from airtable.app.rewind import timeline_shown
 from airtable.physics.table import AirTable
 
 

@@ -154,8 +154,8 @@ def test_quitting_with_a_student_connected_asks_and_says_so(demos, how):
 
             wait_until(joined, what="the student to join")
             shown: list[tuple] = []
-            draw_panel = app.window.draw_panel
-            app.window.draw_panel = lambda title, rows, **k: (shown.append((title, rows)), draw_panel(title, rows, **k))
+            draw_question = app.window.draw_question
+            app.window.draw_question = lambda title, rows: (shown.append((title, rows)), draw_question(title, rows))
             press(app, pygame.K_ESCAPE) if how == "esc" else close_window(app)
             app.frame(FRAME_S)
             assert app.running and app.panel() == "quit"

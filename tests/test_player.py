@@ -18,21 +18,15 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 from test_server import RawClient
 
-from airtable.app.scene import CursorView, Scene
 from airtable.app.window import background_for
+from airtable.model.scene import CursorView, Scene
 from airtable.net import protocol as proto
 from airtable.net.codec import SnapshotEncoder, Viewer, encode_layout, layout_of
 from airtable.net.loadtest import TableLoop, grid_table
-from airtable.net.player import (
-    InputThrottle,
-    NetPlayer,
-    PlayerApp,
-    PlayerError,
-    PlayerState,
-    main,
-    own_cursor_live,
-)
+from airtable.net.player import InputThrottle, NetPlayer, PlayerError, PlayerState
 from airtable.net.server import GameServer
+from airtable.student.command import main
+from airtable.student.window import PlayerApp, own_cursor_live
 
 
 @pytest.fixture

@@ -9,7 +9,7 @@ import threading
 import numpy as np
 import pytest
 
-from airtable.app.scene import CursorView, Scene
+from airtable.model.scene import CursorView, Scene
 from airtable.net import protocol as proto
 from airtable.net.codec import LAYOUT, SnapshotEncoder, Viewer
 from airtable.net.playout import PlayoutBuffer, SnapshotFeed

@@ -22,7 +22,7 @@ from airtable.app.predict_view import draw_predict
 from airtable.app.rewind import timeline_shown
 from airtable.app.window import GameWindow
 from airtable.net import protocol as proto
-from airtable.net.player import NetPlayer, PlayerApp, PlayerState
+from airtable.net.player import NetPlayer, PlayerState
 from airtable.net.predictions import (
     MAX_PREDICT_SPEED_MPS,
     Arrow,
@@ -33,6 +33,7 @@ from airtable.net.predictions import (
     parse_round,
 )
 from airtable.net.server import GameServer
+from airtable.student.window import PlayerApp
 
 # Puck 1 at rest at (5, 4); puck 0 comes at it head-on at 1 m/s. Equal masses, restitution 1:
 # afterwards puck 0 stops and puck 1 leaves at (1, 0) m/s.

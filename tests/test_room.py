@@ -278,7 +278,7 @@ def test_the_anonymous_projector_hides_names_but_not_colours(served, monkeypatch
 
 def test_a_students_window_says_hands_off(served, monkeypatch):
     from airtable.app.window import GameWindow
-    from airtable.net.player import PlayerApp
+    from airtable.student.window import PlayerApp
 
     app, server, _ = served
     banners: list[str] = []

@@ -18,9 +18,8 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from airtable import AirTable, Client
-from airtable.app.client import LOCAL_COLOR, cursor_pulls
-from airtable.app.scene import Scene
-from airtable.colors import rgb
+from airtable.model.client import LOCAL_COLOR, cursor_pulls
+from airtable.model.scene import Scene
 from airtable.net import protocol as proto
 from airtable.net.codec import SnapshotDecoder
 from airtable.net.events import MAX_QUEUED_INPUTS, EventQueue, PlayerInput, PlayerJoined, PlayerLeft
@@ -35,6 +34,7 @@ from airtable.net.server import (
     lan_addresses,
     validate_server_options,
 )
+from airtable.physics.colors import rgb
 
 
 def frame(frame_type: int, payload: bytes) -> bytes:

@@ -9,16 +9,18 @@ from conftest import FRAME_S, post_key, server_frames, teacher_and_student
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from airtable.app import aids
-from airtable.app.aids_share import StudentAids, annotation_of, record_of
-from airtable.app.aids_student_view import VELOCITY_COLOR
-from airtable.app.scene import Scene
+from airtable.model import aids
+from airtable.model.scene import Scene
+from airtable.model.shared_aids import annotation_of, record_of
+from airtable.model.student_aids import StudentAids
 from airtable.net import aids_wire
 from airtable.net.aids_wire import AidsDecoder, AidsEncoder, AidsViewer, SharedAids
 from airtable.net.bench_aids import frame_sizes, measure
 from airtable.net.codec import SnapshotDecoder, SnapshotEncoder, Viewer
-from airtable.net.player import NetPlayer, PlayerApp
+from airtable.net.player import NetPlayer
 from airtable.net.protocol import AIDS, LAYOUT, SNAPSHOT, ProtocolError
+from airtable.student.aids_view import VELOCITY_COLOR
+from airtable.student.window import PlayerApp
 
 
 def _scene(n: int = 3, aids_: SharedAids | None = None, t: float = 0.0) -> Scene:

@@ -14,20 +14,22 @@ from conftest import FRAME_S, WAIT_S, press, server_frames, teacher_and_student,
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from airtable.app.aids_share import StudentAids, shared_aids
-from airtable.app.aids_student_view import draw_student_lessons
+from airtable.app.aids_share import shared_aids
 from airtable.app.app import App
 from airtable.app.demo_loader import BUILTIN_DIR, DemoShelf
 from airtable.app.environment import DEFAULT_SIZE_PX, Environment
 from airtable.app.lessons_paint import TOTAL_COLOR
 from airtable.app.lessons_view import draw_lessons
-from airtable.app.momenta import MAX_DIAGRAM_PUCKS, MomentaView, values_for
 from airtable.app.panel_view import ACCENT
 from airtable.app.window import GameWindow, LessonsPainter, TimelinePainter
+from airtable.model.momenta import MAX_DIAGRAM_PUCKS, MomentaView, values_for
+from airtable.model.student_aids import StudentAids
 from airtable.net import aids_wire
 from airtable.net.aids_wire import AidsDecoder, AidsEncoder, AidsViewer, SharedAids, SharedLessons
-from airtable.net.player import NetPlayer, PlayerApp
+from airtable.net.player import NetPlayer
 from airtable.net.protocol import AIDS, ProtocolError
+from airtable.student.aids_view import draw_student_lessons
+from airtable.student.window import PlayerApp
 
 # Puck 0 (1 m/s) hits puck 1 (at rest) head on after 0.1 s; puck 2 drifts far away. With SIX more
 # pucks at rest in a row at the bottom, the table has nine: more than FEW_PUCKS.
@@ -166,7 +168,7 @@ def test_sizes_and_held_momenta_are_never_trusted():
 
 
 def test_many_collided_pucks_draw_the_forty_whose_momentum_changed_most():
-    from airtable.app.momenta import MomentaAround
+    from airtable.model.momenta import MomentaAround
 
     n = 100
     before = np.zeros((n, 2))

@@ -13,8 +13,8 @@ import numpy as np
 import pytest
 
 from airtable import AirTable, Client
-from airtable.app.client import cursor_pulls
 from airtable.bench import gas_scene
+from airtable.model.client import cursor_pulls
 from airtable.physics.forces import Pull
 from airtable.physics.table import GRAVITY_MPS2
 
@@ -305,7 +305,7 @@ def test_physics_modules_do_not_import_pygame_or_tune_malloc() -> None:
     code = (
         "import sys\n"
         "import airtable, airtable.physics.table, airtable.physics.pairs, airtable.app.environment\n"
-        "import airtable.physics.bodies, airtable.app.client, airtable.app.scene\n"
+        "import airtable.physics.bodies, airtable.model.client, airtable.model.scene\n"
         "bad = sorted(m for m in sys.modules if m == 'pygame' or m.startswith('pygame.'))\n"
         "assert not bad, bad\n"
         "airtable.AirTable().step(0.01)\n"

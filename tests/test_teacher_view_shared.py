@@ -21,7 +21,8 @@ import pygame
 from conftest import FRAME_S, frames_until, post_key, press, teacher_and_student, wait_until
 
 from airtable.app.window import WALL_COLOR
-from airtable.net.player import PlayerApp, PlayerState
+from airtable.net.player import PlayerState
+from airtable.student.window import PlayerApp
 
 ROOT = Path(__file__).resolve().parent.parent
 

@@ -205,8 +205,8 @@ def test_quitting_with_a_student_connected_takes_a_second_esc(demos):
 
             wait_until(joined, what="the student to join")
             shown: list[tuple] = []
-            draw_panel = app.window.draw_panel
-            app.window.draw_panel = lambda title, rows, **k: (shown.append((title, rows)), draw_panel(title, rows, **k))
+            draw_question = app.window.draw_question
+            app.window.draw_question = lambda title, rows: (shown.append((title, rows)), draw_question(title, rows))
             press(app, pygame.K_ESCAPE)
             assert app.running and app.panel() == "quit"
             assert shown[-1][0] == "Quit?" and "1 student will be dropped." in shown[-1][1]

@@ -10,8 +10,8 @@ from airtable.app import panel_view
 from airtable.app.demo_loader import key_order
 from airtable.app.environment import Environment
 from airtable.app.pucks_view import SPRITE_CACHE_BYTES, core_color
-from airtable.app.scene import Scene
 from airtable.app.window import PAUSED_COLOR, GameWindow, fit_parts
+from airtable.model.scene import Scene
 
 TABLE = (10.0, 8.7556)
 

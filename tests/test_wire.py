@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 from conftest import wait_until
 
-from airtable.app.scene import Scene
+from airtable.model.scene import Scene
 from airtable.net import protocol as proto
 from airtable.net.codec import SnapshotDecoder
 from airtable.net.server import GameServer

@@ -126,7 +126,9 @@ def demo_2(shot) -> list[str]:
 
 
 def quit_with_escape(display: str, wid: str, proc: subprocess.Popen) -> None:
-    assert key_taken(display, wid, "Escape") and proc.wait(timeout=20) == 0, proc.stderr.read().decode()
+    """Esc asks, Esc again quits (with nothing open over the table)."""
+    assert key_taken(display, wid, "Escape") and key_taken(display, wid, "Escape")
+    assert proc.wait(timeout=20) == 0, proc.stderr.read().decode()
 
 
 WALL = (255, 69, 0)
@@ -138,25 +140,31 @@ def wall_columns(image: np.ndarray, row: int) -> np.ndarray:
     return np.flatnonzero(np.all(image[:, row] == WALL, axis=1))
 
 
-def status_bar_px(size: tuple[int, int]) -> int:
-    """The status bar's height in a window of `size` (the app fits the table above it)."""
+def laid_out(size: tuple[int, int]):
+    """A headless window of `size` laid out as the app lays out its own: the table between the
+    text's places (the top band or the side margins) and the status bar."""
     from airtable.app.environment import Environment
     from airtable.app.window import GameWindow
 
-    return GameWindow(Environment(size), headless=True).status_bar_px
+    return GameWindow(Environment(size, width_m=10.0, height_m=8.7556), headless=True)
+
+
+def status_bar_px(size: tuple[int, int]) -> int:
+    """The status bar's height in a window of `size` (the app fits the table above it)."""
+    return laid_out(size).status_bar_px
 
 
 def assert_table_fills_the_height(shot, size: tuple[int, int]) -> np.ndarray:
-    """The screenshot is `size`, and the table fills its height above the status bar, centred,
+    """The screenshot is `size`, and the table fills the height the text leaves it, centred,
     with its aspect kept."""
     pygame.display.init()
     image = pygame.surfarray.array3d(pygame.image.load(str(shot)))
     (w, h) = size
     assert image.shape[:2] == size
-    table_h = h - status_bar_px(size)
-    left = round((w - table_h * TABLE_ASPECT) / 2)
-    xs = wall_columns(image, table_h // 2)
-    assert abs(xs.min() - left) <= 2 and abs(xs.max() - (w - 1 - left)) <= 2
+    left, top, width, height = laid_out(size).env.table_rect_px
+    assert width == pytest.approx(height * TABLE_ASPECT)
+    xs = wall_columns(image, int(top + height / 2))
+    assert abs(xs.min() - left) <= 2 and abs(xs.max() - (left + width - 1)) <= 2
     return image
 
 
@@ -169,16 +177,19 @@ def test_demo_key_and_mouse_drag_in_a_real_window(display, tmp_path):
         xdotool(display, "key", "F12")
         shots = sorted((tmp_path / "screenshots").glob("*.png"), key=lambda p: p.stat().st_mtime_ns)
         centre = orange_centre(shots[-1]) if shots else None
-        return centre is not None and centre[0] > 405 + 50 and centre[1] > 383 + 50
+        return centre is not None and centre[0] > start[0] + 50 and centre[1] > start[1] + 50
 
+    start = [0, 0]
     with running(display, demo_2(shot), cwd=tmp_path) as (app, wid):  # F12 saves into ./screenshots
         xdotool(display, "windowfocus", "--sync", wid)
         assert "Demo 2" in xdotool(display, "getwindowname", wid)
         xdotool(display, "key", "3")
         wait_for(lambda: "Demo 3" in xdotool(display, "getwindowname", wid), what="demo 3 to start")
-        # Demo 3's orange puck sits at (4.5, 4.5) m: pixel (405, 383) of the 900 x 788 window.
+        # Demo 3's orange puck sits at (4.5, 4.5) m: where the window's layout puts it.
         # X delivers the move before the press, and SDL reads them in that order: no wait needed between.
-        xdotool(display, "mousemove", "--window", wid, "--sync", "405", "383")
+        x, y = (int(round(v)) for v in laid_out(window_size(display, wid)).env.to_screen(np.array([4.5, 4.5])))
+        start[:] = (x, y)
+        xdotool(display, "mousemove", "--window", wid, "--sync", str(x), str(y))
         xdotool(display, "mousedown", "1")
         xdotool(display, "mousemove", "--window", wid, "--sync", "700", "650")
         wait_for(pulled_far_enough, what="the string to pull the puck toward the cursor")
@@ -187,7 +198,7 @@ def test_demo_key_and_mouse_drag_in_a_real_window(display, tmp_path):
         quit_with_escape(display, wid, app)
     centre = orange_centre(shot)
     # It was pulled toward the cursor: down and to the right of where it started.
-    assert centre is not None and centre[0] > 405 + 50 and centre[1] > 383 + 50
+    assert centre is not None and centre[0] > start[0] + 50 and centre[1] > start[1] + 50
 
 
 def test_the_table_follows_a_resize_of_the_window(display, tmp_path):
@@ -206,7 +217,7 @@ def test_the_table_follows_a_resize_of_the_window(display, tmp_path):
 FULLSCREEN_DRIVER = """
 import sys, numpy as np, pygame
 from airtable.app.environment import Environment
-from airtable.app.scene import Scene
+from airtable.model.scene import Scene
 from airtable.app.window import GameWindow
 env = Environment(width_m=10.0, height_m=8.7556)
 win = GameWindow(env, caption="Air Table - fullscreen test", size_px=(640, 480))

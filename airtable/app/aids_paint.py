@@ -15,9 +15,9 @@ from collections.abc import Sequence
 import numpy as np
 import pygame
 
-from airtable.app.aids import VectorScale
 from airtable.app.panel_view import DIM_TEXT, TEXT_COLOR
 from airtable.app.panel_view import wrap as _wrap
+from airtable.model.aids import VectorScale
 
 ANNOTATION_NORMAL = (255, 230, 90)
 ANNOTATION_TANGENT = (90, 200, 255)

@@ -10,9 +10,9 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from airtable.app import aids
 from airtable.app.aids_paint import draw_annotations
-from airtable.app.client import cursor_pulls
+from airtable.model import aids
+from airtable.model.client import cursor_pulls
 
 if TYPE_CHECKING:
     from airtable.app.app import App

@@ -19,10 +19,9 @@ from pathlib import Path
 import numpy as np
 import pygame
 
-from airtable.app import aids, controls, predict, rewind, room, world
+from airtable.app import controls, predict, rewind, room, world
 from airtable.app.aids_share import shared_aids
 from airtable.app.aids_view import draw_aids
-from airtable.app.client import LOCAL_COLOR, Client, cursor_pulls
 from airtable.app.demo_loader import Demo, DemoError, DemoShelf, error_from_exception, key_label
 from airtable.app.environment import Environment
 from airtable.app.history import History
@@ -33,9 +32,11 @@ from airtable.app.menu import DemoMenu
 from airtable.app.overlays import OverlayFlag, Overlays
 from airtable.app.predict_view import draw_predict
 from airtable.app.roster_view import ALERT_COLOR, draw_roster, room_alert
-from airtable.app.scene import STATUS_SEPARATOR, Scene
 from airtable.app.stats import RunStats
 from airtable.app.window import AidsPainter, GameWindow, TimelinePainter
+from airtable.model import aids
+from airtable.model.client import LOCAL_COLOR, Client, cursor_pulls
+from airtable.model.scene import STATUS_SEPARATOR, Scene
 from airtable.physics.table import TABLE_HEIGHT_M, TABLE_WIDTH_M, AirTable
 
 MESSAGE_S = 4.0
@@ -328,7 +329,7 @@ class App:
     def escape(self) -> None:
         """Esc: close what is on top; with nothing open, ask; Esc again while asked quits."""
         if self.panel() == "quit":
-            self.running = False
+            self.quit_now()
         elif not self.close_panel():
             self.ask_to_quit()
 
@@ -336,9 +337,14 @@ class App:
         """The window's close button: quit, asking first while leaving would drop students or
         lose recording; closing again (or Esc) while asked quits."""
         if self.panel() == "quit" or not self.quit_would_lose():
-            self.running = False
+            self.quit_now()
         else:
             self.ask_to_quit()
+
+    def quit_now(self) -> None:
+        """Quit after this frame, which is drawn without the question (--screenshot saves it)."""
+        self.overlays.close("quit")
+        self.running = False
 
     def ask_to_quit(self) -> None:
         self.quit_armed_until = self.clock_s + QUIT_CONFIRM_S
@@ -512,7 +518,7 @@ class App:
     def _draw_panel(self) -> None:
         panel, w = self.panel(), self.window
         if panel == "quit":
-            w.draw_panel("Quit?", [*self.quit_would_lose(), "Esc again to quit; any other key to stay."])
+            w.draw_question("Quit?", [*self.quit_would_lose(), "Esc again to quit; any other key to stay."])
         elif panel == "menu":
             rows = self.menu.rows(visible=w.panel_rows() - 2, label=key_label)  # the footer under them
             w.draw_panel("Demos", [*rows, self.menu.footer()])

@@ -17,7 +17,8 @@ from typing import TYPE_CHECKING
 
 import pygame
 
-from airtable.app import aids, lessons, predict, rewind, room, world
+from airtable.app import lessons, predict, rewind, room, world
+from airtable.model import aids
 from airtable.physics.pairs import CORRECTION_MODES
 
 if TYPE_CHECKING:

@@ -24,8 +24,8 @@ it when the table runs on from the past.
 from __future__ import annotations
 
 import bisect
-from dataclasses import dataclass
 
+from airtable.model.timeline import Timeline
 from airtable.physics.state import TableState, capture, own_nbytes, restore, unchanged
 from airtable.physics.table import AirTable
 
@@ -34,25 +34,6 @@ BUDGET_BYTES = 64 * 2**20  # 64 MB: the issue's bound, whatever the number of pu
 ENTRY_OVERHEAD_BYTES = 3 * 8 + 2 * 32
 # Simulated times are sums of steps: a second back from t = 2 s may be 0.9999999999 s.
 TIME_SLACK_S = 1e-6
-
-
-@dataclass(frozen=True)
-class Timeline:
-    """Where the view is in the history, for the timeline bar: simulated times in seconds."""
-
-    oldest_s: float
-    newest_s: float
-    view_s: float
-    frames: int  # moments kept
-    index: int  # the moment on view, 0 = oldest
-
-    @property
-    def fraction(self) -> float:
-        """Where the view is along the bar, 0 (oldest) to 1 (newest)."""
-        span = self.newest_s - self.oldest_s
-        if span > 0.0:
-            return min(1.0, max(0.0, (self.view_s - self.oldest_s) / span))
-        return self.index / (self.frames - 1) if self.frames > 1 else 1.0
 
 
 class History:

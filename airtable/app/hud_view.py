@@ -22,7 +22,7 @@ from dataclasses import dataclass
 import pygame
 
 from airtable.app import panel_view
-from airtable.app.scene import STATUS_SEPARATOR
+from airtable.model.scene import STATUS_SEPARATOR
 
 BAND_LINES = 3  # the top band: the title (with the frame rate and PAUSED), then two heads-up lines
 # Side margins at least this share of the window's height hold the text instead of a top band.

@@ -13,10 +13,10 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from airtable.app.demo_loader import BUILTIN_DIR
-from airtable.app.momenta import MomentaLog
 from airtable.app.overlays import OverlayFlag, Overlays
 from airtable.app.recorder import DEFAULT_BUDGET_BYTES, Recorder, free_csv_pair
 from airtable.app.saved_demo import demo_source, free_key, save_folder, write_demo
+from airtable.model.momenta import MomentaLog
 from airtable.physics.table import AirTable
 
 if TYPE_CHECKING:

@@ -9,8 +9,8 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING
 
-from airtable.app.momenta import FEW_PUCKS, values_for
 from airtable.app.window import LessonsPainter
+from airtable.model.momenta import FEW_PUCKS, values_for
 
 if TYPE_CHECKING:
     from airtable.app.app import App

@@ -25,7 +25,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from airtable.net.predictions import MAX_ROUND_PUCKS, Arrow, RoundInfo, clamp_speed
+from airtable.model.rounds import MAX_ROUND_PUCKS, Arrow, RoundInfo, clamp_speed
 
 if TYPE_CHECKING:
     from airtable.app.app import App

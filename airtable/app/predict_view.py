@@ -16,7 +16,7 @@ import pygame
 
 from airtable.app.panel_view import wrap
 from airtable.app.predict import ARROW_S, LOCAL_COLOR, count_text, names_shown
-from airtable.net.predictions import RoundInfo
+from airtable.model.rounds import RoundInfo
 
 if TYPE_CHECKING:
     from airtable.app.app import App

@@ -20,7 +20,7 @@ from airtable.app.predict import holds_the_table, round_holds
 
 if TYPE_CHECKING:
     from airtable.app.app import App
-    from airtable.app.history import Timeline
+    from airtable.model.timeline import Timeline
 
 JUMP_S = 1.0  # Shift+, / Shift+. : this much simulated time
 

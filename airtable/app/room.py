@@ -17,11 +17,11 @@ from dataclasses import dataclass, field
 from typing import TYPE_CHECKING
 
 from airtable.app.overlays import OverlayFlag, Overlays
-from airtable.app.scene import Scene
+from airtable.model.scene import Scene
 
 if TYPE_CHECKING:
     from airtable.app.app import App
-    from airtable.net.server import Seat
+    from airtable.model.seats import Seat
 
 HANDS_OFF = "HANDS OFF"  # a status part: every student's window shows HANDS_OFF_BANNER
 HANDS_OFF_BANNER = "hands off: the teacher is explaining"

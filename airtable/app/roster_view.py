@@ -17,7 +17,7 @@ from airtable.app import panel_view, room
 
 if TYPE_CHECKING:
     from airtable.app.app import App
-    from airtable.net.server import Seat
+    from airtable.model.seats import Seat
 
 ALERT_COLOR = (255, 90, 70)
 SELECTED_COLOR = (60, 60, 110)

@@ -9,8 +9,8 @@ from __future__ import annotations
 
 import pygame
 
-from airtable.app.history import Timeline
 from airtable.app.panel_view import ACCENT
+from airtable.model.timeline import Timeline
 
 TRACK_COLOR = (60, 60, 75)  # the moments after the view (dropped if the table runs on from it)
 KEPT_COLOR = (130, 130, 170)  # the moments up to the view

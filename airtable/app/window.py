@@ -27,9 +27,9 @@ from airtable.app.environment import Environment, fitting_size_px
 from airtable.app.hud_view import HudLine, HudStyle, TextLayout, draw_hud, fit_parts, text_layout
 from airtable.app.lessons_paint import LessonsPainter  # noqa: F401  (imported from here by lessons_view)
 from airtable.app.pucks_view import COLORKEY, MIN_PUCK_RADIUS_PX, PuckSprites, draw_pucks
-from airtable.app.scene import Scene
 from airtable.app.timeline_paint import TimelinePainter  # noqa: F401  (imported from here by the app)
 from airtable.assets import ASSETS_DIR
+from airtable.model.scene import Scene
 
 BACKGROUND = (0, 0, 0)
 BACKGROUND_GRAVITY = (20, 20, 70)
@@ -453,6 +453,26 @@ class GameWindow:
         left = max(pad, w // 40, self.layout.side_px)  # the left margin's text stays in view
         right = w - max(pad, w // 40)
         return pygame.Rect(left, top, right - left, max(4 * self.font.get_linesize(), bottom - top))
+
+    def draw_question(self, title: str, lines: Sequence[str]) -> pygame.Rect:
+        """A short question in an opaque box just big enough for it, in the middle of the window."""
+        font, title_font = self.font, self.big_font
+        pad = font.get_height()
+        width = min(self.surface.get_width() - 2 * pad, max(font.size(t)[0] for t in [title, *lines]) + 2 * pad)
+        wrapped = [row for line in lines for row in panel_view.wrap(font, line, width - 2 * pad)]
+        height = title_font.get_linesize() + len(wrapped) * font.get_linesize() + 2 * pad
+        box = pygame.Rect(0, 0, width, height)
+        box.center = self.surface.get_rect().center
+        pygame.draw.rect(self.surface, panel_view.PANEL_COLOR[:3], box)
+        pygame.draw.rect(self.surface, ACCENT, box, self.line_px(2))
+        title_text = panel_view.shorten(title_font, title, width - 2 * pad)
+        self.surface.blit(title_font.render(title_text, True, ACCENT), (box.x + pad, box.y + pad // 2))
+        y = box.y + pad // 2 + title_font.get_linesize() + pad // 2
+        for row in wrapped:
+            self.surface.blit(font.render(row, True, TEXT_COLOR), (box.x + pad, y))
+            y += font.get_linesize()
+        self.label_boxes.append(box)
+        return box
 
     def panel_rows(self) -> int:
         """How many one-line rows a panel holds on one page at the smallest readable type."""

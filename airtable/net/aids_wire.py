@@ -36,32 +36,39 @@ from __future__ import annotations
 import math
 import struct
 import threading
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 
-from airtable.net.codec import _bad, _deflate, _inflate, _Reader, pack_residuals, unpack_residuals, wire_text
+from airtable.model.shared_aids import (  # noqa: F401  (the numbers these bytes carry, importable from here)
+    ANNOTATIONS,
+    CHART,
+    LESSON_FLAGS,
+    MAX_CHART_HISTORY,
+    MAX_VALUE_ROWS,
+    MOMENTA,
+    MOMENTA_ROWS,
+    MOMENTUM,
+    NOTES,
+    NOTES_TEXT,
+    TIMELINE,
+    TRAILS,
+    VALUES,
+    VECTOR_KEY,
+    VELOCITY,
+    AidsFrame,
+    AnnotationRecord,
+    MomentaRecord,
+    SharedAids,
+    SharedLessons,
+)
 from airtable.net.protocol import AIDS, MAX_DRAWN_PUCKS, ProtocolError, encode_frame
+from airtable.net.wire import Reader, bad, deflate, inflate, pack_residuals, unpack_residuals, wire_text
 
 AIDS_MAGIC = b"ATAD"
 AIDS_VERSION = 1  # no lesson panel on: the frame as it always was
 LESSONS_VERSION = 2  # a lesson flags byte follows the header, then the panels' sections at the end
 
-TRAILS = 1
-ANNOTATIONS = 2
-VELOCITY = 4
-MOMENTUM = 8
-CHART = 16
-NOTES = 32
-NOTES_TEXT = 64  # the notes' text is in this frame
-VECTOR_KEY = 128  # the vector values are not a delta (no base)
-
-# The lesson flags byte (format 2).
-MOMENTA = 1  # the momenta diagram is on: its corner and the serial of the collision it shows
-MOMENTA_ROWS = 2  # that collision's rows follow (this student does not hold them yet)
-VALUES = 4  # the values panel is on: its corner and its pucks' masses and velocities
-TIMELINE = 8  # the rewind timeline bar is on: where the view is in the history
-LESSON_FLAGS = MOMENTA | MOMENTA_ROWS | VALUES | TIMELINE
 
 ARROW_STEPS = 1000  # vector values travel in thousandths of the arrow scale
 MAX_VALUE = 1 << 20  # steps: an arrow of at most a kilometre (the scale keeps real ones under 1 m)
@@ -69,10 +76,8 @@ MAX_ANNOTATIONS = 8
 MAX_AGE_MS = 60_000
 MAX_NOTES_BYTES = 16_384
 MAX_VECTOR_HISTORY = 8  # ticks of vector values kept as bases
-MAX_CHART_HISTORY = 600  # samples of the teacher's chart sent once to a student who lacks them
 MAX_COORD_M = 1e6  # a position or length beyond this is not a picture of a table
 MAX_MOMENTA_ROWS = 64  # arrows in a momenta diagram (momenta.MAX_DIAGRAM_PUCKS draws at most 40)
-MAX_VALUE_ROWS = 256  # pucks in the values panel's section: every puck when few, else one per student
 MAX_HISTORY_FRAMES = 1 << 31
 MAX_NUMBER = 1e30  # any momentum, mass, velocity or time beyond this is not physics
 
@@ -92,84 +97,6 @@ _MOMENTA = struct.Struct("<BI")  # corner, serial of the collision shown (0: non
 _MOMENTA_ROWS = struct.Struct("<d4fH")  # time, total before x y, total after x y, K; K u32 rows; K x 4 f4
 _VALUES = struct.Struct("<BBH")  # corner, every puck (1) or the pointed ones (0), R; R u32 rows; R x 3 f4
 _TIMELINE = struct.Struct("<3dII")  # oldest, newest, view s; frames kept, the one on view
-
-
-@dataclass(frozen=True, eq=False)
-class AnnotationRecord:
-    """The numbers a collision annotation is drawn from (aids.Annotation without its clock)."""
-
-    age_s: float  # how old it was when sent
-    numbers: tuple[float, ...]  # contact 2, normal 2, overlap, separation, 4 positions x 2, radius i, radius j
-    angle_deg: float | None = None
-    target: tuple[float, ...] | None = None  # actual, ideal deg, pos 2, push dir 2, ideal dir 2
-
-
-@dataclass(frozen=True, eq=False)
-class SharedLessons:
-    """The teacher's lesson panels and rewind bar at one tick, as the app hands them to the server."""
-
-    momenta_on: bool = False
-    momenta_corner: int = 0  # aids_paint.CHART_CORNERS
-    momenta: object = None  # the diagram's momenta.MomentaView (a new object: a new collision); None: none yet
-    values_on: bool = False
-    values_corner: int = 0
-    values_every: bool = True  # the rows are every puck (a few); else those under the students' cursors
-    value_rows: tuple[int, ...] = ()
-    value_mass_kg: np.ndarray | None = None  # (R,)
-    value_vel_mps: np.ndarray | None = None  # (R, 2)
-    timeline: tuple[float, float, float, int, int] | None = None  # oldest, newest, view s; frames, index
-
-    @property
-    def flags(self) -> int:
-        f = MOMENTA if self.momenta_on else 0
-        f |= VALUES if self.values_on else 0
-        return f | (TIMELINE if self.timeline is not None else 0)
-
-
-@dataclass(frozen=True)
-class MomentaRecord:
-    """A momenta diagram as it travels: the rows drawn, their momenta (K, 2) and the totals of all pucks."""
-
-    t_s: float
-    rows: np.ndarray
-    before_Ns: np.ndarray
-    after_Ns: np.ndarray
-    total_before_Ns: tuple[float, float]
-    total_after_Ns: tuple[float, float]
-
-
-@dataclass(frozen=True, eq=False)
-class SharedAids:
-    """What the teacher's aids show at one tick, as the app hands it to the server."""
-
-    trails: bool = False
-    vectors: int = 0  # 0 off, 1 velocity, 2 momentum
-    values: np.ndarray | None = None  # (N, 2) the drawn quantity per puck
-    amount: float = 1.0  # the round value an arrow 1 m long stands for
-    velocity_amount: float = 1.0  # the same for velocities (the centre of mass arrow)
-    com: tuple[float, float, float, float] = (0.0, 0.0, 0.0, 0.0)  # x, y, vx, vy
-    annotations: tuple = ()  # live annotations (objects; the encoder gives each a serial), oldest first
-    annotation_records: tuple[AnnotationRecord, ...] = ()
-    chart: tuple[float, ...] | None = None  # the newest sample: time, kinetic, spring, gravity, total, |p|
-    chart_corner: int = 0  # where the teacher's chart is (aids_paint.CHART_CORNERS), + 4 if small
-    chart_history: np.ndarray | None = None  # (H, 6) the samples before `chart`, oldest first
-    notes: str | None = None  # the lecture notes, while their panel is open
-
-    annotations_on: bool = False
-    lessons: SharedLessons | None = None  # the momenta diagram, the values panel, the timeline (format 2)
-
-    @property
-    def lesson_flags(self) -> int:
-        return 0 if self.lessons is None else self.lessons.flags
-
-    @property
-    def flags(self) -> int:
-        f = TRAILS if self.trails else 0
-        f |= {1: VELOCITY, 2: MOMENTUM}.get(self.vectors, 0)
-        f |= ANNOTATIONS if self.annotations_on else 0
-        f |= CHART if self.chart is not None else 0
-        f |= NOTES if self.notes is not None else 0
-        return f
 
 
 @dataclass
@@ -348,7 +275,7 @@ def encode_aids(
     if send_notes:
         raw = (notes or "").encode("utf-8")[:MAX_NOTES_BYTES]
         parts.append(_NOTES.pack(p.notes_version, len(raw)))
-        packed = _deflate(raw)
+        packed = deflate(raw)
         parts.append(len(packed).to_bytes(2, "little") + packed)
     lessons = p.aids.lessons
     if lessons is None or not lessons.flags:
@@ -415,38 +342,6 @@ def _annotation_bytes(r: AnnotationRecord) -> bytes:
 
 
 @dataclass
-class AidsFrame:
-    """One decoded AIDS frame."""
-
-    seq: int
-    flags: int
-    values: np.ndarray | None = None  # (N, 2) float, the drawn quantity
-    amount: float = 1.0
-    velocity_amount: float = 1.0
-    com: tuple[float, float, float, float] = (0.0, 0.0, 0.0, 0.0)
-    annotation_serial: int = 0
-    live: int = 0
-    new_annotations: list[AnnotationRecord] = field(default_factory=list)
-    chart: tuple[float, ...] | None = None
-    chart_corner: int = 0
-    chart_history: np.ndarray | None = None  # (H, 6), only when it came in this frame
-    notes: str | None = None  # only when its text came in this frame
-    lesson_flags: int = 0
-    momenta_corner: int = 0
-    momenta: MomentaRecord | None = None  # the diagram's collision (held from an earlier frame, or new)
-    values_corner: int = 0
-    values_every: bool = True
-    value_rows: np.ndarray | None = None  # (R,) int
-    value_mass_kg: np.ndarray | None = None  # (R,)
-    value_vel_mps: np.ndarray | None = None  # (R, 2)
-    timeline: tuple[float, float, float, int, int] | None = None  # oldest, newest, view s; frames, index
-
-    @property
-    def vectors(self) -> int:
-        return 1 if self.flags & VELOCITY else 2 if self.flags & MOMENTUM else 0
-
-
-@dataclass
 class AidsDecoder:
     """Feed it AIDS payloads in order, each right after the SNAPSHOT of the same tick."""
 
@@ -469,7 +364,7 @@ class AidsDecoder:
             _chart(r, out, time_s)
         if flags & NOTES_TEXT:
             if not flags & NOTES:
-                raise _bad("notes text while the notes are off")
+                raise bad("notes text while the notes are off")
             out.notes = self.notes = _notes(r)
         if out.lesson_flags & MOMENTA:
             self._momenta(r, out, pucks)
@@ -480,159 +375,159 @@ class AidsDecoder:
         r.done()
         return out
 
-    def _momenta(self, r: _Reader, out: AidsFrame, pucks: int) -> None:
+    def _momenta(self, r: Reader, out: AidsFrame, pucks: int) -> None:
         corner, serial = _MOMENTA.unpack(r.take(_MOMENTA.size))
         if corner > 3:
-            raise _bad(f"a momenta diagram in corner {corner}")
+            raise bad(f"a momenta diagram in corner {corner}")
         out.momenta_corner = corner
         if out.lesson_flags & MOMENTA_ROWS:
             if serial == 0:
-                raise _bad("momenta rows for no collision")
+                raise bad("momenta rows for no collision")
             self.momenta = _momenta_rows(r, pucks)
         elif serial == 0:
             self.momenta = None
         elif serial != self.momenta_serial:
-            raise _bad(f"momenta of collision {serial}, which this client was never sent")
+            raise bad(f"momenta of collision {serial}, which this client was never sent")
         self.momenta_serial = serial
         out.momenta = self.momenta
 
-    def _vectors(self, r: _Reader, out: AidsFrame, pucks: int) -> None:
+    def _vectors(self, r: Reader, out: AidsFrame, pucks: int) -> None:
         n, amount, vel_amount, cx, cy, cvx, cvy, width, deflated, size = _VEC.unpack(r.take(_VEC.size))
         kind = out.flags & (VELOCITY | MOMENTUM)
         if n != pucks or n > MAX_DRAWN_PUCKS:
-            raise _bad(f"arrows for {n} pucks on a table of {pucks}")
+            raise bad(f"arrows for {n} pucks on a table of {pucks}")
         for value in (amount, vel_amount):
             if not (math.isfinite(value) and 1e-30 < value < 1e30):
-                raise _bad("an arrow scale that is not a positive number")
+                raise bad("an arrow scale that is not a positive number")
         if deflated > 1:
-            raise _bad("a vector block with a bad flag")
+            raise bad("a vector block with a bad flag")
         out.com = _finite((cx, cy, cvx, cvy), "centre of mass")
         residuals = unpack_residuals(r.take(size), width, 2 * n, bool(deflated))
         if out.flags & VECTOR_KEY:
             values = residuals
         elif self.values is None or len(self.values) != 2 * n or self.values_key != (kind, amount):
-            raise _bad("vector values coded against values this client does not hold")
+            raise bad("vector values coded against values this client does not hold")
         else:
             values = self.values + residuals
         if len(values) and np.abs(values).max() > MAX_VALUE:
-            raise _bad("an arrow longer than any table")
+            raise bad("an arrow longer than any table")
         self.values, self.values_seq, self.values_key = values, out.seq, (kind, amount)
         out.values = np.column_stack([values[:n], values[n:]]) * (amount / ARROW_STEPS)
         out.amount, out.velocity_amount = amount, vel_amount
 
 
-def _header(payload: bytes, seq: int) -> tuple[_Reader, AidsFrame]:
+def _header(payload: bytes, seq: int) -> tuple[Reader, AidsFrame]:
     """The header checked (and format 2's lesson flags): a reader past it, and the frame to fill."""
     if len(payload) < _HEAD.size:
         raise ProtocolError(f"the aids frame is only {len(payload)} bytes, less than its {_HEAD.size} byte header")
     magic, version, flags, aseq = _HEAD.unpack_from(payload)
     if magic != AIDS_MAGIC or version not in (AIDS_VERSION, LESSONS_VERSION):
-        raise _bad("an aids frame of another version")
+        raise bad("an aids frame of another version")
     if aseq != seq & 0xFFFFFFFF:
-        raise _bad(f"aids for tick {aseq} right after tick {seq}")
+        raise bad(f"aids for tick {aseq} right after tick {seq}")
     if flags & VELOCITY and flags & MOMENTUM:
-        raise _bad("aids asking for velocity and momentum arrows at once")
-    r = _Reader(payload, "aids frame")
+        raise bad("aids asking for velocity and momentum arrows at once")
+    r = Reader(payload, "aids frame")
     r.take(_HEAD.size)
     out = AidsFrame(seq=aseq, flags=flags)
     if version == LESSONS_VERSION:
         (lf,) = _LESSONS.unpack(r.take(_LESSONS.size))
         if not lf or lf & ~LESSON_FLAGS or (lf & MOMENTA_ROWS and not lf & MOMENTA):
-            raise _bad(f"lesson panels flagged {lf}")
+            raise bad(f"lesson panels flagged {lf}")
         out.lesson_flags = lf
     return r, out
 
 
-def _rows(r: _Reader, count: int, pucks: int, what: str) -> np.ndarray:
+def _rows(r: Reader, count: int, pucks: int, what: str) -> np.ndarray:
     """`count` u32 puck rows, strictly increasing and on the table."""
     rows = r.array("<u4", (count,)).astype(np.int64)
     if count and (rows[-1] >= pucks or (np.diff(rows) <= 0).any()):
-        raise _bad(f"{what} rows that are not distinct pucks of the table's {pucks}, in order")
+        raise bad(f"{what} rows that are not distinct pucks of the table's {pucks}, in order")
     return rows
 
 
-def _numbers(r: _Reader, shape: tuple[int, int], what: str) -> np.ndarray:
+def _numbers(r: Reader, shape: tuple[int, int], what: str) -> np.ndarray:
     numbers = r.array("<f4", shape).astype(float)
     if not (np.isfinite(numbers).all() and (np.abs(numbers) <= MAX_NUMBER).all()):
-        raise _bad(f"{what} that are not finite numbers")
+        raise bad(f"{what} that are not finite numbers")
     return numbers
 
 
-def _momenta_rows(r: _Reader, pucks: int) -> MomentaRecord:
+def _momenta_rows(r: Reader, pucks: int) -> MomentaRecord:
     t_s, bx, by, ax, ay, count = _MOMENTA_ROWS.unpack(r.take(_MOMENTA_ROWS.size))
     if count > min(MAX_MOMENTA_ROWS, pucks):
-        raise _bad(f"a momenta diagram of {count} pucks on a table of {pucks} (at most {MAX_MOMENTA_ROWS})")
+        raise bad(f"a momenta diagram of {count} pucks on a table of {pucks} (at most {MAX_MOMENTA_ROWS})")
     t_s, *totals = _finite((t_s, bx, by, ax, ay), "momenta total")
     rows = _rows(r, count, pucks, "momenta")
     numbers = _numbers(r, (count, 4), "momenta")
     return MomentaRecord(t_s, rows, numbers[:, :2], numbers[:, 2:], tuple(totals[:2]), tuple(totals[2:]))
 
 
-def _values(r: _Reader, out: AidsFrame, pucks: int) -> None:
+def _values(r: Reader, out: AidsFrame, pucks: int) -> None:
     corner, every, count = _VALUES.unpack(r.take(_VALUES.size))
     if corner > 3 or every > 1:
-        raise _bad(f"a values panel in corner {corner} with flag {every}")
+        raise bad(f"a values panel in corner {corner} with flag {every}")
     if count > min(MAX_VALUE_ROWS, pucks) or (every and count != pucks):
-        raise _bad(f"values of {count} pucks on a table of {pucks}")
+        raise bad(f"values of {count} pucks on a table of {pucks}")
     rows = _rows(r, count, pucks, "values")
     numbers = _numbers(r, (count, 3), "values")
     if count and (numbers[:, 0] <= 0).any():
-        raise _bad("a puck of no mass in the values panel")
+        raise bad("a puck of no mass in the values panel")
     out.values_corner, out.values_every = corner, bool(every)
     out.value_rows, out.value_mass_kg, out.value_vel_mps = rows, numbers[:, 0], numbers[:, 1:]
 
 
-def _timeline(r: _Reader) -> tuple[float, float, float, int, int]:
+def _timeline(r: Reader) -> tuple[float, float, float, int, int]:
     oldest, newest, view, frames, index = _TIMELINE.unpack(r.take(_TIMELINE.size))
     oldest, newest, view = _finite((oldest, newest, view), "timeline time")
     if not (oldest <= view <= newest and 2 <= frames <= MAX_HISTORY_FRAMES and index < frames):
-        raise _bad(f"a timeline at {view} s of {oldest} to {newest} s, frame {index} of {frames}")
+        raise bad(f"a timeline at {view} s of {oldest} to {newest} s, frame {index} of {frames}")
     return (oldest, newest, view, frames, index)
 
 
 def _finite(values, what: str) -> tuple[float, ...]:
     if not all(math.isfinite(v) and abs(v) <= 1e30 for v in values):
-        raise _bad(f"a {what} that is not a finite number")
+        raise bad(f"a {what} that is not a finite number")
     return tuple(float(v) for v in values)
 
 
-def _chart(r: _Reader, out: AidsFrame, time_s: float) -> None:
+def _chart(r: Reader, out: AidsFrame, time_s: float) -> None:
     *sample, corner = _CHART.unpack(r.take(_CHART.size))
     if corner & ~HISTORY_FOLLOWS > 7:
-        raise _bad(f"a chart in corner {corner}")
+        raise bad(f"a chart in corner {corner}")
     out.chart, out.chart_corner = (float(time_s), *_finite(sample, "chart sample")), corner & 7
     if corner & HISTORY_FOLLOWS:
         count = int.from_bytes(r.take(2), "little")
         if count > MAX_CHART_HISTORY:
-            raise _bad(f"a chart history of {count} samples (at most {MAX_CHART_HISTORY})")
+            raise bad(f"a chart history of {count} samples (at most {MAX_CHART_HISTORY})")
         rows = r.array("<f4", (count, 6)).astype(float)
         if not (np.isfinite(rows).all() and (np.abs(rows) <= 1e30).all()):
-            raise _bad("a chart history that is not finite numbers")
+            raise bad("a chart history that is not finite numbers")
         out.chart_history = rows
 
 
-def _annotations(r: _Reader, out: AidsFrame) -> None:
+def _annotations(r: Reader, out: AidsFrame) -> None:
     newest, live, new = _ANN_HEAD.unpack(r.take(_ANN_HEAD.size))
     if live > MAX_ANNOTATIONS or new > live or live > newest:
-        raise _bad(f"{new} new of {live} live collision annotations (at most {MAX_ANNOTATIONS})")
+        raise bad(f"{new} new of {live} live collision annotations (at most {MAX_ANNOTATIONS})")
     out.annotation_serial, out.live = newest, live
     for _ in range(new):
         age_ms, has, *numbers = _ANN.unpack(r.take(_ANN.size))
         if has > 3 or age_ms > MAX_AGE_MS:
-            raise _bad("a collision annotation with bad flags or age")
+            raise bad("a collision annotation with bad flags or age")
         numbers = _finite(numbers, "collision annotation")
         if any(abs(v) > MAX_COORD_M for v in numbers) or numbers[4] < 0 or min(numbers[14:16]) <= 0:
-            raise _bad("a collision annotation with impossible sizes")
+            raise bad("a collision annotation with impossible sizes")
         angle = _finite(_ANGLE.unpack(r.take(_ANGLE.size)), "collision angle")[0] if has & 1 else None
         target = _finite(_TARGET.unpack(r.take(_TARGET.size)), "collision target") if has & 2 else None
         if target is not None and any(abs(v) > MAX_COORD_M for v in target):
-            raise _bad("a collision target far off the table")
+            raise bad("a collision target far off the table")
         out.new_annotations.append(AnnotationRecord(age_ms / 1000, numbers, angle, target))
 
 
-def _notes(r: _Reader) -> str:
+def _notes(r: Reader) -> str:
     _version, size = _NOTES.unpack(r.take(_NOTES.size))
     if size > MAX_NOTES_BYTES:
-        raise _bad(f"notes of {size} bytes (at most {MAX_NOTES_BYTES})")
+        raise bad(f"notes of {size} bytes (at most {MAX_NOTES_BYTES})")
     packed = r.take(int.from_bytes(r.take(2), "little"))
-    return wire_text(_inflate(packed, size, "notes text"), "notes")
+    return wire_text(inflate(packed, size, "notes text"), "notes")

@@ -22,7 +22,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from airtable.app.aids_share import shared_aids
-from airtable.app.client import Client
+from airtable.model.client import Client
 from airtable.net.codec import SnapshotEncoder, Viewer
 from airtable.net.protocol import AIDS, SNAPSHOT
 

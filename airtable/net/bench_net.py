@@ -22,9 +22,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from airtable.app.client import Client
 from airtable.app.demo_loader import BUILTIN_DIR, load_demo_file
-from airtable.app.scene import Scene
+from airtable.model.client import Client
+from airtable.model.scene import Scene
 from airtable.net.codec import SnapshotEncoder, Viewer, predict
 from airtable.physics.table import AirTable
 
@@ -36,7 +36,7 @@ TARGETS_B = {"demo 4, 30 students moving": 600, "1000-puck gas": 3000, "table at
 def step_table(table: AirTable, clients: Sequence[Client], dt_s: float) -> None:
     """One physics step with the clients' cursor strings, on either table API."""
     try:
-        from airtable.app.client import cursor_pulls  # the table takes forces
+        from airtable.model.client import cursor_pulls  # the table takes forces
     except ImportError:
         table.clients[:] = list(clients)
         table.step(dt_s)

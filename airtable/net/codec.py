@@ -35,7 +35,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from airtable.app.scene import CursorView, Scene
+from airtable.model.scene import CursorView, Scene
+from airtable.net import aids_wire
 from airtable.net.protocol import (
     LAYOUT,
     MAX_DRAWN_CURSORS,
@@ -51,6 +52,7 @@ from airtable.net.protocol import (
     printable,
     table_size_problem,
 )
+from airtable.net.wire import Reader, bad, deflate, pack_residuals, unpack_residuals, wire_text
 
 FORMAT_VERSION = 2
 UNITS_PER_M = 4000  # positions travel as whole quarter millimetres
@@ -75,10 +77,6 @@ _TEXT_DELTA = struct.Struct("<HHH")
 _LAYOUT = struct.Struct("<4sBBHIII2d")
 TICK_MAGIC = b"ATSN"
 LAYOUT_MAGIC = b"ATLY"
-
-
-def _bad(what: str) -> ProtocolError:
-    return ProtocolError(f"the snapshot has {what}; the server may run a different airtable version")
 
 
 # ---------------------------------------------------------------- layout
@@ -185,67 +183,7 @@ def encode_layout(layout: Layout) -> bytes:
             *(_text_bytes(name) for name in layout.cursor_names),
         ]
     )
-    return header + _deflate(body)
-
-
-def _deflate(data: bytes) -> bytes:
-    packer = zlib.compressobj(1, zlib.DEFLATED, -15)
-    return packer.compress(data) + packer.flush()
-
-
-def _inflate(data: bytes, size: int, what: str) -> bytes:
-    """Exactly `size` bytes from raw deflate data (never more are made)."""
-    unpacker = zlib.decompressobj(-15)
-    try:
-        out = unpacker.decompress(data, size + 1)
-    except zlib.error:
-        raise _bad(f"a damaged {what}") from None
-    if len(out) != size or not unpacker.eof or unpacker.unused_data:
-        raise _bad(f"a {what} of the wrong size")
-    return out
-
-
-def wire_text(raw: bytes, what: str) -> str:
-    """Text from the wire, checked: UTF-8 and printable, else a ProtocolError naming `what` ("a title")."""
-    try:
-        text = raw.decode("utf-8")
-    except UnicodeDecodeError:
-        raise _bad(f"{what} that is not UTF-8") from None
-    if not text.isprintable():
-        raise _bad(f"{what} that is not printable")
-    return text
-
-
-class _Reader:
-    """Consecutive fields of a byte string whose size is checked before each read."""
-
-    def __init__(self, data: bytes, what: str) -> None:
-        self.data = data
-        self.offset = 0
-        self.what = what
-
-    def take(self, size: int) -> bytes:
-        end = self.offset + size
-        if size < 0 or end > len(self.data):
-            raise ProtocolError(f"the {self.what} is cut short")
-        chunk = self.data[self.offset : end]
-        self.offset = end
-        return chunk
-
-    def array(self, dtype: str, shape: tuple[int, ...]) -> np.ndarray:
-        dt = np.dtype(dtype)
-        count = math.prod(shape)
-        return np.frombuffer(self.take(count * dt.itemsize), dtype=dt).reshape(shape).copy()
-
-    def text(self, limit: int, what: str) -> str:
-        size = int.from_bytes(self.take(2), "little")
-        if size > limit:
-            raise _bad(f"a {what} of {size} bytes (at most {limit})")
-        return wire_text(self.take(size), f"a {what}")
-
-    def done(self) -> None:
-        if self.offset != len(self.data):
-            raise _bad(f"{len(self.data) - self.offset} bytes too many at the end of its {self.what}")
+    return header + deflate(body)
 
 
 def decode_layout(payload: bytes) -> Layout:
@@ -256,16 +194,16 @@ def decode_layout(payload: bytes) -> Layout:
     magic, version, flags, layout_version, n, s, c, width_m, height_m = _LAYOUT.unpack_from(payload)
     _check_magic(magic, version, LAYOUT_MAGIC)
     if n > MAX_DRAWN_PUCKS or s > MAX_DRAWN_SPRINGS or c > MAX_DRAWN_CURSORS:
-        raise _bad(
+        raise bad(
             f"{n} pucks, {s} springs and {c} cursors, more than this client draws "
             f"({MAX_DRAWN_PUCKS}, {MAX_DRAWN_SPRINGS} and {MAX_DRAWN_CURSORS})"
         )
     problem = table_size_problem(width_m, height_m)
     if problem:
-        raise _bad(problem)
+        raise bad(problem)
     fixed = n * 11 + s * 27 + c * 3
     body = _inflate_texts(payload[_LAYOUT.size :], fixed, c)
-    r = _Reader(body, "layout")
+    r = Reader(body, "layout")
     radius = r.array("<f8", (n,))
     color = r.array("u1", (n, 3))
     pairs = r.array("<u4", (s, 2))
@@ -299,16 +237,16 @@ def decode_layout(payload: bytes) -> Layout:
 def _check_bodies(size: float, radius, pairs, spring_length, spring_width, n: int) -> None:
     """The same bounds as the drawing code assumes: sizes against the table's size."""
     if not (np.isfinite(radius).all() and ((radius > 0) & (radius <= size)).all()):
-        raise _bad("a puck radius that is not between 0 and the table's size")
+        raise bad("a puck radius that is not between 0 and the table's size")
     if not (np.isfinite(spring_length).all() and np.isfinite(spring_width).all()):
-        raise _bad("a spring size that is not finite")
+        raise bad("a spring size that is not finite")
     if not (
         ((spring_length >= 0) & (spring_length <= 100 * size)).all()
         and ((spring_width >= 0) & (spring_width <= size)).all()
     ):
-        raise _bad("a spring longer or wider than the table allows")
+        raise bad("a spring longer or wider than the table allows")
     if len(pairs) and int(pairs.max()) >= n:
-        raise _bad("a spring joined to a puck that is not there")
+        raise bad("a spring joined to a puck that is not there")
 
 
 def _inflate_texts(data: bytes, fixed: int, cursors: int) -> bytes:
@@ -318,9 +256,9 @@ def _inflate_texts(data: bytes, fixed: int, cursors: int) -> bytes:
     try:
         out = unpacker.decompress(data, limit + 1)
     except zlib.error:
-        raise _bad("a damaged layout") from None
+        raise bad("a damaged layout") from None
     if len(out) > limit or not unpacker.eof or unpacker.unused_data:
-        raise _bad("a layout of the wrong size")
+        raise bad("a layout of the wrong size")
     return out
 
 
@@ -393,50 +331,6 @@ def predict(tick_time_us: int, moving: int, b1: Tick | None, b2: Tick | None) ->
     return guess
 
 
-def _zigzag(r: np.ndarray) -> np.ndarray:
-    return ((r << 1) ^ (r >> 63)).astype(np.uint64)
-
-
-def _unzigzag(z: np.ndarray) -> np.ndarray:
-    z = z.astype(np.int64)
-    return (z >> 1) ^ -(z & 1)
-
-
-def pack_residuals(residuals: np.ndarray) -> tuple[int, bytes, bool]:
-    """(byte width 0-4, byte planes maybe deflated, deflated?) for int64 residuals."""
-    z = _zigzag(residuals)
-    top = int(z.max()) if len(z) else 0
-    width = (top.bit_length() + 7) // 8
-    if width == 0:
-        return 0, b"", False
-    if width > 4:
-        raise ValueError("residuals must fit 32 bits")
-    planes = z.astype("<u4").view(np.uint8).reshape(-1, 4)[:, :width].T.tobytes()
-    packed = _deflate(planes)
-    if len(packed) < len(planes):
-        return width, packed, True
-    return width, planes, False
-
-
-def unpack_residuals(block: bytes, width: int, count: int, deflated: bool) -> np.ndarray:
-    """The inverse of `pack_residuals`, with every size checked."""
-    if width == 0:
-        if block:
-            raise _bad("residual bytes where none were announced")
-        return np.zeros(count, dtype=np.int64)
-    if width > 4:
-        raise _bad(f"a residual width of {width} bytes (at most 4)")
-    size = width * count
-    raw = _inflate(block, size, "residual block") if deflated else block
-    if len(raw) != size:
-        raise _bad(f"{len(raw)} residual bytes where {size} were due")
-    planes = np.frombuffer(raw, dtype=np.uint8).reshape(width, count).astype(np.uint64)
-    z = np.zeros(count, dtype=np.uint64)
-    for k in range(width):
-        z |= planes[k] << np.uint64(8 * k)
-    return _unzigzag(z)
-
-
 def _text_delta(old: str, new: str) -> bytes:
     """`new` as (bytes kept from the start of `old`, kept from its end, the middle)."""
     a, b = old.encode("utf-8"), new.encode("utf-8")
@@ -451,11 +345,11 @@ def _text_delta(old: str, new: str) -> bytes:
     return _TEXT_DELTA.pack(p, s, len(middle)) + middle
 
 
-def _apply_text_delta(old: str, r: _Reader) -> str:
+def _apply_text_delta(old: str, r: Reader) -> str:
     keep_start, keep_end, size = _TEXT_DELTA.unpack(r.take(_TEXT_DELTA.size))
     a = old.encode("utf-8")
     if keep_start + keep_end > len(a) or keep_start + keep_end + size > MAX_STATUS_BYTES:
-        raise _bad("a status line that does not fit the previous one")
+        raise bad("a status line that does not fit the previous one")
     return wire_text(a[:keep_start] + r.take(size) + a[len(a) - keep_end :], "a status line")
 
 
@@ -502,9 +396,6 @@ def encode_tick(tick: Tick, b1: Tick | None = None, b2: Tick | None = None) -> t
 
 
 # ---------------------------------------------------------------- the server side
-
-# Here, not at the top: aids_wire reuses the packing helpers above.
-from airtable.net import aids_wire  # noqa: E402
 
 
 @dataclass
@@ -655,15 +546,15 @@ class SnapshotDecoder:
         _check_magic(magic, version, TICK_MAGIC)
         layout = self.layout
         if layout is None or layout.version != lv:
-            raise _bad(f"layout {lv}, which was never sent")
+            raise bad(f"layout {lv}, which was never sent")
         if not -MAX_TIME_US <= time_us <= MAX_TIME_US:
-            raise _bad("a time out of range")
+            raise bad("a time out of range")
         b1, b2 = self._bases(flags, seq, gap1, gap2)
-        r = _Reader(payload, "snapshot")
+        r = Reader(payload, "snapshot")
         r.take(_TICK.size)
         view = _VIEW.unpack(r.take(_VIEW.size)) if flags & HAS_VIEW else (b1.view if b1 else None)
         if view is None:
-            raise _bad("a keyframe without the view")
+            raise bad("a keyframe without the view")
         if usable_view(view):
             self.shown_view = view
         else:
@@ -675,7 +566,7 @@ class SnapshotDecoder:
         elif b1 is not None:
             status = b1.status
         else:
-            raise _bad("a keyframe without a status line")
+            raise bad("a keyframe without a status line")
         n, _, c = layout.sizes
         count = 2 * n + 4 * c
         residuals = unpack_residuals(payload[r.offset :], width, count, bool(flags & DEFLATED))
@@ -683,7 +574,7 @@ class SnapshotDecoder:
             values = np.cumsum(residuals)
         else:
             if len(b1.values) != count:
-                raise _bad("a delta on a tick with another number of pucks or cursors")
+                raise bad("a delta on a tick with another number of pucks or cursors")
             values = predict(time_us, 2 * n + 2 * c, b1, b2) + residuals
         shown, problem = _shown_values(values, layout)
         if problem is not None:
@@ -697,15 +588,15 @@ class SnapshotDecoder:
     def _bases(self, flags: int, seq: int, gap1: int, gap2: int) -> tuple[Tick | None, Tick | None]:
         if flags & KEYFRAME:
             if gap1 or gap2:
-                raise _bad("a keyframe with base ticks")
+                raise bad("a keyframe with base ticks")
             return None, None
         last, prev = self.last, self.prev
         if last is None or gap1 == 0 or seq - gap1 != last.seq:
-            raise _bad(f"a delta on tick {seq - gap1}, which this client does not hold")
+            raise bad(f"a delta on tick {seq - gap1}, which this client does not hold")
         if gap2 == 0:
             return last, None
         if prev is None or last.seq - gap2 != prev.seq:
-            raise _bad(f"a delta on tick {last.seq - gap2}, which this client does not hold")
+            raise bad(f"a delta on tick {last.seq - gap2}, which this client does not hold")
         return last, prev
 
     def _scene(self, tick: Tick, v: np.ndarray) -> Scene:

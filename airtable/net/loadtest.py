@@ -43,9 +43,9 @@ import time
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 
-from airtable.app.client import Client, cursor_pulls
 from airtable.app.loop import FixedStep, FpsCounter, FrameLoop
-from airtable.app.scene import Scene
+from airtable.model.client import Client, cursor_pulls
+from airtable.model.scene import Scene
 from airtable.net import protocol as proto
 from airtable.net.rawplayer import WorkerReport, WorkerSpec, play
 from airtable.net.server import GameServer

@@ -31,7 +31,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from airtable.app.scene import Scene
+from airtable.model.scene import Scene
 from airtable.net.codec import LAYOUT, SnapshotDecoder
 
 WINDOW_S = 2.0  # arrivals remembered for the offset, jitter and interval

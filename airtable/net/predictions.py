@@ -21,15 +21,20 @@ from __future__ import annotations
 import math
 import threading
 from collections.abc import Sequence
-from dataclasses import dataclass, field
 
+from airtable.model.rounds import (  # noqa: F401  (the round's data, here where it travels)
+    MAX_PREDICT_SPEED_MPS,
+    MAX_ROUND_PUCKS,
+    STATES,
+    Arrow,
+    Prediction,
+    RoundInfo,
+    clamp_speed,
+)
 from airtable.net import protocol as proto
 
 PREDICT = proto.PREDICT  # 8
 ROUND = proto.ROUND  # 9
-STATES = ("open", "revealed", "closed")
-MAX_PREDICT_SPEED_MPS = 100.0  # far above any demo; a bigger guess is a mistake, not physics
-MAX_ROUND_PUCKS = 256  # pucks a round offers for prediction (a class predicts a handful)
 MAX_ROUND_ARROWS = 4000  # arrows a revealed ROUND carries (about 40 bytes each)
 MAX_SUMMARY_LINES = 32
 MAX_SUMMARY_CHARS = 120
@@ -38,56 +43,10 @@ MAX_ROUND_ID = 2**31 - 1
 PREDICT_EXAMPLE = '{"round": 1, "puck": 0, "vel_mps": [1.5, -0.25]}'
 
 
-@dataclass(frozen=True)
-class Prediction:
-    """One validated guess: in round `round_id`, puck `puck` leaves with `vel_mps`."""
-
-    round_id: int
-    puck: int
-    vel_mps: tuple[float, float]
-
-
-@dataclass(frozen=True)
-class Arrow:
-    """One revealed prediction: whose (label, colour), which puck, what velocity."""
-
-    puck: int
-    vel_mps: tuple[float, float]
-    color: tuple[int, int, int]
-    label: str = ""
-
-
-@dataclass(frozen=True)
-class RoundInfo:
-    """What a ROUND message says (the server's and every student's view of the round)."""
-
-    round_id: int
-    state: str  # "open", "revealed" or "closed"
-    pucks: int  # pucks 0 .. pucks-1 may be predicted
-    predicted: int = 0  # students who predicted at least one puck
-    players: int = 0  # students at the table
-    arrows: tuple[Arrow, ...] = ()
-    truth: tuple[tuple[float, float], ...] = ()  # every predictable puck's velocity after the collision
-    summary: tuple[str, ...] = field(default=())
-    from_m: tuple[tuple[float, float], ...] = ()  # where each predictable puck stood when the round opened
-
-
-# ---------------------------------------------------------------- PREDICT
-
-
 def encode_predict(round_id: int, puck: int, vel_mps: Sequence[float]) -> bytes:
     """A PREDICT frame (under 100 bytes)."""
     vx, vy = (float(v) for v in vel_mps)
     return proto.encode_json(PREDICT, {"round": int(round_id), "puck": int(puck), "vel_mps": [vx, vy]})
-
-
-def clamp_speed(vel_mps: Sequence[float]) -> tuple[float, float]:
-    """`vel_mps` cut to MAX_PREDICT_SPEED_MPS (the player sends only what the server accepts)."""
-    vx, vy = (float(v) for v in vel_mps)
-    speed = math.hypot(vx, vy)
-    if speed > MAX_PREDICT_SPEED_MPS:
-        vx, vy = vx * MAX_PREDICT_SPEED_MPS / speed, vy * MAX_PREDICT_SPEED_MPS / speed
-    return (vx, vy)
 
 
 def validate_predict(message: dict, pucks: int) -> Prediction:

@@ -20,7 +20,7 @@ import socket
 import time
 from dataclasses import dataclass, field
 
-from airtable.app.scene import Scene
+from airtable.model.scene import Scene
 from airtable.net import protocol as proto
 from airtable.net.codec import SnapshotDecoder
 

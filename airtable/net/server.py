@@ -32,11 +32,10 @@ import socket
 import threading
 import time
 from collections.abc import Callable
-from dataclasses import dataclass
 
-from airtable.app.client import Client
-from airtable.app.scene import Scene
-from airtable.colors import rgb
+from airtable.model.client import Client
+from airtable.model.scene import Scene
+from airtable.model.seats import Seat
 from airtable.net import pacing
 from airtable.net import protocol as proto
 from airtable.net.codec import SnapshotEncoder
@@ -45,6 +44,7 @@ from airtable.net.events import EventQueue, PlayerInput, PlayerJoined, PlayerLef
 from airtable.net.gate import FIRST_PASSWORD_WAIT_S, HANDSHAKES_PER_ADDRESS, PLAYERS_PER_ADDRESS, Gate, QuietLog
 from airtable.net.identity import SeatTokens
 from airtable.net.predictions import MAX_ROUND_PUCKS, PredictionBook, RoundInfo, encode_round, parse_predict
+from airtable.physics.colors import rgb
 
 log = logging.getLogger("airtable.net")
 
@@ -119,20 +119,6 @@ def lan_addresses() -> list[str]:
             continue
     usable = [a for a in dict.fromkeys(found) if not a.startswith(("127.", "0.", "169.254."))]
     return usable or ["127.0.0.1"]
-
-
-@dataclass(frozen=True)
-class Seat:
-    """One player in the roster: who, and how their connection is doing."""
-
-    number: int  # n of "Cn"
-    name: str  # as shown on the table, e.g. "C3 Ann"
-    color: tuple[int, int, int]
-    address: str
-    snapshots_per_s: float  # snapshots that went out whole, over the last 2 s
-    lag_s: float  # how long a snapshot waits at the server before it is out (smoothed)
-    idle_s: float  # since the player's input last changed
-    far_off: bool  # the cursor is more than a table size beyond the table's edge
 
 
 def validate_server_options(

@@ -12,7 +12,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from airtable.colors import rgb
+from airtable.physics.colors import rgb
 
 if TYPE_CHECKING:
     from airtable.physics.table import AirTable

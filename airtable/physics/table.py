@@ -44,10 +44,10 @@ from collections.abc import Callable, Sequence
 
 import numpy as np
 
-from airtable.colors import rgb
 from airtable.physics import broadphase, contacts, forces, pairs, sleep, sweep, vectors, walls
 from airtable.physics import implicit as implicit_solve
 from airtable.physics.bodies import Puck, Spring, as_vector
+from airtable.physics.colors import rgb
 from airtable.physics.forces import GRAVITY_MPS2, Pull
 
 # The table's size unless told otherwise: 10 m across, 8:7 like the window.

@@ -9,14 +9,14 @@ from __future__ import annotations
 
 import numpy as np
 
-from airtable.app import aids
 from airtable.app.aids_paint import AidsPainter, draw_annotations
-from airtable.app.aids_share import StudentAids
 from airtable.app.aids_view import COM_COLOR
 from airtable.app.lessons_view import VALUES_HINT
-from airtable.app.momenta import FEW_PUCKS
-from airtable.app.scene import Scene
-from airtable.net import aids_wire
+from airtable.model import aids
+from airtable.model import shared_aids as aids_wire
+from airtable.model.momenta import FEW_PUCKS
+from airtable.model.scene import Scene
+from airtable.model.student_aids import StudentAids
 
 VELOCITY_COLOR = (120, 220, 255)
 MOMENTUM_COLOR = (230, 120, 230)

@@ -1,0 +1,70 @@
+"""`airtable-client HOST[:PORT] [--name NAME] [--password PW] [--headless] [--seconds S]
+[--screenshot FILE.png]`: join a teacher's air table over the LAN."""
+
+from __future__ import annotations
+
+import argparse
+import math
+import os
+import sys
+from collections.abc import Sequence
+
+from airtable.net import protocol as proto
+from airtable.net.player import NetPlayer, PlayerError
+from airtable.student.window import PlayerApp
+
+
+def _parse_args(argv: Sequence[str] | None) -> argparse.Namespace:
+    parser = argparse.ArgumentParser(
+        prog="airtable-client",
+        description="Join a teacher's air table: your mouse pulls pucks on the shared table "
+        "(buttons 1, 2, 3 are the medium, soft and stiff cursor strings; Esc twice leaves; F11 fullscreen).",
+    )
+    parser.add_argument("server", metavar="HOST[:PORT]", help="the address from the teacher's 'join with:' line")
+    parser.add_argument("--name", help=f"a name shown next to your cursor (up to {proto.MAX_NAME_CHARS} characters)")
+    parser.add_argument("--password", help="the table's password, if the teacher set one")
+    parser.add_argument("--headless", action="store_true", help="run without a window (for tests)")
+    parser.add_argument("--seconds", type=float, help="quit after this many seconds")
+    parser.add_argument("--screenshot", metavar="FILE.png", help="save the last frame here when quitting")
+    return parser.parse_args(argv)
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """The airtable-client command; returns the exit status."""
+    args = _parse_args(argv)
+    try:
+        host, port = proto.parse_host_port(args.server)
+        name = None if args.name is None else proto.check_name(args.name)
+        if args.seconds is not None and not (math.isfinite(args.seconds) and args.seconds >= 0):
+            raise ValueError("--seconds must be zero or a positive number")
+    except (ValueError, proto.ProtocolError) as e:
+        print(f"airtable-client: {e}", file=sys.stderr)
+        return 1
+    net = NetPlayer(host, port, name=name, password=args.password)
+    try:
+        welcome = net.connect()
+    except PlayerError as e:
+        print(f"airtable-client: {e}", file=sys.stderr)
+        return 1
+    except KeyboardInterrupt:
+        return 1
+    if welcome is None:
+        print(f"airtable-client: {net.waiting_because}; waiting for a place (Esc quits)")
+    else:
+        print(f"airtable-client: connected to {net.address}; you are {welcome.label}")
+    if args.headless:
+        os.environ.setdefault("SDL_VIDEODRIVER", "dummy")  # no screen: pygame's events still need a driver
+    else:
+        from airtable.app.window import prefer_plain_framebuffer
+
+        prefer_plain_framebuffer()  # software OpenGL behind the window costs 11-35 ms a flip at 1920x1080
+    try:
+        return PlayerApp(net, headless=args.headless).run(seconds=args.seconds, screenshot=args.screenshot)
+    finally:
+        import pygame
+
+        pygame.quit()
+
+
+if __name__ == "__main__":
+    sys.exit(main())
