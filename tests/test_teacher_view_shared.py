@@ -90,6 +90,8 @@ def test_zooming_and_panning_far_keeps_the_student_connected(demos):
         assert np.hypot(*teacher.env.origin_m) > 1000, teacher.env.origin_m
         frames_until(teacher, lambda: student_sees(teacher, net), "the panned view to reach the student")
         student_draws(student, lambda walls: walls == 0)  # nothing of the table there, as on the projector
+        assert "q brings it back" in teacher.hud_lines()[-1]
+        assert student._view_hint(net.latest())  # and each window says so
         wheel(teacher, 200)  # as far in as the zoom goes
         frames_until(teacher, lambda: student_sees(teacher, net), "the zoomed-in view to reach the student")
         wall_pixels(student)

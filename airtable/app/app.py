@@ -49,6 +49,7 @@ MAX_FPS = 240.0
 # and wakes at once on input: a laptop projecting all lesson stays quiet.
 IDLE_FPS = 12.0
 IDLE_AFTER_S = 1.0  # input this recent keeps the full frame rate
+OUT_OF_VIEW = "the table is out of view: q brings it back"
 STILL_PX_PER_S = 0.5  # slower than this on screen, nothing visibly moves: the table idles
 ERROR_TITLES = {
     "load": "Demo {key} could not be loaded",
@@ -496,6 +497,8 @@ class App:
             lines.extend(room.hud_lines(self))
         if self.message and self.clock_s < self.message_until:
             lines.append(self.message)
+        elif not self.window.wall_rects():
+            lines.append(OUT_OF_VIEW)
         return lines
 
     def draw(self, scene: Scene | None = None) -> None:

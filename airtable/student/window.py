@@ -294,7 +294,7 @@ class PlayerApp:
         win.draw(
             dataclasses.replace(scene, cursors=cursors),
             trails=net.aids.shows("e"),
-            hud=(f"You are {me}" if me else "Not at the table yet", net.status_text),
+            hud=(f"You are {me}" if me else "Not at the table yet", net.status_text, *self._view_hint(scene)),
             banner=net.banner_text or student_banner(scene, me),
             hud_color=color,
         )
@@ -312,6 +312,12 @@ class PlayerApp:
         elif net.aids.teacher & NOTES and net.aids.notes is not None:
             win.draw_panel(scene.title, [net.aids.notes], large=True)
         win.present()
+
+    def _view_hint(self, scene: Scene) -> tuple[str, ...]:
+        """A line when the teacher's view shows none of the table (zoomed or panned away)."""
+        if self.window.wall_rects((scene.width_m, scene.height_m)):
+            return ()
+        return ("the teacher's view shows none of the table just now",)
 
     def _draw_round(self, color) -> list:
         """The prediction round, if one is under way; returns the lines of text written and where."""
