@@ -23,7 +23,7 @@ test: $(STAMP)
 	$(BIN)/python -m pytest -q -n auto --dist worksteal
 
 bench: $(STAMP)
-	$(BIN)/python -m airtable.bench $(ARGS)
+	$(BIN)/python -m bench $(ARGS)
 
 lint: $(STAMP)
 	$(BIN)/ruff check .

@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 import shutil
 
-from airtable import bench_frames
+from bench import frames as bench_frames
 
 
 def test_without_xvfb_the_section_says_why_and_passes(monkeypatch, capsys) -> None:

@@ -22,7 +22,6 @@ from airtable.app.scene import CursorView, Scene
 from airtable.app.window import background_for
 from airtable.net import protocol as proto
 from airtable.net.codec import SnapshotEncoder, Viewer, encode_layout, layout_of
-from airtable.net.loadtest import TableLoop, grid_table
 from airtable.net.player import (
     InputThrottle,
     NetPlayer,
@@ -33,6 +32,7 @@ from airtable.net.player import (
     own_cursor_live,
 )
 from airtable.net.server import GameServer
+from tools.loadtest import TableLoop, grid_table
 
 
 @pytest.fixture

@@ -15,10 +15,10 @@ from airtable.app.aids_student_view import VELOCITY_COLOR
 from airtable.app.scene import Scene
 from airtable.net import aids_wire
 from airtable.net.aids_wire import AidsDecoder, AidsEncoder, AidsViewer, SharedAids
-from airtable.net.bench_aids import frame_sizes, measure
 from airtable.net.codec import SnapshotDecoder, SnapshotEncoder, Viewer
 from airtable.net.player import NetPlayer, PlayerApp
 from airtable.net.protocol import AIDS, LAYOUT, SNAPSHOT, ProtocolError
+from bench.aids import frame_sizes, measure
 
 
 def _scene(n: int = 3, aids_: SharedAids | None = None, t: float = 0.0) -> Scene:

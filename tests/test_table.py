@@ -11,10 +11,10 @@ import sys
 
 import numpy as np
 import pytest
+from airtable.demos.demo_0p_gas import gas_scene
 
 from airtable import AirTable, Client
 from airtable.app.client import cursor_pulls
-from airtable.bench import gas_scene
 from airtable.physics.forces import Pull
 from airtable.physics.table import GRAVITY_MPS2
 
