@@ -149,6 +149,7 @@ def test_gas_speeds_spread_from_one_speed_into_the_2d_maxwell_distribution():
     assert speeds.mean() == pytest.approx(np.sqrt(np.pi) / 2.0, abs=0.06)
     assert table.kinetic_energy_J() == pytest.approx(energy, rel=1e-9)  # elastic: only shared out
 
+
 # ---------------------------------------------------------------- springs keep their shape
 
 
