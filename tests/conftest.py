@@ -22,6 +22,13 @@ FRAME_S = 1 / 60  # one frame of the app in tests: simulated time, never the clo
 WAIT_S = 5.0  # the bound on every wait for a condition (generous: never a measurement)
 
 
+@pytest.fixture(autouse=True)
+def _in_a_folder_of_its_own(tmp_path, monkeypatch):
+    """Every test runs in its own empty folder, so what the app reads or writes at relative
+    paths (./my_demos, screenshots, CSV exports) never meets the checkout's files."""
+    monkeypatch.chdir(tmp_path)
+
+
 @pytest.fixture(scope="session")
 def demos():
     """The built-in demos by key, loaded once."""
