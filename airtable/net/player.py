@@ -33,6 +33,7 @@ from airtable.app.predict import StudentGuesses
 from airtable.app.predict_view import paint_round
 from airtable.app.room import student_banner
 from airtable.app.scene import CursorView, Scene
+from airtable.arguments import OneLineParser
 from airtable.net import protocol as proto
 from airtable.net.aids_wire import NOTES, AidsDecoder
 from airtable.net.playout import SnapshotFeed
@@ -923,7 +924,7 @@ def own_cursor_live(
 
 
 def _parse_args(argv: Sequence[str] | None) -> argparse.Namespace:
-    parser = argparse.ArgumentParser(
+    parser = OneLineParser(
         prog="airtable-client",
         description="Join a teacher's air table: your mouse pulls pucks on the shared table "
         "(buttons 1, 2, 3 are the medium, soft and stiff cursor strings; Esc twice leaves; F11 fullscreen).",
