@@ -83,10 +83,11 @@ def _start_openbox(display: str) -> subprocess.Popen | None:
 
 
 def _burst_variation() -> int:
+    """The burst's variation with PUCKS pucks, as --variation counts (from 1)."""
     from airtable.app.demo_loader import BUILTIN_DIR, discover
 
     demos, _ = discover([BUILTIN_DIR])
-    return demos["0"].variations.index(f"n = {PUCKS}")
+    return demos["0"].variations.index(f"n = {PUCKS}") + 1
 
 
 def _run_app(env: dict[str, str], seconds: float) -> tuple[int, float, float, float] | str:
