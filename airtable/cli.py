@@ -21,6 +21,7 @@ from airtable.app.saved_demo import DEFAULT_FOLDER as SAVED_DEMOS_DIR
 from airtable.app.saved_demo import check_save_demo_path
 from airtable.arguments import OneLineParser
 from airtable.assets import ASSETS_DIR
+from airtable.desktop import prepare_for_pygame
 from airtable.memory import keep_freed_memory
 from airtable.net.server import validate_server_options
 
@@ -243,8 +244,7 @@ def load_demos(parser: argparse.ArgumentParser, args: argparse.Namespace) -> Dem
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    # pygame-ce prints a banner when imported; the app has its own window title.
-    os.environ.setdefault("PYGAME_HIDE_SUPPORT_PROMPT", "1")
+    prepare_for_pygame()  # no pygame banner; the taskbar says "Air Table"
     parser = build_parser()
     args = parser.parse_args(argv)
     args.demo = key_from_label(args.demo)  # --demo Shift+1 as the help and the menu write it

@@ -3,6 +3,8 @@ the teacher's command refuses what the server would refuse, in the same sentence
 
 from __future__ import annotations
 
+import os
+
 import pytest
 
 from airtable import cli, client_cli
@@ -99,3 +101,13 @@ def test_variation_counts_from_1_as_list_demos_lists_them(tmp_path, capsys) -> N
     argv = ["--headless", "--no-server", "--seconds", "0.05", "--demo", "8", "--variation", "2"]
     assert cli.main([*argv, "--save-demo", str(tmp_path / "moment.py")]) == 0
     assert f"Demo 8: Pool line ({second})" in (tmp_path / "moment.py").read_text(encoding="utf-8")
+
+
+@pytest.mark.parametrize("main", [cli.main, client_cli.main])
+def test_both_commands_name_their_window_for_the_taskbar_before_pygame_starts(main, monkeypatch) -> None:
+    for var in ("SDL_VIDEO_X11_WMCLASS", "SDL_VIDEO_WAYLAND_WMCLASS"):
+        monkeypatch.delenv(var, raising=False)
+    with pytest.raises(SystemExit):
+        main(["--bogus"])
+    assert os.environ["SDL_VIDEO_X11_WMCLASS"] == "Air Table"  # not "__main__.py", the script's name
+    assert os.environ["SDL_VIDEO_WAYLAND_WMCLASS"] == "airtable"
