@@ -948,7 +948,7 @@ def main(argv: Sequence[str] | None = None) -> int:
             raise ValueError("--seconds must be zero or a positive number")
     except (ValueError, proto.ProtocolError) as e:
         print(f"airtable-client: {e}", file=sys.stderr)
-        return 1
+        return 2  # a bad argument, as argparse's own refusals
     net = NetPlayer(host, port, name=name, password=args.password)
     try:
         welcome = net.connect()
