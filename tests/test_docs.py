@@ -70,3 +70,16 @@ def test_every_link_and_picture_leads_to_a_file_and_heading_that_exist(page):
 def test_every_python_m_command_names_a_module_that_exists(page):
     for module in set(re.findall(r"python -m ([\w.]+)", _text(page))):
         assert importlib.util.find_spec(module) is not None, f"{page.name}: python -m {module} does not exist"
+
+
+def test_the_pictures_tool_draws_a_picture_of_the_app_at_its_time(tmp_path):
+    import pygame
+
+    from tools import doc_pictures
+
+    assert doc_pictures.main(["--out", str(tmp_path), "help.png"]) == 0
+    image = pygame.image.load(str(tmp_path / "help.png"))
+    assert image.get_size() == doc_pictures.SIZE_PX
+    assert len(set(pygame.surfarray.array2d(image).ravel().tolist())) > 20  # drawn, not one flat colour
+    for name in doc_pictures.PICTURES:  # every picture the docs show is one the tool makes
+        assert (ROOT / "docs" / name).is_file()
