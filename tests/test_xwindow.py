@@ -58,9 +58,11 @@ def xwininfo(display: str, *args: str) -> str:
 
 def find_window(display: str, title: str = "Air Table") -> str | None:
     """The window once it is on screen: keys sent to a window not yet mapped are lost."""
-    # `xdotool search --name` misses SDL's windows on some builds; xwininfo lists them all.
+    # `xdotool search --name` misses SDL's windows on some builds; xwininfo lists them all, as
+    # `0x200002 "Air Table - Demo 1": ("Air Table" "Air Table")`: the title, then the class,
+    # which says "Air Table" before the app has set the title.
     for line in xwininfo(display, "-root", "-tree").splitlines():
-        if f'"{title}' in line:
+        if line.split('": (')[0].strip().split(" ", 1)[-1].startswith(f'"{title}'):
             wid = str(int(line.split()[0], 16))
             return wid if "IsViewable" in xwininfo(display, "-id", wid) else None
     return None
