@@ -1,7 +1,7 @@
 """The command line of the teacher's app: `python -m airtable [options]`.
 
 Parses and checks the options (a bad one is a one-line message and exit
-status 2), lists demos, writes a starter demo, starts the network server and
+status 2, see arguments.py), lists demos, writes a starter demo, starts the network server and
 runs the App.
 """
 
@@ -19,7 +19,9 @@ from airtable.app.demo_loader import BUILTIN_DIR, Demo, DemoError, DemoShelf, ke
 from airtable.app.recorder import check_record_path
 from airtable.app.saved_demo import DEFAULT_FOLDER as SAVED_DEMOS_DIR
 from airtable.app.saved_demo import check_save_demo_path
+from airtable.arguments import OneLineParser
 from airtable.assets import ASSETS_DIR
+from airtable.desktop import prepare_for_pygame
 from airtable.memory import keep_freed_memory
 from airtable.net.server import validate_server_options
 
@@ -27,13 +29,19 @@ HEADLESS_FRAME_S = 1 / 60  # a headless run with no server: simulated frames of 
 
 
 def build_parser() -> argparse.ArgumentParser:
-    p = argparse.ArgumentParser(
+    p = OneLineParser(
         prog="python -m airtable",
         description="The air table: pucks, springs and cursor strings. Students join with airtable-client HOST.",
         epilog="In the window: F1 lists the keys, Tab opens the demo menu, Esc closes what is open or quits.",
     )
     p.add_argument("--demo", default="1", metavar="KEY", help="demo to start with (see --list-demos); default 1")
-    p.add_argument("--variation", type=_non_negative_int, default=0, metavar="N", help="variation of that demo")
+    p.add_argument(
+        "--variation",
+        type=_positive_int,
+        default=1,
+        metavar="N",
+        help="which variation of that demo, counting from 1 as --list-demos lists them (default 1)",
+    )
     p.add_argument("--list-demos", action="store_true", help="list the demos and exit")
     _server_options(p)
     _run_options(p)
@@ -119,10 +127,6 @@ def _positive_float(text: str) -> float:
 
 def _positive_int(text: str) -> int:
     return _number(int, text, lambda v: v > 0, "a positive whole number")
-
-
-def _non_negative_int(text: str) -> int:
-    return _number(int, text, lambda v: v >= 0, "a whole number, 0 or more")
 
 
 def _port(text: str) -> int:
@@ -233,14 +237,14 @@ def load_demos(parser: argparse.ArgumentParser, args: argparse.Namespace) -> Dem
             print(error.one_line(), file=sys.stderr)
         parser.error(f"there is no demo {args.demo!r}; choose one of: {', '.join(shelf.demos)}")
     variations = shelf.demos[args.demo].variations
-    if args.variation and args.variation >= max(1, len(variations)):
-        parser.error(f"demo {args.demo} has {len(variations) or 'no'} variations; --variation must be below that")
+    if args.variation > max(1, len(variations)):
+        having = f"variations 1 to {len(variations)}" if variations else "no variations"
+        parser.error(f"demo {args.demo} has {having}; --variation {args.variation} is not one of them")
     return shelf
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    # pygame-ce prints a banner when imported; the app has its own window title.
-    os.environ.setdefault("PYGAME_HIDE_SUPPORT_PROMPT", "1")
+    prepare_for_pygame()  # no pygame banner; the taskbar says "Air Table"
     parser = build_parser()
     args = parser.parse_args(argv)
     args.demo = key_from_label(args.demo)  # --demo Shift+1 as the help and the menu write it
@@ -319,7 +323,7 @@ def run_app(args: argparse.Namespace, shelf: DemoShelf, shot: Path | None) -> in
         app = App(
             shelf,
             demo_key=args.demo,
-            variation=args.variation,
+            variation=args.variation - 1,  # the app counts from 0, a teacher from 1
             headless=args.headless,
             server=server,
             server_problem=server_problem,

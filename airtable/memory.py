@@ -9,7 +9,7 @@ freed memory waits; it never changes a result. Elsewhere (macOS, Windows,
 musl) it does nothing.
 
 It is a setting for the whole process, so the programs call it at their entry
-points (`airtable.cli.main`, `airtable.bench.main`); importing or building a
+points (`airtable.cli.main`, `bench.main.main`); importing or building a
 table never does.
 """
 

@@ -1,6 +1,8 @@
 """Test set-up: every test runs headless unless it asks for a real X display; shared helpers."""
 
 import os
+import sys
+from pathlib import Path
 
 os.environ.setdefault("SDL_VIDEODRIVER", "dummy")
 os.environ.setdefault("SDL_AUDIODRIVER", "dummy")
@@ -12,8 +14,19 @@ from collections.abc import Callable  # noqa: E402
 
 import pytest  # noqa: E402
 
+# The benchmarks and tools sit beside the package (bench/, tools/), not in it: the tests of
+# them and the scenes they share import them from the checkout's top folder.
+sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
+
 FRAME_S = 1 / 60  # one frame of the app in tests: simulated time, never the clock
 WAIT_S = 5.0  # the bound on every wait for a condition (generous: never a measurement)
+
+
+@pytest.fixture(autouse=True)
+def _in_a_folder_of_its_own(tmp_path, monkeypatch):
+    """Every test runs in its own empty folder, so what the app reads or writes at relative
+    paths (./my_demos, screenshots, CSV exports) never meets the checkout's files."""
+    monkeypatch.chdir(tmp_path)
 
 
 @pytest.fixture(scope="session")

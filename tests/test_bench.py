@@ -6,10 +6,11 @@ import math
 
 import numpy as np
 import pytest
+from airtable.demos.demo_0p_gas import gas_scene
 
 from airtable import AirTable
-from airtable.bench import gas_scene, main
 from airtable.physics import broadphase
+from bench.main import main
 
 
 def test_gas_scene_covers_30_percent_without_overlaps() -> None:
@@ -56,7 +57,7 @@ def test_bench_help(capsys: pytest.CaptureFixture[str]) -> None:
 
 
 def test_the_hard_cases_time_the_engines_in_turns() -> None:
-    from airtable import bench_hard
+    from bench import hard as bench_hard
 
     calls = []
 

@@ -9,7 +9,7 @@ import time
 
 import pytest
 
-from airtable.bench_cpu import cpu_seconds
+from bench.cpu import cpu_seconds
 
 
 @pytest.mark.skipif(not sys.platform.startswith("linux"), reason="reads /proc")

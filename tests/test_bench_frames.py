@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 import shutil
 
-from airtable import bench_frames
+from bench import frames as bench_frames
 
 
 def test_without_xvfb_the_section_says_why_and_passes(monkeypatch, capsys) -> None:
@@ -23,3 +23,7 @@ def test_the_stats_line_is_read_and_judged_against_60_fps(capsys) -> None:
     assert bench_frames._report("OpenGL", (100, 16.0, 11.0, 18.0), checked=False) is True
     out = capsys.readouterr().out
     assert "PASS" in out and "MISS" in out and "(for comparison)" in out
+
+
+def test_the_window_section_asks_for_the_burst_of_its_count_counting_variations_from_1(demos):
+    assert demos["0"].variations[bench_frames._burst_variation() - 1] == f"n = {bench_frames.PUCKS}"

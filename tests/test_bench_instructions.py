@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 import subprocess
 
-from airtable import bench_instructions
+from bench import instructions as bench_instructions
 
 
 def _valgrind_says(monkeypatch, stderr: str, returncode: int = 0) -> list[list[str]]:
@@ -25,7 +25,7 @@ def test_the_count_is_callgrinds_total_over_the_steps(monkeypatch) -> None:
     assert bench_instructions.instructions_per_step(1000, 4) == 395000
     cmd = calls[0]
     assert cmd[:2] == ["valgrind", "--tool=callgrind"] and "--toggle-collect=functools_reduce" in cmd
-    assert cmd[-4:] == ["-m", "airtable.bench_instructions", "1000", "4"]
+    assert cmd[-4:] == ["-m", "bench.instructions", "1000", "4"]
 
 
 def test_a_count_of_nothing_or_a_failed_run_is_no_count(monkeypatch) -> None:

@@ -1,10 +1,13 @@
-"""The command line refuses what the server would refuse, in the same one-line sentence."""
+"""The command lines: a bad argument is one line and exit status 2 (usage only on --help), and
+the teacher's command refuses what the server would refuse, in the same sentence."""
 
 from __future__ import annotations
 
+import os
+
 import pytest
 
-from airtable import cli
+from airtable import cli, client_cli
 from airtable.net.server import validate_server_options
 
 
@@ -21,9 +24,8 @@ def test_the_command_line_refuses_what_the_server_would(flags, options, capsys) 
     with pytest.raises(SystemExit) as exited:
         cli.main([*flags, "--headless", "--seconds", "0.05"])
     assert exited.value.code == 2
-    err = capsys.readouterr().err.strip().splitlines()
-    assert err[-1].endswith(str(refused.value).rstrip("."))
-    assert "Traceback" not in "\n".join(err)
+    (err,) = capsys.readouterr().err.strip().splitlines()
+    assert str(refused.value).rstrip(".") in err
 
 
 def test_without_a_server_the_server_options_are_not_checked(capsys) -> None:
@@ -52,3 +54,60 @@ def test_the_menu_shows_every_demo_at_720p(demos):
     rows = shown[-1][:-1]
     assert len(rows) == len(app.demos)
     assert any(key.strip().endswith("Shift+1") for key, _ in rows)
+
+
+BAD_ARGUMENTS = [
+    (cli.main, "airtable", ["--bogus"], "unrecognized arguments: --bogus"),
+    (cli.main, "airtable", ["--port", "99999"], "'99999' is not a port number"),
+    (cli.main, "airtable", ["--demo", "42"], "there is no demo '42'"),
+    (cli.main, "airtable", ["--variation", "0"], "'0' is not a positive whole number"),
+    (cli.main, "airtable", ["--demo", "5", "--variation", "3"], "demo 5 has variations 1 to 2"),
+    (cli.main, "airtable", ["--demo", "1", "--variation", "2"], "demo 1 has no variations"),
+    (client_cli.main, "airtable-client", [], "the following arguments are required: HOST[:PORT]"),
+    (client_cli.main, "airtable-client", ["localhost", "--bogus"], "unrecognized arguments: --bogus"),
+    (client_cli.main, "airtable-client", ["localhost", "--seconds"], "--seconds: expected one argument"),
+]
+
+
+@pytest.mark.parametrize(
+    ("main", "name", "argv", "problem"), BAD_ARGUMENTS, ids=lambda x: " ".join(x) if isinstance(x, list) else None
+)
+def test_a_bad_argument_is_one_line_naming_the_command_and_exit_status_2(main, name, argv, problem, capsys) -> None:
+    with pytest.raises(SystemExit) as exited:
+        main([*argv, "--headless"] if main is cli.main else argv)
+    assert exited.value.code == 2
+    out, err = capsys.readouterr()
+    assert out == ""
+    assert err.count("\n") == 1 and err.endswith("\n"), err
+    assert err.startswith(f"{name}: ") and problem in err and "usage" not in err
+    assert "--help" in err  # where the options are listed
+
+
+@pytest.mark.parametrize(("main", "usage"), [(cli.main, "python -m airtable"), (client_cli.main, "airtable-client")])
+def test_help_prints_the_usage_and_every_option_and_exits_0(main, usage, capsys) -> None:
+    with pytest.raises(SystemExit) as exited:
+        main(["--help"])
+    assert exited.value.code == 0
+    out = capsys.readouterr().out
+    assert out.startswith(f"usage: {usage} ")
+    assert "--name" in out if main is client_cli.main else "--fullscreen" in out and "--stats" in out
+
+
+def test_variation_counts_from_1_as_list_demos_lists_them(tmp_path, capsys) -> None:
+    assert cli.main(["--list-demos"]) == 0
+    (line,) = [row for row in capsys.readouterr().out.splitlines() if row.split()[:1] == ["8"]]
+    second = line.split("[variations: ")[1].split(", ")[1]  # the second one --list-demos names
+    assert second == "cue 10 % of a radius off the line"
+    argv = ["--headless", "--no-server", "--seconds", "0.05", "--demo", "8", "--variation", "2"]
+    assert cli.main([*argv, "--save-demo", str(tmp_path / "moment.py")]) == 0
+    assert f"Demo 8: Pool line ({second})" in (tmp_path / "moment.py").read_text(encoding="utf-8")
+
+
+@pytest.mark.parametrize("main", [cli.main, client_cli.main])
+def test_both_commands_name_their_window_for_the_taskbar_before_pygame_starts(main, monkeypatch) -> None:
+    for var in ("SDL_VIDEO_X11_WMCLASS", "SDL_VIDEO_WAYLAND_WMCLASS"):
+        monkeypatch.delenv(var, raising=False)
+    with pytest.raises(SystemExit):
+        main(["--bogus"])
+    assert os.environ["SDL_VIDEO_X11_WMCLASS"] == "Air Table"  # not "__main__.py", the script's name
+    assert os.environ["SDL_VIDEO_WAYLAND_WMCLASS"] == "airtable"

@@ -1,7 +1,7 @@
 """The code stays readable: short functions, no tangles, and each room keeps its rule.
 
 Students read this code to learn how an engine is built, so every function in
-airtable/ fits on a screen (at most 60 lines) and ruff's mccabe check (`make
+airtable/, bench/ and tools/ fits on a screen (at most 60 lines) and ruff's mccabe check (`make
 lint`, max-complexity 12) keeps branching in check. Physics and protocol code
 never import pygame or sockets.
 """
@@ -13,9 +13,12 @@ from pathlib import Path
 
 import pytest
 
-PACKAGE = Path(__file__).resolve().parent.parent / "airtable"
+ROOT = Path(__file__).resolve().parent.parent
+PACKAGE = ROOT / "airtable"
 MAX_FUNCTION_LINES = 60
-ROOMS = sorted({p.parent for p in PACKAGE.rglob("*.py")})
+# The package, and the benchmarks and tools beside it (in the repository, not in the wheel).
+OUTSIDE = ("bench", "tools")
+ROOMS = sorted({p.parent for top in (PACKAGE, *(ROOT / name for name in OUTSIDE)) for p in top.rglob("*.py")})
 
 
 def _functions(path: Path):
@@ -45,6 +48,12 @@ def test_no_function_over_60_lines(room: Path) -> None:
         if fn.end_lineno - fn.lineno + 1 > MAX_FUNCTION_LINES
     ]
     assert not long, "functions longer than 60 lines:\n" + "\n".join(long)
+
+
+def test_the_package_never_imports_the_benchmarks_or_tools() -> None:
+    # They are not in the wheel: an import of them would break every installed copy.
+    for path in sorted(PACKAGE.rglob("*.py")):
+        assert not _imports(path) & set(OUTSIDE), path
 
 
 def test_physics_imports_no_pygame_and_no_sockets() -> None:

@@ -13,7 +13,6 @@ from hypothesis.extra import numpy as hnp
 
 from airtable import AirTable, Client
 from airtable.model.scene import CursorView, Scene
-from airtable.net import bench_net
 from airtable.net.codec import (
     LAYOUT,
     UNITS_PER_M,
@@ -24,6 +23,7 @@ from airtable.net.codec import (
     usable_view,
 )
 from airtable.net.protocol import MAX_DRAWN_PUCKS, SNAPSHOT, ProtocolError
+from bench import snapshots as bench_net
 
 
 def split_frames(data: bytes) -> list[tuple[int, bytes]]:

@@ -10,11 +10,11 @@ import math
 
 import numpy as np
 import pytest
+from airtable.demos.demo_0p_gas import gas_scene
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from airtable import AirTable
-from airtable.bench import gas_scene
 from airtable.physics import broadphase, pairs
 from airtable.physics import table as table_module
 

@@ -72,7 +72,7 @@ def mechanical_energy(table: AirTable) -> float:
 
 def test_the_keys_are_exactly_the_builtin_set_and_all_load():
     assert ERRORS == []
-    assert list(DEMOS) == ["1", "2", "3", "4", "5", "6", "7", "8", "9", "0", "1p", "2p", "3p", "6p", "t"]
+    assert list(DEMOS) == ["1", "2", "3", "4", "5", "6", "7", "8", "9", "0", "0p", "1p", "2p", "3p", "6p", "t"]
 
 
 @pytest.mark.parametrize("key", list(DEMOS))
@@ -120,6 +120,34 @@ def test_burst_pucks_bounce_off_the_walls_keeping_their_energy():
     run_until(table, "0", 8.0)  # long enough for every puck to reach a wall
     assert_sane(table)
     assert table.kinetic_energy_J() == pytest.approx(energy, rel=1e-12)
+
+
+@pytest.mark.parametrize("variation", range(len(DEMOS["0p"].variations)))
+def test_gas_has_the_number_of_pucks_its_label_says_covering_30_percent(variation):
+    table = fresh("0p", variation)
+    n = int(DEMOS["0p"].variations[variation].split()[0])
+    assert len(table.pucks) == n
+    covered = np.pi * (table.radius_m**2).sum() / (table.width_m * table.height_m)
+    assert covered == pytest.approx(0.3, rel=1e-3)
+    assert [p.color for p in table.pucks].count(ORANGE) == 1
+
+
+def test_gas_speeds_spread_from_one_speed_into_the_2d_maxwell_distribution():
+    # In two dimensions the equilibrium speeds follow f(v) = (v / s^2) exp(-v^2 / 2 s^2), with
+    # s^2 = kT / m and the mean kinetic energy m v0^2 / 2 = kT (two degrees of freedom), so
+    # s = v0 / sqrt(2): P(v < v0) = 1 - 1/e, P(v < v0 / 2) = 1 - e^(-1/4), mean speed v0 sqrt(pi) / 2.
+    table = fresh("0p", DEMOS["0p"].variations.index("500 pucks"))
+    speeds = np.hypot(*table.vel_mps.T)
+    assert speeds == pytest.approx(np.ones(500))  # all start at v0 = 1 m/s
+    energy = table.kinetic_energy_J()
+    run_until(table, "0p", 8.0)  # some ten collisions per puck
+    assert_sane(table)
+    speeds = np.hypot(*table.vel_mps.T)
+    # 500 samples: a binomial fraction's standard deviation is about 0.022; allow three of them.
+    assert (speeds < 1.0).mean() == pytest.approx(1.0 - np.exp(-1.0), abs=0.065)
+    assert (speeds < 0.5).mean() == pytest.approx(1.0 - np.exp(-0.25), abs=0.055)
+    assert speeds.mean() == pytest.approx(np.sqrt(np.pi) / 2.0, abs=0.06)
+    assert table.kinetic_energy_J() == pytest.approx(energy, rel=1e-9)  # elastic: only shared out
 
 
 # ---------------------------------------------------------------- springs keep their shape

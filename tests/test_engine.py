@@ -7,9 +7,9 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from airtable.demos.demo_0p_gas import gas_scene
 
 from airtable import AirTable
-from airtable.bench import gas_scene
 from airtable.physics.reference import Disc, collide_pair
 
 # ---------------------------------------------------------------- the small ones
@@ -143,7 +143,7 @@ def test_pi_from_collisions(n: int, due: int) -> None:
     # A light puck at rest between the left wall and a puck 100^n times
     # heavier coming at 1 m/s: floor(pi 10^n) collisions in all (Galperin),
     # and the final velocities of the exact event-by-event 1D solution.
-    from airtable.bench_hard import pi_exact, pi_scene
+    from bench.hard import pi_exact, pi_scene
 
     table = AirTable(width_m=10.0, height_m=4.0)
     light, heavy = pi_scene(table, n)

@@ -10,7 +10,7 @@ import statistics
 
 import pytest
 
-from airtable.net import fairness
+from tools import fairness
 
 WHY_NOT = fairness.available()
 

@@ -7,9 +7,9 @@ import tracemalloc
 
 import numpy as np
 import pytest
+from airtable.demos.demo_0p_gas import gas_scene
 
 from airtable.app.history import BUDGET_BYTES, History
-from airtable.bench import gas_scene
 from airtable.physics.state import same_bits
 from airtable.physics.table import AirTable
 

@@ -5,8 +5,8 @@ from __future__ import annotations
 import pytest
 from conftest import WAIT_S, wait_until
 
-from airtable.net.loadtest import LoadResult, TableLoop, default_processes, grid_table, run_load
 from airtable.net.server import GameServer
+from tools.loadtest import LoadResult, TableLoop, default_processes, grid_table, run_load
 
 
 @pytest.fixture

@@ -23,7 +23,6 @@ from airtable.model.scene import Scene
 from airtable.net import protocol as proto
 from airtable.net.codec import SnapshotDecoder
 from airtable.net.events import MAX_QUEUED_INPUTS, EventQueue, PlayerInput, PlayerJoined, PlayerLeft
-from airtable.net.loadtest import TableLoop, grid_table, table_for
 from airtable.net.server import (
     COURSE_COLORS,
     RESERVED_FDS,
@@ -35,6 +34,7 @@ from airtable.net.server import (
     validate_server_options,
 )
 from airtable.physics.colors import rgb
+from tools.loadtest import TableLoop, grid_table, table_for
 
 
 def frame(frame_type: int, payload: bytes) -> bytes:

@@ -5,10 +5,10 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from airtable.bench_hard import pile_scene
 from airtable.physics import sleep
 from airtable.physics.state import capture, restore, same_bits
 from airtable.physics.table import AirTable
+from bench.hard import pile_scene
 
 DT_S = 1 / 240
 R_M = 0.25

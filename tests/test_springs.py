@@ -7,10 +7,10 @@ import math
 import numpy as np
 import pytest
 
-from airtable import bench_hard
 from airtable.physics import forces
 from airtable.physics.forces import GRAVITY_MPS2, Pull
 from airtable.physics.table import AirTable
+from bench import hard as bench_hard
 
 DT_S = 1 / 240
 

@@ -4,8 +4,8 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from airtable.demos.demo_0p_gas import gas_scene
 
-from airtable.bench import gas_scene
 from airtable.physics.forces import Pull
 from airtable.physics.state import HANDLED, PLAIN_TYPES, capture, restore, same_bits
 from airtable.physics.table import AirTable

@@ -15,12 +15,12 @@ from airtable.model.shared_aids import annotation_of, record_of
 from airtable.model.student_aids import StudentAids
 from airtable.net import aids_wire
 from airtable.net.aids_wire import AidsDecoder, AidsEncoder, AidsViewer, SharedAids
-from airtable.net.bench_aids import frame_sizes, measure
 from airtable.net.codec import SnapshotDecoder, SnapshotEncoder, Viewer
 from airtable.net.player import NetPlayer
 from airtable.net.protocol import AIDS, LAYOUT, SNAPSHOT, ProtocolError
 from airtable.student.aids_view import VELOCITY_COLOR
 from airtable.student.window import PlayerApp
+from bench.aids import frame_sizes, measure
 
 
 def _scene(n: int = 3, aids_: SharedAids | None = None, t: float = 0.0) -> Scene:

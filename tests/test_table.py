@@ -11,9 +11,9 @@ import sys
 
 import numpy as np
 import pytest
+from airtable.demos.demo_0p_gas import gas_scene
 
 from airtable import AirTable, Client
-from airtable.bench import gas_scene
 from airtable.model.client import cursor_pulls
 from airtable.physics.forces import Pull
 from airtable.physics.table import GRAVITY_MPS2

@@ -58,9 +58,11 @@ def xwininfo(display: str, *args: str) -> str:
 
 def find_window(display: str, title: str = "Air Table") -> str | None:
     """The window once it is on screen: keys sent to a window not yet mapped are lost."""
-    # `xdotool search --name` misses SDL's windows on some builds; xwininfo lists them all.
+    # `xdotool search --name` misses SDL's windows on some builds; xwininfo lists them all, as
+    # `0x200002 "Air Table - Demo 1": ("Air Table" "Air Table")`: the title, then the class,
+    # which says "Air Table" before the app has set the title.
     for line in xwininfo(display, "-root", "-tree").splitlines():
-        if f'"{title}' in line:
+        if line.split('": (')[0].strip().split(" ", 1)[-1].startswith(f'"{title}'):
             wid = str(int(line.split()[0], 16))
             return wid if "IsViewable" in xwininfo(display, "-id", wid) else None
     return None
@@ -277,3 +279,27 @@ def test_on_x11_the_window_keeps_its_pixels_in_the_plain_framebuffer(display):
     env["SDL_FRAMEBUFFER_ACCELERATION"] = "1"
     out = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True, timeout=60)
     assert out.stdout.split() == ["1", "False", "1"], out.stderr
+
+
+def window_class(display: str, wid: str) -> str:
+    """X11's WM_CLASS of a window: what a taskbar and Alt+Tab call it."""
+    env = {**os.environ, "DISPLAY": display}
+    out = subprocess.run(["xprop", "-id", wid, "WM_CLASS"], env=env, capture_output=True, text=True, timeout=20)
+    return out.stdout.strip()
+
+
+@pytest.mark.skipif(shutil.which("xprop") is None, reason="needs xprop (apt-get install x11-utils)")
+def test_the_taskbar_calls_the_teachers_and_the_students_window_air_table(display):
+    from airtable.net.server import GameServer
+
+    teacher = [sys.executable, "-m", "airtable", "--no-server", "--seconds", "60"]
+    with running(display, teacher) as (_, wid):
+        assert window_class(display, wid) == 'WM_CLASS(STRING) = "Air Table", "Air Table"'
+    server = GameServer(host="127.0.0.1", port=0)
+    server.start()
+    try:
+        student = [sys.executable, "-c", "import sys; from airtable.client_cli import main; sys.exit(main())"]
+        with running(display, [*student, f"127.0.0.1:{server.port}", "--seconds", "60"]) as (_, wid):
+            assert window_class(display, wid) == 'WM_CLASS(STRING) = "Air Table", "Air Table"'
+    finally:
+        server.stop()

@@ -9,13 +9,14 @@ import os
 import sys
 from collections.abc import Sequence
 
+from airtable.arguments import OneLineParser
 from airtable.net import protocol as proto
 from airtable.net.player import NetPlayer, PlayerError
 from airtable.student.window import PlayerApp
 
 
 def _parse_args(argv: Sequence[str] | None) -> argparse.Namespace:
-    parser = argparse.ArgumentParser(
+    parser = OneLineParser(
         prog="airtable-client",
         description="Join a teacher's air table: your mouse pulls pucks on the shared table "
         "(buttons 1, 2, 3 are the medium, soft and stiff cursor strings; Esc twice leaves; F11 fullscreen).",
@@ -39,7 +40,7 @@ def main(argv: Sequence[str] | None = None) -> int:
             raise ValueError("--seconds must be zero or a positive number")
     except (ValueError, proto.ProtocolError) as e:
         print(f"airtable-client: {e}", file=sys.stderr)
-        return 1
+        return 2  # a bad argument, as argparse's own refusals
     net = NetPlayer(host, port, name=name, password=args.password)
     try:
         welcome = net.connect()

@@ -1,4 +1,4 @@
-"""Hard cases for the engine, each beside pymunk: `python -m airtable.bench --only hard`.
+"""Hard cases for the engine, each beside pymunk: `python -m bench --only hard`.
 
 The gas benchmark shows speed on an easy scene. These are the scenes a physics
 teacher tries in the first ten minutes, where an engine either holds or not:

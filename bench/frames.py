@@ -12,7 +12,7 @@ included, runs on the processor. A second run with SDL's OpenGL framebuffer
 (`SDL_FRAMEBUFFER_ACCELERATION=1`, what SDL does unless told otherwise) shows
 why the app asks for the plain one on X11 (see window.prefer_plain_framebuffer).
 
-Run alone with `python -m airtable.bench --only window`; `--quick` runs 3 s
+Run alone with `python -m bench --only window`; `--quick` runs 3 s
 and skips the OpenGL comparison.
 """
 
@@ -26,8 +26,8 @@ import subprocess
 import sys
 import time
 
-from airtable.bench_cpu import start_xvfb
 from airtable.processes import stop_process
+from bench.cpu import start_xvfb
 
 SCREEN = "1920x1080"
 PUCKS = 10000
@@ -83,10 +83,11 @@ def _start_openbox(display: str) -> subprocess.Popen | None:
 
 
 def _burst_variation() -> int:
+    """The burst's variation with PUCKS pucks, as --variation counts (from 1)."""
     from airtable.app.demo_loader import BUILTIN_DIR, discover
 
     demos, _ = discover([BUILTIN_DIR])
-    return demos["0"].variations.index(f"n = {PUCKS}")
+    return demos["0"].variations.index(f"n = {PUCKS}") + 1
 
 
 def _run_app(env: dict[str, str], seconds: float) -> tuple[int, float, float, float] | str:

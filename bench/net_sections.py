@@ -4,15 +4,16 @@ from __future__ import annotations
 
 import argparse
 
-from airtable.net import bench_net, fairness
+from bench import snapshots
+from tools import fairness
 
 
 def snapshot_section(args: argparse.Namespace) -> bool:
     """Mean SNAPSHOT bytes of format 2 on the four scenes of the targets; True if all are within them."""
     print("\n== snapshots (format 2) ==")
-    results = bench_net.snapshot_sizes(quick=args.quick)
-    print(bench_net.report(results))
-    return all(m.mean_b <= bench_net.TARGETS_B.get(m.name, float("inf")) for m in results)
+    results = snapshots.snapshot_sizes(quick=args.quick)
+    print(snapshots.report(results))
+    return all(m.mean_b <= snapshots.TARGETS_B.get(m.name, float("inf")) for m in results)
 
 
 def link_section(args: argparse.Namespace) -> bool:

@@ -9,7 +9,7 @@ process's CPU time from /proc over a 10 s window (after 2 s of start-up):
   (demo 2 before the cue moves) and paused;
 - a student's client (`airtable-client`) joined to a still table.
 
-Run alone with `python -m airtable.bench --only cpu`; `--quick` uses 3 s windows.
+Run alone with `python -m bench --only cpu`; `--quick` uses 3 s windows.
 """
 
 from __future__ import annotations
@@ -23,6 +23,7 @@ import time
 from pathlib import Path
 
 from airtable.processes import stop_process
+from bench import ROOT
 
 TARGETS = {"app": 20.0, "client": 15.0}  # most per cent of one core while still
 WARM_UP_S = 2.0
@@ -55,7 +56,7 @@ def start_xvfb(size: str = "1280x720") -> tuple[subprocess.Popen, str]:
 
 def measure(cmd: list[str], env: dict[str, str], window_s: float) -> float:
     """Start `cmd`, wait for its first line of output, warm up, then its CPU % over `window_s`."""
-    proc = subprocess.Popen(cmd, env=env, stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, text=True)
+    proc = subprocess.Popen(cmd, env=env, stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, text=True, cwd=ROOT)
     try:
         if not proc.stdout.readline():
             raise RuntimeError(f"{' '.join(cmd[2:])} exited before it was ready")
@@ -69,7 +70,7 @@ def measure(cmd: list[str], env: dict[str, str], window_s: float) -> float:
 
 
 def _child_app(how: str) -> None:
-    """`python -m airtable.bench_cpu still|paused|server`: the app with its server on, until killed."""
+    """`python -m bench.cpu still|paused|server`: the app with its server on, until killed."""
     from airtable.app.app import App
     from airtable.app.demo_loader import BUILTIN_DIR, DemoShelf
     from airtable.app.window import prefer_plain_framebuffer
@@ -97,7 +98,7 @@ def cpu_section(args: argparse.Namespace) -> bool:
         return True
     xvfb, display = start_xvfb()
     env = {**os.environ, "DISPLAY": display, "SDL_VIDEODRIVER": "x11", "PYGAME_HIDE_SUPPORT_PROMPT": "1"}
-    me = [sys.executable, "-m", "airtable.bench_cpu"]
+    me = [sys.executable, "-m", "bench.cpu"]
     ok = True
     try:
         rows = [
@@ -116,11 +117,11 @@ def cpu_section(args: argparse.Namespace) -> bool:
 def _client_share(env: dict[str, str], window_s: float) -> float:
     """A headless table with its server (still), and one windowed client joined to it."""
     server = subprocess.Popen(
-        [sys.executable, "-m", "airtable.bench_cpu", "server"], env=env, stdout=subprocess.PIPE, text=True
+        [sys.executable, "-m", "bench.cpu", "server"], env=env, stdout=subprocess.PIPE, text=True, cwd=ROOT
     )
     try:
         port = server.stdout.readline().strip()
-        client = [sys.executable, "-m", "airtable.net.player", f"127.0.0.1:{port}", "--name", "bench"]
+        client = [sys.executable, "-m", "airtable.client_cli", f"127.0.0.1:{port}", "--name", "bench"]
         return measure(client, env, window_s)
     finally:
         stop_process(server)

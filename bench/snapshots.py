@@ -1,6 +1,6 @@
 """Bytes per snapshot in format 2, measured on real scenes (no pygame, no sockets).
 
-    python -m airtable.net.bench_net
+    python -m bench.snapshots
 
 builds each scene from the real demos and the benchmark's gas, runs the
 physics, feeds every snapshot tick (30 a second from a 60 fps loop) through a
@@ -98,7 +98,7 @@ def students_on_demo4(count: int = 30) -> Run:
 
 
 def gas(n: int = 1000) -> Run:
-    from airtable.bench import DT_S, gas_scene
+    from airtable.demos.demo_0p_gas import DT_S, gas_scene
 
     return Run(f"{n}-puck gas", gas_scene(n), [Client(name="local", active=False)], dt_s=DT_S)
 

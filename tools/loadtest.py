@@ -1,6 +1,6 @@
 """Load test: can this computer hold a class? (no pygame)
 
-    python -m airtable.net.loadtest HOST[:PORT] --clients 30 --seconds 10
+    python -m tools.loadtest HOST[:PORT] --clients 30 --seconds 10
 
 Connects N simulated players to a running table, spread over worker
 processes (about 50 players each, `--processes` to choose), so the tool is
@@ -24,7 +24,7 @@ teacher's laptop, and run this from another machine on the same network (or
 on the laptop itself with HOST 127.0.0.1, which also counts this tool's own
 CPU use against the laptop).
 
-    python -m airtable.net.loadtest --serve [--port 8888] [--fps 60]
+    python -m tools.loadtest --serve [--port 8888] [--fps 60]
 
 runs a bare headless table (a grid of pucks, no window) with a GameServer, to
 measure the network layer on its own; the tests use the same `TableLoop`.
@@ -47,9 +47,9 @@ from airtable.app.loop import FixedStep, FpsCounter, FrameLoop
 from airtable.model.client import Client, cursor_pulls
 from airtable.model.scene import Scene
 from airtable.net import protocol as proto
-from airtable.net.rawplayer import WorkerReport, WorkerSpec, play
 from airtable.net.server import GameServer
 from airtable.physics.table import AirTable
+from tools.rawplayer import WorkerReport, WorkerSpec, play
 
 MAX_CLIENTS = 200
 MAX_PROCESSES = 16
@@ -252,7 +252,7 @@ def table_for(demo: str | None = None, gas: int | None = None) -> tuple[AirTable
     """(table, physics step, title) to serve: a built-in demo by key, a gas of `gas`
     pucks (the benchmark's: 30 % cover, 1 m/s), or the plain grid."""
     if gas is not None:
-        from airtable.bench import DT_S, gas_scene
+        from airtable.demos.demo_0p_gas import DT_S, gas_scene
 
         return gas_scene(gas), DT_S, f"gas of {gas} pucks"
     if demo is not None:
@@ -429,7 +429,7 @@ def run_load(
 
 def main(argv: Sequence[str] | None = None) -> int:
     parser = argparse.ArgumentParser(
-        prog="python -m airtable.net.loadtest",
+        prog="python -m tools.loadtest",
         description="Connect simulated players to a running air table and measure whether it holds a class.",
     )
     parser.add_argument(

@@ -3,7 +3,7 @@
 Timings on a shared machine move by a fifth from one block of steps to the
 next, too much to see a change of a few per cent. A count of instructions does
 not move: valgrind's callgrind counts the same total for the same run every
-time. This section steps the benchmark's gas (bench.gas_scene) inside a call to
+time. This section steps the benchmark's gas (the gas demo's gas_scene) inside a call to
 `functools.reduce`, and callgrind counts only what runs inside that C function
 (`--toggle-collect`), so neither start-up nor the scene's set-up counts.
 Instructions are not seconds (a cache miss costs more than an addition), but
@@ -11,7 +11,7 @@ at these sizes the step's time follows them closely.
 
 Needs valgrind (`apt install valgrind`) and a Python whose library keeps its
 symbols (pyenv's and python.org's do); otherwise it says so and skips. Run
-alone with `python -m airtable.bench --only instructions`; `--quick` counts
+alone with `python -m bench --only instructions`; `--quick` counts
 N=1000 only.
 """
 
@@ -24,6 +24,8 @@ import re
 import shutil
 import subprocess
 import sys
+
+from bench import ROOT
 
 COUNTS = (1000, 10000)
 # Enough steps for some twenty and ten builds of the neighbour list (one every 3.8 and 3.1 steps).
@@ -38,10 +40,10 @@ def instructions_per_step(n: int, steps: int) -> int | None:
     cmd = [
         "valgrind", "--tool=callgrind", "--callgrind-out-file=/dev/null",
         "--collect-atstart=no", "--toggle-collect=functools_reduce",
-        sys.executable, "-m", "airtable.bench_instructions", str(n), str(steps),
+        sys.executable, "-m", "bench.instructions", str(n), str(steps),
     ]  # fmt: skip
     env = dict(os.environ, PYTHONHASHSEED="0")  # the same dict layouts, the same count every run
-    done = subprocess.run(cmd, env=env, capture_output=True, text=True, timeout=900)
+    done = subprocess.run(cmd, env=env, capture_output=True, text=True, timeout=900, cwd=ROOT)
     found = COLLECTED.search(done.stderr)
     if done.returncode != 0 or found is None or int(found.group(1)) == 0:
         return None
@@ -66,7 +68,8 @@ def instructions_section(args: argparse.Namespace) -> bool:
 
 def _step_inside_reduce(n: int, steps: int) -> None:
     """The child process: the gas, warmed up, then `steps` steps inside functools.reduce."""
-    from airtable.bench import gas_scene
+    from airtable.demos.demo_0p_gas import gas_scene
+
     from airtable.memory import keep_freed_memory
 
     keep_freed_memory()  # as the app and the bench run

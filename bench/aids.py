@@ -3,7 +3,7 @@
 Runs the real App headless (its collision log, chart and arrow scales),
 60 frames a second of simulated time, and hands every other frame's Scene
 (30 ticks a second, as the server does) to a SnapshotEncoder, for one
-student who gets every tick. `python -m airtable.net.bench_aids` prints:
+student who gets every tick. `python -m bench.aids` prints:
 
 - demo 4 with 30 students dragging pucks round circles, aids off and with
   a, v and c on;

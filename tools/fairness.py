@@ -1,6 +1,6 @@
 """Per-student snapshot rates on a link of limited bandwidth (Linux network namespaces).
 
-    python -m airtable.net.fairness [--mbit 5 10 20] [--clients 30] [--seconds 5]
+    python -m tools.fairness [--mbit 5 10 20] [--clients 30] [--seconds 5]
 
 creates a private network namespace, brings up its loopback and holds it to
 the given rate with a token bucket (`tc qdisc add dev lo root tbf rate
@@ -14,7 +14,7 @@ why not where they are missing. Only loopback addresses are used, every wait
 is bounded, and the namespace is deleted in a `finally`.
 
 Inside the namespace run the load tool's own table server (`python -m
-airtable.net.loadtest --serve`) and this module's `measure` subcommand (the
+tools.loadtest --serve`) and this module's `measure` subcommand (the
 players; prints JSON).
 """
 
@@ -33,6 +33,7 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 
 from airtable.processes import stop_process
+from tools import ROOT
 
 PORT = 8888
 BENCH_MBIT = (5, 10, 20)
@@ -89,7 +90,9 @@ class Namespace:
         return ["ip", "netns", "exec", self.name, *args]
 
     def run(self, *args: str, timeout_s: float = 20.0) -> subprocess.CompletedProcess:
-        return subprocess.run(self.command(*args), capture_output=True, text=True, timeout=timeout_s, check=True)
+        return subprocess.run(
+            self.command(*args), capture_output=True, text=True, timeout=timeout_s, check=True, cwd=ROOT
+        )
 
 
 @dataclass
@@ -142,7 +145,8 @@ def measure_rates(mbit: float, clients: int = 30, seconds: float = 5.0, demo: st
     with Namespace(mbit) as ns:
         table = ("--serve", "--host", "127.0.0.1", "--port", str(PORT), "--demo", demo, "--seconds", str(seconds + 60))
         server = subprocess.Popen(
-            ns.command(py, "-m", "airtable.net.loadtest", *table),
+            ns.command(py, "-m", "tools.loadtest", *table),
+            cwd=ROOT,
             stdout=subprocess.PIPE,
             stderr=subprocess.DEVNULL,
             text=True,
@@ -150,7 +154,7 @@ def measure_rates(mbit: float, clients: int = 30, seconds: float = 5.0, demo: st
         try:
             _wait_ready(server, START_TIMEOUT_S)
             args = ("measure", "--clients", str(clients), "--seconds", str(seconds))
-            done = ns.run(py, "-m", "airtable.net.fairness", *args, timeout_s=seconds + 90)
+            done = ns.run(py, "-m", "tools.fairness", *args, timeout_s=seconds + 90)
         finally:
             stop_process(server)
             server.stdout.close()
@@ -163,7 +167,7 @@ def measure_rates(mbit: float, clients: int = 30, seconds: float = 5.0, demo: st
 
 def measure(clients: int, seconds: float) -> int:
     """Players from the load tool; prints one JSON line with each one's rate."""
-    from airtable.net.loadtest import run_load
+    from tools.loadtest import run_load
 
     result = run_load("127.0.0.1", PORT, clients=clients, seconds=seconds, baseline_s=0.0)  # no baseline read
     fps = statistics.median(result.loaded_fps) if result.loaded_fps else 0.0
@@ -197,7 +201,7 @@ def bench(mbits: Sequence[float] = BENCH_MBIT, clients: int = 30, seconds: float
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(prog="python -m airtable.net.fairness", description=__doc__.splitlines()[0])
+    parser = argparse.ArgumentParser(prog="python -m tools.fairness", description=__doc__.splitlines()[0])
     sub = parser.add_subparsers(dest="command")
     m = sub.add_parser("measure")
     m.add_argument("--clients", type=int, default=30)

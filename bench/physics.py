@@ -1,7 +1,7 @@
-"""Benchmarks: `python -m airtable.bench` (or `make bench`).
+"""The "physics" and "frames" sections of `python -m bench` (or `make bench`).
 
-The "physics" section times one `AirTable.step` on a gas of pucks (see
-`gas_scene`) for growing N and, when pymunk is installed, runs the very same
+The "physics" section times one `AirTable.step` on a gas of pucks (the gas
+demo's `gas_scene`, demos/demo_0p_gas.py) for growing N and, when pymunk is installed, runs the very same
 scene in pymunk side by side as a yardstick. Besides speed it reports how deep
 pucks overlap at the end of a step and how much kinetic energy drifts, since a
 fast step that lets pucks sink into each other is no use on a projector.
@@ -12,8 +12,7 @@ estimate of what the code itself costs. Garbage collection is off while
 timing, as `timeit` does.
 
 The "frames" section times whole frames of the app (physics plus drawing,
-headless). Sections are listed in `SECTIONS`; a new one is a function that
-takes the parsed arguments, registered there. `--only` picks sections by name.
+headless).
 """
 
 from __future__ import annotations
@@ -21,86 +20,19 @@ from __future__ import annotations
 import argparse
 import gc
 import math
-import sys
 import time
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
 import numpy as np
+from airtable.demos.demo_0p_gas import COVERAGE, DT_S, RADIUS_M, SPEED_MPS, gas_scene
 
-from airtable import bench_hard
-from airtable.bench_cpu import cpu_section
-from airtable.bench_frames import window_section
-from airtable.bench_instructions import instructions_section
-from airtable.bench_net_sections import link_section, snapshot_section
-from airtable.memory import keep_freed_memory
 from airtable.physics import broadphase, vectors
 from airtable.physics.table import AirTable, kinetic_energy_J
-
-# The gas scene (units in the names).
-RADIUS_M = 0.1
-DENSITY_KGPM2 = 0.3
-COVERAGE = 0.3  # fraction of the table area covered by pucks
-SPEED_MPS = 1.0
-ASPECT = 8.0 / 7.0  # width / height, as the default window
-DT_S = 1.0 / 120.0
 
 # Targets: ours / pymunk time ratio by N, and the deepest overlap allowed.
 TARGET_RATIO = {1000: 1.3, 10000: 0.3}
 TARGET_OVERLAP_MM = 10.0
-
-
-def gas_scene(
-    table_or_n: AirTable | int,
-    *,
-    radius_m: float = RADIUS_M,
-    density_kgpm2: float = DENSITY_KGPM2,
-    coverage: float = COVERAGE,
-    speed_mps: float = SPEED_MPS,
-    seed: int = 0,
-) -> AirTable:
-    """A gas: equal pucks covering `coverage` of the table, all at `speed_mps` in random directions.
-
-    Given a puck count N, makes a table with aspect 8:7 and area
-    N pi r^2 / coverage (m^2). Given a table, clears it and fills it with as
-    many pucks as give that coverage. Pucks start on a jittered grid (no two
-    overlap, none touches a wall); the settings are those of the benchmark:
-    restitution 1, no gravity, two-step correction. Deterministic for a seed.
-    """
-    r = float(radius_m)
-    puck_area = math.pi * r * r
-    if isinstance(table_or_n, AirTable):
-        table = table_or_n
-        table.clear()
-        n = int(round(coverage * table.width_m * table.height_m / puck_area))
-    else:
-        n = int(table_or_n)
-        if n < 1:
-            raise ValueError(f"a gas needs at least one puck, not {table_or_n!r}")
-        area = n * puck_area / coverage
-        table = AirTable(width_m=math.sqrt(area * ASPECT), height_m=math.sqrt(area / ASPECT))
-    table.reset_settings()
-    table.gravity_on = False
-    table.cr_puck = table.cr_wall = 1.0
-    table.puck_correction = "two-step"
-
-    w, h = table.width_m, table.height_m
-    nx = max(1, math.ceil(math.sqrt(n * w / h)))
-    ny = max(1, math.ceil(n / nx))
-    cw, ch = w / nx, h / ny
-    if min(cw, ch) < 2.0 * r:
-        raise ValueError(f"{n} pucks of radius {r} m do not fit on a grid in a {w:.3g} x {h:.3g} m table")
-    rng = np.random.default_rng(seed)
-    cells = np.sort(rng.choice(nx * ny, size=n, replace=False))  # spread the empty cells
-    centre = np.column_stack([(cells // ny + 0.5) * cw, (cells % ny + 0.5) * ch])
-    # Jitter stays 1 % short of the cell edge, so neighbours never touch.
-    room = 0.99 * np.array([cw / 2.0 - r, ch / 2.0 - r])
-    pos = centre + rng.uniform(-1.0, 1.0, size=(n, 2)) * room
-    angle = rng.uniform(0.0, 2.0 * math.pi, size=n)
-    vel = speed_mps * np.column_stack([np.cos(angle), np.sin(angle)])
-    for p, v in zip(pos, vel, strict=True):
-        table.add_puck(pos_m=p, radius_m=r, density_kgpm2=density_kgpm2, vel_mps=v, color="white")
-    return table
 
 
 def deepest_overlap_m(pos_m: np.ndarray, radius_m: np.ndarray) -> float:
@@ -470,46 +402,3 @@ def frames_section(args: argparse.Namespace) -> bool:
         )
     print()
     return all_ok
-
-
-# Name -> section. A section takes the parsed arguments, prints its own
-# report and returns True when every target it checks is met.
-SECTIONS: dict[str, Callable[[argparse.Namespace], bool]] = {
-    "physics": physics_section,
-    "frames": frames_section,
-    "cpu": cpu_section,
-    "window": window_section,
-    "snapshots": snapshot_section,
-    "link": link_section,
-    "hard": bench_hard.hard_section,
-    "instructions": instructions_section,
-}
-
-
-def main(argv: Sequence[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(
-        prog="python -m airtable.bench",
-        description="Time the physics step on a gas of pucks, beside pymunk when it is installed.",
-    )
-    parser.add_argument("--quick", action="store_true", help="smaller counts and fewer steps (a few seconds)")
-    parser.add_argument(
-        "--only",
-        action="append",
-        choices=sorted(SECTIONS),
-        metavar="SECTION",
-        help=f"run only this section (repeatable; one of: {', '.join(SECTIONS)})",
-    )
-    parser.add_argument("--no-pymunk", action="store_true", help="skip the pymunk comparison")
-    parser.add_argument("--seed", type=int, default=0, help="random seed of the scenes (default 0)")
-    args = parser.parse_args(argv)
-    keep_freed_memory()  # as the app does (cli.main): a 10000-puck step is 35 % slower without
-    t0 = time.perf_counter()
-    ok = True
-    for name in args.only or list(SECTIONS):
-        ok = SECTIONS[name](args) and ok
-    print(f"{'all targets met' if ok else 'some targets missed'} ({time.perf_counter() - t0:.0f} s)")
-    return 0  # a missed target is a finding, not a failure of the bench
-
-
-if __name__ == "__main__":
-    sys.exit(main())

@@ -1,0 +1,7 @@
+"""`python -m bench [--quick] [--only SECTION] [--no-pymunk] [--seed N]`."""
+
+import sys
+
+from bench.main import main
+
+sys.exit(main())
