@@ -280,7 +280,7 @@ BINDINGS: tuple[Binding, ...] = (
     ),
     Binding("F11", "fullscreen on / off", {pygame.K_F11: toggle_fullscreen}),
     Binding("F12", "save a screenshot PNG", {pygame.K_F12: screenshot}),
-    Binding("Esc", "close what is open; else quit (twice if students are connected)", {pygame.K_ESCAPE: escape}),
+    Binding("Esc", "close what is open (the newest first); else asks: Esc again quits", {pygame.K_ESCAPE: escape}),
 )
 
 PRESS_ACTIONS: dict[int, Action] = {
