@@ -288,14 +288,12 @@ def write_outputs(app, args: argparse.Namespace) -> int:
             status = 1
         else:
             print(app.message)
-    if args.record is not None:
-        try:
-            pucks, energy = app.lessons.recorder.write(args.record)
-        except OSError as exc:
-            print(f"airtable: could not write the recording {args.record}: {exc}", file=sys.stderr)
+    for rec in app.lessons.finish():  # --record: the files were written as the run went
+        if rec.error is not None:
+            print(f"airtable: could not write the recording {rec.puck_path}: {rec.error}", file=sys.stderr)
             status = 1
         else:
-            print(f"recorded {app.lessons.recorder.summary()} to {pucks} and {energy}")
+            print(f"recorded {rec.summary()} to {rec.puck_path} and {rec.energy_path}")
     return status
 
 
@@ -322,6 +320,8 @@ def run_app(args: argparse.Namespace, shelf: DemoShelf, shot: Path | None) -> in
             server_problem=server_problem,
             fullscreen=args.fullscreen,
         )
+        if args.record is not None:
+            app.lessons.record_into(args.record, app.table)  # streamed from the first step
         app.run(seconds=args.seconds, frame_dt_s=frame_dt_s)
         if shot is not None:
             try:
@@ -335,6 +335,8 @@ def run_app(args: argparse.Namespace, shelf: DemoShelf, shot: Path | None) -> in
     except KeyboardInterrupt:
         pass
     finally:
+        if app is not None:
+            app.lessons.finish()  # the rows still buffered, even after Ctrl+C
         if server is not None:
             server.stop()
         if args.stats and app is not None:
