@@ -12,6 +12,7 @@ import numpy as np
 
 from airtable.app import aids
 from airtable.app.client import cursor_pulls
+from airtable.app.momenta import puck_number
 
 if TYPE_CHECKING:
     from airtable.app.app import App
@@ -47,6 +48,7 @@ def inspector_lines(table, puck) -> list[str]:
     v = puck.vel_mps
     speed = float(np.hypot(*v))
     lines = [
+        f"puck {puck_number(puck.index)}",
         f"mass {puck.mass_kg:.4g} kg   radius {puck.radius_m:.4g} m",
         f"speed {speed:.4g} m/s",
         f"velocity ({v[0]:.3f}, {v[1]:.3f}) m/s",

@@ -51,6 +51,7 @@ class Lessons:
         self.recorded: list[Recorder] = []  # the --record recordings of this run, the current one last
         self.recorder: Recorder | None = None
         self.exported_to_s = -1.0  # the recording's time up to which it was exported
+        self.show_numbers = False  # each puck's number drawn on it (k); kept from demo to demo
         self.momenta = MomentaLog()
         self._hits_seen = 0  # the table's collision count when last looked at
         self.painter = None  # the LessonsPainter, made on the first draw (lessons_view.py)
@@ -124,6 +125,12 @@ def toggle_momenta(app: App) -> None:
 
 def toggle_values(app: App) -> None:
     app.lessons.show_values = not app.lessons.show_values
+
+
+def toggle_numbers(app: App) -> None:
+    app.lessons.show_numbers = not app.lessons.show_numbers
+    shown = app.lessons.show_numbers
+    app.say("puck numbers shown, as values, predict and the CSV name them" if shown else "puck numbers hidden")
 
 
 def export_recording(app: App) -> None:

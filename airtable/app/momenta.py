@@ -20,6 +20,9 @@ import numpy as np
 
 from airtable.physics.table import AirTable, kinetic_energy_J
 
+# Pucks are numbered from 1 wherever the app names one (values, momenta, predict, inspect, the CSV files,
+# the numbers drawn on the pucks): puck_number is that numbering, the table's rows count from 0.
+FIRST_PUCK_NUMBER = 1
 FEW_PUCKS = 6  # the values panel lists every puck up to this many, else the puck under the cursor
 MAX_DIAGRAM_PUCKS = 40  # more than this: the diagram draws the pucks that collided (at most this many), and the total
 
@@ -153,6 +156,11 @@ def fit_chains(chains: list[np.ndarray], size_px: tuple[int, int], margin: float
     return ChainFit(scale if math.isfinite(scale) else 1.0, tuple(centers))
 
 
+def puck_number(row: int) -> int:
+    """The number a class sees for the puck in table row `row`."""
+    return int(row) + FIRST_PUCK_NUMBER
+
+
 @dataclass(frozen=True)
 class PuckValues:
     """What the values panel shows of one puck (or the total of all)."""
@@ -162,6 +170,7 @@ class PuckValues:
     speed_mps: float | None  # None for the total: a sum of speeds means nothing
     momentum_Ns: float
     kinetic_J: float
+    row: int | None = None  # the puck's table row (None for the total)
 
     def cells(self) -> tuple[str, str, str, str, str]:
         speed = "" if self.speed_mps is None else f"{self.speed_mps:.3g}"
@@ -173,7 +182,7 @@ VALUE_HEADINGS = ("puck", "m kg", "|v| m/s", "|p| N s", "KE J")  # mass, speed, 
 
 
 def puck_values(mass_kg: np.ndarray, vel_mps: np.ndarray, rows: Sequence[int]) -> list[PuckValues]:
-    """Mass, speed, |momentum| and kinetic energy of each puck (named by its row, as in the CSV);
+    """Mass, speed, |momentum| and kinetic energy of each puck (named by its number, as in the CSV);
     `mass_kg` (K,) and `vel_mps` (K, 2) are those of `rows`."""
     out = []
     for k, row in enumerate(rows):
@@ -181,7 +190,7 @@ def puck_values(mass_kg: np.ndarray, vel_mps: np.ndarray, rows: Sequence[int]) -
         v = vel_mps[k]
         speed = math.hypot(float(v[0]), float(v[1]))
         speed = 0.0 if speed < ROUND_OFF_MPS else speed  # a cradle's still pucks keep 1e-13 m/s of round-off
-        out.append(PuckValues(str(int(row)), m, speed, m * speed, 0.5 * m * speed * speed))
+        out.append(PuckValues(str(puck_number(row)), m, speed, m * speed, 0.5 * m * speed * speed, int(row)))
     return out
 
 

@@ -26,6 +26,7 @@ from pathlib import Path
 
 import numpy as np
 
+from airtable.app.momenta import FIRST_PUCK_NUMBER
 from airtable.physics.table import AirTable
 
 PUCK_COLUMNS = ("t_s", "puck", "mass_kg", "radius_m", "x_m", "y_m", "vx_mps", "vy_mps")
@@ -60,7 +61,7 @@ class RowText:
         fixed = np.column_stack((table.mass_kg, table.radius_m))
         if self.fixed is None or not np.array_equal(fixed, self.fixed):
             self.fixed = fixed
-            self.heads = [f"{k},{m!r},{r!r}," for k, (m, r) in enumerate(fixed.tolist(), 1)]
+            self.heads = [f"{k},{m!r},{r!r}," for k, (m, r) in enumerate(fixed.tolist(), FIRST_PUCK_NUMBER)]
         moving = np.column_stack((table.pos_m, table.vel_mps))
         if self.moving is None or self.moving.shape != moving.shape:
             self.tails = [""] * len(moving)
