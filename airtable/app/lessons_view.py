@@ -42,6 +42,6 @@ def draw_lessons(app: App) -> None:
         paint.momenta_diagram(None if latest is None else latest.view, corner)
     if lessons.show_values:
         puck = t.puck_at(app.env.to_world(app.mouse_px)) if len(t.pos_m) > FEW_PUCKS else None
-        rows = values_for(t, None if puck is None else puck.index)
+        rows = values_for(t, None if puck is None else puck.index, app.chart.scale)
         colors = [t.color_rgb[r.row] if r.row is not None else None for r in rows]
         paint.values_panel(rows, colors, VALUES_HINT, paint.choose_corner("values", points, taken))
