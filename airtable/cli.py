@@ -92,8 +92,8 @@ def _output_options(p: argparse.ArgumentParser) -> None:
         "--record",
         default=None,
         metavar="FILE.csv",
-        help="at exit, write every puck's state at every step to FILE.csv and the energies and momentum to"
-        " FILE_energy.csv (as far back as memory keeps: minutes for a few pucks)",
+        help="write every puck's state at every step to FILE.csv and the energies and momentum to"
+        " FILE_energy.csv as the run goes, all of it however long (a demo started later: FILE-2.csv, ...)",
     )
     p.add_argument(
         "--save-demo",

@@ -16,6 +16,23 @@ FRAME_S = 1 / 60  # one frame of the app in tests: simulated time, never the clo
 WAIT_S = 5.0  # the bound on every wait for a condition (generous: never a measurement)
 
 
+@pytest.fixture(scope="session", autouse=True)
+def temporary_files_under_pytests_folder(tmp_path_factory):
+    """The app's own temporary files (the recording the export key copies) go under pytest's temporary
+    folder, in this process and in the processes it starts."""
+    import tempfile
+
+    folder = str(tmp_path_factory.mktemp("tempfiles"))
+    old, old_env = tempfile.tempdir, os.environ.get("TMPDIR")
+    tempfile.tempdir, os.environ["TMPDIR"] = folder, folder
+    yield
+    tempfile.tempdir = old
+    if old_env is None:
+        os.environ.pop("TMPDIR", None)
+    else:
+        os.environ["TMPDIR"] = old_env
+
+
 @pytest.fixture(scope="session")
 def demos():
     """The built-in demos by key, loaded once."""

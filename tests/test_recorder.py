@@ -276,3 +276,33 @@ def test_a_crowd_too_big_for_the_export_key_is_not_recorded_and_x_says_why(demos
     assert "--record" in app.message and str(SPOOL_MAX_PUCKS) in app.message
     energy = check_pair_agrees(*sorted((tmp_path / "recordings").iterdir()), app.dt_s, 5)
     assert len(energy) == 10 * 4 + 1  # up to the crowd, every step
+
+
+def test_the_recording_for_x_stops_at_its_size_on_disk_and_x_says_so(demos, tmp_path, monkeypatch):
+    from airtable.app import lessons
+
+    monkeypatch.chdir(tmp_path)
+    monkeypatch.setattr(lessons, "SPOOL_MAX_BYTES", 20_000)
+    app = App(demos, demo_key="1", headless=True)  # five pucks: about 570 bytes a step
+    pygame.event.clear()
+    for _ in range(30):
+        app.frame(FRAME_S)
+    rec = app.lessons.recorder
+    assert rec.closed and 20_000 < rec.nbytes < 21_000 and "GB written" in rec.error
+    press(app, pygame.K_x)
+    assert "stopped" in app.message and "--record" in app.message
+    pucks, energy = sorted((tmp_path / "recordings").iterdir())
+    assert pucks.stat().st_size + energy.stat().st_size == rec.nbytes
+    check_pair_agrees(pucks, energy, app.dt_s, 5)
+
+
+def test_nbytes_follows_a_cut(tmp_path):
+    table = AirTable()
+    table.add_puck((2.0, 2.0), radius_m=0.2, vel_mps=(1.0, 0.5))
+    rec = Recorder(tmp_path / "n.csv", buffer_rows=7)
+    rec.sample(table)
+    fill(rec, table, 50, 0.01)
+    rec.drop_after(0.2)
+    fill(rec, table, 5, 0.01)
+    rec.close()
+    assert rec.nbytes == rec.puck_path.stat().st_size + rec.energy_path.stat().st_size

@@ -29,6 +29,8 @@ RECORDINGS_DIR = Path("recordings")  # where the export key writes, created on d
 # The recording kept for x formats every puck's row every step (about 2 us a row): a table bigger than
 # this is not recorded for x, so that a crowd of pucks keeps its frame rate; --record records any table.
 SPOOL_MAX_PUCKS = 200
+# ... and it stops at this size on disk (demo 4 in motion writes about 100 MB a minute).
+SPOOL_MAX_BYTES = 4 * 2**30
 
 
 class Lessons:
@@ -73,7 +75,7 @@ class Lessons:
     def _begin_recording(self, table: AirTable) -> None:
         if self.recorder is not None:
             self.recorder.close()
-            if self.record_to is None or self.recorder not in self.recorded:
+            if self.recorder not in self.recorded:
                 for p in (self.recorder.puck_path, self.recorder.energy_path):
                     p.unlink(missing_ok=True)  # a spool: the old demo's recording is not kept
         if self.record_to is None:
@@ -87,9 +89,12 @@ class Lessons:
 
     def _sample(self, table: AirTable) -> None:
         rec = self.recorder
-        if rec not in self.recorded and len(table.pos_m) > SPOOL_MAX_PUCKS and not rec.closed:
-            rec.flush()
-            rec.stop(f"over {SPOOL_MAX_PUCKS} pucks (--record FILE.csv records any table)")
+        if rec not in self.recorded and not rec.closed:
+            too = f"over {SPOOL_MAX_PUCKS} pucks" if len(table.pos_m) > SPOOL_MAX_PUCKS else None
+            too = f"{SPOOL_MAX_BYTES / 2**30:.3g} GB written" if rec.nbytes > SPOOL_MAX_BYTES else too
+            if too is not None:
+                rec.flush()
+                rec.stop(f"{too}; --record records all")
         rec.sample(table)
 
     def finish(self) -> list[Recorder]:
@@ -150,9 +155,10 @@ def export_recording(app: App) -> None:
     app.lessons.exported_to_s = app.table.time_s
     stopped = f"; it stopped: {rec.error}" if rec.error else ""
     print(f"recorded {rec.summary()} to {pucks.resolve()} and {energy.name}{stopped}", flush=True)
-    app.say(f"recorded {rec.span_s:.2f} s to {short_path(pucks)} (and _energy.csv)", lasting=True)
     if rec.error:
-        app.say(f"recorded {rec.span_s:.2f} s to {short_path(pucks)}; stopped: {rec.error}", lasting=True)
+        app.say(f"recorded {rec.span_s:.2f} s to {short_path(pucks)} (stopped: {rec.error})", lasting=True)
+    else:
+        app.say(f"recorded {rec.span_s:.2f} s to {short_path(pucks)} (and _energy.csv)", lasting=True)
 
 
 def short_path(path: Path) -> str:

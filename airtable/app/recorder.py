@@ -91,6 +91,7 @@ class Recorder:
         self.buffered_rows = 0  # rows held in memory, not yet written
         self.samples = 0  # samples recorded (one energy row each)
         self.rows = 0  # puck rows recorded
+        self.nbytes = 0  # bytes of text recorded, in both files
         self.first_s: float | None = None
         self.newest_s: float | None = None
         self._text = RowText()
@@ -135,8 +136,10 @@ class Recorder:
         self.newest_s = table.time_s
 
     def _write(self, pucks: str, energy: str, rows: int) -> None:
-        self._buffers[0].append(pucks.encode())
-        self._buffers[1].append(energy.encode())
+        chunks = (pucks.encode(), energy.encode())
+        self._buffers[0].append(chunks[0])
+        self._buffers[1].append(chunks[1])
+        self.nbytes += len(chunks[0]) + len(chunks[1])
         self.buffered_rows += rows + 1
         if self.buffered_rows >= self.buffer_rows:
             self.flush()
@@ -174,6 +177,7 @@ class Recorder:
             return 0
         self.samples -= gone
         self.rows -= puck_rows
+        self.nbytes = sum(f.tell() for f in self._files)  # each file ends where it was cut
         self.newest_s = None if self.samples == 0 else min(self.newest_s, t_s)
         self.first_s = None if self.samples == 0 else self.first_s
         return gone
