@@ -15,7 +15,7 @@ import sys
 from collections.abc import Sequence
 from pathlib import Path
 
-from airtable.app.demo_loader import BUILTIN_DIR, Demo, DemoError, DemoShelf
+from airtable.app.demo_loader import BUILTIN_DIR, Demo, DemoError, DemoShelf, key_from_label, key_label
 from airtable.app.recorder import check_record_path
 from airtable.app.saved_demo import DEFAULT_FOLDER as SAVED_DEMOS_DIR
 from airtable.app.saved_demo import check_save_demo_path
@@ -133,6 +133,8 @@ def list_demos(demos: dict[str, Demo], errors: Sequence[DemoError]) -> str:
     lines = []
     for key, demo in demos.items():
         line = f"{key:>3}  {demo.title}"
+        if key_label(key) != key:
+            line += f"  ({key_label(key)}; --demo {key} or --demo {key_label(key)})"
         if demo.variations:
             line += f"  [variations: {', '.join(demo.variations)}]"
         lines.append(line)
@@ -241,6 +243,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     os.environ.setdefault("PYGAME_HIDE_SUPPORT_PROMPT", "1")
     parser = build_parser()
     args = parser.parse_args(argv)
+    args.demo = key_from_label(args.demo)  # --demo Shift+1 as the help and the menu write it
     if args.headless:
         os.environ.setdefault("SDL_VIDEODRIVER", "dummy")  # no screen: pygame's events still need a driver
     if not args.no_server:  # refuse what the server would, in the server's own words
@@ -319,10 +322,17 @@ def run_app(args: argparse.Namespace, shelf: DemoShelf, shot: Path | None) -> in
             server=server,
             server_problem=server_problem,
             fullscreen=args.fullscreen,
+            show_fps=args.stats,
         )
         if args.record is not None:
             app.lessons.record_into(args.record, app.table)  # streamed from the first step
-        app.run(seconds=args.seconds, frame_dt_s=frame_dt_s)
+        started = None
+        if args.headless and args.seconds is None:  # no window to close: say how it ends
+
+            def started():
+                print("airtable: running without a window; Ctrl+C (or kill) stops it", flush=True)
+
+        app.run(seconds=args.seconds, frame_dt_s=frame_dt_s, started=started)
         if shot is not None:
             try:
                 print(f"screenshot saved to {app.window.save_screenshot(shot)}")

@@ -447,4 +447,6 @@ def test_labels_never_overlap_in_a_crowd(demos):
         most = max(most, len(boxes))
         for k, a in enumerate(boxes):
             assert a.collidelist(boxes[k + 1 :]) < 0, f"label {a} overlaps another"
-    assert most >= 12  # several annotations were labelled at once
+    # The band, the status bar, the chart and the legend, and the newest annotations' boxes (each clear of
+    # the pucks, so in a crowd of 54 some are left out; before, a dozen piled up over the pucks).
+    assert most >= 6

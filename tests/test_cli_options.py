@@ -28,3 +28,27 @@ def test_the_command_line_refuses_what_the_server_would(flags, options, capsys) 
 
 def test_without_a_server_the_server_options_are_not_checked(capsys) -> None:
     assert cli.main(["--no-server", "--max-clients", "5000", "--headless", "--seconds", "0.05", "--demo", "1"]) == 0
+
+
+def test_a_shifted_demo_key_is_taken_as_help_and_menu_write_it(capsys):
+    assert cli.main(["--no-server", "--headless", "--seconds", "0.05", "--demo", "Shift+1"]) == 0
+    assert cli.main(["--no-server", "--headless", "--seconds", "0.05", "--demo", "shift + 2"]) == 0
+    assert cli.main(["--list-demos"]) == 0
+    listing = capsys.readouterr().out
+    assert "1p" in listing and "Shift+1" in listing
+
+
+def test_the_menu_shows_every_demo_at_720p(demos):
+    import pygame
+    from conftest import press
+
+    from airtable.app.app import App
+
+    app = App(demos, headless=True, window_size_px=(1280, 720))
+    shown = []
+    draw_panel = app.window.draw_panel
+    app.window.draw_panel = lambda title, rows, **k: (shown.append(rows), draw_panel(title, rows, **k))
+    press(app, pygame.K_TAB)
+    rows = shown[-1][:-1]
+    assert len(rows) == len(app.demos)
+    assert any(key.strip().endswith("Shift+1") for key, _ in rows)

@@ -101,6 +101,8 @@ def test_the_quit_question_lapses_and_any_other_key_stays(demos):
     pygame.event.clear()
     press(app, pygame.K_ESCAPE)
     assert app.panel() == "quit"
+    press(app, pygame.K_LSHIFT)  # a modifier alone answers nothing
+    assert app.panel() == "quit"
     press(app, pygame.K_SPACE)  # another key: stay, and the key does nothing else
     assert app.running and app.panel() is None and not app.paused
     press(app, pygame.K_ESCAPE)
@@ -162,3 +164,28 @@ def test_quitting_with_a_student_connected_asks_and_says_so(demos, how):
             assert not app.running
         finally:
             student.close()
+
+
+@pytest.mark.parametrize("sig", ["SIGTERM", "SIGINT"])
+def test_a_signal_ends_the_app_at_once_without_asking(sig, tmp_path):
+    """SDL turns SIGTERM and Ctrl+C into the window's QUIT; they must not wait for an answer
+    nobody will give (a logout, a script), while the close button still asks."""
+    import os
+    import signal
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    root = Path(__file__).resolve().parent.parent
+    env = {**os.environ, "SDL_VIDEODRIVER": "dummy", "PYTHONPATH": str(root)}
+    argv = [sys.executable, "-m", "airtable", "--headless", "--no-server", "--stats", "--demo", "3"]
+    app = subprocess.Popen(argv, env=env, cwd=tmp_path, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    try:
+        assert "running without a window" in app.stdout.readline()  # the loop is about to run
+        app.send_signal(getattr(signal, sig))
+        out, err = app.communicate(timeout=20)
+    finally:
+        if app.poll() is None:
+            app.kill()
+    assert app.returncode == 0, err
+    assert "frames" in out and "Traceback" not in err  # the --stats line: it ended the usual way

@@ -388,6 +388,36 @@ def test_an_error_from_the_server_during_play_ends_with_one_line(capsys, cleanup
     assert capsys.readouterr().err.strip() == "airtable-client: the teacher closed the table; thanks for playing"
 
 
+def test_a_removed_student_reads_why_in_the_window_until_a_key(cleanup):
+    """Issue 22: the window used to vanish, the reason only in the terminal."""
+    welcome = proto.encode_welcome("C1", (255, 52, 179), 10.0, 8.7556)
+    fake = FakeServer(welcome + proto.encode_error("the teacher removed you from the table"))
+    cleanup(fake.close)
+    net = player(cleanup, fake.port)
+    net.connect()
+    cleanup(pygame.quit)
+    app = PlayerApp(net, headless=False)  # a window (the dummy driver's): the student is there to read
+    panels = []
+
+    def ended_and_shown() -> bool:
+        if app.window is not None and not panels:
+            draw_panel = app.window.draw_panel
+            app.window.draw_panel = lambda title, rows, **k: (
+                panels.append((title, rows)),
+                draw_panel(title, rows, **k),
+            )
+        return app.ended is not None and any(title == "The session has ended" for title, _ in panels)
+
+    assert app.run(seconds=10, until=ended_and_shown) == 1
+    assert (
+        "The session has ended",
+        ["the teacher removed you from the table", "Press any key to close this window."],
+    ) in [(t, list(r)) for t, r in panels]
+    frames = app.frames
+    pygame.event.post(pygame.event.Event(pygame.KEYDOWN, key=pygame.K_a, mod=0, unicode="a", scancode=4))
+    assert app.run(seconds=10) == 0 and app.frames == frames  # the key closes it at once
+
+
 # ---------------------------------------------------------------- a server that lies
 
 

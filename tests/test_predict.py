@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import json
 import math
+import time
 from pathlib import Path
 
 import numpy as np
@@ -153,11 +154,22 @@ def head_on_app(tmp_path: Path, server=None) -> App:
     return app
 
 
-def next_round(student: RawClient, until) -> RoundInfo:
-    """The next ROUND this student reads for which `until(info)` holds."""
+def next_round(student: RawClient, until, app=None) -> RoundInfo:
+    """The next ROUND this student reads for which `until(info)` holds.
+
+    With `app`, its frames run while the student waits: the app publishes a round's news
+    in the frame after the news arrives (the projector's count is read live)."""
+    deadline = time.monotonic() + WAIT_S
     while True:
-        info = parse_round(student.next_of(proto.ROUND))
-        if until(info):
+        try:
+            got = student.next_frame(timeout_s=0.02 if app is not None else WAIT_S)
+        except TimeoutError:
+            if app is None or time.monotonic() > deadline:
+                raise
+            app.frame(FRAME_S)
+            continue
+        assert got is not None, "connection closed while waiting for a ROUND"
+        if got[0] == proto.ROUND and until(info := parse_round(got[1])):
             return info
 
 
@@ -177,7 +189,7 @@ def test_three_students_predict_over_real_sockets_then_the_reveal_sums_them_up(s
         for s, (speed, deg) in zip(students, GUESSES):
             s.send(encode_predict(info.round_id, 1, polar(speed, deg)))
         frames_until(app, lambda: "PREDICT: 3 of 3 predicted" in app.status_line(), "3 of 3 on the projector")
-        assert next_round(students[0], lambda i: i.predicted == 3).arrows == ()  # a count, no arrows yet
+        assert next_round(students[0], lambda i: i.predicted == 3, app).arrows == ()  # a count, no arrows yet
         t0 = app.table.time_s
         frames_until(app, lambda: app.table.time_s == t0, "the table stays frozen while the round is open")
 
@@ -434,3 +446,16 @@ def test_the_summary_wraps_to_a_students_window(size):
         assert any(t.strip().startswith("speeds within 20 %") for t, _ in placed)
     Net.round = RoundInfo(4, "open", 2, 17, 28, from_m=info.from_m)
     _check_fits(student._draw_round((0, 255, 0)), size[0], ("17 of 28 predicted",))
+
+
+def test_the_students_status_line_has_no_teacher_keys(demos):
+    from conftest import teacher_and_student
+
+    with teacher_and_student(demos, "8") as (teacher, net):
+        frames_until(teacher, lambda: teacher.student_count() == 1, "the student to join")
+        press(teacher, pygame.K_F6)
+        assert "F6 reveals" in teacher.status_line()
+        scene = frames_until(
+            teacher, lambda: (s := net.latest()) is not None and "PREDICT" in s.status and s, "the round's status"
+        )
+        assert "F6" not in scene.status and "PREDICT: 0 of 1 predicted" in scene.status

@@ -9,6 +9,7 @@ import subprocess
 import sys
 from pathlib import Path
 
+import numpy as np
 import pygame
 import pytest
 from conftest import FRAME_S, press, wait_until
@@ -302,3 +303,17 @@ def test_no_display_is_one_line_naming_headless_and_exit_1():
     assert done.returncode == 1
     (line,) = done.stderr.strip().splitlines()
     assert "--headless" in line and "display" in line
+
+
+def test_a_settled_spring_demo_idles_though_round_off_never_stops(demos):
+    """Demo 6 rings down to velocities of about 1e-16 m/s that never reach 0 exactly: nothing on screen
+    moves by half a pixel a second, so the table idles (issue 22: it drew 55 fps at 1080p)."""
+    app = App(demos, demo_key="6", headless=True, window_size_px=(1920, 1080))
+    app.run(seconds=1.0, frame_dt_s=FRAME_S)
+    assert app.motion_px_per_s() > 10 and not app.still()  # it rings at first
+    for _ in range(round(25.0 / app.dt_s)):  # 25 s: rung down, what is left is round-off
+        app.table.step(app.dt_s)
+    app.run(seconds=1.5, frame_dt_s=FRAME_S)
+    assert np.any(app.table.vel_mps) and app.still()
+    app.table.vel_mps[0] = (0.01, 0.0)  # a centimetre a second shows: not still
+    assert not app.still()

@@ -57,7 +57,8 @@ def test_a_puck_resting_on_the_floor_shows_whole_above_the_status_line(size) -> 
     assert 0 < bar < 0.08 * h and win.status_top_px == h - bar
     left, top, width, height = win.env.table_rect_px
     assert top + height == pytest.approx(h - bar)  # the floor sits on the status line
-    assert height == pytest.approx(h - bar) or width == pytest.approx(w)  # and the table is as big as fits
+    room = h - bar - win.layout.top_px  # under the top band of text, if the window has no side margins
+    assert height == pytest.approx(room) or width == pytest.approx(w)  # and the table is as big as fits
     x, floor_y = win.env.to_screen(np.array([5.0, 0.0]))
     img = pixels(win)
     lowest_fill = int(floor_y - 0.25 * win.env.px_per_m)  # inside the puck, a quarter radius above the floor
@@ -97,15 +98,17 @@ def test_status_line_never_overflows_and_drops_the_least_important_parts() -> No
 
 
 @pytest.mark.parametrize("width", [320, 700, 1280, 3840])
-def test_status_bar_fits_every_width_and_paused_is_large_and_centred(width) -> None:
+def test_status_bar_fits_every_width_and_paused_is_large_and_off_the_table(width) -> None:
     win = window((width, 720))
     status = ["PAUSED", "slow motion x1/4", "gravity off", "correction: two-step", "restitution: pucks 1, walls 1"]
     win.draw(scene(status="   ".join(status), title="Demo 1: a very long title " * 3))
     img = pixels(win)
     yellow = np.argwhere(np.all(img == PAUSED_COLOR, axis=2))
     assert len(yellow) > 0
-    assert abs(yellow[:, 0].mean() - width / 2) < width * 0.05  # centred
-    assert np.ptp(yellow[:, 1]) >= 40  # large: its box is at least 40 px tall at 720p
+    assert np.ptp(yellow[:, 1]) >= 30  # large: its box is at least 30 px tall at 720p
+    left, top, w, h = win.env.table_rect_px
+    inside = (yellow[:, 0] > left) & (yellow[:, 0] < left + w) & (yellow[:, 1] > top) & (yellow[:, 1] < top + h)
+    assert not inside.any()  # never over the table (the trick shot's cue)
 
 
 def test_sprite_cache_stays_bounded_at_extreme_zoom() -> None:
@@ -141,7 +144,7 @@ def test_help_fits_720p_with_nothing_cut_and_demos_in_natural_order() -> None:
     assert demo_keys.index("t2") < demo_keys.index("t10")
     demos = [(k, f"Demo {k}: a title") for k in demo_keys]
     rect = win.panel_rect()
-    assert rect.top >= win.hud_bottom_px  # the join line stays visible
+    assert rect.collidelist(win.label_boxes[:2]) == -1  # the title and the join line stay visible
     body = panel_view.body_rect(rect.size, win.font, win.big_font, win.label_font)
     assert body.bottom <= rect.height and body.right <= rect.width
     pages = panel_view.layout(win.font, [("", keys), ("Demos", demos)], body.size)

@@ -42,6 +42,8 @@ CHART_LABELS = {
     "momentum_Ns": "|momentum|",
 }
 CHART_CORNERS = ("top right", "bottom right", "bottom left", "top left")
+MAX_AVOIDED_PUCKS = 2000
+LABELLED_ANNOTATIONS = 2  # only the newest collisions get their numbers in a box: more pile up unreadably
 CHART_SIZE_PX = (520, 240)  # at 720 px tall; the small chart is 0.65 of it
 # Where a label may go around its anchor, in order of preference: (x side, y side).
 AROUND = ((1, 1), (1, -1), (-1, 1), (-1, -1), (0, 1), (0, -1))
@@ -86,6 +88,7 @@ class AidsPainter:
         self.chart_corner: int | None = None  # index into CHART_CORNERS; None: pick one clear of pucks
         self.chart_small = False
         self._vector_scales: dict[str, VectorScale] = {}
+        self.puck_boxes: list[pygame.Rect] = []  # this frame's pucks on screen (note_pucks)
 
     def new_demo(self) -> None:
         """A demo (re)started: arrow scales start afresh, and the chart picks its corner again."""
@@ -101,6 +104,20 @@ class AidsPainter:
     @property
     def _taken(self) -> list[pygame.Rect]:
         return self.w.label_boxes
+
+    def note_pucks(self, pos_m: np.ndarray, radius_m: np.ndarray) -> None:
+        """Where this frame's pucks and the table's walls are on screen: annotation boxes and the legend
+        keep clear of them. Only pucks on screen count, at most MAX_AVOIDED_PUCKS (a gas has no room
+        for boxes anyway)."""
+        self.puck_boxes = self.w.wall_rects()
+        if not len(pos_m):
+            return
+        centers = self.w.env.to_screen(pos_m)
+        r = np.clip(self.w.env.length_to_px(radius_m), 1.0, 1e6)
+        w, h = self.w.surface.get_size()
+        seen = (centers[:, 0] + r > 0) & (centers[:, 0] - r < w) & (centers[:, 1] + r > 0) & (centers[:, 1] - r < h)
+        for (x, y), rad in zip(centers[seen][:MAX_AVOIDED_PUCKS], r[seen][:MAX_AVOIDED_PUCKS]):
+            self.puck_boxes.append(pygame.Rect(int(x - rad), int(y - rad), int(2 * rad) + 1, int(2 * rad) + 1))
 
     def _px(self, point_m) -> tuple[float, float]:
         x, y = self.w.env.to_screen(np.asarray(point_m, dtype=float))
@@ -123,8 +140,10 @@ class AidsPainter:
         font=None,
         *,
         always: bool = False,
+        clear_of_pucks: bool = True,
     ) -> pygame.Rect | None:
-        """A block of coloured lines placed beside `anchor_px` where no other label is.
+        """A block of coloured lines placed beside `anchor_px` where no other label is (nor, with
+        `clear_of_pucks`, any puck noted this frame).
 
         Where there is no such place it is left out (None), unless `always`
         (the inspector, asked for by a held key): then it goes beside its anchor."""
@@ -133,7 +152,8 @@ class AidsPainter:
         size = (max(font.size(t)[0] for t, _ in lines) + 6, line_h * len(lines) + 2)
         pad = self.w.line_px(2)
         screen = self.w.surface.get_rect()
-        rect = place_box(size, anchor_px, gap + pad, self._taken, screen, line_h)
+        avoid = self._taken + self.puck_boxes if clear_of_pucks else self._taken
+        rect = place_box(size, anchor_px, gap + pad, avoid, screen, line_h)
         if rect is None:
             if not always:
                 return None
@@ -163,19 +183,25 @@ class AidsPainter:
         self.label([(label, color)], (x, y), gap=1.5 * r)
 
     def legend(self, lines: Sequence[tuple[str, Sequence[int]]]) -> None:
-        """Coloured lines of text at the left, under the HUD (and under the chart, if that is there)."""
+        """Coloured lines of text in an opaque box in a corner: in a side margin where the window has
+        one, else the first corner clear of the pucks and other text (the top left if none is)."""
         font, pad = self.w.font, self.w.line_px(4)
         line_h = font.get_linesize()
-        block = pygame.Rect(
-            pad * 2 - 2, self.w.hud_bottom_px + pad, max(font.size(t)[0] for t, _ in lines) + 4, line_h * len(lines)
-        )
-        for _ in range(len(self._taken)):  # slide down past whatever is in the way
+        size = (max(font.size(t)[0] for t, _ in lines) + 4, line_h * len(lines))
+        avoid = self._taken + self.puck_boxes
+        order = (3, 2, 0, 1)  # top left first, where the eye starts
+        margins = self.w.layout.side_px > 0
+        corners = [place_in_corner(self.w, pygame.Rect((0, 0), size), c) for c in order] if margins else []
+        inside = [table_corner(self.w, pygame.Rect((0, 0), size), c) for c in order]
+        block = next((r for r in corners + inside if r.collidelist(avoid) < 0), inside[0])
+        for _ in range(len(self._taken)):  # slide down past whatever text is in the way
             hit = block.collidelist(self._taken)
             if hit < 0:
                 break
             block.top = self._taken[hit].bottom + pad
+        pygame.draw.rect(self.w.surface, (0, 0, 0), block.inflate(4, 2))
         for k, (text, color) in enumerate(lines):
-            self._text(text, (pad * 2, block.top + k * line_h), color, font=font)
+            self._text(text, (block.x + 2, block.top + k * line_h), color, font=font)
         self._taken.append(block)
 
     def _dashed(self, color, a_px, b_px, width: int) -> None:
@@ -188,8 +214,9 @@ class AidsPainter:
 
     # ------------------------------------------------------------ collisions
 
-    def annotation(self, a, now_s: float) -> None:
-        """Normal and tangent at the contact, overlap and separation, and the target's push against the ideal."""
+    def annotation(self, a, now_s: float, labelled: bool = True) -> None:
+        """Normal and tangent at the contact, overlap and separation, and the target's push against the ideal;
+        with `labelled`, their numbers in a box clear of the pucks (left out where there is no room)."""
         alpha = a.alpha(now_s)
         surf, lw = self.w.surface, self.w.line_px(2)
         n = np.asarray(a.normal)
@@ -214,9 +241,12 @@ class AidsPainter:
         self._gap_bars(a, n, alpha)
         if a.target is not None:
             self._target_rays(a, alpha, reach)
-        # Labels, most important first: each takes the first free spot.
+        if not labelled:
+            return
+        # Labels, most important first: each takes the first free spot clear of the pucks.
         reach_px = float(self.w.env.length_to_px(a.radius_i_m + a.radius_j_m))
-        self.label(self._annotation_lines(a, alpha), self._px(c), gap=min(reach_px, 200.0), font=self.w.font)
+        lines = self._annotation_lines(a, alpha)
+        self.label(lines, self._px(c), gap=min(reach_px, 200.0), font=self.w.font)
         for name, color in (("normal", ANNOTATION_NORMAL), ("tangent", ANNOTATION_TANGENT)):
             self.label([(name, _faded(color, alpha))], ends[name])
         if a.target is not None:
@@ -295,12 +325,11 @@ class AidsPainter:
         )
 
     def energy_chart(self, series: dict[str, np.ndarray], latest: dict[str, float], note: str | None) -> None:
-        """Strip chart of energies (left scale) and |momentum| (right scale) in a corner panel."""
+        """Strip chart of energies (left scale) and |momentum| (right scale) in an opaque corner panel;
+        the key beside the plot, or under it where the panel is narrow (a side margin)."""
         box = self.chart_rect()
         surf, font = self.w.surface, self.w.label_font
-        panel = pygame.Surface(box.size, pygame.SRCALPHA)
-        panel.fill((0, 0, 0, 215))
-        surf.blit(panel, box)
+        pygame.draw.rect(surf, (0, 0, 0), box)
         pygame.draw.rect(surf, DIM_TEXT, box, 1)
         self._taken.append(box)
         line_h = font.get_linesize()
@@ -312,10 +341,11 @@ class AidsPainter:
         # Sized for the widest value the format gives, so the plot does not jitter.
         widest = max(font.size(f"{CHART_LABELS[k]} -8.88e-88 N s")[0] for k in CHART_COLORS)
         key_w = widest + 5 * pad
+        stacked = box.width < 2 * key_w
         notes = _wrap(font, note, box.width - 20)[:2] if note and not self.chart_small else []
-        plot = pygame.Rect(
-            box.x + pad, box.y + pad, box.width - key_w - 3 * pad, box.height - 2 * pad - line_h * len(notes)
-        )
+        below = line_h * (len(notes) + (len(legend) if stacked else 0))
+        plot_w = box.width - 2 * pad if stacked else box.width - key_w - 3 * pad
+        plot = pygame.Rect(box.x + pad, box.y + pad, plot_w, box.height - 2 * pad - below)
         pygame.draw.rect(surf, (60, 60, 60), plot, 1)
         t = series["time_s"]
         if len(t) >= 2 and plot.width > 10 and plot.height > 10:
@@ -323,14 +353,14 @@ class AidsPainter:
             top_e = chart_top(series["total_J"], latest.get("energy_scale_J", 0.0))
             self._text(f"{top_e:.3g} J", (plot.x + 2, plot.y + 2), DIM_TEXT)
             self._text(f"last {max(t[-1] - t[0], 0.0):.1f} s", (plot.x + 2, plot.bottom - line_h), DIM_TEXT)
-        y = box.y + pad
+        x, y = (box.x + pad, plot.bottom) if stacked else (plot.right + pad, box.y + pad)
         for text, color in legend:
             mid = y + line_h // 2
-            pygame.draw.line(surf, color, (plot.right + pad, mid), (plot.right + 3 * pad, mid), self.w.line_px(3))
-            self._text(text, (plot.right + 3 * pad + 4, y), color)
-            y += line_h + (pad // 2 if not self.chart_small else 0)
+            pygame.draw.line(surf, color, (x, mid), (x + 2 * pad, mid), self.w.line_px(3))
+            self._text(text, (x + 2 * pad + 4, y), color)
+            y += line_h + (pad // 2 if not (self.chart_small or stacked) else 0)
         for k, line in enumerate(notes):
-            self._text(line, (box.x + pad, plot.bottom + k * line_h), DIM_TEXT)
+            self._text(line, (box.x + pad, box.bottom - pad - (len(notes) - k) * line_h), DIM_TEXT)
 
     def _chart_lines(self, series: dict[str, np.ndarray], plot: pygame.Rect, latest: dict[str, float]) -> None:
         t = series["time_s"]
@@ -357,6 +387,30 @@ class AidsPainter:
         )
 
 
+def draw_annotations(paint: AidsPainter, annotations: Sequence, now_s: float) -> None:
+    """The collisions' annotations, oldest first; only the newest LABELLED_ANNOTATIONS get numbers."""
+    labelled_from = len(annotations) - LABELLED_ANNOTATIONS
+    for k, annotation in enumerate(annotations):
+        paint.annotation(annotation, now_s, labelled=k >= labelled_from)
+
+
+def table_corner(window, rect: pygame.Rect, corner: int) -> pygame.Rect:
+    """`rect` moved into CHART_CORNERS[corner] of the table at zoom 1, inside its walls."""
+    left, top, width, height = window.env.table_rect_px
+    inset = window.line_px(4) + max((min(r.width, r.height) for r in window.wall_rects()), default=0)
+    inner = pygame.Rect(int(left), int(top), int(width), int(height)).inflate(-2 * inset, -2 * inset)
+    name = CHART_CORNERS[corner]
+    if name.startswith("top"):
+        rect.top = inner.top
+    else:
+        rect.bottom = inner.bottom
+    if name.endswith("right"):
+        rect.right = inner.right
+    else:
+        rect.left = inner.left
+    return rect
+
+
 def chart_top(values: np.ndarray, scale: float) -> float:
     """The top of a chart's axis: a tenth above the largest of `values`, or 0 if that is round-off of the
     scene's `scale` (readout.py)."""
@@ -364,9 +418,12 @@ def chart_top(values: np.ndarray, scale: float) -> float:
 
 
 def place_in_corner(window, rect: pygame.Rect, corner: int) -> pygame.Rect:
-    """`rect` moved into CHART_CORNERS[corner]: under the HUD or above the status bar, a margin from the side."""
+    """`rect` moved into CHART_CORNERS[corner]: under the HUD or above the status bar, a margin from the side;
+    where the window has side margins, inside them (no wider than they are), clear of the table."""
     pad = window.line_px(4)
     name = CHART_CORNERS[corner]
+    if window.layout.side_px:
+        rect.width = min(rect.width, window.layout.side_px - 2 * pad)
     if name.startswith("top"):
         rect.top = window.hud_bottom_px + pad
     else:

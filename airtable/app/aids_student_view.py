@@ -10,7 +10,7 @@ from __future__ import annotations
 import numpy as np
 
 from airtable.app import aids
-from airtable.app.aids_paint import AidsPainter
+from airtable.app.aids_paint import AidsPainter, draw_annotations
 from airtable.app.aids_share import StudentAids
 from airtable.app.aids_view import COM_COLOR
 from airtable.app.lessons_view import VALUES_HINT
@@ -28,6 +28,7 @@ STUDENT_KEYS = (
     ("i", "inspect the puck under your cursor, on or off"),
     ("e", "trails on your window, on or off"),
     ("F1", "this help (again: close it)"),
+    ("F11", "fullscreen on / off"),
     ("Esc", "close this help; else leave the table (Esc twice)"),
 )
 
@@ -35,6 +36,7 @@ STUDENT_KEYS = (
 def draw_student_aids(paint: AidsPainter, scene: Scene, state: StudentAids, now_s: float, mouse_m) -> None:
     """The aids over a student's frame: chart, vectors, annotations, inspector (in the teacher's order)."""
     env = paint.w.env
+    paint.note_pucks(scene.pos_m, scene.radius_m)  # the legend and the annotations keep clear of them
     # The chart needs the teacher's samples: the student can hide it, not make it up.
     chart = state.chart_view(scene) if state.shows("c") and state.teacher & aids_wire.CHART else None
     series = chart[0] if chart else None
@@ -47,8 +49,7 @@ def draw_student_aids(paint: AidsPainter, scene: Scene, state: StudentAids, now_
         paint.energy_chart(*chart)
     if state.shows("v") and len(scene.pos_m):
         _vectors(paint, scene, state)
-    for annotation in state.live_annotations(now_s):
-        paint.annotation(annotation, now_s)
+    draw_annotations(paint, state.live_annotations(now_s), now_s)
     if state.shows("i"):
         _inspect(paint, scene, state, mouse_m)
 

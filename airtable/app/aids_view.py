@@ -11,6 +11,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from airtable.app import aids
+from airtable.app.aids_paint import draw_annotations
 from airtable.app.client import cursor_pulls
 from airtable.app.momenta import puck_number
 
@@ -28,6 +29,7 @@ MAX_INSPECTED_SPRINGS = 4
 
 def draw_aids(app: App) -> None:
     t, paint = app.table, app.painter
+    paint.note_pucks(t.pos_m, t.radius_m)  # the legend and the annotations keep clear of them
     if app.show_chart:  # first: the labels below then find their places around it
         paint.choose_chart_corner(app.env.to_screen(t.pos_m))
         note = app.chart.euler_wiggle_note(t)
@@ -35,8 +37,7 @@ def draw_aids(app: App) -> None:
     if app.vectors and len(t.pos_m):  # before the annotations: its legend has a fixed place
         _draw_vectors(app)
     if app.show_annotations:
-        for annotation in app.collision_log.live(app.clock_s):
-            paint.annotation(annotation, app.clock_s)
+        draw_annotations(paint, app.collision_log.live(app.clock_s), app.clock_s)
     if app.inspecting:
         puck = t.puck_at(app.env.to_world(app.mouse_px))
         if puck is not None:

@@ -10,8 +10,10 @@ opened and closed here.
 
 from __future__ import annotations
 
+import dataclasses
 import sys
 import time
+from collections.abc import Callable
 from pathlib import Path
 
 import numpy as np
@@ -26,11 +28,11 @@ from airtable.app.environment import Environment
 from airtable.app.history import History
 from airtable.app.lessons import Lessons
 from airtable.app.lessons_view import draw_lessons
-from airtable.app.loop import FixedStep, FpsCounter, FrameLoop
+from airtable.app.loop import FixedStep, FpsCounter, FrameLoop, signals_end_the_run
 from airtable.app.menu import DemoMenu
 from airtable.app.overlays import OverlayFlag, Overlays
 from airtable.app.predict_view import draw_predict
-from airtable.app.roster_view import draw_alert, draw_roster
+from airtable.app.roster_view import ALERT_COLOR, draw_roster, room_alert
 from airtable.app.scene import STATUS_SEPARATOR, Scene
 from airtable.app.stats import RunStats
 from airtable.app.window import AidsPainter, GameWindow, TimelinePainter
@@ -46,12 +48,16 @@ MAX_FPS = 240.0
 # and wakes at once on input: a laptop projecting all lesson stays quiet.
 IDLE_FPS = 12.0
 IDLE_AFTER_S = 1.0  # input this recent keeps the full frame rate
+STILL_PX_PER_S = 0.5  # slower than this on screen, nothing visibly moves: the table idles
 ERROR_TITLES = {
     "load": "Demo {key} could not be loaded",
     "build": "Demo {key} could not be built",
     "event": "Demo {key}: a timed event failed",
 }
 
+MODIFIER_KEYS = frozenset(
+    getattr(pygame, f"K_{side}{name}") for side in "LR" for name in ("SHIFT", "CTRL", "ALT", "META", "SUPER")
+)
 # Kept importable from here: the key table lives in controls.py.
 BINDINGS = controls.BINDINGS
 
@@ -95,6 +101,7 @@ class App:
         demo_errors=(),
         window_size_px: tuple[int, int] | None = None,
         fullscreen: bool = False,
+        show_fps: bool = False,
     ) -> None:
         self.shelf = demos if isinstance(demos, DemoShelf) else DemoShelf.from_demos(demos)
         if not self.shelf.demos:
@@ -105,6 +112,7 @@ class App:
         # The loop owns the clients (index 0 is the local user); the server adds the students.
         self.clients: list[Client] = [self.local]
         self.window = GameWindow(self.env, headless=headless, size_px=window_size_px, fullscreen=fullscreen)
+        self.window.show_fps = show_fps  # --stats: the frame rate in a corner too
         self.painter = AidsPainter(self.window)
         self.timeline_painter = TimelinePainter(self.window)
         if not headless:
@@ -304,6 +312,8 @@ class App:
         panel = self.panel()
         if event.key == pygame.K_ESCAPE or panel not in ("quit", "menu", "notice"):
             return False
+        if event.key in MODIFIER_KEYS:
+            return True  # Shift or Ctrl alone answers nothing: it starts a key
         if panel == "menu" and event.key == pygame.K_TAB:
             self.menu = None
         elif panel == "menu":
@@ -408,8 +418,9 @@ class App:
         self.fps = self._fps_counter.tick(self.clock_s)
         scene = self.scene()
         if self.server is not None:
-            scene.aids = shared_aids(self)  # the students see the teacher's aids too
-            self.server.publish(scene)
+            shared = dataclasses.replace(scene, status=STATUS_SEPARATOR.join(self.status_parts(for_students=True)))
+            shared.aids = shared_aids(self)  # the students see the teacher's aids too
+            self.server.publish(shared)
         self.draw(scene)
         self.stats.frame()
 
@@ -445,20 +456,21 @@ class App:
             origin_m=(float(self.env.origin_m[0]), float(self.env.origin_m[1])),
         )
 
-    def status_parts(self) -> list[str]:
-        """The status line in parts, most important first (a narrow window drops the last)."""
+    def status_parts(self, for_students: bool = False) -> list[str]:
+        """The status line in parts, most important first (a narrow window drops the last);
+        `for_students`: as the students' windows show it, without the teacher's keys."""
         t = self.table
         parts = ["PAUSED"] if self.paused else []
         parts.extend(room.status_parts(self))  # hands off, the floor
         if self.predict.active:
-            parts.append(predict.status_text(self))
+            parts.append(predict.status_text(self, for_students))
         timeline = self.history.timeline() if self.history.in_past else None
         if timeline is not None:
             parts.append(f"rewound {timeline.newest_s - timeline.view_s:.2f} s")
         if self.speed != 1.0:
             parts.append(f"slow motion x1/{round(1 / self.speed)}")
         parts.append(f"t = {t.time_s:.2f} s")
-        parts.append("F1: help")
+        parts.append("F1: help")  # the students' windows have their own F1
         parts.append(world.gravity_label(t))
         parts.append(f"correction: {t.puck_correction}")
         n, hits = len(t.pos_m), t.collision_count
@@ -473,8 +485,11 @@ class App:
     def status_line(self) -> str:
         return STATUS_SEPARATOR.join(self.status_parts())
 
-    def hud_lines(self) -> list[str]:
-        lines = []
+    def hud_lines(self) -> list:
+        """The heads-up lines under the title: why students cannot join (in red), the join line,
+        the student count, then the newest message."""
+        alert = room_alert(self)
+        lines: list = [(alert, ALERT_COLOR)] if alert else []
         if self.server is not None:
             lines.extend(self.server.join_lines())
             lines.extend(room.hud_lines(self))
@@ -486,7 +501,6 @@ class App:
         """Draw `scene` (by default the table as it is now), the aids and the panel on top."""
         projected = self.room.projected(scene or self.scene())  # names hidden if anonymous
         self.window.draw(projected, trails=self.trails, hud=self.hud_lines())
-        draw_alert(self)  # the network thread failed: students can no longer join
         self._draw_timeline()  # first: the lesson panels then stand clear of it
         draw_lessons(self)  # before the aids: their labels then place themselves around its panels
         draw_aids(self)
@@ -505,7 +519,8 @@ class App:
         if panel == "quit":
             w.draw_panel("Quit?", [*self.quit_would_lose(), "Esc again to quit; any other key to stay."])
         elif panel == "menu":
-            w.draw_panel("Demos", [*self.menu.rows(), self.menu.footer()])
+            rows = self.menu.rows(visible=w.panel_rows() - 2, label=key_label)  # the footer under them
+            w.draw_panel("Demos", [*rows, self.menu.footer()])
         elif panel == "error":
             error = self.build_error
             title = ERROR_TITLES[error.stage].format(key=key_label(self.demo_key))
@@ -534,23 +549,43 @@ class App:
             self._students_seen, self.last_input_s = students, self.clock_s
         if self.keys_down or self.mouse_button or self.clock_s - self.last_input_s < IDLE_AFTER_S:
             return False
-        return self.paused or not np.any(self.table.vel_mps)
+        return self.paused or self.motion_px_per_s() < STILL_PX_PER_S
 
-    def run(self, seconds: float | None = None, max_frames: int | None = None, frame_dt_s: float | None = None) -> int:
+    def motion_px_per_s(self) -> float:
+        """How fast the fastest puck crosses the screen: a settled demo's round-off is far below a pixel."""
+        v = self.table.vel_mps
+        if not len(v):
+            return 0.0
+        return float(np.sqrt(np.max(np.einsum("ij,ij->i", v, v)))) * self.env.px_per_m
+
+    def run(
+        self,
+        seconds: float | None = None,
+        max_frames: int | None = None,
+        frame_dt_s: float | None = None,
+        started: Callable[[], None] | None = None,
+    ) -> int:
         """Run until Esc / window close, `seconds` or `max_frames` frames; returns the frames run.
 
         With `frame_dt_s` every frame is that long and nothing sleeps: `seconds`
         is then simulated time (tests and headless runs use it, so they never
         depend on timing). Without it, frames follow the clock, at most at the
         display's refresh rate, sleeping in between; a still table runs at
-        IDLE_FPS and wakes on input.
+        IDLE_FPS and wakes on input. `started` is called once signals end the run (see loop.py).
         """
         self._full_period_s = 1.0 / display_rate_hz()
         self.loop = FrameLoop(fps=1.0 / self._full_period_s, fixed_dt_s=frame_dt_s, sleep=self._sleep)
         try:
-            return self.loop.run(self._frame_running, max_frames=max_frames, max_time_s=seconds)
+            with signals_end_the_run(self.stop):
+                if started is not None:
+                    started()
+                return self.loop.run(self._frame_running, max_frames=max_frames, max_time_s=seconds)
         finally:
             self.loop = None
+
+    def stop(self) -> None:
+        """End the run after this frame, asking nothing (a signal, not a person at the window)."""
+        self.running = False
 
     def _frame_running(self, dt_s: float) -> bool:
         self.frame(dt_s)

@@ -95,6 +95,14 @@ def key_label(key: str) -> str:
     return key
 
 
+def key_from_label(text: str) -> str:
+    """What a person typed for a demo ("Shift+1", "shift + 1", "1p", "3") as its key ("1p", "3")."""
+    plain = text.replace(" ", "")
+    if plain.lower().startswith("shift+") and len(plain) == 7 and plain[-1].isdigit():
+        return f"{plain[-1]}p"
+    return text
+
+
 def error_from_exception(path: Path, exc: BaseException, stage: str = "load") -> DemoError:
     """Point at the line of `path` where `exc` happened (or its syntax error)."""
     if isinstance(exc, SyntaxError) and Path(exc.filename or "").resolve() == path.resolve():

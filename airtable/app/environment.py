@@ -63,16 +63,18 @@ class Environment:
         self.zoom = 1.0
         self.origin_m = np.zeros(2)
 
-    def resize(self, size_px: Sequence[int], bottom_px: float = 0.0) -> None:
+    def resize(self, size_px: Sequence[int], bottom_px: float = 0.0, top_px: float = 0.0) -> None:
         """A new window size: the table is fitted again; zoom and pan are kept.
 
-        `bottom_px`: a band along the bottom of the window kept clear of the table (the
-        status bar's), so that nothing resting on the floor is hidden under it.
+        `bottom_px` and `top_px`: bands along the bottom and the top of the window kept
+        clear of the table (the status bar's, the title's and the heads-up lines'), so
+        that no text lies over the table and nothing resting on the floor is hidden.
         """
         w, h = _checked_size(size_px)
         self.size_px = (w, h)
         band = min(max(0.0, float(bottom_px)), 0.5 * h)
-        room = h - band
+        top = min(max(0.0, float(top_px)), 0.5 * (h - band))
+        room = h - band - top
         # A window within 0.01 % of the table's shape counts as that shape, so 900 x 788
         # is 90 px per metre across the 10 x 8.7556 m table (8.7556 being 788 / 90 rounded).
         if w / self.width_m <= room / self.height_m * (1 + 1e-4):  # the width fits: margins above and below

@@ -21,7 +21,7 @@ from airtable.app.panel_view import ACCENT, DIM_TEXT, TEXT_COLOR, shorten
 from airtable.app.readout import readable
 
 TOTAL_COLOR = CHART_COLORS["momentum_Ns"]  # the chart's |momentum| colour
-PANEL_FILL = (0, 0, 0, 215)
+PANEL_FILL = (0, 0, 0, 255)  # opaque: nothing shows through the numbers
 MOMENTA_SIZE_PX = (480, 250)  # at 720 px tall, like the chart
 
 

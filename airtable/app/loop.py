@@ -33,10 +33,12 @@ A headless table in a thread, as the load tool runs one:
 
 from __future__ import annotations
 
+import contextlib
+import signal
 import threading
 import time
 from collections import deque
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 
 # A stalled frame (window dragged, laptop busy) runs at most this much
 # simulated time; the rest is dropped rather than exploding the physics.
@@ -153,3 +155,23 @@ class FrameLoop:
             self.sleep(delay)
             return due
         return self.clock()  # fell behind: start afresh rather than burst to catch up
+
+
+@contextlib.contextmanager
+def signals_end_the_run(stop: Callable[[], None]) -> Iterator[None]:
+    """While the loop runs: SIGTERM (a logout, `kill`) calls `stop`, Ctrl+C raises KeyboardInterrupt.
+
+    SDL turns both into the QUIT event a window's close button sends, and that one asks
+    before quitting; a signal is no person at the window to answer. Only in the main
+    thread (where Python delivers signals); the previous handlers come back after."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    before = {sig: signal.getsignal(sig) for sig in (signal.SIGTERM, signal.SIGINT)}
+    signal.signal(signal.SIGTERM, lambda *_: stop())
+    signal.signal(signal.SIGINT, signal.default_int_handler)
+    try:
+        yield
+    finally:
+        for sig, handler in before.items():
+            signal.signal(sig, handler if handler is not None else signal.SIG_DFL)

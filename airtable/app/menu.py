@@ -11,7 +11,7 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 
-VISIBLE_ROWS = 14  # rows shown around the selection in a long list
+VISIBLE_ROWS = 14  # rows shown around the selection in a long list, unless the panel says how many fit
 
 
 class DemoMenu:
@@ -54,14 +54,15 @@ class DemoMenu:
             return keys[starting[0]]
         return None
 
-    def rows(self) -> list[tuple[str, str]]:
-        """The rows to show: at most VISIBLE_ROWS around the selection, the selected one marked."""
-        first = min(max(self.selected - VISIBLE_ROWS // 2, 0), max(len(self.items) - VISIBLE_ROWS, 0))
+    def rows(self, visible: int = VISIBLE_ROWS, label=str) -> list[tuple[str, str]]:
+        """The rows to show: all, or `visible` around the selection, the selected one marked;
+        `label` turns a demo key into what a person presses ("1p" -> "Shift+1")."""
+        first = min(max(self.selected - visible // 2, 0), max(len(self.items) - visible, 0))
         shown = []
-        for i in range(first, min(first + VISIBLE_ROWS, len(self.items))):
+        for i in range(first, min(first + visible, len(self.items))):
             key, title = self.items[i]
             mark = "> " if i == self.selected else "   "
-            shown.append((f"{mark}{key}", title))
+            shown.append((f"{mark}{label(key)}", title))
         return shown
 
     def footer(self) -> str:

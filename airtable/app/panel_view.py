@@ -15,7 +15,7 @@ import pygame
 ACCENT = (255, 220, 120)
 TEXT_COLOR = (230, 230, 230)
 DIM_TEXT = (150, 150, 150)
-PANEL_COLOR = (10, 10, 30, 242)
+PANEL_COLOR = (10, 10, 30, 255)  # opaque: nothing shows through the text
 COLUMN_EMS = 20  # a column is at least this many font sizes wide (about 50 characters)
 
 Row = tuple[str, str] | str
@@ -132,7 +132,7 @@ def render_panel(
     small_font: pygame.font.Font,
     page: int = 0,
 ) -> tuple[pygame.Surface, int]:
-    """A translucent panel of `size_px` with `title` and the page `page` of its text, and the page count."""
+    """An opaque panel of `size_px` with `title` and the page `page` of its text, and the page count."""
     pad = font.get_height()
     panel = pygame.Surface(size_px, pygame.SRCALPHA)
     panel.fill(PANEL_COLOR)
@@ -146,6 +146,7 @@ def render_panel(
     for piece in pages[page]:
         panel.blit(font.render(piece.text, True, piece.color), (body.x + piece.x, body.y + piece.y))
     if len(pages) > 1:
-        note = small_font.render(f"page {page + 1} of {len(pages)}: press F1 for the next", True, DIM_TEXT)
+        then = "press F1 for the next" if page + 1 < len(pages) else "F1 again closes it"
+        note = small_font.render(f"page {page + 1} of {len(pages)}: {then}", True, DIM_TEXT)
         panel.blit(note, note.get_rect(bottomright=(size_px[0] - pad, size_px[1] - pad // 4)))
     return panel, len(pages)

@@ -181,13 +181,13 @@ def count_text(app: App) -> str:
     return f"{predicted} of {players} predicted"
 
 
-def status_text(app: App) -> str:
-    """The round in the status line."""
+def status_text(app: App, for_students: bool = False) -> str:
+    """The round in the status line; the teacher's keys only on the teacher's window."""
     r = app.predict
     if r.state == "open":
-        return f"PREDICT: {count_text(app)} (F6 reveals)"
+        return f"PREDICT: {count_text(app)}" + ("" if for_students else " (F6 reveals)")
     if r.settled:
-        return "REVEALED (F6 closes the round)"
+        return "REVEALED" + ("" if for_students else " (F6 closes the round)")
     return "REVEALED: playing until the collision is over"
 
 

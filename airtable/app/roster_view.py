@@ -1,10 +1,10 @@
-"""Drawing the teacher's view of the room: the roster panel (F2) and the network alert.
+"""Drawing the teacher's view of the room: the roster panel (F2), and why students cannot join.
 
 The roster lists each student's seat, colour, name, snapshot rate, lag and
 warnings (idle, cursor far off the table, squatting), one row each, with the
 selected row highlighted; it scrolls to keep the selection in view. The app
-calls `draw_roster(app)` as its panel, and `draw_alert(app)` every frame: a
-network thread that failed shows in red at the top, where nobody can miss it.
+calls `draw_roster(app)` as its panel; `room_alert(app)` is the sentence that
+the heads-up lines show in red when the server did not start or its thread failed.
 """
 
 from __future__ import annotations
@@ -92,21 +92,3 @@ def _draw_row(surf: pygame.Surface, font: pygame.font.Font, seat: Seat, label: s
 def room_alert(app: App) -> str | None:
     """Why students cannot join, if they cannot: the server did not start, or its thread failed."""
     return app.server.failure if app.server is not None else app.server_problem
-
-
-def draw_alert(app: App) -> None:
-    """`room_alert` in red under the HUD, wrapped to the window, so the projector says it."""
-    failure = room_alert(app)
-    if not failure:
-        return
-    w = app.window
-    font, pad = w.font, w.font.get_height() // 2
-    width = w.surface.get_width() * 3 // 4
-    lines = panel_view.wrap(font, failure, width - 2 * pad)
-    box = pygame.Rect(0, 0, width, len(lines) * font.get_linesize() + pad)
-    box.midtop = (w.surface.get_width() // 2, w.hud_bottom_px + pad)
-    pygame.draw.rect(w.surface, (0, 0, 0), box)
-    pygame.draw.rect(w.surface, ALERT_COLOR, box, w.line_px(3))
-    for k, line in enumerate(lines):
-        w.surface.blit(font.render(line, True, ALERT_COLOR), (box.x + pad, box.y + pad // 2 + k * font.get_linesize()))
-    w.label_boxes.append(box)

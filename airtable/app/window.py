@@ -24,9 +24,10 @@ import pygame
 from airtable.app import panel_view
 from airtable.app.aids_paint import AidsPainter  # noqa: F401  (imported from here by the app)
 from airtable.app.environment import Environment, fitting_size_px
+from airtable.app.hud_view import HudLine, HudStyle, TextLayout, draw_hud, fit_parts, text_layout
 from airtable.app.lessons_paint import LessonsPainter  # noqa: F401  (imported from here by lessons_view)
 from airtable.app.pucks_view import COLORKEY, MIN_PUCK_RADIUS_PX, PuckSprites, draw_pucks
-from airtable.app.scene import STATUS_SEPARATOR, Scene
+from airtable.app.scene import Scene
 from airtable.app.timeline_paint import TimelinePainter  # noqa: F401  (imported from here by the app)
 from airtable.assets import ASSETS_DIR
 
@@ -42,7 +43,7 @@ PAUSED_COLOR = (255, 210, 60)
 REFERENCE_HEIGHT_PX = 720  # type sizes below are for a window this tall, and scale with it
 # Font sizes (pygame's default font) at the reference height, and their floor:
 # the smallest, 22, is 15 px tall, so no text is under 14 px at 720p.
-FONT_SIZES = {"label": (24, 22), "text": (28, 22), "big": (44, 30), "huge": (72, 40)}
+FONT_SIZES = {"label": (24, 22), "text": (28, 22), "big": (44, 30)}
 
 PAUSED = "PAUSED"
 FRAMEBUFFER_HINT = "SDL_FRAMEBUFFER_ACCELERATION"
@@ -78,17 +79,6 @@ def background_for(scene: Scene) -> tuple[int, int, int]:
     return BACKGROUND
 
 
-def fit_parts(font: pygame.font.Font, parts: Sequence[str], width_px: int) -> str:
-    """As many of `parts` as fit `width_px`, dropping the least important (last) first.
-
-    The first part alone is shortened with an ellipsis if even it does not fit."""
-    for n in range(len(parts), 0, -1):
-        text = STATUS_SEPARATOR.join(parts[:n])
-        if font.size(text)[0] <= width_px:
-            return text
-    return panel_view.shorten(font, parts[0], width_px) if parts else ""
-
-
 class GameWindow:
     """Owns the display surface (or an off-screen one when headless) and draws scenes.
 
@@ -120,6 +110,8 @@ class GameWindow:
         self._panels: dict[tuple, tuple[pygame.Surface, int]] = {}
         self._status_bar: pygame.Surface | None = None
         self.hud_bottom_px = 0  # below the title and HUD lines: panels start under it
+        self.layout = TextLayout(0, 0)  # where the text goes (hud_view.py)
+        self.show_fps = False  # the frame rate in a corner (--stats): not for the room
         self.label_boxes: list[pygame.Rect] = []  # text drawn this frame; the aids place labels around it
         self.status_top_px = 0
         if headless:
@@ -182,17 +174,24 @@ class GameWindow:
         self.label_font = self._font("label")
         self.font = self._font("text")
         self.big_font = self._font("big")
-        self.huge_font = self._font("huge")
-        self.env.resize(self.surface.get_size(), bottom_px=self.status_bar_px)
+        size = self.surface.get_size()
+        aspect = self.env.width_m / self.env.height_m
+        self.layout = text_layout(size, aspect, self.font.get_linesize(), self.status_bar_px)
+        self.env.resize(size, bottom_px=self.status_bar_px, top_px=self.layout.top_px)
         self._trail_layer = None
         self._status_bar = None
         self._labels.clear()
         self._panels.clear()
 
     @property
+    def timeline_strip_px(self) -> int:
+        """The strip along the top of the status bar kept for the rewind timeline."""
+        return max(2, self.line_px(4))
+
+    @property
     def status_bar_px(self) -> int:
-        """The status bar's height: the table is fitted above it (Environment.resize)."""
-        return self.font.get_linesize() + self.font.get_height() // 2
+        """The status bar's height, with the timeline's strip: the table is fitted above it (Environment.resize)."""
+        return self.font.get_linesize() + self.font.get_height() // 2 + self.timeline_strip_px
 
     def _size_px(self, role: str) -> int:
         size, floor = FONT_SIZES[role]
@@ -295,9 +294,11 @@ class GameWindow:
             self._trail_layer = None
         self._draw_springs(scene)
         self._draw_pucks(surf, scene)
-        self._draw_cursors(scene)
-        self._draw_hud(scene, hud, hud_color)
-        self._draw_walls(scene)  # last, so the status bar never hides the bottom wall
+        self._draw_walls(scene)
+        if hud_color is not None and hud:
+            hud = [(hud[0], hud_color), *hud[1:]]
+        self._draw_hud(scene, hud)  # on opaque ground: a zoomed view passes under it
+        self._draw_cursors(scene)  # the pointers over everything
         if banner:
             self.draw_banner(banner)
 
@@ -325,23 +326,34 @@ class GameWindow:
         right, bottom = int(round(np.clip(x1, -2, w + 2))), int(round(np.clip(y1, -2, h + 2)))
         return pygame.Rect(left, top, max(0, right - left), max(0, bottom - top))
 
-    def _draw_walls(self, scene: Scene) -> None:
-        # The wall line sits just inside the table's edge, so it shows even
-        # when the table exactly fills the window.
+    def wall_rects(self, size_m: Sequence[float] | None = None) -> list[pygame.Rect]:
+        """The four walls' lines on screen for a table of `size_m` (default: the view's), clipped near
+        the window (none when the table is out of view).
+
+        The wall line sits just inside the table's edge, so it shows even when the table
+        exactly fills the window."""
+        width_m, height_m = size_m if size_m is not None else (self.env.width_m, self.env.height_m)
         width = max(self.line_px(2), int(round(self.env.length_to_px(0.03))))
         width = min(width, 4 * self.line_px(2))
-        (x0, y0), (x1, y1) = self.env.to_screen(np.array([[0.0, scene.height_m], [scene.width_m, 0.0]]))
+        (x0, y0), (x1, y1) = self.env.to_screen(np.array([[0.0, height_m], [width_m, 0.0]]))
         w, h = self.surface.get_size()
-        if x0 < w and x1 > 0 and y0 < h and y1 > 0:  # each edge drawn alone, clipped to the window
-            top, bottom = max(y0, -width), min(y1, h + width)
-            left, right = max(x0, -width), min(x1, w + width)
+        if not (x0 < w and x1 > 0 and y0 < h and y1 > 0):
+            return []
+        top, bottom = max(y0, -width), min(y1, h + width)
+        left, right = max(x0, -width), min(x1, w + width)
+        return [
+            pygame.Rect(*(int(round(v)) for v in rect))
             for rect in (
                 (left, y0, right - left, width),
                 (left, y1 - width, right - left, width),
                 (x0, top, width, bottom - top),
                 (x1 - width, top, width, bottom - top),
-            ):
-                self.surface.fill(WALL_COLOR, pygame.Rect(*(int(round(v)) for v in rect)))
+            )
+        ]
+
+    def _draw_walls(self, scene: Scene) -> None:
+        for rect in self.wall_rects((scene.width_m, scene.height_m)):
+            self.surface.fill(WALL_COLOR, rect)
 
     def _draw_pucks(self, target: pygame.Surface, scene: Scene) -> None:
         if len(scene.pos_m) == 0:
@@ -399,55 +411,27 @@ class GameWindow:
             label = self._labels[key] = self.label_font.render(name, True, color)
         self.surface.blit(label, (x + 12 * u, y + 14 * u))
 
-    def _draw_hud(self, scene: Scene, hud: Sequence[str], hud_color: Sequence[int] | None = None) -> None:
+    def _draw_hud(self, scene: Scene, hud: Sequence[HudLine]) -> None:
+        """The title, heads-up lines, frame rate and PAUSED in their places (hud_view.py), then the
+        status line along the bottom: as many of its parts as fit, the least important dropped."""
         w, h = self.surface.get_size()
         pad = self.font.get_height() // 2
-        # Frame-rate box, top right.
-        fps = self.font.render(f"{scene.fps:5.1f} fps", True, TEXT_COLOR)
-        box = fps.get_rect(topright=(w - pad, pad)).inflate(pad, pad // 2)
-        pygame.draw.rect(self.surface, (0, 0, 0), box)
-        pygame.draw.rect(self.surface, DIM_TEXT, box, 1)
-        self.surface.blit(fps, fps.get_rect(center=box.center))
-        self.label_boxes.append(box)
-        y = pad
-        line_h = self.font.get_linesize()
-        if scene.title:
-            title = fit_parts(self.font, [scene.title], box.left - 2 * pad)
-            self.label_boxes.append(self.surface.blit(self.font.render(title, True, TEXT_COLOR), (pad, y)))
-            y += line_h
-        for k, line in enumerate(hud):
-            color = tuple(hud_color) if (k == 0 and hud_color is not None) else DIM_TEXT
-            text = self.font.render(fit_parts(self.font, [line], w - 2 * pad), True, color)
-            self.label_boxes.append(self.surface.blit(text, (pad, y)))
-            y += line_h
-        self.hud_bottom_px = y
         parts = [p.strip() for p in scene.status_parts]
         paused = PAUSED in parts
         parts = [p for p in parts if p != PAUSED]
+        style = HudStyle(self.font, self.big_font, TEXT_COLOR, DIM_TEXT, PAUSED_COLOR, self.line_px(3))
+        fps = scene.fps if self.show_fps else None
+        boxes, self.hud_bottom_px = draw_hud(self.surface, self.layout, style, scene.title, hud, fps, paused)
+        self.label_boxes.extend(boxes)
         bar_h = self.status_bar_px
         self.status_top_px = h - bar_h if parts else h
         if parts:
-            # The table is fitted above the bar (Environment.resize); see-through for a
-            # zoomed or panned view, which can pass under it.
-            if self._status_bar is None or self._status_bar.get_size() != (w, bar_h):
-                self._status_bar = pygame.Surface((w, bar_h), pygame.SRCALPHA)
-                self._status_bar.fill((0, 0, 0, 150))
-            self.label_boxes.append(self.surface.blit(self._status_bar, (0, h - bar_h)))
+            bar = pygame.Rect(0, h - bar_h, w, bar_h)
+            self.surface.fill((0, 0, 0), bar)
+            self.label_boxes.append(bar)
             text = fit_parts(self.font, parts, w - 2 * pad)
-            self.surface.blit(self.font.render(text, True, TEXT_COLOR), (pad, h - bar_h + pad // 2))
-        if paused:
-            self._draw_paused()
-
-    def _draw_paused(self) -> None:
-        """PAUSED, large and centred near the top: unmistakable from the back of a room."""
-        w, _ = self.surface.get_size()
-        label = self.huge_font.render(PAUSED, True, PAUSED_COLOR)
-        pad = self.font.get_height() // 2
-        box = label.get_rect(midtop=(w // 2, self.hud_bottom_px + pad)).inflate(3 * pad, pad)
-        pygame.draw.rect(self.surface, (0, 0, 0), box)
-        pygame.draw.rect(self.surface, PAUSED_COLOR, box, self.line_px(3))
-        self.surface.blit(label, label.get_rect(center=box.center))
-        self.label_boxes.append(box)
+            text_top = h - bar_h + self.timeline_strip_px + pad // 2
+            self.surface.blit(self.font.render(text, True, TEXT_COLOR), (pad, text_top))
 
     def draw_banner(self, text: str) -> None:
         """A big message across the middle of the window."""
@@ -460,13 +444,21 @@ class GameWindow:
         self.surface.blit(label, label.get_rect(center=box.center))
 
     def panel_rect(self) -> pygame.Rect:
-        """Where panels go: under the title and HUD lines (the join line stays visible), above the status bar."""
+        """Where panels go: under the top band, or between the side margins (the join line stays
+        visible either way), above the status bar."""
         w, h = self.surface.get_size()
         pad = self.font.get_height() // 2
-        top = max(pad, self.hud_bottom_px + pad // 2)
+        top = max(pad, self.layout.top_px + pad // 2)
         bottom = min(h - pad, self.status_top_px - pad // 2)
-        side = max(pad, w // 40)
-        return pygame.Rect(side, top, w - 2 * side, max(4 * self.font.get_linesize(), bottom - top))
+        left = max(pad, w // 40, self.layout.side_px)  # the left margin's text stays in view
+        right = w - max(pad, w // 40)
+        return pygame.Rect(left, top, right - left, max(4 * self.font.get_linesize(), bottom - top))
+
+    def panel_rows(self) -> int:
+        """How many one-line rows a panel holds on one page at the smallest readable type."""
+        font = self._font_px(FONT_SIZES["label"][1])
+        body = panel_view.body_rect(self.panel_rect().size, font, self.big_font, self.label_font)
+        return max(3, body.height // font.get_linesize())
 
     def draw_panel(
         self,

@@ -566,6 +566,7 @@ class PlayerApp:
         self.keys: set[str] = set()
         self.show_help = False  # F1: the keys of this window
         self.leave_asked_until = -math.inf  # time.monotonic() until which a second Esc leaves
+        self.ended: str | None = None  # why the session ended for good, shown until a key is pressed
         self.painter = None  # the AidsPainter, once the window is open
         self.lessons_painter = None  # the LessonsPainter (momenta, values) and
         self.timeline_painter = None  # the TimelinePainter, likewise
@@ -591,10 +592,11 @@ class PlayerApp:
         status = 0
         try:
             while self._handle_events(pygame.event.get()):
-                if self.net.state == PlayerState.FAILED:
+                if self.net.state == PlayerState.FAILED and self.ended is None:
                     print(f"airtable-client: {self.net.error}", file=sys.stderr)
-                    status = 1
-                    break
+                    status, self.ended = 1, self.net.error or "the session ended"
+                    if self.headless:
+                        break  # nobody to read it: the line above says it
                 self._frame()
                 if seconds is not None and time.monotonic() - start >= seconds:
                     break
@@ -657,24 +659,38 @@ class PlayerApp:
         for event in events:
             if event.type == pygame.QUIT:
                 return False  # the window's close button: the student meant it
-            if event.type == pygame.KEYDOWN and not self._answer_leave(event.key == pygame.K_ESCAPE):
+            if self.window.handle_event(event):
+                continue  # a resize, or F11: fullscreen on or off
+            if event.type == pygame.KEYDOWN and not self._window_key(event.key):
                 return False
-            if event.type == pygame.KEYDOWN and event.key == pygame.K_ESCAPE:
-                continue
-            if event.type == pygame.KEYDOWN and self._local_key(pygame.key.name(event.key)):
-                continue  # this window's own toggles: the server never hears of them
-            if self._predict_event(event):
-                continue
-            if event.type == pygame.KEYDOWN:
-                self.keys.add(pygame.key.name(event.key))
-            elif event.type == pygame.KEYUP:
-                self.keys.discard(pygame.key.name(event.key))
-            elif event.type == pygame.MOUSEBUTTONDOWN and event.button in (1, 2, 3):
-                self.button = event.button
-            elif event.type == pygame.MOUSEBUTTONUP and event.button == self.button:
-                held = pygame.mouse.get_pressed(3)
-                self.button = next((b for b in (1, 2, 3) if held[b - 1]), 0)
+            if event.type == pygame.KEYDOWN and (event.key == pygame.K_ESCAPE or self._local_key(event.key)):
+                continue  # this window's own keys: the server never hears of them
+            if not self._predict_event(event):
+                self._table_input(event)
         return True
+
+    def _window_key(self, key: int) -> bool:
+        """A key for the window itself first: False to close it (the session ended and was read,
+        or Esc twice)."""
+        import pygame
+
+        if self.ended is not None:
+            return False
+        return self._answer_leave(key == pygame.K_ESCAPE)
+
+    def _table_input(self, event) -> None:
+        """Keys held and the mouse button: what the server hears."""
+        import pygame
+
+        if event.type == pygame.KEYDOWN:
+            self.keys.add(pygame.key.name(event.key))
+        elif event.type == pygame.KEYUP:
+            self.keys.discard(pygame.key.name(event.key))
+        elif event.type == pygame.MOUSEBUTTONDOWN and event.button in (1, 2, 3):
+            self.button = event.button
+        elif event.type == pygame.MOUSEBUTTONUP and event.button == self.button:
+            held = pygame.mouse.get_pressed(3)
+            self.button = next((b for b in (1, 2, 3) if held[b - 1]), 0)
 
     def _answer_leave(self, escape: bool) -> bool:
         """A key while the window may be asking whether to leave; False to leave now.
@@ -693,8 +709,11 @@ class PlayerApp:
             self.leave_asked_until = now + LEAVE_CONFIRM_S
         return True
 
-    def _local_key(self, name: str) -> bool:
-        """F1 and the aids a student turns on or off for their own window; True if `name` was one."""
+    def _local_key(self, key: int) -> bool:
+        """F1 and the aids a student turns on or off for their own window; True if `key` was one."""
+        import pygame
+
+        name = pygame.key.name(key)
         if name == "f1":
             self.show_help = not self.show_help
         elif name in LOCAL_KEYS:
@@ -786,7 +805,9 @@ class PlayerApp:
         if extra and me:  # not in the snapshots yet: the arrow alone
             win.draw_cursor(me, color, cursor_m)
         self._draw_round(color)
-        if self.leave_asked_until > time.monotonic():
+        if self.ended is not None:
+            win.draw_panel("The session has ended", [self.ended, "Press any key to close this window."])
+        elif self.leave_asked_until > time.monotonic():
             win.draw_panel("Leave the table?", [LEAVE_QUESTION])
         elif self.show_help:
             win.draw_panel("Keys", list(STUDENT_KEYS))
@@ -905,7 +926,7 @@ def _parse_args(argv: Sequence[str] | None) -> argparse.Namespace:
     parser = argparse.ArgumentParser(
         prog="airtable-client",
         description="Join a teacher's air table: your mouse pulls pucks on the shared table "
-        "(buttons 1, 2, 3 are the medium, soft and stiff cursor strings; Esc quits).",
+        "(buttons 1, 2, 3 are the medium, soft and stiff cursor strings; Esc twice leaves; F11 fullscreen).",
     )
     parser.add_argument("server", metavar="HOST[:PORT]", help="the address from the teacher's 'join with:' line")
     parser.add_argument("--name", help=f"a name shown next to your cursor (up to {proto.MAX_NAME_CHARS} characters)")
