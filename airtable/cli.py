@@ -100,8 +100,8 @@ def _output_options(p: argparse.ArgumentParser) -> None:
         "--record",
         default=None,
         metavar="FILE.csv",
-        help="at exit, write every puck's state at every step to FILE.csv and the energies and momentum to"
-        " FILE_energy.csv (as far back as memory keeps: minutes for a few pucks)",
+        help="write every puck's state at every step to FILE.csv and the energies and momentum to"
+        " FILE_energy.csv as the run goes, all of it however long (a demo started later: FILE-2.csv, ...)",
     )
     p.add_argument(
         "--save-demo",
@@ -295,14 +295,12 @@ def write_outputs(app, args: argparse.Namespace) -> int:
             status = 1
         else:
             print(app.message)
-    if args.record is not None:
-        try:
-            pucks, energy = app.lessons.recorder.write(args.record)
-        except OSError as exc:
-            print(f"airtable: could not write the recording {args.record}: {exc}", file=sys.stderr)
+    for rec in app.lessons.finish():  # --record: the files were written as the run went
+        if rec.error is not None:
+            print(f"airtable: could not write the recording {rec.puck_path}: {rec.error}", file=sys.stderr)
             status = 1
         else:
-            print(f"recorded {app.lessons.recorder.summary()} to {pucks} and {energy}")
+            print(f"recorded {rec.summary()} to {rec.puck_path} and {rec.energy_path}")
     return status
 
 
@@ -330,6 +328,8 @@ def run_app(args: argparse.Namespace, shelf: DemoShelf, shot: Path | None) -> in
             fullscreen=args.fullscreen,
             show_fps=args.stats,
         )
+        if args.record is not None:
+            app.lessons.record_into(args.record, app.table)  # streamed from the first step
         started = None
         if args.headless and args.seconds is None:  # no window to close: say how it ends
 
@@ -349,6 +349,8 @@ def run_app(args: argparse.Namespace, shelf: DemoShelf, shot: Path | None) -> in
     except KeyboardInterrupt:
         pass
     finally:
+        if app is not None:
+            app.lessons.finish()  # the rows still buffered, even after Ctrl+C
         if server is not None:
             server.stop()
         if args.stats and app is not None:

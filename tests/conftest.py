@@ -29,6 +29,23 @@ def _in_a_folder_of_its_own(tmp_path, monkeypatch):
     monkeypatch.chdir(tmp_path)
 
 
+@pytest.fixture(scope="session", autouse=True)
+def temporary_files_under_pytests_folder(tmp_path_factory):
+    """The app's own temporary files (the recording the export key copies) go under pytest's temporary
+    folder, in this process and in the processes it starts."""
+    import tempfile
+
+    folder = str(tmp_path_factory.mktemp("tempfiles"))
+    old, old_env = tempfile.tempdir, os.environ.get("TMPDIR")
+    tempfile.tempdir, os.environ["TMPDIR"] = folder, folder
+    yield
+    tempfile.tempdir = old
+    if old_env is None:
+        os.environ.pop("TMPDIR", None)
+    else:
+        os.environ["TMPDIR"] = old_env
+
+
 @pytest.fixture(scope="session")
 def demos():
     """The built-in demos by key, loaded once."""

@@ -77,8 +77,8 @@ def test_values_of_few_pucks_and_of_the_puck_under_the_cursor():
     t.mass_kg[:] = (1.0, 2.0)
     rows = values_for(t, None)
     assert [(r.name, r.mass_kg, r.speed_mps, r.momentum_Ns, r.kinetic_J) for r in rows[:2]] == [
-        ("0", 1.0, 5.0, 5.0, 12.5),
-        ("1", 2.0, 1.0, 2.0, 1.0),
+        ("1", 1.0, 5.0, 5.0, 12.5),  # numbered from 1, as everywhere
+        ("2", 2.0, 1.0, 2.0, 1.0),
     ]
     total = rows[2]
     assert (total.name, total.mass_kg, total.speed_mps, total.kinetic_J) == ("total", 3.0, None, 13.5)
@@ -87,7 +87,7 @@ def test_values_of_few_pucks_and_of_the_puck_under_the_cursor():
     for k in range(5):
         t.add_puck((1.0 + k, 6.0))
     assert values_for(t, None) == []  # seven pucks: only the one under the cursor
-    assert [r.name for r in values_for(t, 1)] == ["1"]
+    assert [(r.name, r.row) for r in values_for(t, 1)] == [("2", 1)]
 
 
 def test_a_cradles_still_pucks_show_zero_not_round_off():

@@ -275,7 +275,7 @@ def test_with_many_pucks_a_student_sees_the_values_of_the_puck_under_their_curso
     wait_until(pointed, what="the values of the puck under the student's cursor")
     (row,) = net.aids.values_rows(5)[1]
     (want,) = values_for(teacher.table, 5)
-    assert row.cells() == want.cells() and row.name == "5"
+    assert row.cells() == want.cells() and (row.name, row.row) == ("6", 5)  # row 5 is puck 6
     assert row.mass_kg == pytest.approx(0.3 * np.pi * 0.25**2, rel=1e-6) and row.speed_mps == 0.0
     assert net.aids.values_rows(4)[1] == []  # a puck nobody points at: the hint
     # The student's window draws the row of the puck under its own cursor.

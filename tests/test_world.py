@@ -109,12 +109,12 @@ def test_mass_and_radius_of_the_puck_under_the_cursor(app):
     press(app, pygame.K_EQUALS)
     up = ladder_step(mass, +1, 0.001, 1000)
     assert t.mass_kg[row] == up and t.radius_m[row] == radius
-    assert app.message.startswith(f"puck {row}: mass {up:g} kg")
+    assert app.message.startswith(f"puck {row + 1}: mass {up:g} kg")  # numbered from 1
     press(app, pygame.K_MINUS)
     press(app, pygame.K_MINUS)
     assert t.mass_kg[row] == ladder_step(ladder_step(up, -1, 0.001, 1000), -1, 0.001, 1000)
     press(app, pygame.K_RIGHTBRACKET)
-    assert t.radius_m[row] == ladder_step(radius, +1, 0.05, 2.0) and app.message.startswith(f"puck {row}: radius")
+    assert t.radius_m[row] == ladder_step(radius, +1, 0.05, 2.0) and app.message.startswith(f"puck {row + 1}: radius")
     assert np.array_equal(np.delete(t.mass_kg, row), np.delete(others, row))  # only that puck changed
     # Nothing under the cursor: nothing changes, and the message says what to do.
     pygame.event.post(pygame.event.Event(pygame.MOUSEMOTION, pos=(1, 1), rel=(0, 0), buttons=(0, 0, 0)))

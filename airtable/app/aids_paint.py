@@ -18,6 +18,7 @@ import pygame
 from airtable.app.panel_view import DIM_TEXT, TEXT_COLOR
 from airtable.app.panel_view import wrap as _wrap
 from airtable.model.aids import VectorScale
+from airtable.model.readout import readable
 
 ANNOTATION_NORMAL = (255, 230, 90)
 ANNOTATION_TANGENT = (90, 200, 255)
@@ -348,8 +349,8 @@ class AidsPainter:
         pygame.draw.rect(surf, (60, 60, 60), plot, 1)
         t = series["time_s"]
         if len(t) >= 2 and plot.width > 10 and plot.height > 10:
-            self._chart_lines(series, plot)
-            top_e = max(float(np.max(series["total_J"])), 1e-12) * 1.1
+            self._chart_lines(series, plot, latest)
+            top_e = chart_top(series["total_J"], latest.get("energy_scale_J", 0.0))
             self._text(f"{top_e:.3g} J", (plot.x + 2, plot.y + 2), DIM_TEXT)
             self._text(f"last {max(t[-1] - t[0], 0.0):.1f} s", (plot.x + 2, plot.bottom - line_h), DIM_TEXT)
         x, y = (box.x + pad, plot.bottom) if stacked else (plot.right + pad, box.y + pad)
@@ -361,12 +362,13 @@ class AidsPainter:
         for k, line in enumerate(notes):
             self._text(line, (box.x + pad, box.bottom - pad - (len(notes) - k) * line_h), DIM_TEXT)
 
-    def _chart_lines(self, series: dict[str, np.ndarray], plot: pygame.Rect) -> None:
+    def _chart_lines(self, series: dict[str, np.ndarray], plot: pygame.Rect, latest: dict[str, float]) -> None:
         t = series["time_s"]
         span = max(t[-1] - t[0], 1e-9)
         xs = plot.x + (t - t[0]) / span * plot.width
-        top_e = max(float(np.max(series["total_J"])), 1e-12) * 1.1
-        top_p = max(float(np.max(series["momentum_Ns"])), 1e-12) * 1.1
+        # Round-off (the chart's top is 0) lies on the axis: any positive top draws it there.
+        top_e = chart_top(series["total_J"], latest.get("energy_scale_J", 0.0)) or 1.0
+        top_p = chart_top(series["momentum_Ns"], latest.get("momentum_scale_Ns", 0.0)) or 1.0
         # Decimate to about one point per pixel column.
         pick = np.unique(np.linspace(0, len(t) - 1, min(len(t), plot.width)).astype(int))
         thin, thick = self.w.line_px(1.5), self.w.line_px(3)
@@ -407,6 +409,12 @@ def table_corner(window, rect: pygame.Rect, corner: int) -> pygame.Rect:
     else:
         rect.left = inner.left
     return rect
+
+
+def chart_top(values: np.ndarray, scale: float) -> float:
+    """The top of a chart's axis: a tenth above the largest of `values`, or 0 if that is round-off of the
+    scene's `scale` (readout.py)."""
+    return 1.1 * max(0.0, readable(float(np.max(values)), scale)) if len(values) else 0.0
 
 
 def place_in_corner(window, rect: pygame.Rect, corner: int) -> pygame.Rect:

@@ -13,6 +13,7 @@ import numpy as np
 from airtable.app.aids_paint import draw_annotations
 from airtable.model import aids
 from airtable.model.client import cursor_pulls
+from airtable.model.momenta import puck_number
 
 if TYPE_CHECKING:
     from airtable.app.app import App
@@ -48,6 +49,7 @@ def inspector_lines(table, puck) -> list[str]:
     v = puck.vel_mps
     speed = float(np.hypot(*v))
     lines = [
+        f"puck {puck_number(puck.index)}",
         f"mass {puck.mass_kg:.4g} kg   radius {puck.radius_m:.4g} m",
         f"speed {speed:.4g} m/s",
         f"velocity ({v[0]:.3f}, {v[1]:.3f}) m/s",

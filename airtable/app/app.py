@@ -159,6 +159,7 @@ class App:
         self.stepper = FixedStep(1 / 240)
         self.message = ""
         self.message_until = 0.0
+        self.message_lasts = False  # the message outlives a demo start (App.say)
         self.clock_s = 0.0  # time the app has run (sum of frame times)
         self.frame_dt_s = 0.0  # the current frame's time (held keys act in proportion)
         self.last_input_s = 0.0  # clock_s of the last input, local or a student's
@@ -197,6 +198,8 @@ class App:
         if broken is None and key not in self.demos:
             self.say(f"no demo on key {key_label(key)}")
             return
+        if not self.message_lasts:
+            self.message = ""  # it spoke of the demo that is going
         demo = self.demos.get(key) if broken is None else None
         if self.build_error is not None:
             self.paused = False  # the pause came with the error; a new start runs
@@ -373,12 +376,14 @@ class App:
         except (OSError, pygame.error) as exc:
             self.say(f"could not save the screenshot: {exc}")
         else:
-            self.say(f"screenshot saved to {saved.resolve()}")
+            self.say(f"screenshot saved to {saved.resolve()}", lasting=True)
 
-    def say(self, text: str) -> None:
-        """Show a one-line message on screen for a few seconds."""
+    def say(self, text: str, *, lasting: bool = False) -> None:
+        """Show a one-line message on screen for a few seconds. It is about the demo on the table and goes
+        when another demo starts, unless `lasting` (it says where a file was written)."""
         self.message = text
         self.message_until = self.clock_s + MESSAGE_S
+        self.message_lasts = lasting
 
     def handle_event(self, event: pygame.event.Event) -> None:
         controls.handle_event(self, event)

@@ -251,9 +251,9 @@ BINDINGS: tuple[Binding, ...] = (
         },
     ),
     Binding(
-        "d / t",
-        "momenta before / after the latest collision; values of each puck",
-        {pygame.K_d: lessons.toggle_momenta, pygame.K_t: lessons.toggle_values},
+        "d / t / k",
+        "momenta before / after the latest collision; values of each puck; puck numbers",
+        {pygame.K_d: lessons.toggle_momenta, pygame.K_t: lessons.toggle_values, pygame.K_k: lessons.toggle_numbers},
     ),
     Binding(
         "x / Ctrl+S",

@@ -18,6 +18,7 @@ import pygame
 from airtable.app.aids_paint import CHART_COLORS, CHART_CORNERS, draw_arrow_px, place_in_corner
 from airtable.app.panel_view import ACCENT, DIM_TEXT, TEXT_COLOR, shorten
 from airtable.model.momenta import VALUE_HEADINGS, MomentaView, PuckValues, fit_chains, tip_to_tail
+from airtable.model.readout import readable
 
 TOTAL_COLOR = CHART_COLORS["momentum_Ns"]  # the chart's |momentum| colour
 PANEL_FILL = (0, 0, 0, 255)  # opaque: nothing shows through the numbers
@@ -25,7 +26,7 @@ MOMENTA_SIZE_PX = (480, 250)  # at 720 px tall, like the chart
 
 
 def momenta_scale(m: MomentaView) -> float:
-    """The size of the largest momentum in the diagram (N s): below a billionth of it is round-off."""
+    """The size of the largest momentum in the diagram (N s): the round-off scale of its totals (readout.py)."""
     sizes = [np.abs(np.asarray(a, dtype=float)).max(initial=0.0) for a in (m.before_Ns, m.after_Ns)]
     sizes += [np.abs(np.asarray(t, dtype=float)).max() for t in (m.total_before_Ns, m.total_after_Ns)]
     return float(max(sizes))
@@ -33,8 +34,8 @@ def momenta_scale(m: MomentaView) -> float:
 
 def total_texts(total, scale: float) -> tuple[tuple[str, ...], tuple[str, ...]]:
     """The two lines under a chain, each longest first: the total's components, and its size.
-    A component under a billionth of `scale` is round-off (1.39e-17 after a hit along x) and shows as 0."""
-    x, y = (0.0 if abs(v) < 1e-9 * scale else float(v) + 0.0 for v in total)
+    A component that is round-off of `scale` (1.39e-17 after a hit along x) shows as 0 (readout.readable)."""
+    x, y = (readable(v, scale) for v in total)
     size = math.hypot(x, y)
     return (
         (f"total ({x:.3g}, {y:.3g}) N s", f"({x:.3g}, {y:.3g}) N s", f"({x:.3g}, {y:.3g})"),

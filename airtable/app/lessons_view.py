@@ -9,8 +9,9 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING
 
+from airtable.app.pucks_view import draw_numbers
 from airtable.app.window import LessonsPainter
-from airtable.model.momenta import FEW_PUCKS, values_for
+from airtable.model.momenta import FEW_PUCKS, puck_number, values_for
 
 if TYPE_CHECKING:
     from airtable.app.app import App
@@ -20,6 +21,10 @@ VALUES_HINT = f"values: more than {FEW_PUCKS} pucks, so point at one"
 
 def draw_lessons(app: App) -> None:
     lessons = app.lessons
+    if lessons.show_numbers and len(app.table.pos_m):
+        t = app.table
+        numbers = [puck_number(row) for row in range(len(t.pos_m))]
+        draw_numbers(app.window.surface, app.window.label_font, app.env.to_screen(t.pos_m), numbers)
     if not (lessons.show_momenta or lessons.show_values):
         return
     if lessons.painter is None:
@@ -37,6 +42,6 @@ def draw_lessons(app: App) -> None:
         paint.momenta_diagram(None if latest is None else latest.view, corner)
     if lessons.show_values:
         puck = t.puck_at(app.env.to_world(app.mouse_px)) if len(t.pos_m) > FEW_PUCKS else None
-        rows = values_for(t, None if puck is None else puck.index)
-        colors = [t.color_rgb[int(r.name)] if r.speed_mps is not None else None for r in rows]
+        rows = values_for(t, None if puck is None else puck.index, app.chart.scale)
+        colors = [t.color_rgb[r.row] if r.row is not None else None for r in rows]
         paint.values_panel(rows, colors, VALUES_HINT, paint.choose_corner("values", points, taken))

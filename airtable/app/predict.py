@@ -25,6 +25,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from airtable.model.momenta import puck_number
 from airtable.model.rounds import MAX_ROUND_PUCKS, Arrow, RoundInfo, clamp_speed
 
 if TYPE_CHECKING:
@@ -52,7 +53,7 @@ def angle_deg(a: Sequence[float], b: Sequence[float]) -> float:
 def puck_summary(puck: int, truth: Sequence[float], guesses: Sequence[Sequence[float]]) -> str:
     """One line: how far the guesses for `puck` spread from its true velocity."""
     n = len(guesses)
-    label = f"puck {puck + 1}"
+    label = f"puck {puck_number(puck)}"
     speed = math.hypot(*truth)
     if n == 0:
         return f"{label}: no predictions"

@@ -218,3 +218,26 @@ def _stamp(target: pygame.Surface, stamp: tuple[np.ndarray, np.ndarray], corner:
         pixels[where] = values[: len(where)]
     del pixels  # unlocks it
     return inside
+
+
+MAX_NUMBERED_PUCKS = 120  # more pucks on screen than this: their numbers would be a blur; none drawn
+NUMBER_FILL = (0, 0, 0)
+
+
+def draw_numbers(target: pygame.Surface, font: pygame.font.Font, centers_px: np.ndarray, numbers) -> int:
+    """Each puck's number (as the values panel, the momenta diagram, predict and the CSV name it), in white
+    on a small dark box at its centre, for the pucks whose centre is on `target`; returns how many were
+    drawn (none when more than MAX_NUMBERED_PUCKS would be)."""
+    w, h = target.get_size()
+    centers_px = np.asarray(centers_px, dtype=float).reshape(-1, 2)
+    on = np.flatnonzero(
+        (centers_px[:, 0] >= 0) & (centers_px[:, 0] < w) & (centers_px[:, 1] >= 0) & (centers_px[:, 1] < h)
+    )
+    if len(on) > MAX_NUMBERED_PUCKS:
+        return 0
+    for k in on.tolist():
+        text = font.render(str(numbers[k]), True, (255, 255, 255))
+        box = text.get_rect(center=(round(centers_px[k, 0]), round(centers_px[k, 1])))
+        target.fill(NUMBER_FILL, box.inflate(4, 0))
+        target.blit(text, box)
+    return len(on)

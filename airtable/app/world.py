@@ -17,6 +17,7 @@ from __future__ import annotations
 import math
 from typing import TYPE_CHECKING
 
+from airtable.model.momenta import puck_number
 from airtable.physics.forces import GRAVITY_MPS2
 from airtable.physics.table import AirTable
 
@@ -122,12 +123,12 @@ def _change_puck(app: App, what: str, direction: int) -> None:
     if what == "mass":
         old = float(t.mass_kg[row])
         t.mass_kg[row] = ladder_step(old, direction, *MASS_RANGE_KG)
-        app.say(f"puck {row}: mass {t.mass_kg[row]:g} kg (was {old:.3g} kg; its velocity kept)")
+        app.say(f"puck {puck_number(row)}: mass {t.mass_kg[row]:g} kg (was {old:.3g} kg; its velocity kept)")
     else:
         old = float(t.radius_m[row])
         top = min(RADIUS_RANGE_M[1], 0.45 * min(t.width_m, t.height_m))
         t.radius_m[row] = ladder_step(old, direction, RADIUS_RANGE_M[0], top)
-        app.say(f"puck {row}: radius {t.radius_m[row]:g} m (was {old:.3g} m; its mass kept)")
+        app.say(f"puck {puck_number(row)}: radius {t.radius_m[row]:g} m (was {old:.3g} m; its mass kept)")
 
 
 def mass_down(app: App) -> None:

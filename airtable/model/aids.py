@@ -12,6 +12,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from airtable.model.readout import SceneScale
 from airtable.physics.table import AirTable
 
 SLOW_MOTION_FACTORS = (1.0, 1 / 2, 1 / 4, 1 / 8, 1 / 16)
@@ -173,21 +174,26 @@ class EnergyChart:
         self._data = np.zeros((capacity, len(self.FIELDS)))
         self._next = 0
         self._count = 0
+        self.scale = SceneScale()  # the scene's round-off scale: readouts show less than it as 0
 
     def clear(self) -> None:
         self._next = self._count = 0
+        self.scale.clear()
 
     def sample(self, table: AirTable) -> None:
         ke, se, ge = table.kinetic_energy_J(), table.spring_energy_J(), table.gravity_energy_J()
         p = table.momentum_Ns()
-        self._data[self._next] = (table.time_s, ke, se, ge, ke + se + ge, float(np.hypot(p[0], p[1])))
+        size = float(np.hypot(p[0], p[1]))
+        self._data[self._next] = (table.time_s, ke, se, ge, ke + se + ge, size)
         self._next = (self._next + 1) % len(self._data)
         self._count = min(self._count + 1, len(self._data))
+        self.scale.observe((ke, se, ge), size, float(table.mass_kg.sum()))
 
     def append(self, row) -> None:
         """One sample made elsewhere (a student's window gets the teacher's): the values of FIELDS."""
         if self._count and row[0] < self._data[(self._next - 1) % len(self._data), 0]:
             self.clear()  # time went back: a restart or a rewind
+        self.scale.observe(row[1:4], row[5])
         self._data[self._next] = row
         self._next = (self._next + 1) % len(self._data)
         self._count = min(self._count + 1, len(self._data))
@@ -208,10 +214,15 @@ class EnergyChart:
         return {f: rows[:, k] for k, f in enumerate(self.FIELDS)}
 
     def latest(self) -> dict[str, float]:
+        """The newest sample, round-off shown as 0 (readout.py), and the scene's scales (`energy_scale_J`,
+        `momentum_scale_Ns`) for the chart's axes."""
+        scales = {"energy_scale_J": self.scale.energy_J, "momentum_scale_Ns": self.scale.momentum_Ns}
         if self._count == 0:
-            return {f: 0.0 for f in self.FIELDS}
+            return {**{f: 0.0 for f in self.FIELDS}, **scales}
         row = self._data[(self._next - 1) % len(self._data)]
-        return {f: float(row[k]) for k, f in enumerate(self.FIELDS)}
+        values = {f: self.scale.energy(row[k]) for k, f in enumerate(self.FIELDS)}
+        values["time_s"], values["momentum_Ns"] = float(row[0]), self.scale.momentum(row[-1])
+        return {**values, **scales}
 
     def euler_wiggle_note(self, table: AirTable) -> str | None:
         """One line explaining the swing of the total, when springs make it visible."""

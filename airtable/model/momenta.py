@@ -18,8 +18,12 @@ from functools import cached_property
 
 import numpy as np
 
+from airtable.model.readout import SceneScale
 from airtable.physics.table import AirTable, kinetic_energy_J
 
+# Pucks are numbered from 1 wherever the app names one (values, momenta, predict, inspect, the CSV files,
+# the numbers drawn on the pucks): puck_number is that numbering, the table's rows count from 0.
+FIRST_PUCK_NUMBER = 1
 FEW_PUCKS = 6  # the values panel lists every puck up to this many, else the puck under the cursor
 MAX_DIAGRAM_PUCKS = 40  # more than this: the diagram draws the pucks that collided (at most this many), and the total
 
@@ -153,6 +157,11 @@ def fit_chains(chains: list[np.ndarray], size_px: tuple[int, int], margin: float
     return ChainFit(scale if math.isfinite(scale) else 1.0, tuple(centers))
 
 
+def puck_number(row: int) -> int:
+    """The number a class sees for the puck in table row `row`."""
+    return int(row) + FIRST_PUCK_NUMBER
+
+
 @dataclass(frozen=True)
 class PuckValues:
     """What the values panel shows of one puck (or the total of all)."""
@@ -162,47 +171,62 @@ class PuckValues:
     speed_mps: float | None  # None for the total: a sum of speeds means nothing
     momentum_Ns: float
     kinetic_J: float
+    row: int | None = None  # the puck's table row (None for the total)
 
     def cells(self) -> tuple[str, str, str, str, str]:
         speed = "" if self.speed_mps is None else f"{self.speed_mps:.3g}"
         return (self.name, f"{self.mass_kg:.3g}", speed, f"{self.momentum_Ns:.3g}", f"{self.kinetic_J:.3g}")
 
 
-ROUND_OFF_MPS = 1e-9  # a nanometre a second: below it a speed is the round-off of a collision, shown as 0
 VALUE_HEADINGS = ("puck", "m kg", "|v| m/s", "|p| N s", "KE J")  # mass, speed, momentum, kinetic energy
 
 
-def puck_values(mass_kg: np.ndarray, vel_mps: np.ndarray, rows: Sequence[int]) -> list[PuckValues]:
-    """Mass, speed, |momentum| and kinetic energy of each puck (named by its row, as in the CSV);
-    `mass_kg` (K,) and `vel_mps` (K, 2) are those of `rows`."""
+def own_scale(mass_kg: np.ndarray, vel_mps: np.ndarray) -> SceneScale:
+    """A round-off scale from these pucks alone (when the scene's is not known): their kinetic energy and
+    the sum of the sizes of their momenta."""
+    scale = SceneScale()
+    m, v = np.asarray(mass_kg, dtype=float), np.asarray(vel_mps, dtype=float).reshape(-1, 2)
+    scale.observe((kinetic_energy_J(m, v),), float(m @ np.hypot(v[:, 0], v[:, 1])), float(m.sum()))
+    return scale
+
+
+def puck_values(
+    mass_kg: np.ndarray, vel_mps: np.ndarray, rows: Sequence[int], scale: SceneScale | None = None
+) -> list[PuckValues]:
+    """Mass, speed, |momentum| and kinetic energy of each puck (named by its number, as in the CSV);
+    `mass_kg` (K,) and `vel_mps` (K, 2) are those of `rows`. Round-off of the scene's `scale` shows as 0
+    (a cradle's still pucks keep 1e-13 m/s)."""
+    scale = own_scale(mass_kg, vel_mps) if scale is None else scale
     out = []
     for k, row in enumerate(rows):
         m = float(mass_kg[k])
         v = vel_mps[k]
         speed = math.hypot(float(v[0]), float(v[1]))
-        speed = 0.0 if speed < ROUND_OFF_MPS else speed  # a cradle's still pucks keep 1e-13 m/s of round-off
-        out.append(PuckValues(str(int(row)), m, speed, m * speed, 0.5 * m * speed * speed))
+        speed = speed if scale.momentum(m * speed) else 0.0
+        ke = scale.energy(0.5 * m * speed * speed)
+        out.append(PuckValues(str(puck_number(row)), m, speed, m * speed, ke, int(row)))
     return out
 
 
-def every_puck_values(mass_kg: np.ndarray, vel_mps: np.ndarray) -> list[PuckValues]:
+def every_puck_values(mass_kg: np.ndarray, vel_mps: np.ndarray, scale: SceneScale | None = None) -> list[PuckValues]:
     """Every puck and, if there are several, their total (the teacher's table, or a student's copy of it)."""
     mass_kg, vel_mps = np.asarray(mass_kg, dtype=float), np.asarray(vel_mps, dtype=float).reshape(-1, 2)
+    scale = own_scale(mass_kg, vel_mps) if scale is None else scale
     n = len(mass_kg)
-    rows = puck_values(mass_kg, vel_mps, range(n))
+    rows = puck_values(mass_kg, vel_mps, range(n), scale)
     if n > 1:
-        p = math.hypot(*(mass_kg @ vel_mps))
-        p = 0.0 if p < 1e-9 * sum(r.momentum_Ns for r in rows) else p  # equal and opposite: round-off, not 1e-17
-        total = PuckValues("total", float(mass_kg.sum()), None, p, kinetic_energy_J(mass_kg, vel_mps))
-        rows.append(total)
+        p = scale.momentum(math.hypot(*(mass_kg @ vel_mps)))  # equal and opposite: 0, not 1e-17
+        ke = scale.energy(kinetic_energy_J(mass_kg, vel_mps))
+        rows.append(PuckValues("total", float(mass_kg.sum()), None, p, ke))
     return rows
 
 
-def values_for(table: AirTable, cursor_row: int | None) -> list[PuckValues]:
-    """Every puck and their total when there are few; else the puck under the cursor (none: empty)."""
+def values_for(table: AirTable, cursor_row: int | None, scale: SceneScale | None = None) -> list[PuckValues]:
+    """Every puck and their total when there are few; else the puck under the cursor (none: empty).
+    `scale`: the scene's round-off scale (the energy chart keeps it), else one from the pucks shown."""
     n = len(table.pos_m)
     if n <= FEW_PUCKS:
-        return every_puck_values(table.mass_kg, table.vel_mps)
+        return every_puck_values(table.mass_kg, table.vel_mps, scale)
     if cursor_row is None:
         return []
-    return puck_values(table.mass_kg[[cursor_row]], table.vel_mps[[cursor_row]], [cursor_row])
+    return puck_values(table.mass_kg[[cursor_row]], table.vel_mps[[cursor_row]], [cursor_row], scale)

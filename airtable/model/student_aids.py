@@ -122,13 +122,14 @@ class StudentAids:
         if frame is None or not frame.lesson_flags & aids_wire.VALUES:
             return None
         mass, vel, rows = frame.value_mass_kg, frame.value_vel_mps, frame.value_rows
+        scale = self.chart.scale if self.chart.scale.energy_J > 0 else None  # the scene's, while the chart came
         if frame.values_every:
-            return frame.values_corner, every_puck_values(mass, vel)
+            return frame.values_corner, every_puck_values(mass, vel, scale)
         at = np.flatnonzero(rows == pointed) if pointed is not None else ()
         if not len(at):
             return frame.values_corner, []
         k = int(at[0])
-        return frame.values_corner, puck_values(mass[k : k + 1], vel[k : k + 1], [pointed])
+        return frame.values_corner, puck_values(mass[k : k + 1], vel[k : k + 1], [pointed], scale)
 
     def timeline(self) -> Timeline | None:
         """Where the teacher's view is in the history while the teacher's window shows the bar, else None."""

@@ -14,7 +14,7 @@ from airtable.app.aids_view import COM_COLOR
 from airtable.app.lessons_view import VALUES_HINT
 from airtable.model import aids
 from airtable.model import shared_aids as aids_wire
-from airtable.model.momenta import FEW_PUCKS
+from airtable.model.momenta import FEW_PUCKS, puck_number
 from airtable.model.scene import Scene
 from airtable.model.student_aids import StudentAids
 
@@ -71,7 +71,7 @@ def draw_student_lessons(paint, timeline_paint, scene: Scene, state: StudentAids
     if values is not None:
         corner, rows = values
         n = len(scene.color_rgb)
-        colors = [scene.color_rgb[int(r.name)] if r.speed_mps is not None and int(r.name) < n else None for r in rows]
+        colors = [scene.color_rgb[r.row] if r.row is not None and r.row < n else None for r in rows]
         paint.values_panel(rows, colors, VALUES_HINT, corner)
 
 
@@ -118,7 +118,7 @@ def _inspect(paint: AidsPainter, scene: Scene, state: StudentAids, mouse_m) -> N
     k = int(np.argmin(d))
     if d[k] > scene.radius_m[k]:
         return
-    lines = [f"puck {k}   radius {scene.radius_m[k]:.4g} m", f"at ({pos[k, 0]:.3f}, {pos[k, 1]:.3f}) m"]
+    lines = [f"puck {puck_number(k)}   radius {scene.radius_m[k]:.4g} m", f"at ({pos[k, 0]:.3f}, {pos[k, 1]:.3f}) m"]
     v = state.velocities(len(pos))
     if v is not None:
         lines.append(f"speed {np.hypot(*v[k]):.3g} m/s (from the snapshots)")
