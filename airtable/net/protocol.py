@@ -22,6 +22,7 @@ import unicodedata
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
 
+from airtable.net.names import MAX_NAME_CHARS, looks_like_label
 from airtable.physics.table import TABLE_HEIGHT_M, TABLE_WIDTH_M
 
 PROTOCOL_VERSION = 2
@@ -60,7 +61,6 @@ MAX_CLIENT_FRAME = 1024
 # drawing budget below with room to spare, while a bogus length cannot eat memory.
 MAX_SERVER_FRAME = 16 * 1024 * 1024
 
-MAX_NAME_CHARS = 20
 MAX_PASSWORD_CHARS = 100
 MAX_KEYS = 16
 MAX_KEY_CHARS = 16
@@ -265,8 +265,6 @@ def _integer(value: object, what: str) -> int:
 
 # Hangul fillers count as letters but draw nothing; a name of them looks blank.
 _INVISIBLE_LETTERS = frozenset("\u115f\u1160\u3164\uffa0")
-# "C7" on its own: the table labels players "C<n> name", so a name must not imitate one.
-_PLAYER_LABEL = re.compile(r"\bc\s*\d+\b", re.IGNORECASE)
 
 
 def _visible(char: str) -> bool:
@@ -275,7 +273,7 @@ def _visible(char: str) -> bool:
 
 def check_name(name: object) -> str:
     """A player name: 1-20 printable characters with a visible letter or digit, not
-    like another player's "C<n>" label (spaces around are dropped)."""
+    like another player's "C<n>" label (names.py; spaces around are dropped)."""
     if not isinstance(name, str):
         raise ProtocolError(f"the name must be text, not {_short(name)}")
     name = name.strip()
@@ -292,7 +290,7 @@ def check_name(name: object) -> str:
         raise ProtocolError(
             f"the name {_short(name)} has no visible letter or digit; pick a name others can read, like Ann"
         )
-    if _PLAYER_LABEL.search(name):
+    if looks_like_label(name):  # also in look-alike letters: "С1" with a Cyrillic С, "C-1", "C¹"
         raise ProtocolError(
             f"the name {_short(name)} looks like a player label such as C7; pick a name without C and a number"
         )

@@ -44,6 +44,7 @@ from airtable.net.connection import Connection, State
 from airtable.net.events import EventQueue, PlayerInput, PlayerJoined, PlayerLeft
 from airtable.net.gate import FIRST_PASSWORD_WAIT_S, HANDSHAKES_PER_ADDRESS, PLAYERS_PER_ADDRESS, Gate, QuietLog
 from airtable.net.identity import SeatTokens
+from airtable.net.names import distinct_name
 from airtable.net.predictions import MAX_ROUND_PUCKS, PredictionBook, RoundInfo, encode_round, parse_predict
 
 log = logging.getLogger("airtable.net")
@@ -714,7 +715,8 @@ class GameServer:
             while number in self._numbers:  # the lowest free number, so names get reused
                 number += 1
         client = f"C{number}"
-        name = client + (f" {hello.name}" if hello.name else "")  # the cursor's label
+        shown = self._distinct(hello.name)
+        name = client + (f" {shown}" if shown else "")  # the cursor's label
         color = client_color(number)
         self._gate.handshake_ended(conn.host, seated=True)
         conn.number, conn.name, conn.state = number, name, State.PLAYING
@@ -724,13 +726,20 @@ class GameServer:
         self._events.join(conn.cid, name, color, number)
         width_m, height_m = self._table_size_m
         token = self._tokens.make(number, hello.name or "")
-        conn.send_control(proto.encode_welcome(client, color, width_m, height_m, hello.name, token))
+        conn.send_control(proto.encode_welcome(client, color, width_m, height_m, shown, token))
         conn.offer_tick(self._encoder, now)  # the newest picture straight away, if there is one
         with self._lock:
             round_frame = self._round_frame
         if round_frame is not None:  # a prediction round is under way
             conn.send_control(round_frame)
         self._log_seat(conn, "%s joined from %s", name, conn.peer)
+
+    def _distinct(self, name: str | None) -> str | None:
+        """`name` as the table shows it: "Ann 2" when an "Ann" (or an "Αnn", in look-alike letters) plays."""
+        if not name:
+            return name
+        playing = (self._conns[cid].name.partition(" ")[2] for cid in self._numbers.values())
+        return distinct_name(name, playing)
 
     def _log_seat(self, conn: Connection, line: str, *args) -> None:
         """Joins and leaves, one line each, but summarised when one computer churns."""
