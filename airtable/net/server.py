@@ -71,6 +71,7 @@ SELECT_SOCKETS = 500  # select() watches at most 512 sockets on Windows (1024 fd
 RESERVED_FDS = 32  # descriptors kept for the app itself (files, the display, the listener)
 FAR_OFF_TABLES = 1.0  # a cursor this many table sizes beyond the edge is "far off" in the roster
 ACCEPT_PAUSE_S = 0.5  # out of descriptors: stop accepting for this long
+NOTICE_S = 60.0  # the projector shows why students were turned away for this long after the last one
 
 
 def client_color(number: int) -> tuple[int, int, int]:
@@ -230,6 +231,7 @@ class GameServer:
         self._table_size_m: tuple[float, float] = proto.DEFAULT_TABLE_SIZE_M  # plain tuple: replaced, never mutated
         self.predictions = PredictionBook()  # the predict-then-reveal round's guesses (has its own lock)
         self._round_frame: bytes | None = None  # the newest ROUND, for players who join during a round
+        self._door_notice: tuple[str, float] = ("", 0.0)  # for the teacher, and until when (see join_lines)
 
         # Game loop only.
         self._clients: dict[int, Client] = {}
@@ -360,12 +362,15 @@ class GameServer:
         return self._thread is not None and self._thread.is_alive() and not self._stopping.is_set()
 
     def join_lines(self) -> list[str]:
-        """What students type to join, e.g. ["join with: airtable-client 192.168.1.23"].
+        """What students type to join, e.g. ["join with: airtable-client 192.168.1.23"], and, for
+        NOTICE_S after students were turned away per address, the line that says how to let them in.
 
         Worked out once per port and cached, since the app may ask every frame."""
         if self._join_lines is None or self._join_lines[0] != self.port:
             self._join_lines = (self.port, self._make_join_lines())
-        return list(self._join_lines[1])
+        with self._lock:
+            notice, until = self._door_notice
+        return list(self._join_lines[1]) + ([notice] if notice and time.monotonic() < until else [])
 
     def _make_join_lines(self) -> list[str]:
         host = self.host or "0.0.0.0"
@@ -700,7 +705,9 @@ class GameServer:
     def _welcome(self, conn: Connection, hello: proto.Hello, now: float) -> None:
         if not self._password_ok(conn, hello, now):
             return
-        refusal = self._gate.seat_refusal(conn.host)
+        refusal = self._gate.seat_refusal(conn.host, password_given=self.password is not None)
+        if refusal is not None:
+            self._tell_teacher(self._gate.teacher_notice())
         if refusal is None and hello.name and self._name_refusal is not None:
             refusal = self._name_refusal(hello.name)
         if refusal is not None:
@@ -733,6 +740,13 @@ class GameServer:
         if round_frame is not None:  # a prediction round is under way
             conn.send_control(round_frame)
         self._log_seat(conn, "%s joined from %s", name, conn.peer)
+
+    def _tell_teacher(self, notice: str | None) -> None:
+        """A line for the log (once, then summaries) and for the projector, under the join lines, for a while."""
+        if notice:
+            self._quiet.note("students turned away per address", "%s", notice)
+            with self._lock:
+                self._door_notice = (notice, time.monotonic() + NOTICE_S)
 
     def _distinct(self, name: str | None) -> str | None:
         """`name` as the table shows it: "Ann 2" when an "Ann" (or an "Αnn", in look-alike letters) plays."""
