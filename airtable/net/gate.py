@@ -105,6 +105,17 @@ class Gate:
         """Handshakes under way, from every address."""
         return self._open
 
+    def crowding(self, host: str) -> str | None:
+        """When every handshake slot is taken: the address that should give one up for `host`, or None.
+
+        The address holding the most handshakes, if it holds more than `host` would once let in:
+        so one computer with many addresses cannot keep a newcomer out, and a newcomer's own
+        handshake cannot be pushed out by an address that holds as few (see GameServer._admit)."""
+        if not self.handshakes:
+            return None
+        crowded, most = self.handshakes.most_common(1)[0]
+        return crowded if most > self.handshakes[host] + 1 else None
+
     def handshake_started(self, host: str) -> None:
         self.handshakes[host] += 1
         self._open += 1

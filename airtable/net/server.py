@@ -15,7 +15,9 @@ player's rate drops evenly.
 
 Joining is guarded (see gate.py): handshakes have their own cap and a short
 deadline, one computer may hold only a few handshakes and seats, and wrong
-passwords earn a growing wait. A client that breaks the protocol gets an
+passwords earn a growing wait. When every handshake slot is taken, the
+address holding the most gives its oldest up to a newcomer (`_make_room`),
+so many addresses dribbling HELLOs cannot keep an honest student out. A client that breaks the protocol gets an
 ERROR with a sentence it can act on and is dropped; nobody else notices.
 The teacher sees the seats with `roster()` and can `remove()` a player.
 """
@@ -599,11 +601,8 @@ class GameServer:
         refusal = self._gate.handshake_refusal(host)
         if len(self._numbers) >= self.max_clients:
             refusal = self._full_sentence()
-        elif self._gate.handshakes_open >= self.max_handshakes:
-            refusal = (
-                f"the table is busy: {self.max_handshakes} computers are joining at once; "
-                "your client tries again by itself in a few seconds"
-            )
+        elif self._gate.handshakes_open >= self.max_handshakes and not self._make_room(host):
+            refusal = self._busy_sentence()
         if refusal is not None:
             try:
                 sock.send(proto.encode_error(refusal, retry=True))
@@ -619,6 +618,28 @@ class GameServer:
         self._next_cid += 1
         self._conns[conn.cid] = conn
         self._gate.handshake_started(host)
+
+    def _busy_sentence(self) -> str:
+        return (
+            f"the table is busy: {self.max_handshakes} computers are joining at once; "
+            "your client tries again by itself in a few seconds"
+        )
+
+    def _make_room(self, host: str) -> bool:
+        """Every handshake slot is taken: drop one so that `host` may start, if that is fair.
+
+        The oldest handshake of the address holding the most goes (gate.crowding); when no address
+        holds more than `host` would, the oldest of all goes if it has used a third of its HELLO time
+        (an honest HELLO takes a round trip, a dribbled one seconds). False: `host` must wait."""
+        now = time.monotonic()
+        crowded = self._gate.crowding(host)
+        joining = [c for c in self._conns.values() if c.state == State.HELLO and crowded in (None, c.host)]
+        oldest = min(joining, key=lambda c: c.opened, default=None)
+        if oldest is None or (crowded is None and now - oldest.opened < self.hello_timeout_s / 3):
+            return False
+        self._fail(oldest, self._busy_sentence(), retry=True, quiet=True)
+        self._settle(oldest)
+        return True
 
     def _drain_wake(self) -> None:
         assert self._wake_r is not None
