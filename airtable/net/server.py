@@ -45,7 +45,7 @@ from airtable.net.codec import SnapshotEncoder
 from airtable.net.connection import Connection, State
 from airtable.net.events import EventQueue, PlayerInput, PlayerJoined, PlayerLeft
 from airtable.net.gate import FIRST_PASSWORD_WAIT_S, HANDSHAKES_PER_ADDRESS, PLAYERS_PER_ADDRESS, Gate, QuietLog
-from airtable.net.identity import SeatTokens
+from airtable.net.identity import SeatTokens, new_nonce
 from airtable.net.names import distinct_name
 from airtable.net.predictions import MAX_ROUND_PUCKS, PredictionBook, RoundInfo, encode_round, parse_predict
 
@@ -694,9 +694,11 @@ class GameServer:
             self._log_seat(conn, "%s said goodbye", conn.who)
             conn.close()
         elif frame_type == proto.HELLO:
-            if conn.state != State.HELLO:
+            if conn.state != State.HELLO or conn.challenge is not None:
                 raise proto.ProtocolError("HELLO was sent twice; say HELLO once, then send INPUT")
-            self._welcome(conn, proto.parse_hello(payload), now)
+            self._hello(conn, proto.parse_hello(payload), now)
+        elif frame_type == proto.PROOF:
+            self._prove(conn, payload, now)
         elif frame_type == proto.INPUT:
             if conn.state != State.PLAYING:
                 raise proto.ProtocolError(
@@ -707,6 +709,31 @@ class GameServer:
             self._events.input(conn.cid, record)
         elif frame_type == proto.PREDICT:
             self._predict(conn, payload)
+
+    def _hello(self, conn: Connection, hello: proto.Hello, now: float) -> None:
+        """A HELLO that asks for a seat back is challenged first; the token itself never comes (identity.py)."""
+        if hello.seat is None:
+            self._welcome(conn, hello, now)
+            return
+        conn.challenge = (hello, new_nonce())
+        conn.send_control(proto.encode_challenge(conn.challenge[1]))
+
+    def _prove(self, conn: Connection, payload: bytes, now: float) -> None:
+        """The answer to our CHALLENGE: the seat is theirs if it is right; a wrong one is no seat, not an error."""
+        if conn.challenge is None or conn.state != State.HELLO:
+            raise proto.ProtocolError("PROOF came without a CHALLENGE; send PROOF only to answer one")
+        (hello, nonce), conn.challenge = conn.challenge, None
+        proof = proto.parse_proof(payload)
+        assert hello.seat is not None  # only such a HELLO is challenged
+        if self._tokens.proves(hello.seat, hello.name or "", nonce, proof):
+            conn.proven_seat = hello.seat
+        self._welcome(conn, hello, now)
+
+    def _claimed_seat(self, conn: Connection, hello: proto.Hello) -> int | None:
+        """The seat this client proved it holds: by a PROOF, or (older clients) by its token in clear."""
+        if conn.proven_seat is not None:
+            return conn.proven_seat
+        return self._tokens.seat(hello.token, hello.name or "")
 
     def _predict(self, conn: Connection, payload: bytes) -> None:
         """A guess in the prediction round: checked, then kept in the book (never the physics).
@@ -737,7 +764,7 @@ class GameServer:
         if len(self._numbers) >= self.max_clients:
             self._fail(conn, self._full_sentence(), retry=True)
             return
-        number = self._tokens.seat(hello.token, hello.name or "")  # their old seat, if it is free
+        number = self._claimed_seat(conn, hello)  # their old seat, if it is free
         if number is None or number in self._numbers or number > MAX_PLAYERS:
             number = 1
             while number in self._numbers:  # the lowest free number, so names get reused
