@@ -28,6 +28,12 @@ def test_the_proof_is_the_documented_hmac_and_only_the_right_token_and_nonce_mak
     token, nonce = tokens.make(7, "Ann"), "0123456789abcdef" * 2
     assert seat_proof(token, nonce) == proof_by_hand(token, nonce)
     assert len(seat_proof(token, nonce)) == 64
+    docs_example = "5d5a8f1e5bad2a1718286f7ecf5ad3da153025f35a062a0b03baa8f71b369bbc"  # docs/protocol.md
+    assert seat_proof("7-" + "0" * 32, "0123456789abcdef" * 2) == docs_example
+    hello = b'\x00\x00\x00\x25\x01{"protocol":2,"name":"Ann","seat":2}'  # docs/protocol.md, byte by byte
+    assert proto.encode_hello("Ann", seat=2) == hello
+    assert proto.encode_challenge("0" * 32)[:5] == b"\x00\x00\x00\x2d\x0d"
+    assert proto.encode_proof("0" * 64)[:5] == b"\x00\x00\x00\x4d\x0e"
     assert tokens.proves(7, "Ann", nonce, proof_by_hand(token, nonce))
     assert not tokens.proves(7, "Bo", nonce, proof_by_hand(token, nonce))  # the token is the name's
     assert not tokens.proves(6, "Ann", nonce, proof_by_hand(token, nonce))

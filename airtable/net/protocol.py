@@ -345,14 +345,14 @@ def encode_hello(
 ) -> bytes:
     """A HELLO frame. `seat`: ask for that seat back, proving the token in a PROOF (never send `token`)."""
     message: dict = {"protocol": protocol}
-    if seat is not None:
-        message["seat"] = seat
     if name is not None:
         message["name"] = name
     if password is not None:
         message["password"] = password
     if token is not None:
         message["token"] = token
+    if seat is not None:
+        message["seat"] = seat
     return encode_json(HELLO, message)
 
 
