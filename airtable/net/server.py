@@ -601,7 +601,7 @@ class GameServer:
         refusal = self._gate.handshake_refusal(host)
         if len(self._numbers) >= self.max_clients:
             refusal = self._full_sentence()
-        elif self._gate.handshakes_open >= self.max_handshakes and not self._make_room(host):
+        elif refusal is None and self._gate.handshakes_open >= self.max_handshakes and not self._make_room(host):
             refusal = self._busy_sentence()
         if refusal is not None:
             try:
