@@ -15,6 +15,7 @@ from test_server import RawClient, clients, make_server  # noqa: F401  (fixtures
 from airtable.cli import build_parser
 from airtable.net import protocol as proto
 from airtable.net.gate import Gate
+from airtable.net.player import NetPlayer, PlayerState
 
 NAT = "127.0.0.9"  # the one address a classroom's router shows the server
 
@@ -38,6 +39,19 @@ def test_a_class_behind_one_router_is_turned_away_with_how_to_let_it_in(make_ser
     assert "5 students at 127.0.0.9 could not join" in notice and "--per-address 40" in notice
     told = [r.getMessage() for r in caplog.records if "could not join" in r.getMessage()]
     assert len(told) == 1 and "--per-address" in told[0] and told[0].startswith("1 student at 127.0.0.9")
+
+
+def test_the_teachers_window_shows_how_to_let_a_class_in(make_server, clients, demos):  # noqa: F811
+    from airtable.app.app import App
+
+    server = make_server(limit_loopback=True, players_per_address=1)
+    app = App(demos, headless=True, server=server)
+    clients(server.port, source=NAT).hello()
+    late = clients(server.port, source=NAT)
+    late.send(proto.encode_hello())
+    late.expect_error()
+    shown = app.hud_lines()
+    assert any("1 student at 127.0.0.9 could not join" in line and "--per-address" in line for line in shown)
 
 
 def test_eight_students_from_one_address_join_once_the_teacher_allows_it(make_server, clients):  # noqa: F811
@@ -158,6 +172,15 @@ def test_an_honest_student_joins_within_5_s_while_20_addresses_dribble_handshake
     try:
         wait_until(lambda: server.connection_count >= 32 and flood.reopened >= 20, what="the flood to fill the door")
         took = [join_through(server.port, f"127.0.0.{k}", within_s=10.0) for k in (30, 31, 32)]
+        # The real client, from 127.0.0.1, as a student would join.
+        started = time.monotonic()
+        net = NetPlayer("127.0.0.1", server.port, name="Bo")
+        try:
+            net.connect()
+            wait_until(lambda: net.state == PlayerState.CONNECTED, what="the real client to join")
+            took.append((time.monotonic() - started, []))
+        finally:
+            net.close()
     finally:
         flood.stop.set()
         flood.thread.join(timeout=WAIT_S)
