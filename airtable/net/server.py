@@ -17,7 +17,9 @@ Joining is guarded (see gate.py): handshakes have their own cap and a short
 deadline, one computer may hold only a few handshakes and seats, and wrong
 passwords earn a growing wait. When every handshake slot is taken, the
 address holding the most gives its oldest up to a newcomer (`_make_room`),
-so many addresses dribbling HELLOs cannot keep an honest student out. A client that breaks the protocol gets an
+so many addresses dribbling HELLOs cannot keep an honest student out. A
+client that asks for its seat back proves its token (CHALLENGE, PROOF;
+identity.py). A client that breaks the protocol gets an
 ERROR with a sentence it can act on and is dropped; nobody else notices.
 The teacher sees the seats with `roster()` and can `remove()` a player.
 """
