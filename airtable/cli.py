@@ -23,6 +23,7 @@ from airtable.arguments import OneLineParser
 from airtable.assets import ASSETS_DIR
 from airtable.desktop import prepare_for_pygame
 from airtable.memory import keep_freed_memory
+from airtable.net.gate import PLAYERS_PER_ADDRESS
 from airtable.net.server import validate_server_options
 
 HEADLESS_FRAME_S = 1 / 60  # a headless run with no server: simulated frames of this length
@@ -65,6 +66,14 @@ def _server_options(p: argparse.ArgumentParser) -> None:
     p.add_argument("--host", default="0.0.0.0", help="address to listen on (default 0.0.0.0: every network)")
     p.add_argument("--password", default=None, help="students must give this password to join")
     p.add_argument("--max-clients", type=_positive_int, default=30, metavar="N", help="most students at once")
+    p.add_argument(
+        "--per-address",
+        type=_positive_int,
+        default=PLAYERS_PER_ADDRESS,
+        metavar="N",
+        help=f"most students from one address (default {PLAYERS_PER_ADDRESS}); a class behind one router shares"
+        " one address: raise it to the class size (with --password the limit does not apply)",
+    )
     p.add_argument("--snapshot-hz", type=_positive_float, default=30.0, metavar="HZ", help="snapshots per second")
     p.add_argument("--no-server", action="store_true", help="do not accept students over the network")
 
@@ -170,6 +179,7 @@ def start_server(args):
         password=args.password,
         max_clients=args.max_clients,
         snapshot_hz=args.snapshot_hz,
+        players_per_address=args.per_address,
         token_key=load_key(),  # kept in the config folder: students keep their seats across restarts
         name_refusal=NameCheck(drawable_characters()),  # names the projector would draw as boxes are refused
     )

@@ -79,6 +79,8 @@ class Connection:
         self.last_rx = now
         self.deadline = now  # set by the server: when the HELLO or the closing must be done
         self.last_input: proto.InputRecord | None = None
+        self.challenge: tuple[proto.Hello, str] | None = None  # a HELLO asking for a seat, and our nonce
+        self.proven_seat: int | None = None  # the seat the client's PROOF proved (identity.py)
         self.last_change = now  # when the input last changed (for "idle" in the roster)
         self.snapshot_times: deque[float] = deque()  # when each snapshot went out whole
         self.lag_s = 0.0  # smoothed time a snapshot waited here before it was sent

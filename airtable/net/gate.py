@@ -3,7 +3,10 @@
 Used by the server's network thread only. One computer (one address) may
 hold only a few handshakes and a few seats at once, so one student cannot
 fill the table. Connections from this computer itself (loopback) are the
-teacher's own and are not limited unless `limit_loopback` is set.
+teacher's own and are not limited unless `limit_loopback` is set. A class
+behind one router shares one address: the teacher lets it in with
+--per-address N, or with a password (whoever gives it is not limited per
+address); the refusal says so to the student, the log and the projector.
 
 Wrong passwords from an address earn a growing wait before the next guess
 is even checked, then a lockout; the log gets one line per address, not one
@@ -24,6 +27,8 @@ FIRST_PASSWORD_WAIT_S = 1.0  # after the first wrong password; doubles with each
 LOCKOUT_AFTER = 5  # wrong passwords in a row before the lockout
 LOCKOUT_S = 60.0
 SUMMARY_EVERY_S = 30.0
+# How the teacher lets a whole class in from one address (a school's router, NAT).
+ALLOW_A_CLASS = "start the table with --per-address 40, or with a --password (then the limit does not apply)"
 
 
 def is_loopback(host: str) -> bool:
@@ -56,6 +61,7 @@ class Gate:
         self.limit_loopback = limit_loopback
         self.handshakes: Counter[str] = Counter()
         self.players: Counter[str] = Counter()
+        self.turned_away: Counter[str] = Counter()  # seats refused per address, for the teacher's notice
         self._guesses: dict[str, _Guesses] = {}
         self._open = 0
 
@@ -71,19 +77,44 @@ class Gate:
             )
         return None
 
-    def seat_refusal(self, host: str) -> str | None:
-        """Why `host` may not take one more seat, or None."""
-        if self._limited(host) and self.players[host] >= self.players_per_address:
-            return (
-                f"your computer already plays with {self.players[host]} windows, the most one computer may; "
-                "close one of them to join with another"
-            )
-        return None
+    def seat_refusal(self, host: str, password_given: bool = False) -> str | None:
+        """Why `host` may not take one more seat, or None.
+
+        `password_given`: the student gave the table's password, which is the teacher's own
+        door, so a class behind one router (one address to the server) may come in."""
+        if password_given or not self._limited(host) or self.players[host] < self.players_per_address:
+            return None
+        self.turned_away[host] += 1
+        return (
+            f"your computer already plays with {self.players[host]} windows, the most one address ({host}) may; "
+            f"close one of them, or, if your class shares one router, ask the teacher to {ALLOW_A_CLASS}"
+        )
+
+    def teacher_notice(self) -> str | None:
+        """One line for the projector and the log while students are turned away per address, else None."""
+        if not self.turned_away:
+            return None
+        host, count = self.turned_away.most_common(1)[0]
+        return (
+            f"{count} student{'' if count == 1 else 's'} at {host} could not join: one address may have "
+            f"{self.players_per_address} seats; a class behind one router? {ALLOW_A_CLASS}"
+        )
 
     @property
     def handshakes_open(self) -> int:
         """Handshakes under way, from every address."""
         return self._open
+
+    def crowding(self, host: str) -> str | None:
+        """When every handshake slot is taken: the address that should give one up for `host`, or None.
+
+        The address holding the most handshakes, if it holds more than `host` would once let in:
+        so one computer with many addresses cannot keep a newcomer out, and a newcomer's own
+        handshake cannot be pushed out by an address that holds as few (see GameServer._admit)."""
+        if not self.handshakes:
+            return None
+        crowded, most = self.handshakes.most_common(1)[0]
+        return crowded if most > self.handshakes[host] + 1 else None
 
     def handshake_started(self, host: str) -> None:
         self.handshakes[host] += 1

@@ -9,6 +9,14 @@ user's config folder, see `load_key`) still recognises its students, and a
 student cannot make up a token for someone else's seat. The colour follows
 the number, so it comes back too. A token whose seat is taken, or that does
 not verify, is simply not honoured: the player gets the lowest free seat.
+
+The token crosses the network once, in the WELCOME. To ask for the seat
+again a client sends only the seat's number in HELLO; the server answers
+with a CHALLENGE (a fresh random nonce) and the client with a PROOF,
+`seat_proof(token, nonce)`. A program that takes the port after the teacher
+quits therefore learns a proof for its own nonce, which no real server will
+ever ask for again: nothing it can reuse (docs/classroom.md says what the
+token does and does not protect against).
 """
 
 from __future__ import annotations
@@ -21,6 +29,7 @@ import secrets
 from pathlib import Path
 
 KEY_BYTES = 32
+PROOF_LABEL = b"airtable seat proof\n"  # so a proof is never some other HMAC under the same token
 _TOKEN = re.compile(r"^([1-9][0-9]{0,5})-([0-9a-f]{32})$")
 
 
@@ -38,6 +47,10 @@ class SeatTokens:
         """The token of seat `number` held by `name` ("" for a player without a name)."""
         return f"{number}-{self._mac(number, name)}"
 
+    def proves(self, number: int, name: str, nonce: str, proof: str) -> bool:
+        """Whether `proof` answers CHALLENGE `nonce` with the token of seat `number` held by `name`."""
+        return hmac.compare_digest(proof, seat_proof(self.make(number, name), nonce))
+
     def seat(self, token: str | None, name: str) -> int | None:
         """The seat number `token` proves for `name`, or None."""
         match = _TOKEN.match(token or "")
@@ -45,6 +58,22 @@ class SeatTokens:
             return None
         number = int(match.group(1))
         return number if hmac.compare_digest(match.group(2), self._mac(number, name)) else None
+
+
+def new_nonce() -> str:
+    """A CHALLENGE's nonce: 16 random bytes as 32 hex digits, never the same twice."""
+    return secrets.token_hex(16)
+
+
+def seat_proof(token: str, nonce: str) -> str:
+    """The PROOF that answers CHALLENGE `nonce`: HMAC-SHA256 under the token, 64 hex digits."""
+    return hmac.new(token.encode(), PROOF_LABEL + nonce.encode(), hashlib.sha256).hexdigest()
+
+
+def token_seat(token: str | None) -> int | None:
+    """The seat number a token names ("3-..." -> 3), or None for no token or a malformed one."""
+    match = _TOKEN.match(token or "")
+    return int(match.group(1)) if match else None
 
 
 def config_dir() -> Path:

@@ -23,6 +23,7 @@ from airtable.model.scene import Scene
 from airtable.model.student_aids import StudentAids
 from airtable.net import protocol as proto
 from airtable.net.aids_wire import AidsDecoder
+from airtable.net.identity import seat_proof, token_seat
 from airtable.net.playout import SnapshotFeed
 from airtable.net.predictions import RoundInfo, clamp_speed, encode_predict, parse_round
 
@@ -257,15 +258,17 @@ class NetPlayer:
         reader = proto.FrameReader(proto.MAX_SERVER_FRAME, sender="the server")
         deadline = time.monotonic() + self.timeout_s
         try:
-            # After a first WELCOME, its token asks for the same seat (number, name, colour) again.
+            # After a first WELCOME, its token asks for the same seat (number, name, colour) again:
+            # HELLO names the seat, and the token is proven in answer to a CHALLENGE, never sent.
             token = self.welcome.token if self.welcome is not None else None
-            sock.sendall(proto.encode_hello(self.name, self.password, self.protocol_version, token))
+            seat = token_seat(token)
+            sock.sendall(proto.encode_hello(self.name, self.password, self.protocol_version, seat=seat))
             while True:
                 sock.settimeout(max(0.01, deadline - time.monotonic()))
                 data = sock.recv(65536)
                 if not data:
                     raise _ConnectError(f"the server at {where} hung up before saying WELCOME", retry=True)
-                frames = reader.feed(data)
+                frames = self._answer_challenge(sock, reader.feed(data), token)
                 if frames:
                     welcome, rest = self._first_frame(frames)
                     return welcome, reader, rest
@@ -281,6 +284,15 @@ class NetPlayer:
             ) from None
         except OSError as e:
             raise _ConnectError(f"the connection to {where} broke during the handshake ({e})", retry=True) from None
+
+    def _answer_challenge(self, sock: socket.socket, frames: list, token: str | None) -> list:
+        """`frames` without a leading CHALLENGE, which is answered with the token's PROOF."""
+        if not frames or frames[0][0] != proto.CHALLENGE:
+            return frames
+        if token is None:
+            raise proto.ProtocolError("a CHALLENGE came though this client asked for no seat")
+        sock.sendall(proto.encode_proof(seat_proof(token, proto.parse_challenge(frames[0][1]))))
+        return frames[1:]
 
     def _first_frame(self, frames: list) -> tuple[proto.Welcome, list]:
         frame_type, payload = frames[0]

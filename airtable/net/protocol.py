@@ -22,6 +22,7 @@ import unicodedata
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
 
+from airtable.net.names import MAX_NAME_CHARS, looks_like_label
 from airtable.physics.table import TABLE_HEIGHT_M, TABLE_WIDTH_M
 
 PROTOCOL_VERSION = 2
@@ -38,6 +39,8 @@ LAYOUT = 7  # what rarely changes in a snapshot (codec.py), sent when it changes
 AIDS = 10  # the teacher's teaching aids at a tick (aids_wire.py), after its SNAPSHOT while any aid is on
 PREDICT = 8  # a student's guess in a predict-then-reveal round (predictions.py)
 ROUND = 9  # the round's state, counts and, once revealed, every guess (predictions.py)
+CHALLENGE = 13  # server: prove you hold the seat's token (a nonce), answering a HELLO with "seat"
+PROOF = 14  # client: HMAC(token, nonce), so the token itself never crosses the network again (identity.py)
 FRAME_NAMES = {
     HELLO: "HELLO",
     WELCOME: "WELCOME",
@@ -49,8 +52,10 @@ FRAME_NAMES = {
     AIDS: "AIDS",
     PREDICT: "PREDICT",
     ROUND: "ROUND",
+    CHALLENGE: "CHALLENGE",
+    PROOF: "PROOF",
 }
-CLIENT_FRAMES = frozenset({HELLO, INPUT, BYE, PREDICT})
+CLIENT_FRAMES = frozenset({HELLO, INPUT, BYE, PREDICT, PROOF})
 
 # Bytes of L (type + payload) a client may send. A real INPUT is under 400
 # bytes and a HELLO with the longest name and password under 1000, so a
@@ -60,12 +65,12 @@ MAX_CLIENT_FRAME = 1024
 # drawing budget below with room to spare, while a bogus length cannot eat memory.
 MAX_SERVER_FRAME = 16 * 1024 * 1024
 
-MAX_NAME_CHARS = 20
 MAX_PASSWORD_CHARS = 100
 MAX_KEYS = 16
 MAX_KEY_CHARS = 16
 MAX_ERROR_CHARS = 500
 MAX_TOKEN_CHARS = 48  # a seat token, "<number>-<32 hex digits>" (see identity.py)
+MAX_SEAT = 999_999  # the highest seat number a token can name (six digits)
 # A cursor may wander off the table (the view can be zoomed out), but not
 # further than this many table sizes from it; the player clamps to the same box.
 CURSOR_MARGIN_TABLES = 5.0
@@ -266,8 +271,6 @@ def _integer(value: object, what: str) -> int:
 
 # Hangul fillers count as letters but draw nothing; a name of them looks blank.
 _INVISIBLE_LETTERS = frozenset("\u115f\u1160\u3164\uffa0")
-# "C7" on its own: the table labels players "C<n> name", so a name must not imitate one.
-_PLAYER_LABEL = re.compile(r"\bc\s*\d+\b", re.IGNORECASE)
 
 
 def _visible(char: str) -> bool:
@@ -276,7 +279,7 @@ def _visible(char: str) -> bool:
 
 def check_name(name: object) -> str:
     """A player name: 1-20 printable characters with a visible letter or digit, not
-    like another player's "C<n>" label (spaces around are dropped)."""
+    like another player's "C<n>" label (names.py; spaces around are dropped)."""
     if not isinstance(name, str):
         raise ProtocolError(f"the name must be text, not {_short(name)}")
     name = name.strip()
@@ -293,7 +296,7 @@ def check_name(name: object) -> str:
         raise ProtocolError(
             f"the name {_short(name)} has no visible letter or digit; pick a name others can read, like Ann"
         )
-    if _PLAYER_LABEL.search(name):
+    if looks_like_label(name):  # also in look-alike letters: "С1" with a Cyrillic С, "C-1", "C¹"
         raise ProtocolError(
             f"the name {_short(name)} looks like a player label such as C7; pick a name without C and a number"
         )
@@ -327,16 +330,21 @@ class Hello:
     protocol: int
     name: str | None = None
     password: str | None = None
-    token: str | None = None  # from an earlier WELCOME: asks for the same seat again
+    token: str | None = None  # from an earlier WELCOME, in clear (older clients): asks for the same seat again
+    seat: int | None = None  # the seat whose token the client holds: the server sends a CHALLENGE first
 
 
 HELLO_EXAMPLE = f'{{"protocol": {PROTOCOL_VERSION}, "name": "Ann"}}'
 
 
 def encode_hello(
-    name: str | None = None, password: str | None = None, protocol: int = PROTOCOL_VERSION, token: str | None = None
+    name: str | None = None,
+    password: str | None = None,
+    protocol: int = PROTOCOL_VERSION,
+    token: str | None = None,
+    seat: int | None = None,
 ) -> bytes:
-    """A HELLO frame."""
+    """A HELLO frame. `seat`: ask for that seat back, proving the token in a PROOF (never send `token`)."""
     message: dict = {"protocol": protocol}
     if name is not None:
         message["name"] = name
@@ -344,6 +352,8 @@ def encode_hello(
         message["password"] = password
     if token is not None:
         message["token"] = token
+    if seat is not None:
+        message["seat"] = seat
     return encode_json(HELLO, message)
 
 
@@ -377,7 +387,7 @@ def _validate_hello(message: dict) -> Hello:
         raise ProtocolError(f'HELLO "protocol" must be a whole number like {PROTOCOL_VERSION}, not {_short(protocol)}')
     if protocol != PROTOCOL_VERSION:
         raise ProtocolError(version_mismatch(protocol))
-    _check_fields(message, "HELLO", ("protocol",), ("name", "password", "token"))
+    _check_fields(message, "HELLO", ("protocol",), ("name", "password", "token", "seat"))
     name = message.get("name")
     if name is not None:
         name = check_name(name)
@@ -387,7 +397,10 @@ def _validate_hello(message: dict) -> Hello:
     token = message.get("token")
     if token is not None:
         token = _text(token, "the seat token", MAX_TOKEN_CHARS)
-    return Hello(protocol, name, password, token)
+    seat = message.get("seat")
+    if seat is not None and not (1 <= _integer(seat, 'HELLO "seat"') <= MAX_SEAT):
+        raise ProtocolError(f'HELLO "seat" must be a seat number 1-{MAX_SEAT}, not {_short(seat)}')
+    return Hello(protocol, name, password, token, seat)
 
 
 def parse_hello(payload: bytes) -> Hello:
@@ -594,6 +607,43 @@ def parse_error(payload: bytes) -> str:
 
 def encode_bye() -> bytes:
     return encode_frame(BYE)
+
+
+# ---------------------------------------------------------------- CHALLENGE, PROOF (a seat's token, proven)
+
+_NONCE = re.compile(r"[0-9a-f]{32}")
+_PROOF = re.compile(r"[0-9a-f]{64}")
+
+
+def encode_challenge(nonce: str) -> bytes:
+    """A CHALLENGE: `nonce` is 32 lowercase hex digits, new for every connection."""
+    return encode_json(CHALLENGE, {"nonce": nonce})
+
+
+def parse_challenge(payload: bytes) -> str:
+    """The nonce of the server's CHALLENGE."""
+    message = parse_json(payload, "the server's CHALLENGE", '{"nonce": "<32 hex digits>"}')
+    _check_fields(message, "the server's CHALLENGE", ("nonce",))
+    nonce = message["nonce"]
+    if not (isinstance(nonce, str) and _NONCE.fullmatch(nonce)):
+        raise ProtocolError("the server's CHALLENGE has a bad nonce (it should be 32 hex digits)")
+    return nonce
+
+
+def encode_proof(proof: str) -> bytes:
+    """A PROOF: `proof` is identity.seat_proof(token, nonce), 64 lowercase hex digits."""
+    return encode_json(PROOF, {"proof": proof})
+
+
+def parse_proof(payload: bytes) -> str:
+    """The proof of a client's PROOF."""
+    example = '{"proof": "<64 hex digits>"}'
+    message = parse_json(payload, "PROOF", example)
+    _check_fields(message, "PROOF", ("proof",))
+    proof = message["proof"]
+    if not (isinstance(proof, str) and _PROOF.fullmatch(proof)):
+        raise ProtocolError(f"PROOF must be 64 lowercase hex digits; send {example}")
+    return proof
 
 
 # ---------------------------------------------------------------- what a player can draw

@@ -15,7 +15,11 @@ player's rate drops evenly.
 
 Joining is guarded (see gate.py): handshakes have their own cap and a short
 deadline, one computer may hold only a few handshakes and seats, and wrong
-passwords earn a growing wait. A client that breaks the protocol gets an
+passwords earn a growing wait. When every handshake slot is taken, the
+address holding the most gives its oldest up to a newcomer (`_make_room`),
+so many addresses dribbling HELLOs cannot keep an honest student out. A
+client that asks for its seat back proves its token (CHALLENGE, PROOF;
+identity.py). A client that breaks the protocol gets an
 ERROR with a sentence it can act on and is dropped; nobody else notices.
 The teacher sees the seats with `roster()` and can `remove()` a player.
 """
@@ -42,7 +46,8 @@ from airtable.net.codec import SnapshotEncoder
 from airtable.net.connection import Connection, State
 from airtable.net.events import EventQueue, PlayerInput, PlayerJoined, PlayerLeft
 from airtable.net.gate import FIRST_PASSWORD_WAIT_S, HANDSHAKES_PER_ADDRESS, PLAYERS_PER_ADDRESS, Gate, QuietLog
-from airtable.net.identity import SeatTokens
+from airtable.net.identity import SeatTokens, new_nonce
+from airtable.net.names import distinct_name
 from airtable.net.predictions import MAX_ROUND_PUCKS, PredictionBook, RoundInfo, encode_round, parse_predict
 from airtable.physics.colors import rgb
 
@@ -70,6 +75,7 @@ SELECT_SOCKETS = 500  # select() watches at most 512 sockets on Windows (1024 fd
 RESERVED_FDS = 32  # descriptors kept for the app itself (files, the display, the listener)
 FAR_OFF_TABLES = 1.0  # a cursor this many table sizes beyond the edge is "far off" in the roster
 ACCEPT_PAUSE_S = 0.5  # out of descriptors: stop accepting for this long
+NOTICE_S = 60.0  # the projector shows why students were turned away for this long after the last one
 
 
 def client_color(number: int) -> tuple[int, int, int]:
@@ -227,6 +233,7 @@ class GameServer:
         self._table_size_m: tuple[float, float] = proto.DEFAULT_TABLE_SIZE_M  # plain tuple: replaced, never mutated
         self.predictions = PredictionBook()  # the predict-then-reveal round's guesses (has its own lock)
         self._round_frame: bytes | None = None  # the newest ROUND, for players who join during a round
+        self._door_notice: tuple[str, float] = ("", 0.0)  # for the teacher, and until when (see join_lines)
 
         # Game loop only.
         self._clients: dict[int, Client] = {}
@@ -356,12 +363,15 @@ class GameServer:
         return self._thread is not None and self._thread.is_alive() and not self._stopping.is_set()
 
     def join_lines(self) -> list[str]:
-        """What students type to join, e.g. ["join with: airtable-client 192.168.1.23"].
+        """What students type to join, e.g. ["join with: airtable-client 192.168.1.23"], and, for
+        NOTICE_S after students were turned away per address, the line that says how to let them in.
 
         Worked out once per port and cached, since the app may ask every frame."""
         if self._join_lines is None or self._join_lines[0] != self.port:
             self._join_lines = (self.port, self._make_join_lines())
-        return list(self._join_lines[1])
+        with self._lock:
+            notice, until = self._door_notice
+        return list(self._join_lines[1]) + ([notice] if notice and time.monotonic() < until else [])
 
     def _make_join_lines(self) -> list[str]:
         host = self.host or "0.0.0.0"
@@ -592,11 +602,8 @@ class GameServer:
         refusal = self._gate.handshake_refusal(host)
         if len(self._numbers) >= self.max_clients:
             refusal = self._full_sentence()
-        elif self._gate.handshakes_open >= self.max_handshakes:
-            refusal = (
-                f"the table is busy: {self.max_handshakes} computers are joining at once; "
-                "your client tries again by itself in a few seconds"
-            )
+        elif refusal is None and self._gate.handshakes_open >= self.max_handshakes and not self._make_room(host):
+            refusal = self._busy_sentence()
         if refusal is not None:
             try:
                 sock.send(proto.encode_error(refusal, retry=True))
@@ -612,6 +619,28 @@ class GameServer:
         self._next_cid += 1
         self._conns[conn.cid] = conn
         self._gate.handshake_started(host)
+
+    def _busy_sentence(self) -> str:
+        return (
+            f"the table is busy: {self.max_handshakes} computers are joining at once; "
+            "your client tries again by itself in a few seconds"
+        )
+
+    def _make_room(self, host: str) -> bool:
+        """Every handshake slot is taken: drop one so that `host` may start, if that is fair.
+
+        The oldest handshake of the address holding the most goes (gate.crowding); when no address
+        holds more than `host` would, the oldest of all goes if it has used a third of its HELLO time
+        (an honest HELLO takes a round trip, a dribbled one seconds). False: `host` must wait."""
+        now = time.monotonic()
+        crowded = self._gate.crowding(host)
+        joining = [c for c in self._conns.values() if c.state == State.HELLO and crowded in (None, c.host)]
+        oldest = min(joining, key=lambda c: c.opened, default=None)
+        if oldest is None or (crowded is None and now - oldest.opened < self.hello_timeout_s / 3):
+            return False
+        self._fail(oldest, self._busy_sentence(), retry=True, quiet=True)
+        self._settle(oldest)
+        return True
 
     def _drain_wake(self) -> None:
         assert self._wake_r is not None
@@ -666,9 +695,11 @@ class GameServer:
             self._log_seat(conn, "%s said goodbye", conn.who)
             conn.close()
         elif frame_type == proto.HELLO:
-            if conn.state != State.HELLO:
+            if conn.state != State.HELLO or conn.challenge is not None:
                 raise proto.ProtocolError("HELLO was sent twice; say HELLO once, then send INPUT")
-            self._welcome(conn, proto.parse_hello(payload), now)
+            self._hello(conn, proto.parse_hello(payload), now)
+        elif frame_type == proto.PROOF:
+            self._prove(conn, payload, now)
         elif frame_type == proto.INPUT:
             if conn.state != State.PLAYING:
                 raise proto.ProtocolError(
@@ -679,6 +710,31 @@ class GameServer:
             self._events.input(conn.cid, record)
         elif frame_type == proto.PREDICT:
             self._predict(conn, payload)
+
+    def _hello(self, conn: Connection, hello: proto.Hello, now: float) -> None:
+        """A HELLO that asks for a seat back is challenged first; the token itself never comes (identity.py)."""
+        if hello.seat is None:
+            self._welcome(conn, hello, now)
+            return
+        conn.challenge = (hello, new_nonce())
+        conn.send_control(proto.encode_challenge(conn.challenge[1]))
+
+    def _prove(self, conn: Connection, payload: bytes, now: float) -> None:
+        """The answer to our CHALLENGE: the seat is theirs if it is right; a wrong one is no seat, not an error."""
+        if conn.challenge is None or conn.state != State.HELLO:
+            raise proto.ProtocolError("PROOF came without a CHALLENGE; send PROOF only to answer one")
+        (hello, nonce), conn.challenge = conn.challenge, None
+        proof = proto.parse_proof(payload)
+        assert hello.seat is not None  # only such a HELLO is challenged
+        if self._tokens.proves(hello.seat, hello.name or "", nonce, proof):
+            conn.proven_seat = hello.seat
+        self._welcome(conn, hello, now)
+
+    def _claimed_seat(self, conn: Connection, hello: proto.Hello) -> int | None:
+        """The seat this client proved it holds: by a PROOF, or (older clients) by its token in clear."""
+        if conn.proven_seat is not None:
+            return conn.proven_seat
+        return self._tokens.seat(hello.token, hello.name or "")
 
     def _predict(self, conn: Connection, payload: bytes) -> None:
         """A guess in the prediction round: checked, then kept in the book (never the physics).
@@ -698,7 +754,9 @@ class GameServer:
     def _welcome(self, conn: Connection, hello: proto.Hello, now: float) -> None:
         if not self._password_ok(conn, hello, now):
             return
-        refusal = self._gate.seat_refusal(conn.host)
+        refusal = self._gate.seat_refusal(conn.host, password_given=self.password is not None)
+        if refusal is not None:
+            self._tell_teacher(self._gate.teacher_notice())
         if refusal is None and hello.name and self._name_refusal is not None:
             refusal = self._name_refusal(hello.name)
         if refusal is not None:
@@ -707,13 +765,14 @@ class GameServer:
         if len(self._numbers) >= self.max_clients:
             self._fail(conn, self._full_sentence(), retry=True)
             return
-        number = self._tokens.seat(hello.token, hello.name or "")  # their old seat, if it is free
+        number = self._claimed_seat(conn, hello)  # their old seat, if it is free
         if number is None or number in self._numbers or number > MAX_PLAYERS:
             number = 1
             while number in self._numbers:  # the lowest free number, so names get reused
                 number += 1
         client = f"C{number}"
-        name = client + (f" {hello.name}" if hello.name else "")  # the cursor's label
+        shown = self._distinct(hello.name)
+        name = client + (f" {shown}" if shown else "")  # the cursor's label
         color = client_color(number)
         self._gate.handshake_ended(conn.host, seated=True)
         conn.number, conn.name, conn.state = number, name, State.PLAYING
@@ -723,13 +782,27 @@ class GameServer:
         self._events.join(conn.cid, name, color, number)
         width_m, height_m = self._table_size_m
         token = self._tokens.make(number, hello.name or "")
-        conn.send_control(proto.encode_welcome(client, color, width_m, height_m, hello.name, token))
+        conn.send_control(proto.encode_welcome(client, color, width_m, height_m, shown, token))
         conn.offer_tick(self._encoder, now)  # the newest picture straight away, if there is one
         with self._lock:
             round_frame = self._round_frame
         if round_frame is not None:  # a prediction round is under way
             conn.send_control(round_frame)
         self._log_seat(conn, "%s joined from %s", name, conn.peer)
+
+    def _tell_teacher(self, notice: str | None) -> None:
+        """A line for the log (once, then summaries) and for the projector, under the join lines, for a while."""
+        if notice:
+            self._quiet.note("students turned away per address", "%s", notice)
+            with self._lock:
+                self._door_notice = (notice, time.monotonic() + NOTICE_S)
+
+    def _distinct(self, name: str | None) -> str | None:
+        """`name` as the table shows it: "Ann 2" when an "Ann" (or an "Αnn", in look-alike letters) plays."""
+        if not name:
+            return name
+        playing = (self._conns[cid].name.partition(" ")[2] for cid in self._numbers.values())
+        return distinct_name(name, playing)
 
     def _log_seat(self, conn: Connection, line: str, *args) -> None:
         """Joins and leaves, one line each, but summarised when one computer churns."""
