@@ -573,10 +573,24 @@ def test_password(make_server, clients):
     c.send(proto.encode_hello("Ann", "open sesame"))
     sentence = c.expect_error()
     assert "wrong password" in sentence and "--password" in sentence and "sesame" not in sentence
-    # Right after a wrong guess even the right password waits, so guessing is slow.
+    # One typo costs nothing: the right password straight after gets in.
     c = clients(server.port)
     c.send(proto.encode_hello("Ann", "sesame"))
-    assert "wait 1 s" in c.expect_error()
+    got = c.next_frame()
+    assert got[0] == proto.WELCOME, got
+    c.close()
+    wait_until(lambda: server.player_count == 0, what="Ann to leave")
+    # After a second wrong guess even the right password waits, so guessing is slow; the
+    # refusal asks the client to try again by itself.
+    for _ in range(2):
+        c = clients(server.port)
+        c.send(proto.encode_hello("Ann", "open sesame"))
+        assert "wrong password" in c.expect_error()
+    c = clients(server.port)
+    c.send(proto.encode_hello("Ann", "sesame"))
+    got = c.next_frame()
+    sentence, retry = proto.parse_error_message(got[1])
+    assert "waiting 1 s" in sentence and retry
 
     def joined():
         c = clients(server.port)
@@ -602,10 +616,10 @@ def test_wrong_passwords_earn_a_growing_wait_then_a_lockout_and_few_log_lines(ma
 
     caplog.set_level(logging.INFO, logger="airtable.net")
     # Guess as fast as the server answers until it locks us out: only 5 guesses are ever checked.
-    wait_until(lambda: "wait 60 s" in guess("guess"), what="the lockout")
+    wait_until(lambda: "waiting 60 s" in guess("guess"), what="the lockout")
     checked = [a for a in answers if a.startswith("wrong password")]
     waits = [a for a in answers if a.startswith("too many wrong passwords")]
-    assert len(checked) == 5 and waits, answers
+    assert len(checked) == 5 and waits, answers  # the first wrong one costs no wait, the later ones do
     for _ in range(200):
         guess("guess")
     assert guess("sesame").startswith("too many wrong passwords"), "locked out: even the right password waits"
@@ -919,3 +933,21 @@ def test_a_name_the_teachers_screen_cannot_draw_is_refused_with_a_sentence(make_
         c.send(proto.encode_hello(name))
         sentence = c.expect_error()
         assert f"{ch!r} (U+{ord(ch):04X}), which the teacher's screen cannot draw" in sentence
+
+
+def test_a_student_who_mistyped_the_password_twice_gets_in_with_the_right_one(make_server, clients):
+    """The teacher's window is locked for a second after two wrong passwords; the real client
+    waits it out by itself instead of ending with 'wait 1 s' (issue 22: a typo ended the join)."""
+    from airtable.net.player import NetPlayer
+
+    server = make_server(password="sesame", password_wait_s=0.5)
+    for _ in range(2):
+        c = clients(server.port)
+        c.send(proto.encode_hello("Ann", "sesam"))
+        assert "wrong password" in c.expect_error()
+    net = NetPlayer("127.0.0.1", server.port, name="Ann", password="sesame", max_backoff_s=0.2)
+    try:
+        welcome = net.connect() or wait_until(lambda: net.welcome, what="the join after the wait")
+        assert welcome.label == "C1 Ann" and net.error is None
+    finally:
+        net.close()

@@ -23,7 +23,7 @@ from dataclasses import dataclass
 
 HANDSHAKES_PER_ADDRESS = 4
 PLAYERS_PER_ADDRESS = 3
-FIRST_PASSWORD_WAIT_S = 1.0  # after the first wrong password; doubles with each one
+FIRST_PASSWORD_WAIT_S = 1.0  # after the second wrong password in a row; doubles with each one (a typo costs nothing)
 LOCKOUT_AFTER = 5  # wrong passwords in a row before the lockout
 LOCKOUT_S = 60.0
 SUMMARY_EVERY_S = 30.0
@@ -147,10 +147,10 @@ class Gate:
             guesses.next_try = now + LOCKOUT_S
             if guesses.wrong == LOCKOUT_AFTER:
                 log.warning("%s gave %d wrong passwords: locked out for %g s", host, guesses.wrong, LOCKOUT_S)
-        else:
-            guesses.next_try = now + self.password_wait_s * 2 ** (guesses.wrong - 1)
-            if guesses.wrong == 1:
-                log.info("wrong password from %s", host)
+        elif guesses.wrong > 1:
+            guesses.next_try = now + self.password_wait_s * 2 ** (guesses.wrong - 2)
+        if guesses.wrong == 1:
+            log.info("wrong password from %s", host)
 
     def right_password(self, host: str) -> None:
         self._guesses.pop(host, None)
@@ -159,7 +159,7 @@ class Gate:
         """Drop addresses whose wait is long over; log what was refused meanwhile."""
         for host, guesses in list(self._guesses.items()):
             if guesses.refused and now >= guesses.next_try:
-                log.info("%s tried %d more passwords while it had to wait", host, guesses.refused)
+                log.info("%s tried to join %d more times while it had to wait", host, guesses.refused)
                 guesses.refused = 0
             if now > guesses.next_try + LOCKOUT_S:
                 del self._guesses[host]

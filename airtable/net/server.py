@@ -816,10 +816,10 @@ class GameServer:
             return False
         wait = self._gate.password_wait(conn.host, now)
         if wait > 0:
-            self._fail(
+            self._fail(  # retry: the client asks again by itself; a right password then gets in
                 conn,
-                f"too many wrong passwords from your computer: wait {math.ceil(wait)} s, "
-                "then join again with the teacher's password",
+                f"too many wrong passwords from your computer: waiting {math.ceil(wait)} s before the next try",
+                retry=True,
                 quiet=True,
             )
             return False
