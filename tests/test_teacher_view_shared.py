@@ -25,6 +25,7 @@ from airtable.net.player import PlayerState
 from airtable.student.window import PlayerApp
 
 ROOT = Path(__file__).resolve().parent.parent
+STARTUP_S = 60.0  # the bound on a client process's start (a bound, not a delay)
 
 
 def wheel(teacher, clicks: int) -> None:
@@ -103,6 +104,10 @@ def test_zooming_and_panning_far_keeps_the_student_connected(demos):
         assert teacher.student_count() == 1
 
 
+def bo_plays(teacher) -> bool:
+    return any(name.endswith(" Bo") for name in teacher.server.player_names())
+
+
 def test_a_real_client_outlives_any_view(demos, tmp_path):
     shot = tmp_path / "student.png"
     with teacher_and_student(demos, "1") as (teacher, _):
@@ -115,8 +120,12 @@ def test_a_real_client_outlives_any_view(demos, tmp_path):
             stderr=subprocess.PIPE,
         )
         try:
-            frames_until(teacher, lambda: teacher.student_count() == 2 or client.poll() is not None, "Bo to join")
-            assert client.poll() is None, client.communicate()
+            # A new Python process with pygame and numpy takes seconds to start on a busy machine.
+            deadline = time.monotonic() + STARTUP_S
+            while not bo_plays(teacher) and client.poll() is None and time.monotonic() < deadline:
+                teacher.frame(FRAME_S)
+                time.sleep(FRAME_S)
+            assert client.poll() is None and bo_plays(teacher), client.communicate()
             wheel(teacher, -40)
             ctrl_drag(teacher, 12, (-700, 300))
             wheel(teacher, 200)
@@ -125,7 +134,7 @@ def test_a_real_client_outlives_any_view(demos, tmp_path):
                 teacher.frame(FRAME_S)
                 time.sleep(FRAME_S)
             assert client.poll() is None, client.communicate()
-            assert teacher.student_count() == 2
+            assert bo_plays(teacher)  # (Ann, who sends nothing, may be dropped meanwhile as any silent client)
         finally:
             if client.poll() is None:
                 client.send_signal(signal.SIGINT)  # as Ctrl+C: the client saves its screenshot and leaves

@@ -2,7 +2,8 @@
 
 Each frame (`App.frame`): input (controls.py), the network's joins and inputs,
 as many fixed physics steps as the frame's time allows (loop.py), a snapshot
-for the students, then drawing. `App.run` repeats frames with a FrameLoop.
+for the students, then drawing. `App.run` repeats frames with an IdlingLoop (loop.py),
+as the student's window does.
 Demo scenes come from demo files (demo_loader.py), read again when they
 change; the panels over the table (help, notes, the demo menu, errors) are
 opened and closed here.
@@ -27,7 +28,7 @@ from airtable.app.environment import Environment
 from airtable.app.history import History
 from airtable.app.lessons import Lessons
 from airtable.app.lessons_view import draw_lessons
-from airtable.app.loop import FixedStep, FpsCounter, FrameLoop, signals_end_the_run
+from airtable.app.loop import FixedStep, FpsCounter, IdlingLoop, signals_end_the_run
 from airtable.app.menu import DemoMenu
 from airtable.app.overlays import OverlayFlag, Overlays
 from airtable.app.predict_view import draw_predict
@@ -164,7 +165,7 @@ class App:
         self.frame_dt_s = 0.0  # the current frame's time (held keys act in proportion)
         self.last_input_s = 0.0  # clock_s of the last input, local or a student's
         self._students_seen: tuple = ()  # the students' cursors when last looked at
-        self.loop: FrameLoop | None = None  # while run() runs
+        self.loop: IdlingLoop | None = None  # while run() runs
         self.demo_key = ""
         self.demo_path: Path | None = None
 
@@ -582,8 +583,7 @@ class App:
         display's refresh rate, sleeping in between; a still table runs at
         IDLE_FPS and wakes on input. `started` is called once signals end the run (see loop.py).
         """
-        self._full_period_s = 1.0 / display_rate_hz()
-        self.loop = FrameLoop(fps=1.0 / self._full_period_s, fixed_dt_s=frame_dt_s, sleep=self._sleep)
+        self.loop = IdlingLoop(display_rate_hz(), IDLE_FPS, self.still, self.window.headless, fixed_dt_s=frame_dt_s)
         try:
             with signals_end_the_run(self.stop):
                 if started is not None:
@@ -598,14 +598,5 @@ class App:
 
     def _frame_running(self, dt_s: float) -> bool:
         self.frame(dt_s)
-        self.loop.period_s = 1.0 / IDLE_FPS if self.still() else self._full_period_s
+        self.loop.after_frame()
         return self.running
-
-    def _sleep(self, seconds: float) -> None:
-        """Between frames: a plain sleep, or while idle a wait that ends early on input."""
-        if self.window.headless or self.loop.period_s == self._full_period_s:
-            self.loop.stop.wait(seconds)
-            return
-        event = pygame.event.wait(max(1, int(seconds * 1000)))
-        if event.type != pygame.NOEVENT:
-            pygame.event.post(event)  # back in the queue, for the frame it woke

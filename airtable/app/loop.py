@@ -175,3 +175,28 @@ def signals_end_the_run(stop: Callable[[], None]) -> Iterator[None]:
     finally:
         for sig, handler in before.items():
             signal.signal(sig, handler if handler is not None else signal.SIG_DFL)
+
+
+class IdlingLoop(FrameLoop):
+    """The windows' loop (the teacher's and each student's): full rate while anything moves or input
+    came lately, `idle_fps` while the window is still (`still()` says so after each frame), and
+    while idle the wait between frames ends at once on input (a pygame event)."""
+
+    def __init__(self, fps: float, idle_fps: float, still: Callable[[], bool], headless: bool, **kw) -> None:
+        super().__init__(fps=fps, sleep=self._sleep, **kw)
+        self.full_period_s, self.idle_period_s = 1.0 / fps, 1.0 / idle_fps
+        self.still, self.headless = still, headless
+
+    def after_frame(self) -> None:
+        """Call at the end of each frame: the next one comes at the full or the idle rate."""
+        self.period_s = self.idle_period_s if self.still() else self.full_period_s
+
+    def _sleep(self, seconds: float) -> None:
+        if self.headless or self.period_s == self.full_period_s:
+            self.stop.wait(seconds)
+            return
+        import pygame  # only the windows idle this way; the load tool's loops have no pygame
+
+        event = pygame.event.wait(max(1, int(seconds * 1000)))
+        if event.type != pygame.NOEVENT:
+            pygame.event.post(event)  # back in the queue, for the frame it woke

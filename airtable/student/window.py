@@ -16,6 +16,7 @@ from collections.abc import Callable, Sequence
 
 import numpy as np
 
+from airtable.app.loop import IdlingLoop, signals_end_the_run
 from airtable.app.predict import StudentGuesses
 from airtable.app.predict_view import paint_round
 from airtable.app.room import student_banner
@@ -38,16 +39,6 @@ MAX_PUCK_LOOKS = 1024
 MAX_SPRING_SPAN_PX = 20_000_000
 
 
-def _wait_for_input(seconds: float) -> None:
-    """Sleep up to `seconds`, waking early when an event (input, the window) comes in; the
-    event stays in the queue for the next frame."""
-    import pygame
-
-    event = pygame.event.wait(max(1, int(seconds * 1000)))
-    if event.type != pygame.NOEVENT:
-        pygame.event.post(event)
-
-
 class PlayerApp:
     """The pygame window of a player: the server's table from snapshots, our cursor drawn locally."""
 
@@ -65,6 +56,7 @@ class PlayerApp:
         self.show_help = False  # F1: the keys of this window
         self.leave_asked_until = -math.inf  # time.monotonic() until which a second Esc leaves
         self.ended: str | None = None  # why the session ended for good, shown until a key is pressed
+        self.status = 0  # what run() returns: 1 once the session ended for good
         self.painter = None  # the AidsPainter, once the window is open
         self.lessons_painter = None  # the LessonsPainter (momenta, values) and
         self.timeline_painter = None  # the TimelinePainter, likewise
@@ -82,35 +74,34 @@ class PlayerApp:
         Ends after `seconds`, or after the frame in which `until()` is true, or
         when the user quits. Closes the connection when it ends, but leaves
         pygame running (main() quits it)."""
-        import pygame
-
         self._open_window()
-        clock = pygame.time.Clock()
-        start = time.monotonic()
-        status = 0
+        self.status = 0
+        loop = IdlingLoop(self.fps, IDLE_FPS, lambda: self.still(time.monotonic()), self.headless)
         try:
-            while self._handle_events(pygame.event.get()):
-                if self.net.state == PlayerState.FAILED and self.ended is None:
-                    print(f"airtable-client: {self.net.error}", file=sys.stderr)
-                    status, self.ended = 1, self.net.error or "the session ended"
-                    if self.headless:
-                        break  # nobody to read it: the line above says it
-                self._frame()
-                if seconds is not None and time.monotonic() - start >= seconds:
-                    break
-                if until is not None and until():
-                    break
-                if self.still(time.monotonic()) and not self.headless:
-                    _wait_for_input(1.0 / IDLE_FPS)
-                else:
-                    clock.tick(self.fps)
+            with signals_end_the_run(loop.stop.set):
+                loop.run(lambda dt_s: self._frame_running(loop, until), max_time_s=seconds)
         except KeyboardInterrupt:
             pass
         finally:
             if screenshot:
                 self.window.save_screenshot(screenshot)
             self.net.close(bye=True)
-        return status
+        return self.status
+
+    def _frame_running(self, loop: IdlingLoop, until: Callable[[], bool] | None) -> bool:
+        """One frame of the window's loop; False to end it."""
+        import pygame
+
+        if not self._handle_events(pygame.event.get()):
+            return False
+        if self.net.state == PlayerState.FAILED and self.ended is None:
+            print(f"airtable-client: {self.net.error}", file=sys.stderr)
+            self.status, self.ended = 1, self.net.error or "the session ended"
+            if self.headless:
+                return False  # nobody to read it: the line above says it
+        self._frame()
+        loop.after_frame()
+        return until is None or not until()
 
     def note_motion(self, scene: Scene, cursor_m: np.ndarray, now_s: float) -> None:
         """Remember what moves in this frame: the pucks, every cursor, our own input."""
