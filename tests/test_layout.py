@@ -42,12 +42,12 @@ def crossings(app, boxes) -> list[tuple]:
 
 
 @pytest.mark.parametrize("size", SIZES, ids=lambda s: f"{s[0]}x{s[1]}")
-@pytest.mark.parametrize("demo", ["3", "8"])
+@pytest.mark.parametrize("demo", ["3", "6", "8"])
 def test_no_text_crosses_a_wall_or_a_resting_puck(demos, server, size, demo):
     app = App(demos, demo_key=demo, headless=True, server=server, window_size_px=size)
     pygame.event.clear()
     app.say("a message for the room, long enough to need its own line on a small window")
-    for key in (pygame.K_SPACE, pygame.K_v, pygame.K_a):
+    for key in (pygame.K_SPACE, pygame.K_v, pygame.K_a, pygame.K_k):
         press(app, key)
     app.frame(FRAME_S)
     assert app.paused

@@ -184,25 +184,28 @@ class AidsPainter:
 
     def legend(self, lines: Sequence[tuple[str, Sequence[int]]]) -> None:
         """Coloured lines of text in an opaque box in a corner: in a side margin where the window has
-        one, else the first corner clear of the pucks and other text (the top left if none is)."""
+        one (wrapped to it), else the first corner clear of the pucks and other text (the top left if none is)."""
         font, pad = self.w.font, self.w.line_px(4)
         line_h = font.get_linesize()
+        column = self.w.layout.side_px - 2 * pad
+        if column > 0:
+            lines = [(row, color) for text, color in lines for row in _wrap(font, text, column)]
         size = (max(font.size(t)[0] for t, _ in lines) + 4, line_h * len(lines))
         avoid = self._taken + self.puck_boxes
         order = (3, 2, 0, 1)  # top left first, where the eye starts
-        margins = self.w.layout.side_px > 0
-        corners = [place_in_corner(self.w, pygame.Rect((0, 0), size), c) for c in order] if margins else []
+        fits_margin = 0 < size[0] <= self.w.layout.side_px - 2 * pad
+        corners = [place_in_corner(self.w, pygame.Rect((0, 0), size), c) for c in order] if fits_margin else []
         inside = [table_corner(self.w, pygame.Rect((0, 0), size), c) for c in order]
-        block = next((r for r in corners + inside if r.collidelist(avoid) < 0), inside[0])
-        for _ in range(len(self._taken)):  # slide down past whatever text is in the way
-            hit = block.collidelist(self._taken)
-            if hit < 0:
-                break
-            block.top = self._taken[hit].bottom + pad
+        # The first corner clear of everything; else the one over the fewest pucks and walls, clear of text.
+        candidates = corners + inside
+        block = next((r for r in candidates if r.collidelist(avoid) < 0), None)
+        if block is None:
+            clear_of_text = [r for r in candidates if r.collidelist(self._taken) < 0] or candidates
+            block = min(clear_of_text, key=lambda r: len(r.collidelistall(self.puck_boxes)))
         pygame.draw.rect(self.w.surface, (0, 0, 0), block.inflate(4, 2))
         for k, (text, color) in enumerate(lines):
-            self._text(text, (block.x + 2, block.top + k * line_h), color, font=font)
-        self._taken.append(block)
+            block.union_ip(self._text(text, (block.x + 2, block.top + k * line_h), color, font=font))
+        self._taken.append(block)  # where the text really is: the layout test reads it
 
     def _dashed(self, color, a_px, b_px, width: int) -> None:
         length = math.hypot(b_px[0] - a_px[0], b_px[1] - a_px[1])

@@ -6,6 +6,7 @@ aids.EnergyChart)."""
 
 from __future__ import annotations
 
+import dataclasses
 import threading
 
 import numpy as np
@@ -122,7 +123,10 @@ class StudentAids:
         if frame is None or not frame.lesson_flags & aids_wire.VALUES:
             return None
         mass, vel, rows = frame.value_mass_kg, frame.value_vel_mps, frame.value_rows
-        scale = self.chart.scale if self.chart.scale.energy_J > 0 else None  # the scene's, while the chart came
+        scale = None
+        if self.chart.scale.energy_J > 0:  # the scene's, while the chart comes; its momentum scale needs the masses
+            scale = dataclasses.replace(self.chart.scale)
+            scale.observe((), 0.0, float(np.sum(mass)) if mass is not None else 0.0)
         if frame.values_every:
             return frame.values_corner, every_puck_values(mass, vel, scale)
         at = np.flatnonzero(rows == pointed) if pointed is not None else ()
