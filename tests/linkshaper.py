@@ -174,7 +174,8 @@ def run_isolated(module: str, function: str, timeout_s: float = 60.0, **kwargs):
         "json.loads(sys.argv[4]))))"
     )
     args = ["unshare", "-n", sys.executable, "-c", code, str(ROOT), module, function, json.dumps(kwargs)]
-    path = os.pathsep.join(p for p in sys.path if p and os.path.isdir(p))  # the module is found as here
+    # The child finds modules as this process does.
+    path = os.pathsep.join(os.path.abspath(p or ".") for p in sys.path if os.path.isdir(p or "."))
     env = {**os.environ, "SDL_VIDEODRIVER": "dummy", "SDL_AUDIODRIVER": "dummy", "PYTHONPATH": path}
     done = subprocess.run(args, capture_output=True, text=True, timeout=timeout_s, env=env)
     for line in done.stdout.splitlines():
@@ -192,3 +193,104 @@ def _child(module: str, function: str, kwargs: dict):
         return getattr(importlib.import_module(module), function)(shaper, **kwargs)
     finally:
         shaper.close()
+
+
+class Classroom:
+    """A teacher's table (a headless 60 fps loop publishing 30 snapshots a second) and students built on
+    the real client (`NetPlayer`), joined across the shaped link. For tests and the bench, in the child."""
+
+    def __init__(self, students: int = 3, pucks: int = 12, **server_options) -> None:
+        from airtable.app.client import Client
+        from airtable.net.server import GameServer
+        from airtable.physics.table import AirTable
+
+        # Every student comes from one address here: no per-address limit.
+        options = {"players_per_address": 1000, "handshakes_per_address": 1000, **server_options}
+        self.server = GameServer(host=SERVER_HOST, port=0, **options)
+        self.server.start()
+        self.table = AirTable()
+        for i in range(pucks):  # a row of pucks drifting, so every snapshot carries motion
+            self.table.add_puck((0.5 + 0.7 * i % 9.0, 1.0 + 0.6 * (i // 12)), radius_m=0.2, vel_mps=(0.3, 0.2))
+        self.clients = [Client(name="local", active=False)]
+        self.lock = threading.Lock()
+        self.effects: dict[str, dict[float, float]] = {}  # player name -> {cursor x: when the table first had it}
+        self.students: list = []
+        self._stop = threading.Event()
+        self._loop = threading.Thread(target=self._run, name="table-loop", daemon=True)
+        self._loop.start()
+        self.join(students)
+
+    def join(self, count: int, prefix: str = "S") -> list:
+        """`count` more students, connected in parallel; returns them."""
+        from airtable.net.player import NetPlayer
+
+        first = len(self.students)
+        new = [
+            NetPlayer(SERVER_VIA, self.server.port, name=f"{prefix}{first + i}", max_backoff_s=1.0)
+            for i in range(count)
+        ]
+        threads = [threading.Thread(target=_connect_quietly, args=(net,), daemon=True) for net in new]
+        for t in threads:
+            t.start()
+        for t in threads:
+            t.join(timeout=60.0)
+        self.students += new
+        return new
+
+    def _run(self) -> None:
+        from airtable.app.scene import Scene
+
+        frame_s, next_t = 1 / 60, time.monotonic()
+        while not self._stop.is_set():
+            with self.lock:
+                self.server.update_clients(self.clients, self.table)
+                now = time.monotonic()
+                for client in self.clients[1:]:
+                    seen = self.effects.setdefault(client.name, {})
+                    seen.setdefault(round(float(client.cursor_m[0]), 4), now)
+                for _ in range(4):
+                    self.table.step(frame_s / 4)
+                self.server.publish(Scene.from_table(self.table, self.clients, title="link", status=f"{now:.3f}"))
+            next_t += frame_s
+            time.sleep(max(0.0, next_t - time.monotonic()))
+
+    def rates(self, seconds: float) -> list[float]:
+        """Snapshots a second each student received over the next `seconds`."""
+        before = [net.snapshots for net in self.students]
+        time.sleep(seconds)
+        return [(net.snapshots - b) / seconds for net, b in zip(self.students, before, strict=True)]
+
+    def seats(self) -> list[tuple[str, list[int]] | None]:
+        """Each student's seat ("C3") and colour, or None while it has none."""
+        return [None if n.welcome is None else (n.welcome.client, list(n.welcome.color)) for n in self.students]
+
+    def port_of(self, net) -> int | None:
+        sock = net._sock
+        try:
+            return None if sock is None else sock.getsockname()[1]
+        except OSError:
+            return None
+
+    def close(self) -> None:
+        for net in self.students:
+            net.close()
+        self._stop.set()
+        self._loop.join(timeout=5.0)
+        self.server.stop()
+
+
+def _connect_quietly(net) -> None:
+    try:
+        net.connect()
+    except Exception as e:  # the caller looks at net.state and net.error
+        net.error = str(e)
+
+
+def wait_for(condition, timeout_s: float, poll_s: float = 0.05) -> bool:
+    """Poll `condition` until true (True) or `timeout_s` passed (False): a bound, not a measurement."""
+    deadline = time.monotonic() + timeout_s
+    while time.monotonic() < deadline:
+        if condition():
+            return True
+        time.sleep(poll_s)
+    return bool(condition())
