@@ -29,8 +29,10 @@ def rate(shaper, delay_s: float, jitter_s: float = 0.0, students: int = 30, seco
     try:
         joined = sum(net.welcome is not None for net in room.students)
         time.sleep(1.0 + 4 * delay_s)  # the first snapshots are on their way
+        seq = room.server._snapshot_seq
         rates = room.rates(seconds)
-        return {"joined": joined, "slowest": min(rates), "median": statistics.median(rates)}
+        offered = (room.server._snapshot_seq - seq) / seconds  # what the loop published: the ceiling here
+        return {"joined": joined, "slowest": min(rates), "median": statistics.median(rates), "offered": offered}
     finally:
         room.close()
 
@@ -114,7 +116,7 @@ def run(quick: bool = False) -> list[str]:
         )
         lines.append(
             f"  rate at {delay_s * 1000:3.0f} ms one-way: slowest {r['slowest']:5.1f}/s, "
-            f"median {r['median']:5.1f}/s ({r['joined']} of {students} joined)"
+            f"median {r['median']:5.1f}/s of {r['offered']:.1f} published ({r['joined']} of {students} joined)"
         )
     c = linkshaper.run_isolated("bench.classroom_link", "cut", 180.0)
     back = "never (40 s bound)" if c["back_s"] is None else f"{c['back_s']:.1f} s"

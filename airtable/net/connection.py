@@ -3,8 +3,8 @@
 Owned by the server's network thread. A `Connection` reads frames (at most a
 message and byte budget a second, see `RateLimit`), and sends in this order:
 control frames (WELCOME, ERROR, BYE) first, then the newest snapshot tick,
-coded for this player (codec.py) only when it can go: once the previous one
-is acknowledged (pacing.py), so a slow reader misses snapshots instead of
+coded for this player (codec.py) only when it can go: while fewer bytes are
+unacknowledged than one round trip of snapshots needs (pacing.py), so a slow reader misses snapshots instead of
 piling them up, and on a tight link every player's rate drops evenly. After an ERROR
 it shuts its side and waits for the client to hang up (`closing`).
 """
@@ -88,8 +88,11 @@ class Connection:
         self._encoder: SnapshotEncoder | None = None
         self._tick_due = False  # a newer tick than the player holds is waiting to be coded and sent
         self._last_snap_bytes = 0
+        self._mean_snap_bytes = 0.0  # smoothed snapshot size, for pacing
         self.held_back = False  # the tick waits for the previous one to be acknowledged
         self._snap_offered = now
+        self._last_offer = now
+        self.period_s = 1 / 30  # smoothed time between snapshot ticks (pacing needs the rate it aims for)
         self._sending_snap = False
         self._shut = False  # our side is shut down after an ERROR
         self._events = selectors.EVENT_READ
@@ -148,6 +151,9 @@ class Connection:
         and is coded against what this player holds when its turn comes."""
         if encoder.newest is None or self.state != State.PLAYING:
             return
+        gap, self._last_offer = now - self._last_offer, now
+        if 0 < gap < 1.0:  # a pause (nobody played, the app was busy) says nothing about the rate
+            self.period_s += 0.1 * (gap - self.period_s)
         if not self._tick_due:
             self._snap_offered = now
         self._encoder, self._tick_due = encoder, True
@@ -203,7 +209,8 @@ class Connection:
         return True
 
     def _start_tick(self) -> bool:
-        self.held_back = not pacing.may_send(self.sock, self._last_snap_bytes)
+        size = max(self._last_snap_bytes, round(self._mean_snap_bytes))
+        self.held_back = not pacing.may_send(self.sock, size, self.period_s)
         if self.held_back:
             return False
         self._tick_due = False
@@ -211,6 +218,7 @@ class Connection:
         if not data:
             return False
         self._last_snap_bytes = len(data)
+        self._mean_snap_bytes += 0.1 * (len(data) - self._mean_snap_bytes)
         self._out_cur, self._sending_snap = memoryview(data), True
         return True
 

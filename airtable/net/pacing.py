@@ -5,10 +5,16 @@ takes; the TCP connections then fight over the link, and the ones that lose a
 few packets back off for hundreds of milliseconds at a time: some students get
 everything and some nothing. The remedy is per-student pacing:
 
-- a student gets a new snapshot only once its previous one has left the
-  server and been acknowledged. While the link is not queueing (the smoothed
-  round trip is near the lowest seen), one more snapshot may be in flight, so
-  a Wi-Fi link with a long round trip still carries every snapshot;
+- a student gets a new snapshot only while the bytes it has not yet
+  acknowledged are fewer than the snapshots the rate needs in one round trip
+  (the bandwidth-delay product of the snapshot stream: round trip / period
+  snapshots, plus one), so the rate is set by the snapshot rate and the link's
+  bandwidth, never by the round trip (a cap of two unacknowledged snapshots
+  gave 17 a second at 50 ms one-way, 9.6 at 100 and 3.2 at 300);
+- once the link queues (the smoothed round trip is well above the lowest
+  seen: a full hotspot, a slow reader), a student gets a new snapshot only
+  when its previous one has been acknowledged, so the queue drains and every
+  student's rate drops evenly;
 - when a snapshot is ready, the students are served in round-robin order,
   so nobody is always first;
 - a student that was skipped simply gets the next snapshot, coded against
@@ -25,6 +31,7 @@ written".
 
 from __future__ import annotations
 
+import math
 import struct
 from collections.abc import Sequence
 from typing import TypeVar
@@ -38,7 +45,9 @@ except (ImportError, AttributeError):  # Windows, or a platform without the requ
     fcntl = None
     _OUTQ = None
 
-SLACK_SNAPSHOTS = 1  # snapshots in flight besides the new one, while the link is not queueing
+SLACK_SNAPSHOTS = 1  # snapshots in flight besides what one round trip needs, while the link is not queueing
+SLACK_BYTES = 1500  # and a packet more: small delta-coded snapshots vary by tens of bytes
+MAX_IN_FLIGHT = 40  # snapshots unacknowledged at most (30 a second for 1.3 s of round trip)
 # The link is queueing when the smoothed round trip exceeds the lowest seen by this much.
 QUEUEING_FACTOR = 2.0
 QUEUEING_EXTRA_S = 0.03
@@ -74,16 +83,32 @@ def round_trip_s(sock) -> tuple[float, float] | None:
     return smoothed_us / 1e6, lowest_us / 1e6
 
 
-def may_send(sock, last_snapshot_bytes: int) -> bool:
-    """Whether this student may be handed a new snapshot now: its previous ones are
-    acknowledged, or the link is not queueing and at most one snapshot is in flight."""
+def may_send(sock, snapshot_bytes: int, period_s: float = 1 / 30) -> bool:
+    """Whether this student may be handed a new snapshot now, when snapshots of about `snapshot_bytes`
+    come every `period_s`:
+    nothing is unacknowledged, or the link is not queueing and fewer bytes are in flight than the
+    rate needs over one round trip (see `in_flight_budget`)."""
     queued = queued_bytes(sock)
     if not queued:  # nothing unacknowledged, or the platform cannot tell
         return True
-    if queued > SLACK_SNAPSHOTS * last_snapshot_bytes:
-        return False
     rtt = round_trip_s(sock)
-    return rtt is not None and rtt[0] <= QUEUEING_FACTOR * rtt[1] + QUEUEING_EXTRA_S
+    if rtt is None:
+        return False
+    return queued <= in_flight_budget(rtt[0], rtt[1], snapshot_bytes, period_s)
+
+
+def in_flight_budget(smoothed_s: float, lowest_s: float, snapshot_bytes: int, period_s: float) -> int:
+    """Unacknowledged bytes a student may have and still be handed a snapshot.
+
+    A snapshot is acknowledged a round trip after it leaves, so to get one every `period_s`,
+    round trip / period of them must be in flight: that many plus SLACK_SNAPSHOTS (at most
+    MAX_IN_FLIGHT) of `snapshot_bytes` each, plus SLACK_BYTES. Once the link queues (the smoothed
+    round trip is above QUEUEING_FACTOR times the lowest plus QUEUEING_EXTRA_S), none: the next one
+    waits for every byte to be acknowledged."""
+    if smoothed_s > QUEUEING_FACTOR * lowest_s + QUEUEING_EXTRA_S:
+        return 0
+    snapshots = min(MAX_IN_FLIGHT, SLACK_SNAPSHOTS + math.ceil(smoothed_s / max(period_s, 1e-3)))
+    return snapshots * max(0, snapshot_bytes) + SLACK_BYTES
 
 
 class RoundRobin:
