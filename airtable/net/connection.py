@@ -94,6 +94,9 @@ class Connection:
         self._last_offer = now
         self.period_s = 1 / 30  # smoothed time between snapshot ticks (pacing needs the rate it aims for)
         self._sending_snap = False
+        self.keep_seat = True  # a drop holds the seat for a return (seats.py); not after BYE or a removal
+        self._drained_at = now  # when the client last took bytes we sent (see unread_s)
+        self._queued_seen = 0
         self._shut = False  # our side is shut down after an ERROR
         self._events = selectors.EVENT_READ
         self.closed = False
@@ -231,6 +234,19 @@ class Connection:
             times.append(now)
             while now - times[0] > RATE_WINDOW_S:
                 times.popleft()
+
+    def unread_s(self, now: float) -> float:
+        """Seconds since the client last took any of the bytes sent to it (0 while nothing waits).
+
+        A closed lid or a frozen client stops acknowledging; so does one that never reads, once
+        its receive buffer is full. Where the kernel cannot tell, a frame stuck half-sent counts."""
+        queued = pacing.queued_bytes(self.sock)
+        if queued is None:
+            queued = len(self._out_cur) if self._out_cur is not None else 0
+        if queued == 0 or queued < self._queued_seen:
+            self._drained_at = now
+        self._queued_seen = queued
+        return now - self._drained_at
 
     def snapshot_rate(self, now: float) -> float:
         """Snapshots a second that went out whole, over the last RATE_WINDOW_S."""

@@ -45,6 +45,7 @@ from airtable.net.events import EventQueue, PlayerInput, PlayerJoined, PlayerLef
 from airtable.net.gate import FIRST_PASSWORD_WAIT_S, HANDSHAKES_PER_ADDRESS, PLAYERS_PER_ADDRESS, Gate, QuietLog
 from airtable.net.identity import SeatTokens
 from airtable.net.predictions import MAX_ROUND_PUCKS, PredictionBook, RoundInfo, encode_round, parse_predict
+from airtable.net.seats import HOLD_S, HeldSeats
 
 log = logging.getLogger("airtable.net")
 
@@ -204,6 +205,7 @@ class GameServer:
         password_wait_s: float = FIRST_PASSWORD_WAIT_S,
         token_key: bytes | None = None,
         name_refusal: Callable[[str], str | None] | None = None,
+        seat_hold_s: float = HOLD_S,
     ) -> None:
         validate_server_options(port, max_clients, snapshot_hz, timeout_s)
         self.host = host
@@ -237,6 +239,7 @@ class GameServer:
 
         self._gate = Gate(handshakes_per_address, players_per_address, limit_loopback, password_wait_s)
         self._name_refusal = name_refusal  # a name the teacher's screen cannot draw (app/glyphs.py), or None
+        self._held = HeldSeats(seat_hold_s)  # seats of students who dropped, kept for their return (network thread)
         self._init_network_thread_state()
 
     def _init_network_thread_state(self) -> None:
@@ -665,6 +668,7 @@ class GameServer:
     def _handle(self, conn: Connection, frame_type: int, payload: bytes, now: float) -> None:
         if frame_type == proto.BYE:
             self._log_seat(conn, "%s said goodbye", conn.who)
+            conn.keep_seat = False
             conn.close()
         elif frame_type == proto.HELLO:
             if conn.state != State.HELLO:
@@ -699,20 +703,17 @@ class GameServer:
     def _welcome(self, conn: Connection, hello: proto.Hello, now: float) -> None:
         if not self._password_ok(conn, hello, now):
             return
+        self._take_over(hello)
         refusal = self._gate.seat_refusal(conn.host)
         if refusal is None and hello.name and self._name_refusal is not None:
             refusal = self._name_refusal(hello.name)
         if refusal is not None:
             self._fail(conn, refusal)
             return
-        if len(self._numbers) >= self.max_clients:
+        number = self._seat_for(hello, now)
+        if number is None:
             self._fail(conn, self._full_sentence(), retry=True)
             return
-        number = self._tokens.seat(hello.token, hello.name or "")  # their old seat, if it is free
-        if number is None or number in self._numbers or number > MAX_PLAYERS:
-            number = 1
-            while number in self._numbers:  # the lowest free number, so names get reused
-                number += 1
         client = f"C{number}"
         name = client + (f" {hello.name}" if hello.name else "")  # the cursor's label
         color = client_color(number)
@@ -731,6 +732,30 @@ class GameServer:
         if round_frame is not None:  # a prediction round is under way
             conn.send_control(round_frame)
         self._log_seat(conn, "%s joined from %s", name, conn.peer)
+
+    def _take_over(self, hello: proto.Hello) -> None:
+        """A student back with their seat's token, while their old connection still holds it (it has
+        not noticed the drop yet): the old one is closed at once, so the seat is free for the new one."""
+        number = self._tokens.seat(hello.token, hello.name or "")
+        stale = self._conns.get(self._numbers.get(number, -1)) if number is not None else None
+        if stale is None:
+            return
+        self._log_seat(stale, "%s is back on a new connection; the old one is closed", stale.who)
+        stale.keep_seat = False
+        self._release_slot(stale)
+        stale.close()
+        self._settle(stale)
+
+    def _seat_for(self, hello: proto.Hello, now: float) -> int | None:
+        """The seat a welcomed HELLO gets: the one its token proves, if free (given back from hold);
+        else the lowest seat neither taken nor held for someone who dropped. None: the table is full."""
+        if len(self._numbers) >= self.max_clients:
+            return None
+        number = self._tokens.seat(hello.token, hello.name or "")
+        if number is not None and number <= MAX_PLAYERS and number not in self._numbers:
+            self._held.give_back(number)
+            return number
+        return self._held.free_number(self._numbers, now)
 
     def _log_seat(self, conn: Connection, line: str, *args) -> None:
         """Joins and leaves, one line each, but summarised when one computer churns."""
@@ -777,6 +802,7 @@ class GameServer:
         cid = self._numbers.get(number)
         conn = self._conns.get(cid) if cid is not None else None
         if conn is not None:
+            conn.keep_seat = False  # removed: the seat is not kept for a return
             self._fail(conn, sentence)
             self._settle(conn)
 
@@ -787,6 +813,8 @@ class GameServer:
             conn.state = State.CLOSING
         if conn.number and self._numbers.get(conn.number) == conn.cid:
             del self._numbers[conn.number]
+            if conn.keep_seat:  # a drop, not a goodbye or a removal: held for their return
+                self._held.hold(conn.number, time.monotonic())
             self._gate.seat_freed(conn.host)
             with self._lock:
                 self._names.pop(conn.number, None)
@@ -816,12 +844,8 @@ class GameServer:
                     "join with airtable-client, which says HELLO at once",
                     quiet=True,
                 )
-            elif now - conn.last_rx > self.timeout_s:
-                self._fail(
-                    conn,
-                    f"nothing complete was received for {self.timeout_s:g} s (a client sends at least one INPUT "
-                    "a second), so the connection was closed; check the network and join again",
-                )
+            elif (dead := self._dead_sentence(conn, now)) is not None:
+                self._fail(conn, dead, retry=True)
             self._settle(conn)
         if self._accept_paused_until and now >= self._accept_paused_until:
             self._accept_paused_until = 0.0
@@ -829,6 +853,22 @@ class GameServer:
             self._selector.register(self._listener, selectors.EVENT_READ, "listen")
         self._gate.forget_old_guesses(now, log)
         self._quiet.flush(now)
+
+    def _dead_sentence(self, conn: Connection, now: float) -> str | None:
+        """Why a connection counts as dead (a player's seat is then held; the ERROR carries retry), or None."""
+        after = (
+            "your seat is kept and your client reconnects by itself"
+            if conn.state == State.PLAYING
+            else "check the network and join again"
+        )
+        if now - conn.last_rx > self.timeout_s:
+            return (
+                f"nothing complete was received for {self.timeout_s:g} s (a client sends at least one INPUT "
+                f"a second), so the connection was closed; {after}"
+            )
+        if conn.unread_s(now) > self.timeout_s:
+            return f"nothing sent to you was read for {self.timeout_s:g} s, so the connection was closed; {after}"
+        return None
 
     def _refresh_roster(self, now: float) -> None:
         width_m, height_m = self._table_size_m
