@@ -198,7 +198,7 @@ def test_player_reconnects_when_the_server_comes_back(cleanup):
     loop.stop()
     server.stop()
     wait_until(lambda: net.state == net.RETRYING, what="server gone, retrying")
-    assert net.status_text == "server gone, retrying..."
+    assert net.status_text == "reconnecting to the teacher's table..."
     first_try = net.next_try
     wait_until(lambda: net.next_try > first_try, what="a refused attempt while the server is away")
     assert net.state == net.RETRYING

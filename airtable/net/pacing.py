@@ -83,6 +83,18 @@ def round_trip_s(sock) -> tuple[float, float] | None:
     return smoothed_us / 1e6, lowest_us / 1e6
 
 
+SLOW_LINK_RTT_S = 0.15  # a round trip longer than this is a slow link (Wi-Fi under load, a hotspot)
+
+
+def link_is_slow(sock) -> bool | None:
+    """Whether a TCP connection is on a slow link: a long round trip, or bytes written and not yet
+    acknowledged (lost and being sent again). None where the kernel cannot tell (not Linux)."""
+    queued, rtt = queued_bytes(sock), round_trip_s(sock)
+    if queued is None or rtt is None:
+        return None
+    return queued > 0 or rtt[0] > SLOW_LINK_RTT_S
+
+
 def may_send(sock, snapshot_bytes: int, period_s: float = 1 / 30) -> bool:
     """Whether this student may be handed a new snapshot now, when snapshots of about `snapshot_bytes`
     come every `period_s`:

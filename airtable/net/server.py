@@ -64,6 +64,7 @@ COURSE_COLORS = (
 )
 
 HELLO_TIMEOUT_S = 3.0  # a connection must be welcomed this soon after it opens
+SLOW_HELLO_S = 12.0  # or this soon, on a slow link (pacing.link_is_slow)
 MAX_HANDSHAKES = 32  # connections still saying HELLO, beyond the players
 MAX_PLAYERS = 1000
 MAX_SNAPSHOT_HZ = 1000.0
@@ -838,12 +839,7 @@ class GameServer:
                 if now > conn.deadline:
                     conn.close()
             elif conn.state == State.HELLO and now > conn.deadline:
-                self._fail(
-                    conn,
-                    f"no HELLO came within {self.hello_timeout_s:g} s of connecting; "
-                    "join with airtable-client, which says HELLO at once",
-                    quiet=True,
-                )
+                self._hello_missing(conn, now)
             elif (dead := self._dead_sentence(conn, now)) is not None:
                 self._fail(conn, dead, retry=True)
             self._settle(conn)
@@ -853,6 +849,27 @@ class GameServer:
             self._selector.register(self._listener, selectors.EVENT_READ, "listen")
         self._gate.forget_old_guesses(now, log)
         self._quiet.flush(now)
+
+    def _hello_missing(self, conn: Connection, now: float) -> None:
+        """The HELLO deadline passed. On a slow link (long round trip, bytes lost and sent again) the HELLO
+        may still be on its way: wait up to SLOW_HELLO_S, then ask the client to try again. On a quick
+        link this is not an airtable client."""
+        slow = pacing.link_is_slow(conn.sock)
+        if slow and now - conn.opened < SLOW_HELLO_S:
+            return
+        if slow:
+            sentence = (
+                f"the network is slow: your HELLO did not arrive within {SLOW_HELLO_S:g} s; "
+                "your client tries again by itself"
+            )
+            self._fail(conn, sentence, retry=True, quiet=True)
+            return
+        self._fail(
+            conn,
+            f"no HELLO came within {self.hello_timeout_s:g} s of connecting; "
+            "join with airtable-client, which says HELLO at once",
+            quiet=True,
+        )
 
     def _dead_sentence(self, conn: Connection, now: float) -> str | None:
         """Why a connection counts as dead (a player's seat is then held; the ERROR carries retry), or None."""
