@@ -69,6 +69,7 @@ def input_effect(shaper, delay_s: float = 0.1, loss: float = 0.1, seconds: float
     room = linkshaper.Classroom(2)
     try:
         net = room.students[0]
+        room.still = net
         sent: dict[float, float] = {}
         end = time.monotonic() + seconds
         k = 0

@@ -219,6 +219,8 @@ class Classroom:
         self._loop = threading.Thread(target=self._run, name="table-loop", daemon=True)
         self._loop.start()
         self.join(students)
+        self._hands = threading.Thread(target=self._move, name="students-hands", daemon=True)
+        self._hands.start()
 
     def join(self, count: int, prefix: str = "S") -> list:
         """`count` more students, connected in parallel; returns them."""
@@ -254,6 +256,20 @@ class Classroom:
             next_t += frame_s
             time.sleep(max(0.0, next_t - time.monotonic()))
 
+    def _move(self) -> None:
+        """Every student's cursor circles slowly, as a hand on a mouse would (30 updates a second;
+        the client sends what changed, at least once a second)."""
+        import math
+
+        while not self._stop.wait(1 / 30):
+            t = time.monotonic()
+            for i, net in enumerate(list(self.students)):
+                if net is not self.still:
+                    angle = 0.5 * t + i
+                    net.update_input((5.0 + 2.0 * math.cos(angle), 4.0 + 2.0 * math.sin(angle)))
+
+    still = None  # a student whose cursor the caller drives itself
+
     def rates(self, seconds: float) -> list[float]:
         """Snapshots a second each student received over the next `seconds`."""
         before = [net.snapshots for net in self.students]
@@ -272,9 +288,10 @@ class Classroom:
             return None
 
     def close(self) -> None:
+        self._stop.set()
+        self._hands.join(timeout=5.0)
         for net in self.students:
             net.close()
-        self._stop.set()
         self._loop.join(timeout=5.0)
         self.server.stop()
 
