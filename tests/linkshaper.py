@@ -63,6 +63,7 @@ class Shaper:
         self.down = Direction()  # teacher -> student
         self.cut_ports: set[int] = set()  # students' local TCP/UDP ports whose packets are all dropped
         self.cut_all = False
+        self.block_udp = False  # as a school firewall that lets only TCP through
         self.dropped = 0
         self._rng = random.Random(seed)
         self._lock = threading.Lock()
@@ -122,7 +123,7 @@ class Shaper:
         direction = self.up if upward else self.down
         with self._lock:
             cut = self.cut_all or port in self.cut_ports
-        if cut or self._rng.random() < direction.loss:
+        if cut or (self.block_udp and packet[9] == 17) or self._rng.random() < direction.loss:
             self.dropped += 1
             return
         pkt = bytearray(packet)

@@ -5,6 +5,7 @@ from __future__ import annotations
 import json
 import logging
 import os
+import re
 import selectors
 import socket
 import struct
@@ -264,7 +265,9 @@ def test_hello_gets_welcome_then_a_snapshot(make_server, make_loop, clients):
         "color": list(rgb("maroon1")),
         "table": {"width_m": loop.table.width_m, "height_m": loop.table.height_m},
         "token": message["token"],
+        "udp_key": message["udp_key"],  # this session's input datagrams' key
     }
+    assert re.fullmatch("[0-9a-f]{32}", message["udp_key"])
     scene = c.next_scene()
     assert len(scene.pos_m) == 30 and scene.title == "headless table"
     assert server.player_names() == ["C1 Ann"]

@@ -12,6 +12,7 @@ it shuts its side and waits for the client to hang up (`closing`).
 from __future__ import annotations
 
 import enum
+import math
 import selectors
 import socket
 import time
@@ -28,6 +29,7 @@ BYTES_BURST = 48 * 1024
 RECV_BYTES = 16384
 LINGER_S = 2.0  # after an ERROR: time to let it reach the client before closing
 RATE_WINDOW_S = 2.0  # snapshot rates are measured over this many seconds
+UDP_FRESH_S = 1.5  # a player whose input datagram came this recently sends its cursor by UDP
 
 
 class State(enum.Enum):
@@ -94,6 +96,9 @@ class Connection:
         self._last_offer = now
         self.period_s = 1 / 30  # smoothed time between snapshot ticks (pacing needs the rate it aims for)
         self._sending_snap = False
+        self.udp_key: str | None = None  # this session's input datagrams' key (datagrams.py), once welcomed
+        self.udp_sequence = 0  # the newest input datagram applied
+        self.udp_at = -math.inf  # when it came
         self.keep_seat = True  # a drop holds the seat for a return (seats.py); not after BYE or a removal
         self._drained_at = now  # when the client last took bytes we sent (see unread_s)
         self._queued_seen = 0
@@ -137,6 +142,11 @@ class Connection:
         if frames:
             self.last_rx = now
         return frames
+
+    def inputs_by_udp(self, now: float) -> bool:
+        """Whether this player's cursor comes by UDP now (a datagram came lately): TCP INPUTs are
+        then only a heartbeat, since one held up behind a lost packet is older than the datagrams."""
+        return now - self.udp_at < UDP_FRESH_S
 
     def note_input(self, record: proto.InputRecord, now: float) -> None:
         if record != self.last_input:

@@ -39,6 +39,7 @@ from airtable.net.outbox import Outbox
 from airtable.net.pacing import link_is_slow
 from airtable.net.playout import SnapshotFeed
 from airtable.net.predictions import RoundInfo, clamp_speed, encode_predict, parse_round
+from airtable.net.udp_inputs import UdpInputs
 
 CONNECT_TIMEOUT_S = 5.0
 SILENCE_S = 10.0  # no snapshot for this long: the server is gone (snapshots come 30 times a second)
@@ -184,6 +185,8 @@ class NetPlayer:
         self._sock: socket.socket | None = None
         self._send_lock = threading.Lock()
         self._outbox = Outbox()  # what the socket has not taken yet (never waited for)
+        self._udp: UdpInputs | None = None  # inputs as datagrams, where the server takes them (datagrams.py)
+        self._tcp_input_at = -math.inf  # when an INPUT last went by TCP
         self._closed = threading.Event()
         self._thread: threading.Thread | None = None
         self._throttle = InputThrottle()
@@ -335,6 +338,7 @@ class NetPlayer:
             self._sock = sock
             self.welcome = welcome
             self._outbox = Outbox()  # what waited for the old connection is stale
+            self._udp = _udp_for(sock, welcome, self._udp)
             self._feed = SnapshotFeed()  # a new connection starts from a keyframe
             self._aids = AidsDecoder()
             self._throttle.reset()
@@ -509,7 +513,18 @@ class NetPlayer:
 
     def _send(self, record: proto.InputRecord, now: float) -> bool:
         frame = proto.encode_input(record.cursor_m, record.button, record.keys)
-        return self._send_frame(frame, on_sent=lambda: self._throttle.sent(record, now), replaceable=True)
+        udp = self._udp
+        if udp is not None and self.state == PlayerState.CONNECTED:
+            udp.send(frame[5:])  # the INPUT's JSON, without the frame's envelope
+            if udp.confirmed(now) and now - self._tcp_input_at < HEARTBEAT_S:
+                self._throttle.sent(record, now)
+                return True  # UDP gets through: TCP carries only a heartbeat a second
+
+        def sent() -> None:
+            self._throttle.sent(record, now)
+            self._tcp_input_at = now
+
+        return self._send_frame(frame, on_sent=sent, replaceable=True)
 
     def _send_frame(self, frame: bytes, on_sent: Callable[[], None] | None = None, replaceable: bool = False) -> bool:
         """Send one frame while connected, never waiting (see outbox.py; a `replaceable` INPUT
@@ -548,8 +563,22 @@ class NetPlayer:
                 _shut(sock)
         if self._thread is not None and self._thread is not threading.current_thread():
             self._thread.join(timeout=5.0)
+        if self._udp is not None:
+            self._udp.close()
         if self.state != PlayerState.FAILED:
             self.state = PlayerState.CLOSED
+
+
+def _udp_for(sock: socket.socket, welcome: proto.Welcome, old: UdpInputs | None) -> UdpInputs | None:
+    """This session's input datagrams, when the server offers them (closing the last session's)."""
+    if old is not None:
+        old.close()
+    if not welcome.udp_key:
+        return None
+    try:
+        return UdpInputs(sock.getpeername(), welcome.udp_key, int(welcome.client[1:]))
+    except OSError:
+        return None  # no UDP here: every input goes by TCP
 
 
 # -------------------------------------------------------------------- the window

@@ -23,6 +23,7 @@ The teacher sees the seats with `roster()` and can `remove()` a player.
 from __future__ import annotations
 
 import colorsys
+import contextlib
 import errno
 import hmac
 import logging
@@ -37,7 +38,7 @@ from dataclasses import dataclass
 from airtable.app.client import Client
 from airtable.app.scene import Scene
 from airtable.colors import rgb
-from airtable.net import pacing
+from airtable.net import datagrams, pacing
 from airtable.net import protocol as proto
 from airtable.net.codec import SnapshotEncoder
 from airtable.net.connection import Connection, State
@@ -253,6 +254,7 @@ class GameServer:
         self._next_cid = 1
         self._accept_paused_until = 0.0
         self._listener: socket.socket | None = None
+        self._udp: socket.socket | None = None  # input datagrams, on the listener's port (datagrams.py)
         self._selector: selectors.BaseSelector | None = None
         self._wake_r, self._wake_w = None, None  # a socketpair that wakes the network thread (made in start)
         self._thread: threading.Thread | None = None
@@ -275,6 +277,7 @@ class GameServer:
         self._selector = selectors.DefaultSelector()
         self._selector.register(self._listener, selectors.EVENT_READ, "listen")
         self._selector.register(self._wake_r, selectors.EVENT_READ, "wake")
+        self._udp = self._bind_udp()
         self._fit_to_room(connection_room(type(self._selector), _open_file_limit()))
         self._thread = threading.Thread(target=self._run, name="airtable-server", daemon=True)
         self._thread.start()
@@ -342,9 +345,10 @@ class GameServer:
         for conn in list(self._conns.values()):
             conn.close()
             self._settle(conn)
-        for sock in (self._listener, self._wake_r, self._wake_w):
+        for sock in (self._listener, self._wake_r, self._wake_w, self._udp):
             if sock is not None:
                 sock.close()
+        self._udp = None
         if self._selector is not None:
             self._selector.close()
         self._thread = None
@@ -555,6 +559,9 @@ class GameServer:
         if key.data == "listen":
             self._accept()
             return
+        if key.data == "udp":
+            self._on_datagrams()
+            return
         if key.data == "wake":
             self._drain_wake()
             self._run_commands()
@@ -617,6 +624,47 @@ class GameServer:
         self._next_cid += 1
         self._conns[conn.cid] = conn
         self._gate.handshake_started(host)
+
+    def _bind_udp(self) -> socket.socket | None:
+        """A UDP socket on the listener's address and port, for input datagrams; None if it cannot be had
+        (players then send every input over TCP)."""
+        assert self._listener is not None and self._selector is not None
+        address = self._listener.getsockname()
+        sock = socket.socket(self._listener.family, socket.SOCK_DGRAM)
+        try:
+            sock.bind(address)
+            sock.setblocking(False)
+        except OSError as e:
+            sock.close()
+            log.warning("inputs come over TCP only: cannot listen for UDP on port %d (%s)", self.port, e)
+            return None
+        self._selector.register(sock, selectors.EVENT_READ, "udp")
+        return sock
+
+    def _on_datagrams(self) -> None:
+        """Input datagrams: each from a welcomed player, signed with its session's key and newer than the
+        last, is applied as its INPUT and acknowledged; anything else is dropped without a word."""
+        assert self._udp is not None
+        for _ in range(256):  # a bounded batch, so a flood cannot starve the TCP side
+            try:
+                data, sender = self._udp.recvfrom(datagrams.MAX_DATAGRAM + 1)
+            except OSError:  # nothing more (or an ICMP error for an old ack)
+                return
+            d = datagrams.parse(data)
+            conn = self._conns.get(self._numbers.get(d.number, -1)) if d is not None else None
+            if conn is None or d.kind != datagrams.INPUT_DATAGRAM or not d.verify(conn.udp_key):
+                continue
+            now = time.monotonic()
+            if d.sequence > conn.udp_sequence and conn.rate.spend(now, 1, len(data)) is None:
+                try:
+                    record = proto.parse_input(d.payload, self._table_size_m)
+                except proto.ProtocolError:
+                    continue
+                conn.udp_sequence, conn.udp_at, conn.last_rx = d.sequence, now, now
+                conn.note_input(record, now)
+                self._events.input(conn.cid, record)
+            with contextlib.suppress(OSError):
+                self._udp.sendto(datagrams.encode_ack(conn.udp_key, d.number, d.sequence), sender)
 
     def _drain_wake(self) -> None:
         assert self._wake_r is not None
@@ -681,8 +729,9 @@ class GameServer:
                     'INPUT came before HELLO; a client must first send HELLO like {"protocol": 1} and wait for WELCOME'
                 )
             record = proto.parse_input(payload, self._table_size_m)
-            conn.note_input(record, now)
-            self._events.input(conn.cid, record)
+            if not conn.inputs_by_udp(now):  # else a heartbeat: the datagrams carry newer cursors
+                conn.note_input(record, now)
+                self._events.input(conn.cid, record)
         elif frame_type == proto.PREDICT:
             self._predict(conn, payload)
 
@@ -726,7 +775,8 @@ class GameServer:
         self._events.join(conn.cid, name, color, number)
         width_m, height_m = self._table_size_m
         token = self._tokens.make(number, hello.name or "")
-        conn.send_control(proto.encode_welcome(client, color, width_m, height_m, hello.name, token))
+        conn.udp_key = datagrams.new_key() if self._udp is not None else None
+        conn.send_control(proto.encode_welcome(client, color, width_m, height_m, hello.name, token, conn.udp_key))
         conn.offer_tick(self._encoder, now)  # the newest picture straight away, if there is one
         with self._lock:
             round_frame = self._round_frame
