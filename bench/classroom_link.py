@@ -95,6 +95,20 @@ def input_effect(shaper, delay_s: float = 0.1, loss: float = 0.1, seconds: float
         room.close()
 
 
+def bad_join(shaper, students: int = 30, bound_s: float = 60.0) -> dict:
+    """Students joining across 300 ms +-90 one-way with 20 % loss: how many are in within `bound_s` (child)."""
+    shaper.shape(0.3, 0.09, loss=0.2)
+    start = time.monotonic()
+    room = linkshaper.Classroom(students)
+    try:
+        linkshaper.wait_for(lambda: all(n.welcome is not None for n in room.students), bound_s)
+        joined = sum(n.welcome is not None for n in room.students)
+        failed = sorted({n.error for n in room.students if n.welcome is None and n.error})
+        return {"joined": joined, "students": students, "s": time.monotonic() - start, "failed": failed[:3]}
+    finally:
+        room.close()
+
+
 def _effect_delays(sent: dict[float, float], seen: dict[float, float]) -> list[float | None]:
     """For each cursor sent (x -> when), the time until the table had it or a newer one (x only grows)."""
     delays, first_at_or_after = [], None
@@ -124,6 +138,11 @@ def run(quick: bool = False) -> list[str]:
     lines.append(
         f"  7 s cut of {c['students']} students: all back after {back}; seats kept {c['seats_kept']} of "
         f"{c['students']}; {c['reconnects']} reconnects"
+    )
+    j = linkshaper.run_isolated("bench.classroom_link", "bad_join", 180.0, students=students)
+    lines.append(
+        f"  joining at 300 ms +-90 one-way, 20 % loss: {j['joined']} of {j['students']} in within "
+        f"{j['s']:.0f} s" + (f"; failed: {j['failed'][0]}" if j["failed"] else "")
     )
     e = linkshaper.run_isolated("bench.classroom_link", "input_effect", 120.0)
     if e["median_s"] is None:

@@ -56,10 +56,14 @@ def test_the_budget_is_a_round_trip_of_snapshots_plus_slack():
     assert pacing.in_flight_budget(10.0, 9.0, 100, 1 / 30) == pacing.MAX_IN_FLIGHT * 100 + 1500
 
 
-def test_a_queueing_link_gets_no_budget():
+def test_a_queueing_link_gets_only_what_its_lowest_round_trip_needs():
     # The smoothed round trip is above 2 x the lowest + 30 ms: a queue has built up (a full hotspot).
-    assert pacing.in_flight_budget(0.25, 0.1, 1000, 1 / 30) == 0
-    assert pacing.in_flight_budget(0.23, 0.1, 1000, 1 / 30) > 0  # exactly at the line: not yet
+    # Lowest 90 ms, a snapshot every 40 ms: 2.25 -> 3 snapshots a round trip, less the one about to go.
+    assert pacing.in_flight_budget(0.25, 0.09, 1000, 0.04) == 2 * 1000
+    # 200 ms, below the line (210 ms): 5 a round trip, plus one, plus a packet.
+    assert pacing.in_flight_budget(0.2, 0.09, 1000, 0.04) == 6 * 1000 + 1500
+    # On a LAN (lowest 1 ms): nothing, the next snapshot waits for every byte to be acknowledged.
+    assert pacing.in_flight_budget(0.05, 0.001, 1000, 1 / 30) == 0
 
 
 def test_the_rate_a_budget_allows_on_a_simulated_link():

@@ -12,9 +12,9 @@ everything and some nothing. The remedy is per-student pacing:
   bandwidth, never by the round trip (a cap of two unacknowledged snapshots
   gave 17 a second at 50 ms one-way, 9.6 at 100 and 3.2 at 300);
 - once the link queues (the smoothed round trip is well above the lowest
-  seen: a full hotspot, a slow reader), a student gets a new snapshot only
-  when its previous one has been acknowledged, so the queue drains and every
-  student's rate drops evenly;
+  seen: a full hotspot, a slow reader), only what the lowest round trip needs
+  may be in flight (on a LAN: a new snapshot only once the previous one is
+  acknowledged), so the queue drains and every student's rate drops evenly;
 - when a snapshot is ready, the students are served in round-robin order,
   so nobody is always first;
 - a student that was skipped simply gets the next snapshot, coded against
@@ -115,11 +115,14 @@ def in_flight_budget(smoothed_s: float, lowest_s: float, snapshot_bytes: int, pe
     A snapshot is acknowledged a round trip after it leaves, so to get one every `period_s`,
     round trip / period of them must be in flight: that many plus SLACK_SNAPSHOTS (at most
     MAX_IN_FLIGHT) of `snapshot_bytes` each, plus SLACK_BYTES. Once the link queues (the smoothed
-    round trip is above QUEUEING_FACTOR times the lowest plus QUEUEING_EXTRA_S), none: the next one
-    waits for every byte to be acknowledged."""
+    round trip is above QUEUEING_FACTOR times the lowest plus QUEUEING_EXTRA_S), only what the
+    lowest round trip needs, less the snapshot about to go: on a LAN nothing (the next one waits
+    for every byte to be acknowledged), on a long link its bandwidth-delay product, so the rate
+    falls with the queue, evenly for everyone behind it, and not with the length of the link."""
+    period_s = max(period_s, 1e-3)
     if smoothed_s > QUEUEING_FACTOR * lowest_s + QUEUEING_EXTRA_S:
-        return 0
-    snapshots = min(MAX_IN_FLIGHT, SLACK_SNAPSHOTS + math.ceil(smoothed_s / max(period_s, 1e-3)))
+        return max(0, min(MAX_IN_FLIGHT, math.ceil(lowest_s / period_s)) - 1) * max(0, snapshot_bytes)
+    snapshots = min(MAX_IN_FLIGHT, SLACK_SNAPSHOTS + math.ceil(smoothed_s / period_s))
     return snapshots * max(0, snapshot_bytes) + SLACK_BYTES
 
 
