@@ -45,23 +45,23 @@ def test_the_free_number_is_the_lowest_neither_taken_nor_held(taken, held):
 # ----------------------------------------------------------------- the in-flight budget
 
 
-def test_the_budget_is_a_round_trip_of_snapshots_plus_slack():
-    # 200 ms round trip, a snapshot every 1/30 s: 6 in flight plus one, of 1000 bytes, plus 1500 bytes.
-    assert pacing.in_flight_budget(0.2, 0.2, 1000, 1 / 30) == 7 * 1000 + 1500
-    # 600 ms (300 ms one-way): 18 + 1.
-    assert pacing.in_flight_budget(0.6, 0.59, 100, 1 / 30) == 19 * 100 + 1500
-    # Loopback: one round trip needs one snapshot, plus one.
-    assert pacing.in_flight_budget(0.0001, 0.0001, 500, 1 / 30) == 2 * 500 + 1500
+def test_the_budget_is_a_round_trip_of_snapshots():
+    # Snapshots of 1000 bytes count as 1250 (SIZE_MARGIN). 200 ms round trip, one every 40 ms: 5 in flight.
+    assert pacing.in_flight_budget(0.2, 0.2, 1000, 0.04) == 5 * 1250
+    # 600 ms (300 ms one-way), one every 1/30 s: 18.
+    assert pacing.in_flight_budget(0.6, 0.59, 100, 1 / 30) == 18 * 125
+    # Loopback: one, as the old rule allowed (the next goes while one is unacknowledged).
+    assert pacing.in_flight_budget(0.0001, 0.0001, 400, 1 / 30) == 500
     # A 10 s round trip is capped at MAX_IN_FLIGHT snapshots.
-    assert pacing.in_flight_budget(10.0, 9.0, 100, 1 / 30) == pacing.MAX_IN_FLIGHT * 100 + 1500
+    assert pacing.in_flight_budget(10.0, 9.0, 100, 1 / 30) == pacing.MAX_IN_FLIGHT * 125
 
 
 def test_a_queueing_link_gets_only_what_its_lowest_round_trip_needs():
     # The smoothed round trip is above 2 x the lowest + 30 ms: a queue has built up (a full hotspot).
     # Lowest 90 ms, a snapshot every 40 ms: 2.25 -> 3 snapshots a round trip, less the one about to go.
-    assert pacing.in_flight_budget(0.25, 0.09, 1000, 0.04) == 2 * 1000
-    # 200 ms, below the line (210 ms): 5 a round trip, plus one, plus a packet.
-    assert pacing.in_flight_budget(0.2, 0.09, 1000, 0.04) == 6 * 1000 + 1500
+    assert pacing.in_flight_budget(0.25, 0.09, 1000, 0.04) == 2 * 1250
+    # 200 ms, below the line (210 ms): 5 a round trip.
+    assert pacing.in_flight_budget(0.2, 0.09, 1000, 0.04) == 5 * 1250
     # On a LAN (lowest 1 ms): nothing, the next snapshot waits for every byte to be acknowledged.
     assert pacing.in_flight_budget(0.05, 0.001, 1000, 1 / 30) == 0
 

@@ -8,7 +8,7 @@ everything and some nothing. The remedy is per-student pacing:
 - a student gets a new snapshot only while the bytes it has not yet
   acknowledged are fewer than the snapshots the rate needs in one round trip
   (the bandwidth-delay product of the snapshot stream: round trip / period
-  snapshots, plus one), so the rate is set by the snapshot rate and the link's
+  snapshots; one on a LAN, as before), so the rate is set by the snapshot rate and the link's
   bandwidth, never by the round trip (a cap of two unacknowledged snapshots
   gave 17 a second at 50 ms one-way, 9.6 at 100 and 3.2 at 300);
 - once the link queues (the smoothed round trip is well above the lowest
@@ -45,8 +45,7 @@ except (ImportError, AttributeError):  # Windows, or a platform without the requ
     fcntl = None
     _OUTQ = None
 
-SLACK_SNAPSHOTS = 1  # snapshots in flight besides what one round trip needs, while the link is not queueing
-SLACK_BYTES = 1500  # and a packet more: small delta-coded snapshots vary by tens of bytes
+SIZE_MARGIN = 1.25  # delta-coded snapshots vary in size: count each as this much of the typical one
 MAX_IN_FLIGHT = 40  # snapshots unacknowledged at most (30 a second for 1.3 s of round trip)
 # The link is queueing when the smoothed round trip exceeds the lowest seen by this much.
 QUEUEING_FACTOR = 2.0
@@ -113,17 +112,17 @@ def in_flight_budget(smoothed_s: float, lowest_s: float, snapshot_bytes: int, pe
     """Unacknowledged bytes a student may have and still be handed a snapshot.
 
     A snapshot is acknowledged a round trip after it leaves, so to get one every `period_s`,
-    round trip / period of them must be in flight: that many plus SLACK_SNAPSHOTS (at most
-    MAX_IN_FLIGHT) of `snapshot_bytes` each, plus SLACK_BYTES. Once the link queues (the smoothed
+    round trip / period of them must be in flight besides the one about to go: that many (at most
+    MAX_IN_FLIGHT) of SIZE_MARGIN x `snapshot_bytes` each. On a LAN that is one, as it always was,
+    so a tight link (a hotspot) fills no faster than before. Once the link queues (the smoothed
     round trip is above QUEUEING_FACTOR times the lowest plus QUEUEING_EXTRA_S), only what the
     lowest round trip needs, less the snapshot about to go: on a LAN nothing (the next one waits
     for every byte to be acknowledged), on a long link its bandwidth-delay product, so the rate
     falls with the queue, evenly for everyone behind it, and not with the length of the link."""
-    period_s = max(period_s, 1e-3)
+    period_s, size = max(period_s, 1e-3), SIZE_MARGIN * max(0, snapshot_bytes)
     if smoothed_s > QUEUEING_FACTOR * lowest_s + QUEUEING_EXTRA_S:
-        return max(0, min(MAX_IN_FLIGHT, math.ceil(lowest_s / period_s)) - 1) * max(0, snapshot_bytes)
-    snapshots = min(MAX_IN_FLIGHT, SLACK_SNAPSHOTS + math.ceil(smoothed_s / period_s))
-    return snapshots * max(0, snapshot_bytes) + SLACK_BYTES
+        return round(max(0, min(MAX_IN_FLIGHT, math.ceil(lowest_s / period_s)) - 1) * size)
+    return round(min(MAX_IN_FLIGHT, math.ceil(smoothed_s / period_s)) * size)
 
 
 class RoundRobin:
