@@ -29,6 +29,7 @@ BYTES_BURST = 48 * 1024
 RECV_BYTES = 16384
 LINGER_S = 2.0  # after an ERROR: time to let it reach the client before closing
 RATE_WINDOW_S = 2.0  # snapshot rates are measured over this many seconds
+RTT_READ_S = 0.02  # pacing reads the kernel's round trip at most this often
 UDP_FRESH_S = 1.5  # a player whose input datagram came this recently sends its cursor by UDP
 
 
@@ -91,6 +92,8 @@ class Connection:
         self._tick_due = False  # a newer tick than the player holds is waiting to be coded and sent
         self._last_snap_bytes = 0
         self._mean_snap_bytes = 0.0  # smoothed snapshot size, for pacing
+        self._rtt: tuple[float, float] | None = None  # the kernel's round trip (smoothed, lowest), read at _rtt_at
+        self._rtt_at = -math.inf
         self.held_back = False  # the tick waits for the previous one to be acknowledged
         self._snap_offered = now
         self._last_offer = now
@@ -223,7 +226,10 @@ class Connection:
 
     def _start_tick(self) -> bool:
         size = max(self._last_snap_bytes, round(self._mean_snap_bytes))
-        self.held_back = not pacing.may_send(self.sock, size, self.period_s)
+        now = time.monotonic()
+        if now - self._rtt_at > RTT_READ_S:  # a held-back tick is looked at every 2 ms: read the round trip less often
+            self._rtt, self._rtt_at = pacing.round_trip_s(self.sock), now
+        self.held_back = not pacing.may_send(self.sock, size, self.period_s, self._rtt)
         if self.held_back:
             return False
         self._tick_due = False

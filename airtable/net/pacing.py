@@ -94,15 +94,15 @@ def link_is_slow(sock) -> bool | None:
     return queued > 0 or rtt[0] > SLOW_LINK_RTT_S
 
 
-def may_send(sock, snapshot_bytes: int, period_s: float = 1 / 30) -> bool:
+def may_send(sock, snapshot_bytes: int, period_s: float = 1 / 30, rtt: tuple[float, float] | None = None) -> bool:
     """Whether this student may be handed a new snapshot now, when snapshots of about `snapshot_bytes`
-    come every `period_s`:
+    come every `period_s` (`rtt`: a recent round_trip_s reading, else it is read now):
     nothing is unacknowledged, or the link is not queueing and fewer bytes are in flight than the
     rate needs over one round trip (see `in_flight_budget`)."""
     queued = queued_bytes(sock)
     if not queued:  # nothing unacknowledged, or the platform cannot tell
         return True
-    rtt = round_trip_s(sock)
+    rtt = rtt or round_trip_s(sock)  # the caller may pass a recent reading: this is asked every few ms
     if rtt is None:
         return False
     return queued <= in_flight_budget(rtt[0], rtt[1], snapshot_bytes, period_s)
