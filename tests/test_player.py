@@ -199,7 +199,7 @@ def test_player_reconnects_when_the_server_comes_back(cleanup):
     loop.stop()
     server.stop()
     wait_until(lambda: net.state == net.RETRYING, what="server gone, retrying")
-    assert net.status_text == "server gone, retrying..."
+    assert net.status_text == "reconnecting to the teacher's table..."
     first_try = net.next_try
     wait_until(lambda: net.next_try > first_try, what="a refused attempt while the server is away")
     assert net.state == net.RETRYING
@@ -673,10 +673,8 @@ def test_extreme_but_valid_snapshots_never_crash_hang_or_bloat_the_client(cleanu
             fake.send(b"".join(frames))
             app = PlayerApp(net, headless=True)
             drawn = lambda: net.snapshots == len(scenes) and app.frames > 1  # noqa: E731
-            start = time.monotonic()
-            assert app.run(seconds=20, until=drawn) == 0, net.error
+            assert app.run(seconds=60, until=drawn) == 0, net.error  # 60 s: a bound on a hang, not a measurement
             assert drawn(), "every snapshot arrived and was drawn"
-            assert time.monotonic() - start < 20
             peak[0] = max(peak[0], _rss_mb())
         finally:
             net.close()

@@ -5,6 +5,7 @@ from __future__ import annotations
 import json
 import logging
 import os
+import re
 import selectors
 import socket
 import struct
@@ -264,7 +265,9 @@ def test_hello_gets_welcome_then_a_snapshot(make_server, make_loop, clients):
         "color": list(rgb("maroon1")),
         "table": {"width_m": loop.table.width_m, "height_m": loop.table.height_m},
         "token": message["token"],
+        "udp_key": message["udp_key"],  # this session's input datagrams' key
     }
+    assert re.fullmatch("[0-9a-f]{32}", message["udp_key"])
     scene = c.next_scene()
     assert len(scene.pos_m) == 30 and scene.title == "headless table"
     assert server.player_names() == ["C1 Ann"]
@@ -598,7 +601,8 @@ def test_password(make_server, clients):
         got = c.next_frame()
         return got is not None and got[0] == proto.WELCOME and proto.parse_welcome(got[1])
 
-    assert wait_until(joined, what="the wait after a wrong password to end").label == "C1 Ann"
+    # C1 is held for the Ann who left (she may come back with her token): this one is C2.
+    assert wait_until(joined, what="the wait after a wrong password to end").label == "C2 Ann"
 
 
 def test_wrong_passwords_earn_a_growing_wait_then_a_lockout_and_few_log_lines(make_server, clients, caplog):

@@ -3,8 +3,8 @@
 Owned by the server's network thread. A `Connection` reads frames (at most a
 message and byte budget a second, see `RateLimit`), and sends in this order:
 control frames (WELCOME, ERROR, BYE) first, then the newest snapshot tick,
-coded for this player (codec.py) only when it can go: once the previous one
-is acknowledged (pacing.py), so a slow reader misses snapshots instead of
+coded for this player (codec.py) only when it can go: while fewer bytes are
+unacknowledged than one round trip of snapshots needs (pacing.py), so a slow reader misses snapshots instead of
 piling them up, and on a tight link every player's rate drops evenly. After an ERROR
 it shuts its side and waits for the client to hang up (`closing`).
 """
@@ -12,6 +12,7 @@ it shuts its side and waits for the client to hang up (`closing`).
 from __future__ import annotations
 
 import enum
+import math
 import selectors
 import socket
 import time
@@ -28,6 +29,8 @@ BYTES_BURST = 48 * 1024
 RECV_BYTES = 16384
 LINGER_S = 2.0  # after an ERROR: time to let it reach the client before closing
 RATE_WINDOW_S = 2.0  # snapshot rates are measured over this many seconds
+RTT_READ_S = 0.02  # pacing reads the kernel's round trip at most this often
+UDP_FRESH_S = 1.5  # a player whose input datagram came this recently sends its cursor by UDP
 
 
 class State(enum.Enum):
@@ -90,9 +93,20 @@ class Connection:
         self._encoder: SnapshotEncoder | None = None
         self._tick_due = False  # a newer tick than the player holds is waiting to be coded and sent
         self._last_snap_bytes = 0
+        self._mean_snap_bytes = 0.0  # smoothed snapshot size, for pacing
+        self._rtt: tuple[float, float] | None = None  # the kernel's round trip (smoothed, lowest), read at _rtt_at
+        self._rtt_at = -math.inf
         self.held_back = False  # the tick waits for the previous one to be acknowledged
         self._snap_offered = now
+        self._last_offer = now
+        self.period_s = 1 / 30  # smoothed time between snapshot ticks (pacing needs the rate it aims for)
         self._sending_snap = False
+        self.udp_key: str | None = None  # this session's input datagrams' key (datagrams.py), once welcomed
+        self.udp_sequence = 0  # the newest input datagram applied
+        self.udp_at = -math.inf  # when it came
+        self.keep_seat = True  # a drop holds the seat for a return (seats.py); not after BYE or a removal
+        self._drained_at = now  # when the client last took bytes we sent (see unread_s)
+        self._queued_seen = 0
         self._shut = False  # our side is shut down after an ERROR
         self._events = selectors.EVENT_READ
         self.closed = False
@@ -134,6 +148,11 @@ class Connection:
             self.last_rx = now
         return frames
 
+    def inputs_by_udp(self, now: float) -> bool:
+        """Whether this player's cursor comes by UDP now (a datagram came lately): TCP INPUTs are
+        then only a heartbeat, since one held up behind a lost packet is older than the datagrams."""
+        return now - self.udp_at < UDP_FRESH_S
+
     def note_input(self, record: proto.InputRecord, now: float) -> None:
         if record != self.last_input:
             self.last_change = now
@@ -150,6 +169,9 @@ class Connection:
         and is coded against what this player holds when its turn comes."""
         if encoder.newest is None or self.state != State.PLAYING:
             return
+        gap, self._last_offer = now - self._last_offer, now
+        if 0 < gap < 1.0:  # a pause (nobody played, the app was busy) says nothing about the rate
+            self.period_s += 0.1 * (gap - self.period_s)
         if not self._tick_due:
             self._snap_offered = now
         self._encoder, self._tick_due = encoder, True
@@ -205,7 +227,11 @@ class Connection:
         return True
 
     def _start_tick(self) -> bool:
-        self.held_back = not pacing.may_send(self.sock, self._last_snap_bytes)
+        size = max(self._last_snap_bytes, round(self._mean_snap_bytes))
+        now = time.monotonic()
+        if now - self._rtt_at > RTT_READ_S:  # a held-back tick is looked at every 2 ms: read the round trip less often
+            self._rtt, self._rtt_at = pacing.round_trip_s(self.sock), now
+        self.held_back = not pacing.may_send(self.sock, size, self.period_s, self._rtt)
         if self.held_back:
             return False
         self._tick_due = False
@@ -213,6 +239,7 @@ class Connection:
         if not data:
             return False
         self._last_snap_bytes = len(data)
+        self._mean_snap_bytes += 0.1 * (len(data) - self._mean_snap_bytes)
         self._out_cur, self._sending_snap = memoryview(data), True
         return True
 
@@ -225,6 +252,19 @@ class Connection:
             times.append(now)
             while now - times[0] > RATE_WINDOW_S:
                 times.popleft()
+
+    def unread_s(self, now: float) -> float:
+        """Seconds since the client last took any of the bytes sent to it (0 while nothing waits).
+
+        A closed lid or a frozen client stops acknowledging; so does one that never reads, once
+        its receive buffer is full. Where the kernel cannot tell, a frame stuck half-sent counts."""
+        queued = pacing.queued_bytes(self.sock)
+        if queued is None:
+            queued = len(self._out_cur) if self._out_cur is not None else 0
+        if queued == 0 or queued < self._queued_seen:
+            self._drained_at = now
+        self._queued_seen = queued
+        return now - self._drained_at
 
     def snapshot_rate(self, now: float) -> float:
         """Snapshots a second that went out whole, over the last RATE_WINDOW_S."""

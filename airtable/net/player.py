@@ -24,8 +24,11 @@ from airtable.model.student_aids import StudentAids
 from airtable.net import protocol as proto
 from airtable.net.aids_wire import AidsDecoder
 from airtable.net.identity import seat_proof, token_seat
+from airtable.net.outbox import Outbox
+from airtable.net.pacing import link_is_slow
 from airtable.net.playout import SnapshotFeed
 from airtable.net.predictions import RoundInfo, clamp_speed, encode_predict, parse_round
+from airtable.net.udp_inputs import UdpInputs
 
 CONNECT_TIMEOUT_S = 5.0
 SILENCE_S = 10.0  # no snapshot for this long: the server is gone (snapshots come 30 times a second)
@@ -34,6 +37,8 @@ HEARTBEAT_S = 1.0
 FIRST_BACKOFF_S = 0.25
 FIRST_FULL_BACKOFF_S = 1.0  # the table is full: ask again after this, then less and less often
 MAX_BACKOFF_S = 4.0
+MAX_PATIENCE_S = 30.0  # the longest a handshake is waited for, on a link found slow
+RECONNECTING = "reconnecting to the teacher's table..."
 
 
 class PlayerError(Exception):
@@ -44,10 +49,11 @@ class _ConnectError(Exception):
     """One connection attempt failed; `retry` says whether trying again can help,
     `full` that the server asked us to wait for a place."""
 
-    def __init__(self, message: str, retry: bool, full: bool = False) -> None:
+    def __init__(self, message: str, retry: bool, full: bool = False, slow: bool = False) -> None:
         super().__init__(message)
         self.retry = retry
         self.full = full
+        self.slow = slow  # the link is slow: try again, waiting longer
 
 
 class _ConnectionEndedError(Exception):
@@ -139,6 +145,7 @@ class NetPlayer:
         self.name = None if name is None else proto.check_name(name)
         self.password = password
         self.timeout_s = float(timeout_s)
+        self.patience_s = self.timeout_s  # how long a handshake is waited for: longer once the link is found slow
         self.on_snapshot = on_snapshot
         self.protocol_version = protocol_version  # other than 1 only to test the server's answer
         self.max_backoff_s = max_backoff_s
@@ -157,6 +164,9 @@ class NetPlayer:
         self._aids = AidsDecoder()
         self._sock: socket.socket | None = None
         self._send_lock = threading.Lock()
+        self._outbox = Outbox()  # what the socket has not taken yet (never waited for)
+        self._udp: UdpInputs | None = None  # inputs as datagrams, where the server takes them (datagrams.py)
+        self._tcp_input_at = -math.inf  # when an INPUT last went by TCP
         self._closed = threading.Event()
         self._thread: threading.Thread | None = None
         self._throttle = InputThrottle()
@@ -185,9 +195,11 @@ class NetPlayer:
         """A line across the window while the player cannot play, else None."""
         wait = max(0, math.ceil(self.next_try - time.monotonic()))
         if self.state == PlayerState.RETRYING:
-            return "server gone, retrying..."
+            return self.waiting_because or RECONNECTING
         if self.state == PlayerState.WAITING:
             return f"the table is full: asking again in {wait} s (Esc quits)"
+        if self.state == PlayerState.FAILED:
+            return self.error
         return None
 
     # ---------------------------------------------------------------- connecting
@@ -199,10 +211,13 @@ class NetPlayer:
         try:
             opened = self._open()
         except _ConnectError as e:
-            if not e.full:
+            if not (e.full or e.slow):
                 self.state, self.error = PlayerState.FAILED, str(e)
                 raise PlayerError(str(e)) from None
-            self._wait_for_place(str(e), self.full_backoff_s)
+            if e.full:
+                self._wait_for_place(str(e), self.full_backoff_s)
+            else:
+                self._slow_link(str(e))
             opened = None
         if opened is not None:
             self._adopt(opened[0], opened[1])
@@ -256,7 +271,7 @@ class NetPlayer:
         where = self.address
         sock.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
         reader = proto.FrameReader(proto.MAX_SERVER_FRAME, sender="the server")
-        deadline = time.monotonic() + self.timeout_s
+        deadline = time.monotonic() + self.patience_s
         try:
             # After a first WELCOME, its token asks for the same seat (number, name, colour) again:
             # HELLO names the seat, and the token is proven in answer to a CHALLENGE, never sent.
@@ -277,8 +292,14 @@ class NetPlayer:
                 f"{where} does not answer like an airtable server ({e}); check the address and port", retry=False
             ) from None
         except TimeoutError:
+            if link_is_slow(sock) is not False:  # a long round trip, or our HELLO not yet acknowledged
+                raise _ConnectError(
+                    f"the network to {where} is slow: no answer within {self.patience_s:g} s; trying again",
+                    retry=True,
+                    slow=True,
+                ) from None
             raise _ConnectError(
-                f"{where} accepted the connection but did not answer within {self.timeout_s:g} s; "
+                f"{where} accepted the connection but did not answer within {self.patience_s:g} s; "
                 "is it an airtable server?",
                 retry=True,
             ) from None
@@ -309,12 +330,20 @@ class NetPlayer:
         with self._send_lock:
             self._sock = sock
             self.welcome = welcome
+            self._outbox = Outbox()  # what waited for the old connection is stale
+            self._udp = _udp_for(sock, welcome, self._udp)
             self._feed = SnapshotFeed()  # a new connection starts from a keyframe
             self._aids = AidsDecoder()
             self._throttle.reset()
             self.round = None  # a round under way comes again after the WELCOME
             self.state = PlayerState.CONNECTED
             self.waiting_because = None
+
+    def _slow_link(self, sentence: str) -> None:
+        """A handshake timed out on a slow link: wait longer next time, and say so."""
+        self.patience_s = min(MAX_PATIENCE_S, 2 * self.patience_s)
+        self.waiting_because = sentence
+        self.state = PlayerState.RETRYING
 
     def _wait_for_place(self, sentence: str, backoff_s: float) -> None:
         self.waiting_because = sentence
@@ -341,7 +370,7 @@ class NetPlayer:
             if fatal is not None:
                 self.state, self.error = PlayerState.FAILED, fatal
                 return
-            self.state = PlayerState.RETRYING
+            self.state, self.waiting_because = PlayerState.RETRYING, None
             opened = None
 
     def _read(self, sock: socket.socket, reader: proto.FrameReader, frames: list) -> str | None:
@@ -355,6 +384,7 @@ class NetPlayer:
                     self._take(frames, now)
                 elif now - last_rx > max(SILENCE_S, self.timeout_s):
                     return None
+                self._flush(sock)  # what the socket could not take when it was sent
                 frames = self._receive(sock, reader)
         except _ConnectionEndedError as end:
             return end.fatal
@@ -450,6 +480,8 @@ class NetPlayer:
                 if e.full:
                     self._wait_for_place(str(e), max(backoff, self.full_backoff_s))
                 else:
+                    if e.slow:
+                        self._slow_link(str(e))
                     self.next_try = time.monotonic() + backoff
         return None
 
@@ -493,21 +525,41 @@ class NetPlayer:
 
     def _send(self, record: proto.InputRecord, now: float) -> bool:
         frame = proto.encode_input(record.cursor_m, record.button, record.keys)
-        return self._send_frame(frame, on_sent=lambda: self._throttle.sent(record, now))
+        udp = self._udp
+        if udp is not None and self.state == PlayerState.CONNECTED:
+            udp.send(frame[5:])  # the INPUT's JSON, without the frame's envelope
+            if udp.confirmed(now) and now - self._tcp_input_at < HEARTBEAT_S:
+                self._throttle.sent(record, now)
+                return True  # UDP gets through: TCP carries only a heartbeat a second
 
-    def _send_frame(self, frame: bytes, on_sent: Callable[[], None] | None = None) -> bool:
-        """Send one frame while connected (on_sent runs under the send lock once it is out); False if not."""
+        def sent() -> None:
+            self._throttle.sent(record, now)
+            self._tcp_input_at = now
+
+        return self._send_frame(frame, on_sent=sent, replaceable=True)
+
+    def _send_frame(self, frame: bytes, on_sent: Callable[[], None] | None = None, replaceable: bool = False) -> bool:
+        """Send one frame while connected, never waiting (see outbox.py; a `replaceable` INPUT
+        replaces an older one still waiting); on_sent runs under the send lock. False if not connected."""
         with self._send_lock:
             sock = self._sock
             if sock is None or self.state != PlayerState.CONNECTED:
                 return False
+            self._outbox.put(frame, replaceable)
+            if on_sent is not None:
+                on_sent()
+        return self._flush(sock)
+
+    def _flush(self, sock: socket.socket) -> bool:
+        """Send what waits in the outbox; False when the connection broke (the reader then reconnects)."""
+        with self._send_lock:
+            if sock is not self._sock:
+                return False
             try:
-                sock.sendall(frame)
+                self._outbox.flush(sock)
             except OSError:
                 _shut(sock)  # the reader thread notices too and starts reconnecting; wake it now
                 return False
-            if on_sent is not None:
-                on_sent()
         return True
 
     def close(self, bye: bool = True) -> None:
@@ -517,10 +569,25 @@ class NetPlayer:
             sock = self._sock
             if sock is not None:
                 if bye and self.state == PlayerState.CONNECTED:
+                    self._outbox.put(proto.encode_bye())
                     with contextlib.suppress(OSError):
-                        sock.sendall(proto.encode_bye())
+                        self._outbox.flush(sock)
                 _shut(sock)
         if self._thread is not None and self._thread is not threading.current_thread():
             self._thread.join(timeout=5.0)
+        if self._udp is not None:
+            self._udp.close()
         if self.state != PlayerState.FAILED:
             self.state = PlayerState.CLOSED
+
+
+def _udp_for(sock: socket.socket, welcome: proto.Welcome, old: UdpInputs | None) -> UdpInputs | None:
+    """This session's input datagrams, when the server offers them (closing the last session's)."""
+    if old is not None:
+        old.close()
+    if not welcome.udp_key:
+        return None
+    try:
+        return UdpInputs(sock.getpeername(), welcome.udp_key, int(welcome.client[1:]))
+    except OSError:
+        return None  # no UDP here: every input goes by TCP

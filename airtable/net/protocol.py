@@ -516,6 +516,7 @@ class Welcome:
     protocol: int = PROTOCOL_VERSION
     name: str | None = None
     token: str | None = None
+    udp_key: str | None = None  # where the server takes inputs over UDP too (datagrams.py)
 
     @property
     def label(self) -> str:
@@ -530,9 +531,11 @@ def encode_welcome(
     height_m: float,
     name: str | None = None,
     token: str | None = None,
+    udp_key: str | None = None,
 ) -> bytes:
     """A WELCOME frame; `client` is the id alone ("C3"), `name` the name the player gave,
-    `token` the seat token a reconnecting client sends back in HELLO."""
+    `token` the seat token a reconnecting client sends back in HELLO, `udp_key` the key of
+    this session's input datagrams (datagrams.py), when the server takes them."""
     message = {
         "protocol": PROTOCOL_VERSION,
         "client": client,
@@ -543,6 +546,8 @@ def encode_welcome(
         message["name"] = name
     if token is not None:
         message["token"] = token
+    if udp_key is not None:
+        message["udp_key"] = udp_key
     return encode_json(WELCOME, message)
 
 
@@ -555,7 +560,9 @@ def parse_welcome(payload: bytes) -> Welcome:
             f"the server speaks airtable protocol {_short(protocol)} but this client speaks protocol "
             f"{PROTOCOL_VERSION}; install the same airtable version as the teacher's"
         )
-    _check_fields(message, "the server's WELCOME", ("protocol", "client", "color", "table"), ("name", "token"))
+    _check_fields(
+        message, "the server's WELCOME", ("protocol", "client", "color", "table"), ("name", "token", "udp_key")
+    )
     client = message["client"]
     if not (isinstance(client, str) and re.fullmatch(r"C[1-9][0-9]{0,5}", client)):
         raise ProtocolError(f"the server's WELCOME has a bad client id {_short(client)} (it should be like C3)")
@@ -565,6 +572,9 @@ def parse_welcome(payload: bytes) -> Welcome:
     token = message.get("token")
     if token is not None and not (isinstance(token, str) and len(token) <= MAX_TOKEN_CHARS and token.isprintable()):
         raise ProtocolError("the server's WELCOME has a bad seat token")
+    udp_key = message.get("udp_key")
+    if udp_key is not None and not (isinstance(udp_key, str) and re.fullmatch(r"[0-9a-f]{32}", udp_key)):
+        raise ProtocolError("the server's WELCOME has a bad udp_key (it should be 32 hex digits)")
     color = _color(message["color"], "the server's WELCOME colour")
     table = message["table"]
     if not isinstance(table, dict):
@@ -575,7 +585,7 @@ def parse_welcome(payload: bytes) -> Welcome:
     problem = table_size_problem(w, h)
     if problem:
         raise ProtocolError(f"the server's WELCOME has {problem}")
-    return Welcome(client, color, w, h, protocol, name, token)
+    return Welcome(client, color, w, h, protocol, name, token, udp_key)
 
 
 def encode_error(sentence: str, retry: bool = False) -> bytes:

@@ -27,6 +27,7 @@ The teacher sees the seats with `roster()` and can `remove()` a player.
 from __future__ import annotations
 
 import colorsys
+import contextlib
 import errno
 import hmac
 import logging
@@ -40,7 +41,7 @@ from collections.abc import Callable
 from airtable.model.client import Client
 from airtable.model.scene import Scene
 from airtable.model.seats import Seat
-from airtable.net import pacing
+from airtable.net import datagrams, pacing
 from airtable.net import protocol as proto
 from airtable.net.codec import SnapshotEncoder
 from airtable.net.connection import Connection, State
@@ -49,6 +50,7 @@ from airtable.net.gate import FIRST_PASSWORD_WAIT_S, HANDSHAKES_PER_ADDRESS, PLA
 from airtable.net.identity import SeatTokens, new_nonce
 from airtable.net.names import distinct_name
 from airtable.net.predictions import MAX_ROUND_PUCKS, PredictionBook, RoundInfo, encode_round, parse_predict
+from airtable.net.seats import HOLD_S, HeldSeats
 from airtable.physics.colors import rgb
 
 log = logging.getLogger("airtable.net")
@@ -68,6 +70,7 @@ COURSE_COLORS = (
 )
 
 HELLO_TIMEOUT_S = 3.0  # a connection must be welcomed this soon after it opens
+SLOW_HELLO_S = 12.0  # or this soon, on a slow link (pacing.link_is_slow)
 MAX_HANDSHAKES = 32  # connections still saying HELLO, beyond the players
 MAX_PLAYERS = 1000
 MAX_SNAPSHOT_HZ = 1000.0
@@ -208,6 +211,7 @@ class GameServer:
         password_wait_s: float = FIRST_PASSWORD_WAIT_S,
         token_key: bytes | None = None,
         name_refusal: Callable[[str], str | None] | None = None,
+        seat_hold_s: float = HOLD_S,
     ) -> None:
         validate_server_options(port, max_clients, snapshot_hz, timeout_s)
         self.host = host
@@ -242,6 +246,7 @@ class GameServer:
 
         self._gate = Gate(handshakes_per_address, players_per_address, limit_loopback, password_wait_s)
         self._name_refusal = name_refusal  # a name the teacher's screen cannot draw (app/glyphs.py), or None
+        self._held = HeldSeats(seat_hold_s)  # seats of students who dropped, kept for their return (network thread)
         self._init_network_thread_state()
 
     def _init_network_thread_state(self) -> None:
@@ -254,6 +259,7 @@ class GameServer:
         self._next_cid = 1
         self._accept_paused_until = 0.0
         self._listener: socket.socket | None = None
+        self._udp: socket.socket | None = None  # input datagrams, on the listener's port (datagrams.py)
         self._selector: selectors.BaseSelector | None = None
         self._wake_r, self._wake_w = None, None  # a socketpair that wakes the network thread (made in start)
         self._thread: threading.Thread | None = None
@@ -276,6 +282,7 @@ class GameServer:
         self._selector = selectors.DefaultSelector()
         self._selector.register(self._listener, selectors.EVENT_READ, "listen")
         self._selector.register(self._wake_r, selectors.EVENT_READ, "wake")
+        self._udp = self._bind_udp()
         self._fit_to_room(connection_room(type(self._selector), _open_file_limit()))
         self._thread = threading.Thread(target=self._run, name="airtable-server", daemon=True)
         self._thread.start()
@@ -342,9 +349,10 @@ class GameServer:
         for conn in list(self._conns.values()):
             conn.close()
             self._settle(conn)
-        for sock in (self._listener, self._wake_r, self._wake_w):
+        for sock in (self._listener, self._wake_r, self._wake_w, self._udp):
             if sock is not None:
                 sock.close()
+        self._udp = None
         if self._selector is not None:
             self._selector.close()
         self._thread = None
@@ -560,6 +568,9 @@ class GameServer:
         if key.data == "listen":
             self._accept()
             return
+        if key.data == "udp":
+            self._on_datagrams()
+            return
         if key.data == "wake":
             self._drain_wake()
             self._run_commands()
@@ -642,6 +653,47 @@ class GameServer:
         self._settle(oldest)
         return True
 
+    def _bind_udp(self) -> socket.socket | None:
+        """A UDP socket on the listener's address and port, for input datagrams; None if it cannot be had
+        (players then send every input over TCP)."""
+        assert self._listener is not None and self._selector is not None
+        address = self._listener.getsockname()
+        sock = socket.socket(self._listener.family, socket.SOCK_DGRAM)
+        try:
+            sock.bind(address)
+            sock.setblocking(False)
+        except OSError as e:
+            sock.close()
+            log.warning("inputs come over TCP only: cannot listen for UDP on port %d (%s)", self.port, e)
+            return None
+        self._selector.register(sock, selectors.EVENT_READ, "udp")
+        return sock
+
+    def _on_datagrams(self) -> None:
+        """Input datagrams: each from a welcomed player, signed with its session's key and newer than the
+        last, is applied as its INPUT and acknowledged; anything else is dropped without a word."""
+        assert self._udp is not None
+        for _ in range(256):  # a bounded batch, so a flood cannot starve the TCP side
+            try:
+                data, sender = self._udp.recvfrom(datagrams.MAX_DATAGRAM + 1)
+            except OSError:  # nothing more (or an ICMP error for an old ack)
+                return
+            d = datagrams.parse(data)
+            conn = self._conns.get(self._numbers.get(d.number, -1)) if d is not None else None
+            if conn is None or d.kind != datagrams.INPUT_DATAGRAM or not d.verify(conn.udp_key):
+                continue
+            now = time.monotonic()
+            if d.sequence > conn.udp_sequence and conn.rate.spend(now, 1, len(data)) is None:
+                try:
+                    record = proto.parse_input(d.payload, self._table_size_m)
+                except proto.ProtocolError:
+                    continue
+                conn.udp_sequence, conn.udp_at, conn.last_rx = d.sequence, now, now
+                conn.note_input(record, now)
+                self._events.input(conn.cid, record)
+            with contextlib.suppress(OSError):
+                self._udp.sendto(datagrams.encode_ack(conn.udp_key, d.number, d.sequence), sender)
+
     def _drain_wake(self) -> None:
         assert self._wake_r is not None
         try:
@@ -693,6 +745,7 @@ class GameServer:
     def _handle(self, conn: Connection, frame_type: int, payload: bytes, now: float) -> None:
         if frame_type == proto.BYE:
             self._log_seat(conn, "%s said goodbye", conn.who)
+            conn.keep_seat = False
             conn.close()
         elif frame_type == proto.HELLO:
             if conn.state != State.HELLO or conn.challenge is not None:
@@ -706,8 +759,9 @@ class GameServer:
                     'INPUT came before HELLO; a client must first send HELLO like {"protocol": 1} and wait for WELCOME'
                 )
             record = proto.parse_input(payload, self._table_size_m)
-            conn.note_input(record, now)
-            self._events.input(conn.cid, record)
+            if not conn.inputs_by_udp(now):  # else a heartbeat: the datagrams carry newer cursors
+                conn.note_input(record, now)
+                self._events.input(conn.cid, record)
         elif frame_type == proto.PREDICT:
             self._predict(conn, payload)
 
@@ -754,6 +808,7 @@ class GameServer:
     def _welcome(self, conn: Connection, hello: proto.Hello, now: float) -> None:
         if not self._password_ok(conn, hello, now):
             return
+        self._take_over(conn, hello)
         refusal = self._gate.seat_refusal(conn.host, password_given=self.password is not None)
         if refusal is not None:
             self._tell_teacher(self._gate.teacher_notice())
@@ -762,14 +817,10 @@ class GameServer:
         if refusal is not None:
             self._fail(conn, refusal)
             return
-        if len(self._numbers) >= self.max_clients:
+        number = self._seat_for(conn, hello, now)
+        if number is None:
             self._fail(conn, self._full_sentence(), retry=True)
             return
-        number = self._claimed_seat(conn, hello)  # their old seat, if it is free
-        if number is None or number in self._numbers or number > MAX_PLAYERS:
-            number = 1
-            while number in self._numbers:  # the lowest free number, so names get reused
-                number += 1
         client = f"C{number}"
         shown = self._distinct(hello.name)
         name = client + (f" {shown}" if shown else "")  # the cursor's label
@@ -782,7 +833,8 @@ class GameServer:
         self._events.join(conn.cid, name, color, number)
         width_m, height_m = self._table_size_m
         token = self._tokens.make(number, hello.name or "")
-        conn.send_control(proto.encode_welcome(client, color, width_m, height_m, shown, token))
+        conn.udp_key = datagrams.new_key() if self._udp is not None else None
+        conn.send_control(proto.encode_welcome(client, color, width_m, height_m, shown, token, conn.udp_key))
         conn.offer_tick(self._encoder, now)  # the newest picture straight away, if there is one
         with self._lock:
             round_frame = self._round_frame
@@ -803,6 +855,30 @@ class GameServer:
             return name
         playing = (self._conns[cid].name.partition(" ")[2] for cid in self._numbers.values())
         return distinct_name(name, playing)
+
+    def _take_over(self, conn: Connection, hello: proto.Hello) -> None:
+        """A student back with their seat's token, while their old connection still holds it (it has
+        not noticed the drop yet): the old one is closed at once, so the seat is free for the new one."""
+        number = self._claimed_seat(conn, hello)
+        stale = self._conns.get(self._numbers.get(number, -1)) if number is not None else None
+        if stale is None:
+            return
+        self._log_seat(stale, "%s is back on a new connection; the old one is closed", stale.who)
+        stale.keep_seat = False
+        self._release_slot(stale)
+        stale.close()
+        self._settle(stale)
+
+    def _seat_for(self, conn: Connection, hello: proto.Hello, now: float) -> int | None:
+        """The seat a welcomed HELLO gets: the one its token proves, if free (given back from hold);
+        else the lowest seat neither taken nor held for someone who dropped. None: the table is full."""
+        if len(self._numbers) >= self.max_clients:
+            return None
+        number = self._claimed_seat(conn, hello)
+        if number is not None and number <= MAX_PLAYERS and number not in self._numbers:
+            self._held.give_back(number)
+            return number
+        return self._held.free_number(self._numbers, now)
 
     def _log_seat(self, conn: Connection, line: str, *args) -> None:
         """Joins and leaves, one line each, but summarised when one computer churns."""
@@ -849,6 +925,7 @@ class GameServer:
         cid = self._numbers.get(number)
         conn = self._conns.get(cid) if cid is not None else None
         if conn is not None:
+            conn.keep_seat = False  # removed: the seat is not kept for a return
             self._fail(conn, sentence)
             self._settle(conn)
 
@@ -859,6 +936,8 @@ class GameServer:
             conn.state = State.CLOSING
         if conn.number and self._numbers.get(conn.number) == conn.cid:
             del self._numbers[conn.number]
+            if conn.keep_seat:  # a drop, not a goodbye or a removal: held for their return
+                self._held.hold(conn.number, time.monotonic())
             self._gate.seat_freed(conn.host)
             with self._lock:
                 self._names.pop(conn.number, None)
@@ -882,18 +961,9 @@ class GameServer:
                 if now > conn.deadline:
                     conn.close()
             elif conn.state == State.HELLO and now > conn.deadline:
-                self._fail(
-                    conn,
-                    f"no HELLO came within {self.hello_timeout_s:g} s of connecting; "
-                    "join with airtable-client, which says HELLO at once",
-                    quiet=True,
-                )
-            elif now - conn.last_rx > self.timeout_s:
-                self._fail(
-                    conn,
-                    f"nothing complete was received for {self.timeout_s:g} s (a client sends at least one INPUT "
-                    "a second), so the connection was closed; check the network and join again",
-                )
+                self._hello_missing(conn, now)
+            elif (dead := self._dead_sentence(conn, now)) is not None:
+                self._fail(conn, dead, retry=True)
             self._settle(conn)
         if self._accept_paused_until and now >= self._accept_paused_until:
             self._accept_paused_until = 0.0
@@ -901,6 +971,43 @@ class GameServer:
             self._selector.register(self._listener, selectors.EVENT_READ, "listen")
         self._gate.forget_old_guesses(now, log)
         self._quiet.flush(now)
+
+    def _hello_missing(self, conn: Connection, now: float) -> None:
+        """The HELLO deadline passed. On a slow link (long round trip, bytes lost and sent again) the HELLO
+        may still be on its way: wait up to SLOW_HELLO_S, then ask the client to try again. On a quick
+        link this is not an airtable client."""
+        slow = pacing.link_is_slow(conn.sock)
+        if slow and now - conn.opened < SLOW_HELLO_S:
+            return
+        if slow:
+            sentence = (
+                f"the network is slow: your HELLO did not arrive within {SLOW_HELLO_S:g} s; "
+                "your client tries again by itself"
+            )
+            self._fail(conn, sentence, retry=True, quiet=True)
+            return
+        self._fail(
+            conn,
+            f"no HELLO came within {self.hello_timeout_s:g} s of connecting; "
+            "join with airtable-client, which says HELLO at once",
+            quiet=True,
+        )
+
+    def _dead_sentence(self, conn: Connection, now: float) -> str | None:
+        """Why a connection counts as dead (a player's seat is then held; the ERROR carries retry), or None."""
+        after = (
+            "your seat is kept and your client reconnects by itself"
+            if conn.state == State.PLAYING
+            else "check the network and join again"
+        )
+        if now - conn.last_rx > self.timeout_s:
+            return (
+                f"nothing complete was received for {self.timeout_s:g} s (a client sends at least one INPUT "
+                f"a second), so the connection was closed; {after}"
+            )
+        if conn.unread_s(now) > self.timeout_s:
+            return f"nothing sent to you was read for {self.timeout_s:g} s, so the connection was closed; {after}"
+        return None
 
     def _refresh_roster(self, now: float) -> None:
         width_m, height_m = self._table_size_m

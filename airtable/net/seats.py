@@ -1,0 +1,56 @@
+"""Held seats: a student who drops keeps their number and colour for a while.
+
+When a student's connection ends without a goodbye (the Wi-Fi dropped, the lid was closed, the
+server timed them out), their seat is held for HOLD_S: a newcomer gets the lowest number that is
+neither taken nor held, and the student who comes back with the seat's token (identity.py) gets
+their own number, name and colour again. A seat is given up by a goodbye or the teacher's removal,
+and when its hold runs out. Owned by the server's network thread.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Container
+
+HOLD_S = 150.0  # at least two minutes, as the classroom expects after a drop
+MAX_HELD = 10_000  # bound on what is remembered, whatever the churn
+
+
+class HeldSeats:
+    """Seat numbers held for students who dropped, until a time (time.monotonic seconds)."""
+
+    def __init__(self, hold_s: float = HOLD_S) -> None:
+        self.hold_s = float(hold_s)
+        self._until: dict[int, float] = {}
+
+    def hold(self, number: int, now: float) -> None:
+        """Keep seat `number` for its student until now + hold_s."""
+        if len(self._until) >= MAX_HELD:
+            self._forget_old(now)
+            if len(self._until) >= MAX_HELD:
+                self._until.pop(min(self._until, key=self._until.__getitem__))
+        self._until[number] = now + self.hold_s
+
+    def give_back(self, number: int) -> None:
+        """The seat is its student's again (or given up): no longer held."""
+        self._until.pop(number, None)
+
+    def is_held(self, number: int, now: float) -> bool:
+        until = self._until.get(number)
+        return until is not None and now < until
+
+    def held(self, now: float) -> list[int]:
+        """The numbers held now, lowest first."""
+        self._forget_old(now)
+        return sorted(self._until)
+
+    def free_number(self, taken: Container[int], now: float) -> int:
+        """The lowest seat number that is neither `taken` nor held (so numbers get reused)."""
+        self._forget_old(now)
+        number = 1
+        while number in taken or number in self._until:
+            number += 1
+        return number
+
+    def _forget_old(self, now: float) -> None:
+        for number in [n for n, until in self._until.items() if now >= until]:
+            del self._until[number]
