@@ -68,7 +68,9 @@ def test_a_gas_under_gravity_replays(cr, mode):
     table.cr_puck = table.cr_wall = cr
     table.puck_correction = mode
     assert_replays(table, k=37, m=50, dt_s=1 / 120)
-    assert table.collision_count > 50
+    # At restitution 0 a hit of pucks pressed by gravity is a resting contact (contacts.rest_for_restitution):
+    # the contact stage stops it, and the pair stage counts only the few of pucks it did not press.
+    assert table.collision_count > 50 or (cr == 0.0 and table._contacts.count > 50)
 
 
 def test_pucks_added_and_removed_after_the_capture_come_and_go_with_their_handles():
