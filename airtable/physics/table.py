@@ -45,7 +45,7 @@ from collections.abc import Callable, Sequence
 import numpy as np
 
 from airtable.colors import rgb
-from airtable.physics import broadphase, contacts, forces, pairs, sleep, sweep, vectors, walls
+from airtable.physics import broadphase, contacts, forces, pairs, sleep, substeps, sweep, vectors, walls
 from airtable.physics import implicit as implicit_solve
 from airtable.physics.bodies import Puck, Spring, as_vector
 from airtable.physics.forces import GRAVITY_MPS2, Pull
@@ -72,10 +72,11 @@ WALL_BAND_MIN_PUCKS = 4000
 PRESSED_REST_MPS = 0.2
 # Overlaps smaller than this (m) are left to the next step: round-off only.
 OVERLAP_SLOP_M = 1e-9
-# Said once (in `notices`) when springs are first solved implicitly.
+# Said once (in `notices`) when springs are first solved implicitly (beyond what substeps.py takes).
 IMPLICIT_NOTICE = (
-    "Some springs vibrate faster than a step can follow: the step solves them implicitly,"
-    " so they hold and sag as their k says, but their fastest wobble is damped away."
+    f"Some springs vibrate faster than even {substeps.MAX_SUBSTEPS} substeps of a step can follow: the step"
+    " solves them implicitly, so they hold and sag as their k says, but their vibrations are damped away,"
+    " the fastest at once and the slow ones too, a little each period."
 )
 # Passes that add walls to the implicit solve (see _brace_walls).
 BRACE_PASSES = 4
@@ -486,8 +487,7 @@ class AirTable:
         if self._pucks.n and not self._wake(pulls, dt):  # 0b. sleepers: wake those disturbed
             kick = None
             if dt > 0.0:
-                implicit = self._add_forces(pulls, dt)  # 1. forces
-                kick = self._integrate(implicit, dt)  # 2. semi-implicit Euler
+                kick = self._forces_and_integrate(pulls, dt)  # 1-2. forces, semi-implicit Euler (substeps)
                 self._sweep_fast(dt)  # 2b. fast pucks: their hits in time order, exactly
                 self._wake_hit()
             self.force_N[:] = 0.0  # the accumulators hold one step's forces
@@ -598,6 +598,23 @@ class AirTable:
         while self._events and self._events[0][0] <= self.time_s + 1e-9:
             _, _, fn = heapq.heappop(self._events)
             fn(self)
+
+    def _forces_and_integrate(self, pulls: Sequence[Pull], dt: float) -> np.ndarray | float | None:
+        """Stages 1 and 2, in as many substeps as the springs need (substeps.py); return the kick
+        (see _integrate) of the whole step. Forces written from outside act through every substep."""
+        n = 1
+        if self._springs.n:
+            a, b = self._springs.view("i"), self._springs.view("j")
+            n = substeps.count(self.mass_kg, a, b, self.spring_k_Npm, dt)
+        if n == 1:
+            return self._integrate(self._add_forces(pulls, dt), dt)
+        h, outside, kick = dt / n, self.force_N.copy(), None
+        for s in range(n):
+            if s:
+                self.force_N[:] = outside
+            add = self._integrate(self._add_forces(pulls, h), h)
+            kick = add if kick is None else kick if add is None else kick + add
+        return kick
 
     def _add_forces(self, pulls: Sequence[Pull], dt: float) -> forces.Implicit | None:
         """Add the pulls' and springs' forces to force_N; return what the step takes implicitly (None: nothing)."""
