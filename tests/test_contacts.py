@@ -65,7 +65,7 @@ def test_the_stage_solves_the_contact_problem(monkeypatch) -> None:
     # still be the one plain sequential impulses reach, one contact at a time,
     # when they have converged: no contact approaches faster than its bound,
     # and no contact pushes that need not. (Given the iterations to converge:
-    # a step stops at its budget, ROUND_BUDGET.)
+    # a step stops at its budget, ITERATION_WORK.)
     monkeypatch.setattr(contacts, "ITERATIONS", 200)
     pos, vel, radius, mass = _small_pile()
     dt = 1 / 240

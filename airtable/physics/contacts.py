@@ -31,7 +31,7 @@ rest starts from the answer. The contacts are coloured into rounds in which
 no puck appears twice, so each round is one numpy operation and still the
 exact sequential result. The iterations after the first are sped up as
 conjugate gradients speed up plain ones (_iterate), and a small group of
-contacts gets as many as a round budget pays for: a stack landing settles
+contacts gets as many as ITERATION_WORK pays for: a stack landing settles
 within its step.
 
 Order of the step: positions have already moved with the velocities when
@@ -50,11 +50,12 @@ from airtable.physics import vectors
 # Iterations over all contacts per step (Box2D and pymunk use about ten);
 # the loop stops early once an iteration changes no velocity by CONVERGED_MPS.
 ITERATIONS = 10
-# A round costs numpy's fixed price whatever its size, and a large pile takes
-# about 15 of them an iteration: a step may spend this many rounds, so a small
-# group of contacts (a stack, a slab: a few rounds) gets more iterations, as
-# many as a chain of its depth needs (a column of 6 dropped: about 30).
-ROUND_BUDGET = 160
+# A step may spend about this many contact-iterations before it stops unconverged,
+# and at most MAX_ITERATIONS: a small group of contacts (a stack, a slab) gets as
+# many iterations as its chains need (a column of 7 with masses 8 times apart,
+# dropped: about 100), and a large pile (2000 contacts) its ITERATIONS.
+ITERATION_WORK = 20_000
+MAX_ITERATIONS = 200
 SOLVER = "gs"
 OMEGA = 1.0
 CONVERGED_MPS = 1e-7
@@ -467,8 +468,9 @@ def _iterate(w: np.ndarray, first: _Layout, later: _Layout) -> tuple[int, _Layou
     gradients speed up plain iterations (Silcowitz, Niebe and Erleben's
     nonsmooth nonlinear conjugate gradients, 2009): each sweep's change of
     the impulses is a gradient, and a share of the last direction is added
-    to it. A chain of n contacts (a stack landing) then settles in about n
-    sweeps instead of about n^2, so no impulse is left half done.
+    to it. Plain sweeps pass a push along a chain of contacts (a stack
+    landing) one link at a time and back; these carry it on, and the chain
+    settles within its step instead of leaving impulses half done.
     """
     flat = w.reshape(-1)
     _sweep(flat, first)
@@ -476,12 +478,12 @@ def _iterate(w: np.ndarray, first: _Layout, later: _Layout) -> tuple[int, _Layou
         return 1, first
     later.take_impulses(first.impulses())
     direction, last_gg = None, None
-    iterations = max(ITERATIONS, ROUND_BUDGET // max(len(later.rounds), 1))
+    iterations = max(ITERATIONS, min(MAX_ITERATIONS, ITERATION_WORK // len(later.order)))
     for it in range(2, iterations + 1):
         before = later.current()
         _sweep(flat, later)
-        if later.converged():
-            return it, later
+        if later.converged() or it == iterations:
+            return it, later  # (the last word is a sweep's, never an extrapolation)
         after = later.current()
         gradient = before - after
         gg = np.einsum("ij,ij->j", gradient, gradient)
@@ -492,7 +494,7 @@ def _iterate(w: np.ndarray, first: _Layout, later: _Layout) -> tuple[int, _Layou
             later.push(flat, np.maximum(after + beta * direction, 0.0))
             direction = beta * direction - gradient
         last_gg = gg
-    return iterations, later
+    return iterations, later  # (only with fewer than two iterations)
 
 
 def _sweep(flat: np.ndarray, layout: _Layout) -> None:
