@@ -53,8 +53,9 @@ ITERATIONS = 10
 # A step may spend about this many contact-iterations before it stops unconverged,
 # and at most MAX_ITERATIONS: a small group of contacts (a stack, a slab) gets as
 # many iterations as its chains need (a column of 7 with masses 8 times apart,
-# dropped: about 100), and a large pile (2000 contacts) its ITERATIONS.
-ITERATION_WORK = 20_000
+# dropped: about 100), and a pile of 800 contacts or more its ITERATIONS (an 800-puck
+# pile settling has 1000 to 2000 awake ones: more iterations there cost more than they show).
+ITERATION_WORK = 8_000
 MAX_ITERATIONS = 200
 SOLVER = "gs"
 OMEGA = 1.0
