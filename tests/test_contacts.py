@@ -27,8 +27,9 @@ def _small_pile() -> tuple[np.ndarray, ...]:
     return pos, vel, radius, mass
 
 
-def _sequential(c, rounds, free_rounds, iterations, vel, mass, dt):
-    """Sequential impulses in plain Python, one contact at a time, in the solver's order of contacts."""
+def _sequential(c, vel, mass, dt, sweeps=5000):
+    """Plain sequential impulses in plain Python, one contact at a time in index order, until a sweep
+    changes nothing: the velocities then solve the contact problem, whatever the order was."""
     rows = len(mass)
     inv = np.append(1.0 / mass, 0.0)
     w = np.zeros((rows + 1, 2), dtype=complex)  # velocity and pseudo-velocity; the last row: the walls
@@ -41,23 +42,31 @@ def _sequential(c, rounds, free_rounds, iterations, vel, mass, dt):
         ]
     )
     impulse = np.zeros((len(c.a), 2))
-    for it in range(iterations):
-        for k in np.concatenate(rounds if it == 0 else free_rounds).tolist():
+    for _ in range(sweeps):
+        largest = 0.0
+        for k in range(len(c.a)):
             a, b, n = int(c.a[k]), int(c.b[k]), complex(c.n[k])
             wa, wb = inv[a], inv[b]
             for col in (0, 1):
                 vn = (n.conjugate() * (w[a, col] - w[b, col])).real
                 new = max(impulse[k, col] + (target[k, col] - vn) / (wa + wb), 0.0)
                 change, impulse[k, col] = new - impulse[k, col], new
+                largest = max(largest, abs(change) * (wa + wb))
                 w[a, col] += change * n * wa
                 w[b, col] -= change * n * wb
+        if largest < 1e-15:
+            break
     return w
 
 
-def test_the_rounds_give_the_sequential_result() -> None:
-    # Each round solves contacts that share no puck all at once, gathering
-    # body a's and body b's rows in one go and writing them back in one go;
-    # that must be exactly what solving them one after another gives.
+def test_the_stage_solves_the_contact_problem(monkeypatch) -> None:
+    # The rounds solve contacts that share no puck all at once, and the later
+    # iterations are sped up (conjugate-gradient-like steps); the answer must
+    # still be the one plain sequential impulses reach, one contact at a time,
+    # when they have converged: no contact approaches faster than its bound,
+    # and no contact pushes that need not. (Given the iterations to converge:
+    # a step stops at its budget, ITERATION_WORK.)
+    monkeypatch.setattr(contacts, "ITERATIONS", 200)
     pos, vel, radius, mass = _small_pile()
     dt = 1 / 240
     size = np.array([1.0, 1.0])
@@ -76,11 +85,12 @@ def test_the_rounds_give_the_sequential_result() -> None:
     p, v = pos.copy(), vel.copy()
     assert solver.solve(p, v, radius, mass, size, candidates, rest, dt)
     assert len(solver._free_rounds) < len(c.a)  # contacts were solved several to a round
-    w = _sequential(c, solver._rounds, solver._free_rounds, solver.iterations, vel, mass, dt)
+    assert solver.iterations < 100  # converged (plain sequential impulses are 0.2 mm/s off after 100 sweeps)
+    w = _sequential(c, vel, mass, dt)
 
-    np.testing.assert_allclose(v[:, 0] + 1j * v[:, 1], w[:-1, 0], rtol=0, atol=1e-12)
+    np.testing.assert_allclose(v[:, 0] + 1j * v[:, 1], w[:-1, 0], rtol=0, atol=1e-6)
     moved = (w[:-1, 0] - (vel[:, 0] + 1j * vel[:, 1]) + w[:-1, 1]) * dt
-    np.testing.assert_allclose(p, pos + np.column_stack([moved.real, moved.imag]), rtol=0, atol=1e-15)
+    np.testing.assert_allclose(p, pos + np.column_stack([moved.real, moved.imag]), rtol=0, atol=1e-8)
     assert np.all(v[:, 1] > vel[:, 1] + 0.01)  # held up: every puck falls slower than before
 
 

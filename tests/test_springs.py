@@ -7,7 +7,7 @@ import math
 import numpy as np
 import pytest
 
-from airtable.physics import forces
+from airtable.physics import forces, substeps
 from airtable.physics.forces import GRAVITY_MPS2, Pull
 from airtable.physics.table import AirTable
 from bench import hard as bench_hard
@@ -52,8 +52,10 @@ def test_hanging_chain_sags_as_hookes_law_says(k: float, mass_kg: float) -> None
     assert np.abs(table.vel_mps).max() < 1e-4
 
 
-def test_one_implicit_step_by_hand() -> None:
+def test_one_implicit_step_by_hand(monkeypatch) -> None:
     """Two 9 g pucks 0.1 m too far apart on a 1000 N/m spring, at rest: one step, worked by hand.
+
+    (Taken implicitly as a spring beyond what substeps take would be: substeps off.)
 
     Each puck's springs take k dt^2 / m = 1000 / 240^2 / 0.009 = 1.93 > 0.25, so
     the spring is explicit only up to k_e = 0.25 m / dt^2 and the rest,
@@ -61,6 +63,7 @@ def test_one_implicit_step_by_hand() -> None:
     (m + 2 dt^2 k_i) dv_a = dt k (d - L), along the line towards b.
     """
     m, k, dt = 0.009, 1000.0, DT_S
+    monkeypatch.setattr(substeps, "MAX_SUBSTEPS", 1)
     table = AirTable()
     a = _light_puck(table, (4.0, 4.0), m)
     b = _light_puck(table, (5.1, 4.0), m)
@@ -227,13 +230,14 @@ def test_soft_springs_raise_no_notice_and_stay_explicit() -> None:
 
 
 def test_the_implicit_notice_comes_once_per_scene() -> None:
+    # k 1e6 N/m on 9 g pucks: beyond what substeps.MAX_SUBSTEPS take, so solved implicitly.
     table = AirTable()
-    bench_hard.jelly_scene(table)
+    bench_hard.jelly_scene(table, k_Npm=1e6)
     for _ in range(50):
         table.step(DT_S)
     assert len(table.notices) == 1 and "implicitly" in table.notices[0]
     table.clear()
-    bench_hard.jelly_scene(table)
+    bench_hard.jelly_scene(table, k_Npm=1e6)
     table.step(DT_S)
     assert len(table.notices) == 1
 

@@ -53,7 +53,8 @@ def test_the_cradle_replays_through_its_timed_throw(demos, cr):
 
 @pytest.mark.parametrize("cr", RESTITUTIONS)
 def test_a_jelly_on_stiff_springs_replays_while_dragged(demos, cr):
-    table = build(demos, "6p", 2, cr)  # k 1500 N/m: springs solved implicitly
+    table = build(demos, "6p", 2, cr)  # k 1500 N/m: taken in substeps (substeps.py), kept nowhere
+    table.spring_k_Npm[:] *= 1000.0  # k 1.5e6 N/m: beyond what substeps take, so solved implicitly
     table.gravity_on = True
     pull = Pull(row=0, anchor_m=(3.0, 6.0), k_Npm=60.0, drag_Nspm=2.0)
     assert_replays(table, k=60, m=240, dt_s=demos["6p"].dt_s, pulls=[pull])
@@ -68,7 +69,9 @@ def test_a_gas_under_gravity_replays(cr, mode):
     table.cr_puck = table.cr_wall = cr
     table.puck_correction = mode
     assert_replays(table, k=37, m=50, dt_s=1 / 120)
-    assert table.collision_count > 50
+    # At restitution 0 a hit of pucks pressed by gravity is a resting contact (contacts.rest_for_restitution):
+    # the contact stage stops it, and the pair stage counts only the few of pucks it did not press.
+    assert table.collision_count > 50 or (cr == 0.0 and table._contacts.count > 50)
 
 
 def test_pucks_added_and_removed_after_the_capture_come_and_go_with_their_handles():
@@ -131,6 +134,7 @@ def test_a_resting_pile_replays_with_its_warm_started_contacts():
     table = gas_scene(200, seed=3)
     table.gravity_on = True
     table.cr_puck = table.cr_wall = 0.0
+    table.sleeping = False  # at restitution 0 it lands dead and would be mostly asleep: keep its contacts busy
     run(table, 300, 1 / 120)  # settled into a pile: the contact stage holds it up
     state = capture(table)
     keys, impulses = state.contacts[:2]

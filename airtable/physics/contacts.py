@@ -9,8 +9,9 @@ after the collisions, in which walls and puck pairs take part together.
 
 Which contacts: pairs and puck-wall contacts that touch or nearly touch
 (gap under a margin: MARGIN_M plus as far as the stage may move a puck)
-and approach slower than the rest speed (faster ones are collisions: they
-keep the course's model), and pairs that pressed on each other in the last
+and approach slower than the rest speed over the restitution (faster ones
+are collisions: they keep the course's model; at restitution 0 no contact
+is: see rest_for_restitution), and pairs that pressed on each other in the last
 step, whatever their speed. Each contact k has a normal
 n (from body b to body a; a wall is a body that never moves) and asks:
 
@@ -28,7 +29,10 @@ iterations and clamped at zero (contacts push, never pull); a contact's
 impulse from the last step is applied first ("warm starting"), so a pile at
 rest starts from the answer. The contacts are coloured into rounds in which
 no puck appears twice, so each round is one numpy operation and still the
-exact sequential result.
+exact sequential result. The iterations after the first are sped up as
+conjugate gradients speed up plain ones (_iterate), and a small group of
+contacts gets as many as ITERATION_WORK pays for: a stack landing settles
+within its step.
 
 Order of the step: positions have already moved with the velocities when
 this stage runs, so a velocity change dv also moves the puck by dv dt: the
@@ -46,6 +50,13 @@ from airtable.physics import vectors
 # Iterations over all contacts per step (Box2D and pymunk use about ten);
 # the loop stops early once an iteration changes no velocity by CONVERGED_MPS.
 ITERATIONS = 10
+# A step may spend about this many contact-iterations before it stops unconverged,
+# and at most MAX_ITERATIONS: a small group of contacts (a stack, a slab) gets as
+# many iterations as its chains need (a column of 7 with masses 8 times apart,
+# dropped: about 100), and a pile of 800 contacts or more its ITERATIONS (an 800-puck
+# pile settling has 1000 to 2000 awake ones: more iterations there cost more than they show).
+ITERATION_WORK = 8_000
+MAX_ITERATIONS = 200
 SOLVER = "gs"
 OMEGA = 1.0
 CONVERGED_MPS = 1e-7
@@ -69,6 +80,22 @@ MAX_PUSH_MPS = 0.5
 # The four walls as unit normals pointing into the table (complex x + iy):
 # left, bottom, right, top.
 WALL_NORMALS = np.array([1.0, 1j, -1.0, -1j])
+
+
+def rest_for_restitution(rest: np.ndarray, cr: float) -> np.ndarray:
+    """Rest speeds (m/s) for contacts of restitution cr: a contact rests when its bounce, cr times
+    its approach, would be slower than `rest`, so when it approaches slower than rest / cr.
+
+    At cr = 0 every pressed contact rests, however fast: a perfectly inelastic hit and a
+    resting contact ask the same (no approach after it), and only the contact stage solves
+    them all together, as a stack or a slab landing needs (pair by pair, a chain of 6 pucks
+    takes more passes than a step has). Not pressed (rest 0): left to the collision stages.
+    """
+    if cr >= 1.0:
+        return rest
+    if cr <= 0.0:
+        return np.where(rest > 0.0, np.inf, 0.0)
+    return rest / cr
 
 
 def _same_rows(a: np.ndarray | None, b: np.ndarray | None) -> bool:
@@ -215,11 +242,12 @@ class ContactSolver:
         """Drop the kept impulses (pucks were added, removed or moved by hand)."""
         self.__init__()
 
-    def solve(self, pos, vel, radius, mass, size_m, candidates, rest, dt, asleep=None) -> bool:
+    def solve(self, pos, vel, radius, mass, size_m, candidates, rest, dt, asleep=None, rest_walls=None) -> bool:
         """Solve the resting contacts in place; return whether there were any.
 
         candidates: (i, j, reach) pairs that may touch; rest: each puck's rest
-        speed (m/s): contacts approaching slower than it are resting; asleep:
+        speed (m/s): contacts approaching slower than it are resting (towards
+        the walls, rest_walls if given); asleep:
         which pucks sleep (sleep.py), or None: to the awake pucks a sleeper is
         immovable, and its contacts with the walls and with other sleepers are
         left out.
@@ -233,7 +261,8 @@ class ContactSolver:
             awake = np.flatnonzero(~(asleep.take(ci) & asleep.take(cj)))
             ci, cj, reach = ci.take(awake), cj.take(awake), reach.take(awake)
         pc = _pair_contacts(pos, vel, ci, cj, reach, rest, self.held, margin)
-        wc = _wall_contacts(pos, vel, radius, size_m, self.wall_rest(rest), margin)
+        rest_walls = rest if rest_walls is None else rest_walls
+        wc = _wall_contacts(pos, vel, radius, size_m, self.wall_rest(rest_walls), margin)
         if asleep is not None:
             wc = _Contacts(*(getattr(wc, f).take(np.flatnonzero(~asleep.take(wc.a))) for f in _FIELDS))
         c = _Contacts(*(np.concatenate([getattr(pc, f), getattr(wc, f)]) for f in _FIELDS))
@@ -362,6 +391,10 @@ class _Layout:
             for s, e in bounds
         ]  # fmt: skip
         self._impulses = [g.impulse for g in self.rounds]
+        # For a change of every impulse at once (push): the flat rows of both bodies, and which
+        # contact (in this layout's order) each of nab's rows belongs to.
+        self.fab = fab.ravel()
+        self.ab_contact = np.concatenate([x for s, e in bounds for x in (np.arange(s, e), np.arange(s, e))])
 
     def converged(self) -> bool:
         """Whether the last iteration changed no speed by CONVERGED_MPS (a change of impulse times w_max).
@@ -379,6 +412,19 @@ class _Layout:
         out = np.empty((len(self.order), 2))
         out[self.order] = np.concatenate([g.impulse for g in self.rounds])
         return out
+
+    def current(self) -> np.ndarray:
+        """(contacts, 2) the rounds' impulses so far, in this layout's order."""
+        return np.concatenate([g.impulse for g in self.rounds])
+
+    def push(self, flat: np.ndarray, impulses: np.ndarray) -> None:
+        """Set the impulses (this layout's order) and change the velocities in `flat` to match."""
+        change = (impulses - self.current()).take(self.ab_contact, axis=0) * self.nab
+        size = len(flat)
+        flat += np.bincount(self.fab, change.real.ravel(), size) + 1j * np.bincount(self.fab, change.imag.ravel(), size)
+        self.impulse[:] = impulses
+        for g, view in zip(self.rounds, self._impulses, strict=True):
+            g.impulse = view
 
     def take_impulses(self, impulses: np.ndarray) -> None:
         """Start the rounds from these impulses (contact by contact)."""
@@ -418,27 +464,53 @@ def _iterate(w: np.ndarray, first: _Layout, later: _Layout) -> tuple[int, _Layou
     and the layout whose rounds hold the impulses.
 
     The first iteration goes bottom-up (`first`), so support from the floor
-    travels up a pile; the later ones only refine it and take the fewer
-    rounds of `later`, which get the impulses so far.
+    travels up a pile; the later ones refine it and take the fewer rounds of
+    `later`, which get the impulses so far. Those are sped up as conjugate
+    gradients speed up plain iterations (Silcowitz, Niebe and Erleben's
+    nonsmooth nonlinear conjugate gradients, 2009): each sweep's change of
+    the impulses is a gradient, and a share of the last direction is added
+    to it. Plain sweeps pass a push along a chain of contacts (a stack
+    landing) one link at a time and back; these carry it on, and the chain
+    settles within its step instead of leaving impulses half done.
     """
     flat = w.reshape(-1)
-    layout = first
-    for it in range(1, ITERATIONS + 1):
-        if it == 2:
-            later.take_impulses(first.impulses())
-            layout = later
-        # Velocities as one row of numbers (1-D fancy indexing is several times
-        # cheaper than 2-D). No body appears twice in a round, so each writes
-        # back what it read plus its change; the walls' row takes many writes,
-        # all the same (wb = 0).
-        for g in layout.rounds:
-            v = flat.take(g.fab).reshape(2, -1, 2)  # body a's rows, then body b's
-            vn = (g.nc * (v[0] - v[1])).real
-            new = np.maximum(g.impulse + g.k * (g.target - vn), 0.0)
-            np.subtract(new, g.impulse, out=g.change)
-            g.impulse = new
-            v += g.change * g.nab
-            flat[g.fab] = v.reshape(-1)
-        if layout.converged():
-            return it, layout
-    return ITERATIONS, layout
+    _sweep(flat, first)
+    if first.converged():
+        return 1, first
+    later.take_impulses(first.impulses())
+    direction, last_gg = None, None
+    iterations = max(ITERATIONS, min(MAX_ITERATIONS, ITERATION_WORK // len(later.order)))
+    for it in range(2, iterations + 1):
+        before = later.current()
+        _sweep(flat, later)
+        if later.converged() or it == iterations:
+            return it, later  # (the last word is a sweep's, never an extrapolation)
+        after = later.current()
+        gradient = before - after
+        gg = np.einsum("ij,ij->j", gradient, gradient)
+        if direction is None:
+            direction = -gradient
+        else:
+            beta = np.where(gg <= last_gg, gg / np.maximum(last_gg, 1e-300), 0.0)  # a rise: start again
+            later.push(flat, np.maximum(after + beta * direction, 0.0))
+            direction = beta * direction - gradient
+        last_gg = gg
+    return iterations, later  # (only with fewer than two iterations)
+
+
+def _sweep(flat: np.ndarray, layout: _Layout) -> None:
+    """One iteration of sequential impulses over the layout's rounds, in place.
+
+    Velocities as one row of numbers (1-D fancy indexing is several times
+    cheaper than 2-D). No body appears twice in a round, so each writes back
+    what it read plus its change; the walls' row takes many writes, all the
+    same (wb = 0).
+    """
+    for g in layout.rounds:
+        v = flat.take(g.fab).reshape(2, -1, 2)  # body a's rows, then body b's
+        vn = (g.nc * (v[0] - v[1])).real
+        new = np.maximum(g.impulse + g.k * (g.target - vn), 0.0)
+        np.subtract(new, g.impulse, out=g.change)
+        g.impulse = new
+        v += g.change * g.nab
+        flat[g.fab] = v.reshape(-1)

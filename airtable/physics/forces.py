@@ -16,8 +16,9 @@ dampers). So each puck gets a budget (EXPLICIT_STIFFNESS, EXPLICIT_DAMPING):
 springs within it are taken explicitly, exactly as before, and what a spring
 has beyond it is taken implicitly (backward Euler along the spring's current
 line, see implicit.py). The force is always the full k and c asked for, so a
-spring under load stretches exactly as k says; the implicit part only damps
-vibrations faster than the step can show. A pull's drag is always implicit.
+spring under load stretches exactly as k says. The implicit part damps every
+mode it takes, the slow ones too, so a step first tries substeps short enough
+for its springs to be explicit (substeps.py). A pull's drag is always implicit.
 
 Only a spring so stiff that the implicit solve would lose its digits to
 round-off (k dt^2 / mu over SOFTENING_LIMIT, mu the pair's reduced mass) is

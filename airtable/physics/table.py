@@ -44,7 +44,7 @@ from collections.abc import Callable, Sequence
 
 import numpy as np
 
-from airtable.physics import broadphase, contacts, forces, pairs, sleep, sweep, vectors, walls
+from airtable.physics import broadphase, contacts, forces, pairs, sleep, substeps, sweep, vectors, walls
 from airtable.physics import implicit as implicit_solve
 from airtable.physics.bodies import Puck, Spring, as_vector
 from airtable.physics.colors import rgb
@@ -72,10 +72,11 @@ WALL_BAND_MIN_PUCKS = 4000
 PRESSED_REST_MPS = 0.2
 # Overlaps smaller than this (m) are left to the next step: round-off only.
 OVERLAP_SLOP_M = 1e-9
-# Said once (in `notices`) when springs are first solved implicitly.
+# Said once (in `notices`) when springs are first solved implicitly (beyond what substeps.py takes).
 IMPLICIT_NOTICE = (
-    "Some springs vibrate faster than a step can follow: the step solves them implicitly,"
-    " so they hold and sag as their k says, but their fastest wobble is damped away."
+    f"Some springs vibrate faster than even {substeps.MAX_SUBSTEPS} substeps of a step can follow: the step"
+    " solves them implicitly, so they hold and sag as their k says, but their vibrations are damped away,"
+    " the fastest at once and the slow ones too, a little each period."
 )
 # Passes that add walls to the implicit solve (see _brace_walls).
 BRACE_PASSES = 4
@@ -486,21 +487,20 @@ class AirTable:
         if self._pucks.n and not self._wake(pulls, dt):  # 0b. sleepers: wake those disturbed
             kick = None
             if dt > 0.0:
-                implicit = self._add_forces(pulls, dt)  # 1. forces
-                kick = self._integrate(implicit, dt)  # 2. semi-implicit Euler
+                kick = self._forces_and_integrate(pulls, dt)  # 1-2. forces, semi-implicit Euler (substeps)
                 self._sweep_fast(dt)  # 2b. fast pucks: their hits in time order, exactly
                 self._wake_hit()
             self.force_N[:] = 0.0  # the accumulators hold one step's forces
-            rest = self._rest_speeds(kick, dt)  # below these speeds contacts rest, not bounce
-            wall_rest = None if rest is None else self._contacts.wall_rest(rest)
+            rest = self._rest_speeds(kick, dt)  # below these speeds contacts rest, not bounce: (pairs, walls)
+            wall_rest = None if rest is None else self._contacts.wall_rest(rest[1])
             near = self._near_walls()
             past = self._resolve_walls(near, wall_rest)  # 3. walls
             moved = np.empty(0, dtype=np.intp)
             if self.puck_collisions:  # 4. pairs (told what the walls moved if the list was just checked)
-                moved = self._resolve_pairs(dt, rest, None if near is None else past)
+                moved = self._resolve_pairs(dt, None if rest is None else rest[0], None if near is None else past)
             self._wake_hit()
             if rest is not None and self._resolve_contacts(rest, dt):  # 5. resting contacts
-                self._resolve_walls(rest=self._contacts.wall_rest(rest), hold=True)  # 6. walls again
+                self._resolve_walls(rest=self._contacts.wall_rest(rest[1]), hold=True)  # 6. walls again
             elif len(moved):
                 self._resolve_walls(only=moved)  # 6. walls again, for the pucks the pairs moved
             self._fall_asleep(pulls, dt)  # 7. pucks still for long enough fall asleep
@@ -599,6 +599,23 @@ class AirTable:
             _, _, fn = heapq.heappop(self._events)
             fn(self)
 
+    def _forces_and_integrate(self, pulls: Sequence[Pull], dt: float) -> np.ndarray | float | None:
+        """Stages 1 and 2, in as many substeps as the springs need (substeps.py); return the kick
+        (see _integrate) of the whole step. Forces written from outside act through every substep."""
+        n = 1
+        if self._springs.n:
+            a, b = self._springs.view("i"), self._springs.view("j")
+            n = substeps.count(self.mass_kg, a, b, self.spring_k_Npm, dt)
+        if n == 1:
+            return self._integrate(self._add_forces(pulls, dt), dt)
+        h, outside, kick = dt / n, self.force_N.copy(), None
+        for s in range(n):
+            if s:
+                self.force_N[:] = outside
+            add = self._integrate(self._add_forces(pulls, h), h)
+            kick = add if kick is None else kick if add is None else kick + add
+        return kick
+
     def _add_forces(self, pulls: Sequence[Pull], dt: float) -> forces.Implicit | None:
         """Add the pulls' and springs' forces to force_N; return what the step takes implicitly (None: nothing)."""
         if not pulls and self._springs.n == 0:
@@ -693,9 +710,13 @@ class AirTable:
             self._collision_records.append(_swept_record(s, self.radius_m))
             self.collision_count += len(s.i)
 
-    def _rest_speeds(self, kick: np.ndarray | float | None, dt: float) -> np.ndarray | None:
-        """Each puck's rest speed: rest_speed_mps, and where this step's forces gave it a kick,
-        PRESSED_REST_MPS and twice the kick; None: all zero."""
+    def _rest_speeds(self, kick: np.ndarray | float | None, dt: float) -> tuple[np.ndarray, np.ndarray] | None:
+        """Each puck's rest speeds towards other pucks and towards the walls; None: all zero.
+
+        The rest speed is rest_speed_mps, and where this step's forces gave the puck a kick,
+        PRESSED_REST_MPS and twice the kick; a contact rests when its bounce would be slower
+        than that (contacts.rest_for_restitution: at restitution 0, always).
+        """
         floor = _non_negative(self.rest_speed_mps, "rest_speed_mps")
         if kick is None and floor == 0.0:
             return None  # nothing presses: every contact is a collision, as in the course's model
@@ -703,19 +724,19 @@ class AirTable:
         if kick is not None:
             kick = np.asarray(kick)
             np.maximum(rest, np.where(kick > 0.0, np.maximum(2.0 * kick, PRESSED_REST_MPS), 0.0), out=rest)
-        return rest
+        return contacts.rest_for_restitution(rest, self.cr_puck), contacts.rest_for_restitution(rest, self.cr_wall)
 
-    def _resolve_contacts(self, rest: np.ndarray, dt: float) -> bool:
-        """Hold resting contacts (contacts.py); return whether there were any."""
+    def _resolve_contacts(self, rest: tuple[np.ndarray, np.ndarray], dt: float) -> bool:
+        """Hold resting contacts (contacts.py), `rest` being the rest speeds (pairs, walls); return whether
+        there were any."""
         if self.puck_collisions:
             candidates = self._neighbours.pairs(self.pos_m, self.radius_m)
         else:
             none = np.empty(0, dtype=np.intp)
             candidates = (none, none, np.empty(0))
         asleep = None if self._sleepers is None else self._pucks.view("asleep")
-        return self._contacts.solve(
-            self.pos_m, self.vel_mps, self.radius_m, self.mass_kg, self.size_m, candidates, rest, dt, asleep
-        )
+        pucks = (self.pos_m, self.vel_mps, self.radius_m, self.mass_kg)
+        return self._contacts.solve(*pucks, self.size_m, candidates, rest[0], dt, asleep, rest_walls=rest[1])
 
     def _near_walls(self) -> np.ndarray | None:
         """The rows that may be past a wall: those the neighbour list keeps near one (None: every row).
