@@ -45,7 +45,7 @@ from collections.abc import Callable, Sequence
 import numpy as np
 
 from airtable.colors import rgb
-from airtable.physics import broadphase, contacts, forces, pairs, sleep, sweep, vectors, walls
+from airtable.physics import broadphase, contacts, events, forces, pairs, sleep, vectors, walls
 from airtable.physics import implicit as implicit_solve
 from airtable.physics.bodies import Puck, Spring, as_vector
 from airtable.physics.forces import GRAVITY_MPS2, Pull
@@ -100,18 +100,6 @@ def _non_negative(value, what: str) -> float:
     if not (math.isfinite(v) and v >= 0.0):
         raise ValueError(f"{what} must be zero or a positive number, not {value!r}")
     return v
-
-
-def _swept_record(s: sweep.Swept, radius: np.ndarray) -> pairs.Collisions:
-    """The sweep's puck hits as a collision record: the pucks where they touched, overlap 0."""
-    i, j = np.array(s.i), np.array(s.j)
-    xi, xj = (np.array([x[k] for x in s.x]) for k in (0, 1))
-    vi0, vj0 = (np.array([v[k] for v in s.v_before]) for k in (0, 1))
-    vi1, vj1 = (np.array([v[k] for v in s.v_after]) for k in (0, 1))
-    n = np.array(s.normal)
-    reach = radius.take(i) + radius.take(j)
-    contact = xj + n * radius.take(j)[:, None]
-    return pairs.Collisions(i, j, n, contact, np.zeros(len(i)), reach, xi, xj, xi, xj, vi0, vj0, vi1, vj1)
 
 
 def _farthest_move(pos: np.ndarray, rows: np.ndarray, before: np.ndarray) -> float:
@@ -407,7 +395,6 @@ class AirTable:
         self._last_collisions: pairs.Collisions | None = None
         self._world_key = ""  # what the sleepers fell asleep in (see _world): any change wakes them
         self._sleepers: np.ndarray | None = None  # this step's sleeping rows (scratch)
-        self._top_component_mps = math.inf  # the step's largest |velocity component| (scratch, see _integrate)
 
     def schedule(self, t_s: float, fn: Callable[[AirTable], None]) -> None:
         """Run fn(table) at the start of the first step at or after simulation time t_s."""
@@ -488,15 +475,16 @@ class AirTable:
             if dt > 0.0:
                 implicit = self._add_forces(pulls, dt)  # 1. forces
                 kick = self._integrate(implicit, dt)  # 2. semi-implicit Euler
-                self._sweep_fast(dt)  # 2b. fast pucks: their hits in time order, exactly
-                self._wake_hit()
             self.force_N[:] = 0.0  # the accumulators hold one step's forces
             rest = self._rest_speeds(kick, dt)  # below these speeds contacts rest, not bounce
             wall_rest = None if rest is None else self._contacts.wall_rest(rest)
+            if dt > 0.0:
+                self._hits_in_order(dt, rest, wall_rest)  # 3. hits, walls and pairs, in time order
+                self._wake_hit()
             near = self._near_walls()
-            past = self._resolve_walls(near, wall_rest)  # 3. walls
+            past = self._resolve_walls(near, wall_rest)  # 3b. what is still past a wall
             moved = np.empty(0, dtype=np.intp)
-            if self.puck_collisions:  # 4. pairs (told what the walls moved if the list was just checked)
+            if self.puck_collisions:  # 4. overlapping pairs (told what the walls moved if the list was just checked)
                 moved = self._resolve_pairs(dt, rest, None if near is None else past)
             self._wake_hit()
             if rest is not None and self._resolve_contacts(rest, dt):  # 5. resting contacts
@@ -641,11 +629,9 @@ class AirTable:
             vel[self._sleepers] = 0.0  # sleepers stay where they are
         # A last guard against runaway values; a cheap bound first: a speed
         # over the limit has a component over limit / sqrt(2).
-        self._top_component_mps = float(np.abs(vel).max())  # _sweep_fast uses it too
-        if self._top_component_mps > MAX_SPEED_MPS / math.sqrt(2.0):
+        if float(np.abs(vel).max()) > MAX_SPEED_MPS / math.sqrt(2.0):
             speed = np.hypot(vel[:, 0], vel[:, 1])  # not lengths(): v^2 may overflow here
             vel *= np.minimum(1.0, MAX_SPEED_MPS / np.maximum(speed, 1e-300))[:, None]
-            self._top_component_mps = math.inf
         pos += vel * dt
         return kick
 
@@ -673,25 +659,28 @@ class AirTable:
         walls = (self.size_m, self.cr_wall)
         return implicit_solve.brace_walls(self.pos_m, self.vel_mps, dv, self.radius_m, walls, implicit, released, dt)
 
-    def _sweep_fast(self, dt: float) -> None:
-        """Sweep the pucks that move a good part of their radius this step (sweep.py)."""
-        # No puck's speed is over sqrt(2) times the largest velocity component
-        # (_integrate's): below the limit, nobody is fast, and no speeds are needed.
-        top = self._top_component_mps
-        if 2.0 * top * top * dt * dt <= (sweep.FAST_FRACTION * float(self.radius_m.min())) ** 2:
-            return
-        movers = sweep.fast_rows(self.vel_mps, self.radius_m, dt)
-        if len(movers) == 0:
-            return
-        s = sweep.sweep(
-            self.pos_m, self.vel_mps, self.radius_m, self.mass_kg, self.size_m,
-            self.cr_puck, self.cr_wall, dt, pucks=self.puck_collisions, movers=movers,
-            leave=self.puck_correction != "perfect-kiss",
-        )  # fmt: skip
-        self.wall_collision_count += s.walls
-        if s.i:
-            self._collision_records.append(_swept_record(s, self.radius_m))
-            self.collision_count += len(s.i)
+    def _hits_in_order(self, dt: float, rest: np.ndarray | None, wall_rest: np.ndarray | None) -> None:
+        """Resolve the step's wall and pair hits in the order they happen (events.py)."""
+        mode = self.puck_correction
+        rules = events.Rules(
+            self.cr_puck,
+            self.cr_wall,
+            pairs=mode if self.puck_collisions and mode != "off" else "none",
+            walls=self.wall_correction,
+            accel_y_mps2=-self.gravity_mps2 if self.gravity_on else 0.0,
+            rest=rest,
+            wall_rest=wall_rest,
+        )
+        near = self._near_walls()
+        hits = events.resolve_hits(
+            self.pos_m, self.vel_mps, self.radius_m, self.mass_kg, self.size_m, dt, rules, self._neighbours, near
+        )
+        self.wall_collision_count += hits.walls
+        if hits.rows:
+            self._collision_records.append(hits.collisions(self.radius_m))
+            self.collision_count += len(hits.rows)
+        if hits.capped:
+            self._notice("capped", events.CAPPED_NOTICE)
 
     def _rest_speeds(self, kick: np.ndarray | float | None, dt: float) -> np.ndarray | None:
         """Each puck's rest speed: rest_speed_mps, and where this step's forces gave it a kick,
