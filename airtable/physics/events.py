@@ -41,10 +41,11 @@ CAPPED_NOTICE = (
     "A step had more hits than the engine resolves one by one; the rest of that step's hits"
     " were left to the overlap correction."
 )
-# A pair hitting again in one step slower than this (m/s) below restitution 1 is left to the
-# pair and contact stages: else pucks that collide inelastically in a cluster hit each other
-# again and again at ever smaller speeds (inelastic collapse): 200000 events in one step.
-REPEAT_MIN_APPROACH_MPS = 1e-3
+# Below restitution 1, a pair hits at most this many times in one step; its further hits are
+# left to the pair and contact stages: else pucks that collide inelastically in a cluster hit
+# each other again and again at ever smaller speeds (inelastic collapse): 200000 events in
+# one step of a 300-puck gas at restitution 0.
+REPEAT_MAX = 3
 # In two-step, pair hits are predicted when some puck moves this share of the smallest radius
 # in a step; below it nobody can pass through a puck, and the pair stage sees every hit.
 FAST_FRACTION = 0.5
@@ -56,7 +57,7 @@ class Rules:
 
     cr_puck: float
     cr_wall: float
-    pairs: str  # "perfect-kiss", "two-step" (the course's correction where it applies) or "none"
+    pairs: str  # the correction mode ("perfect-kiss", "two-step", "off"), or "none": no pair hits
     walls: bool  # wall hits at their time (wall_correction); else the wall stage puts pucks back
     accel_y_mps2: float = 0.0  # gravity's part of the step's velocity change (0 or -g)
     rest: np.ndarray | None = None  # per puck: pair hits slower than this rest (contacts.py)
@@ -67,20 +68,21 @@ class Rules:
 class Hits:
     """What the hits in time order did in one step: the pair hits as rows, the wall bounces."""
 
-    rows: list = field(default_factory=list)  # (i, j, n, xi, xj, vi, vj, wi, wj), vectors complex
+    # (i, j, n, overlap, xi, xj before, xi, xj after, vi, vj before, after), vectors complex
+    rows: list = field(default_factory=list)
     walls: int = 0
     capped: bool = False
 
     def collisions(self, radius: np.ndarray) -> Collisions:
-        """The pair hits as a collision record: positions where they touched (overlap 0)."""
+        """The pair hits as a collision record: an exact hit where the pucks touched (overlap 0), a
+        two-step one where the step's end caught them overlapping, and where it moved them."""
         if not self.rows:
             return Collisions.empty()
-        i, j, n, *states = (np.array(column) for column in zip(*self.rows, strict=True))
+        i, j, n, overlap, *states = (np.array(column) for column in zip(*self.rows, strict=True))
         reach = radius.take(i) + radius.take(j)
         contact = states[1] + radius.take(j) * n
-        rows = [vectors.as_rows(np.ascontiguousarray(z)) for z in (n, contact, *states)]
-        n, contact, xi, xj, vi, vj, wi, wj = rows
-        return Collisions(i, j, n, contact, np.zeros(len(i)), reach, xi, xj, xi, xj, vi, vj, wi, wj)
+        n, contact, *states = (vectors.as_rows(np.ascontiguousarray(z)) for z in (n, contact, *states))
+        return Collisions(i, j, n, contact, overlap, reach, *states)
 
 
 def resolve_hits(pos, vel, radius, mass, size_m, dt: float, rules: Rules, neighbours, near_walls=None) -> Hits:
@@ -117,7 +119,7 @@ class _Step:
         self.t_now = 0.0
         self.origin: dict[int, complex] = {}  # the pucks whose path changed, and their new origin
         self.version: dict[int, int] = {}  # per puck: how many times its path changed
-        self.hit_pairs: set[tuple[int, int]] = set()
+        self.hit_pairs: dict[tuple[int, int], int] = {}  # how many times each pair hit
         self.hits = Hits()
         self.partners = None  # the pairs that may meet, per puck (see find_partners)
         speed = float(np.sqrt(vectors.squared_abs(self.zvel).max())) if len(vel) else 0.0
@@ -186,8 +188,11 @@ class _Step:
     def predicts_pairs(self) -> bool:
         if self.rules.pairs == "perfect-kiss":
             return True
-        fast = self.travel > FAST_FRACTION * float(self.radius.min())
-        return self.rules.pairs == "two-step" and fast
+        return self.rules.pairs != "none" and self.travel > FAST_FRACTION * float(self.radius.min())
+
+    def fast(self, k: int) -> bool:
+        """Whether puck k moves FAST_FRACTION of its radius in a step on its present path."""
+        return abs(self.zvel.item(k)) * self.dt > FAST_FRACTION * self.radius.item(k)
 
     def find_partners(self, neighbours) -> None:
         """The pairs that may meet during the step, on any path within 2 travels of the step's ends."""
@@ -214,26 +219,34 @@ class _Step:
         close = (dw - ww * self.dt < 0.0) & (vectors.squared_abs(d - w * s) < reach * reach)
         if self.rules.rest is not None:
             close &= ww > np.maximum(self.rules.rest.take(i), self.rules.rest.take(j)) ** 2
+        if self.rules.pairs != "perfect-kiss":  # only where a puck is fast: the others are seen overlapping
+            lim = FAST_FRACTION * self.radius / self.dt
+            fast = vectors.squared_abs(self.zvel) > lim * lim
+            close &= fast.take(i) | fast.take(j)
         k = close.nonzero()[0]
         return list(zip(i.take(k).tolist(), j.take(k).tolist(), strict=True))
 
     def predict_pair(self, a: int, b: int) -> None:
         """Queue the next hit of a and b on their present paths, if it comes within the step."""
         t_now, dt = self.t_now, self.dt
+        if self.rules.pairs != "perfect-kiss" and not (self.fast(a) or self.fast(b)):
+            return  # the pair stage sees this pair overlapping, if it hits
         d, w = self.at(a, t_now) - self.at(b, t_now), self.zvel.item(a) - self.zvel.item(b)
         reach = self.radius.item(a) + self.radius.item(b)
         hit = reference.contact_time((d.real, d.imag), (w.real, w.imag), reach)
         if hit is None or t_now + hit[0] > dt:
             return
         t, speed = t_now + hit[0], hit[1]
-        if self.rules.pairs == "two-step":
+        if self.rules.pairs != "perfect-kiss":
             caught = _caught_overlapping(d + w * (dt - t_now), w, reach)
+            if caught is not None and self.rules.pairs == "off":
+                return  # seen overlapping: velocities only, at the step's end (the pair stage's)
             if caught is not None:  # the course's case: resolved t_p before the step's end
                 t, speed = max(dt - caught[0], t_now), caught[1]
         rest = self.rules.rest
         if rest is not None and not speed > max(rest.item(a), rest.item(b)):
             return  # a resting contact: the contact stage's
-        if self.rules.cr_puck < 1.0 and speed < REPEAT_MIN_APPROACH_MPS and (a, b) in self.hit_pairs:
+        if self.rules.cr_puck < 1.0 and self.hit_pairs.get((a, b), 0) >= REPEAT_MAX:
             return
         self.push(t, a, b)
 
@@ -316,19 +329,21 @@ class _Step:
         """
         xa, xb = self.at(a, self.t_now), self.at(b, self.t_now)
         va, vb = self.zvel.item(a), self.zvel.item(b)
-        n = xa - xb
+        n, overlap, seen = xa - xb, 0.0, (xa, xb)  # the record: where the hit was seen, how deep
         if self.rules.pairs == "two-step":
-            end = n + (va - vb) * (self.dt - self.t_now)
-            if _caught_overlapping(end, va - vb, self.radius.item(a) + self.radius.item(b)) is not None:
-                n = end
+            left = self.dt - self.t_now
+            end, reach = n + (va - vb) * left, self.radius.item(a) + self.radius.item(b)
+            if _caught_overlapping(end, va - vb, reach) is not None:
+                n, overlap, seen = end, reach - abs(end), (xa + va * left, xb + vb * left)
         n /= abs(n)
         ua, ub = vectors.dot_one(va, n), vectors.dot_one(vb, n)
         wa, wb = reference.collide_1d(ua, ub, self.mass.item(a), self.mass.item(b), self.rules.cr_puck)
         new_a, new_b = va + (wa - ua) * n, vb + (wb - ub) * n
-        self.hits.rows.append((a, b, n, xa, xb, va, vb, new_a, new_b))
-        self.hit_pairs.add((a, b))
         self.set_path(a, xa, new_a)
         self.set_path(b, xb, new_b)
+        after = (self.at(a, self.dt), self.at(b, self.dt)) if overlap else seen
+        self.hits.rows.append((a, b, n, overlap, *seen, *after, va, vb, new_a, new_b))
+        self.hit_pairs[a, b] = self.hit_pairs.get((a, b), 0) + 1
 
 
 def _caught_overlapping(d: complex, w: complex, reach: float) -> tuple[float, float] | None:

@@ -665,7 +665,7 @@ class AirTable:
         rules = events.Rules(
             self.cr_puck,
             self.cr_wall,
-            pairs=mode if self.puck_collisions and mode != "off" else "none",
+            pairs=mode if self.puck_collisions else "none",
             walls=self.wall_correction,
             accel_y_mps2=-self.gravity_mps2 if self.gravity_on else 0.0,
             rest=rest,
