@@ -27,6 +27,7 @@ always caught overlapping.
 from __future__ import annotations
 
 import heapq
+from collections.abc import Callable
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -62,6 +63,7 @@ class Rules:
     accel_y_mps2: float = 0.0  # gravity's part of the step's velocity change (0 or -g)
     rest: np.ndarray | None = None  # per puck: pair hits slower than this rest (contacts.py)
     wall_rest: np.ndarray | None = None  # per puck (N,) or per puck and axis (N, 2), for walls
+    held: Callable[[np.ndarray, np.ndarray], np.ndarray] | None = None  # pairs (i < j) resting: the contacts'
 
 
 @dataclass
@@ -128,6 +130,7 @@ class _Step:
         # of its puck's step end; `reach_out` is the farthest any present path strays.
         self.covered = self.reach_out = 2.0 * self.travel
         self.extra: dict[int, set[int]] = {}  # partners found for paths that stray farther
+        self.offset: dict[int, complex] = {}  # added to a velocity at the end (bounce_under_gravity)
 
     # ------------------------------------------------------------ paths
 
@@ -172,6 +175,8 @@ class _Step:
         """The pucks whose path changed end the step where their present path has them."""
         for k, o in self.origin.items():
             self.zpos[k] = o + self.zvel.item(k) * self.dt
+        for k, dv in self.offset.items():
+            self.zvel[k] += dv
 
     # ------------------------------------------------------------ predicting
 
@@ -224,6 +229,8 @@ class _Step:
             fast = vectors.squared_abs(self.zvel) > lim * lim
             close &= fast.take(i) | fast.take(j)
         k = close.nonzero()[0]
+        if self.rules.held is not None and len(k):
+            k = k.take((~self.rules.held(i.take(k), j.take(k))).nonzero()[0])
         return list(zip(i.take(k).tolist(), j.take(k).tolist(), strict=True))
 
     def predict_pair(self, a: int, b: int) -> None:
@@ -246,6 +253,8 @@ class _Step:
         rest = self.rules.rest
         if rest is not None and not speed > max(rest.item(a), rest.item(b)):
             return  # a resting contact: the contact stage's
+        if self.rules.held is not None and self.rules.held(np.array([min(a, b)]), np.array([max(a, b)]))[0]:
+            return  # pressed on each other in the last step: resting, whatever the speed
         if self.rules.cr_puck < 1.0 and self.hit_pairs.get((a, b), 0) >= REPEAT_MAX:
             return
         self.push(t, a, b)
@@ -302,24 +311,39 @@ class _Step:
                 self.predict(b)
 
     def bounce(self, k: int, axis: int) -> None:
-        """Puck k reaches the wall across `axis` now: its normal velocity reverses times cr_wall.
-
-        Under gravity, the step's velocity already holds the whole step's pull;
-        the part after contact (over the rest of the step) acts on the
-        reflected velocity instead, so a bounce gives back e times the speed it
-        hit with, as in continuous time.
-        """
+        """Puck k reaches the wall across `axis` now: its normal velocity reverses times cr_wall."""
         x, v = self.at(k, self.t_now), self.zvel.item(k)
-        e = self.rules.cr_wall
-        if axis == 0:
-            v = complex(-e * v.real, v.imag)
-        else:
-            after = self.rules.accel_y_mps2 * (self.dt - self.t_now)  # the pull after contact
-            vy = -e * (v.imag - after) + after
-            # Where the pull after contact would take it on into the wall, it lands there.
-            v = complex(v.real, vy if vy * v.imag < 0.0 else 0.0)
+        e, a = self.rules.cr_wall, self.rules.accel_y_mps2
         self.hits.walls += 1
-        self.set_path(k, x, v)
+        if axis == 0:
+            self.set_path(k, x, complex(-e * v.real, v.imag))
+        elif a == 0.0:
+            self.set_path(k, x, complex(v.real, -e * v.imag))
+        else:
+            vy, offset = self.bounce_under_gravity(v.imag, a)
+            self.set_path(k, x, complex(v.real, vy))
+            self.offset[k] = complex(0.0, offset)
+
+    def bounce_under_gravity(self, vy: float, a: float) -> tuple[float, float]:
+        """(velocity along y of the path to the step's end, what to add to it at the end) after a
+        floor or ceiling hit now, under a pull a (m/s^2) along y; vy: the step's velocity.
+
+        Semi-implicit Euler samples a parabola exactly: over a step whose end velocity is vy,
+        the puck is at y0 + (vy - a dt / 2) s + a s^2 / 2 at time s, and vy is that parabola's
+        velocity half a step before the end. So the hit is resolved on the parabola: the speed
+        there at contact reverses times e, a new parabola leaves the wall, and the step ends
+        on it with its velocity half a step back, as if the step had run continuously: bounce
+        heights fall by e^2. (A straight path is kept for the rest of the step's hits.)
+        """
+        s, left = self.t_now, self.dt - self.t_now
+        leave = -self.rules.cr_wall * (vy - a * (0.5 * self.dt - s))  # -e times the speed at contact
+        end = leave + a * (0.5 * self.dt - s)  # the new parabola's velocity half a step before the end
+        if left <= 0.0 and leave * vy < 0.0:
+            return leave, end - leave  # a hit at the very end
+        path = leave + 0.5 * a * left  # to where the new parabola is at the step's end
+        if path * vy >= 0.0 or left <= 0.0:
+            return 0.0, 0.0  # it would be back at the wall within the step: it lands there
+        return path, end - path
 
     def collide(self, a: int, b: int) -> None:
         """a and b hit now: their normal velocities collide in 1D (reference.collide_1d).

@@ -670,6 +670,7 @@ class AirTable:
             accel_y_mps2=-self.gravity_mps2 if self.gravity_on else 0.0,
             rest=rest,
             wall_rest=wall_rest,
+            held=None if rest is None else self._contacts.held,
         )
         near = self._near_walls()
         hits = events.resolve_hits(
