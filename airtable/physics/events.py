@@ -16,12 +16,17 @@ Which pairs can meet: those the neighbour list holds while every path stays
 near where the step ends (NeighbourList.pairs_while_moving); a puck given a
 path longer than that is checked against every puck.
 
-What is left to later stages: hits slower than a puck's rest speed (the contact
-stage holds those), and in two-step the hits that end the step overlapping and
-approaching (the pair stage corrects those the course's way: that is what the
-mode shows). In two-step, pair hits are predicted only when some puck moves a
-good part of a radius in the step (it could pass through); slower pairs are
-always caught overlapping.
+What is left to later stages: hits slower than a puck's rest speed, and pairs
+that pressed on each other in the last step (the contact stage holds those).
+In two-step, a pair hit that the step's end would catch overlapping and
+approaching is resolved the course's way, at dt - t_p (t_p = overlap / normal
+speed there) along the line of centres there: the pair ends where the
+two-step correction puts it, and a hit it would catch too late (past the
+closest approach, or through) is resolved at first contact. In "off", such a
+pair is left overlapping to the pair stage (velocities only: what it shows).
+Outside perfect kiss only fast pucks' pair hits are predicted (those moving
+FAST_FRACTION of their radius in a step: they could pass through); the pair
+stage sees the others overlapping.
 """
 
 from __future__ import annotations

@@ -11,15 +11,17 @@ and the numpy work of each is in a module of its own:
    springs have beyond what an explicit step can hold is marked implicit;
 2. integrate, semi-implicit Euler: v += (F/m + g) dt, then x += v dt; the
    pulls' drag and the stiff springs' implicit parts are solved for
-   (implicit.py), so springs hold at any stiffness; then the fast pucks
-   (moving a good part of their radius) are swept over the step, their hits
-   resolved exactly at first contact, in time order (sweep.py), so they
-   never pass through;
-3. walls: push pucks back inside and bounce them (walls.py);
-4. puck pairs: the candidates from a neighbour list (broadphase.py), then
-   collision + position correction one pair at a time, in the order the
-   pairs met during the step (pairs.py), then a
-   second look at the pairs the corrections pushed into overlap;
+   (implicit.py), so springs hold at any stiffness;
+3. hits in time order (events.py): every wall hit and pair hit of the step,
+   found on the pucks' paths through it and resolved at the moment it
+   happens, earliest first, a puck's later hits on its new path (in perfect
+   kiss every pair hit; in two-step and off those of fast pucks, which the
+   overlap test at the step's end could miss). Then what is still past a
+   wall (walls.py: wall_correction off, or resting on it);
+4. puck pairs still overlapping: the candidates from a neighbour list
+   (broadphase.py), then the course's collision + position correction one
+   pair at a time (pairs.py), then a second look at the pairs the
+   corrections pushed into overlap;
 5. resting contacts: pucks pressing on each other or on a wall, approaching
    slower than the rest speed, held up together by impulses (contacts.py);
    stages 3 and 4 leave those to this one. Only when something presses:
