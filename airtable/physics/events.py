@@ -32,6 +32,7 @@ stage sees the others overlapping.
 from __future__ import annotations
 
 import heapq
+import math
 from collections.abc import Callable
 from dataclasses import dataclass, field
 
@@ -69,6 +70,7 @@ class Rules:
     rest: np.ndarray | None = None  # per puck: pair hits slower than this rest (contacts.py)
     wall_rest: np.ndarray | None = None  # per puck (N,) or per puck and axis (N, 2), for walls
     held: Callable[[np.ndarray, np.ndarray], np.ndarray] | None = None  # pairs (i < j) resting: the contacts'
+    speed_bound_mps: float = math.inf  # no puck is faster (inf: work it out)
 
 
 @dataclass
@@ -79,6 +81,7 @@ class Hits:
     rows: list = field(default_factory=list)
     walls: int = 0
     capped: bool = False
+    maybe_past: np.ndarray | None = None  # the rows that may still be past a wall (None: any)
 
     def collisions(self, radius: np.ndarray) -> Collisions:
         """The pair hits as a collision record: an exact hit where the pucks touched (overlap 0), a
@@ -102,15 +105,17 @@ def resolve_hits(pos, vel, radius, mass, size_m, dt: float, rules: Rules, neighb
     step = _Step(pos, vel, radius, mass, size_m, dt, rules)
     if len(pos) == 0 or dt <= 0.0:
         return step.hits
-    if rules.walls:
-        for k in step.past_walls(near_walls):
-            step.predict_walls(k)
+    past = step.past_walls(near_walls) if rules.walls else None
+    for k in past or ():
+        step.predict_walls(k)
     if step.predicts_pairs():
         step.find_partners(neighbours)
         for a, b in step.first_pairs():
             step.predict_pair(a, b)
     step.run()
     step.write_back()
+    if past is not None:  # only those past a wall, or on a new path, may still be (resting, landed)
+        step.hits.maybe_past = np.array(sorted(set(past) | step.origin.keys()), dtype=np.intp)
     return step.hits
 
 
@@ -129,7 +134,9 @@ class _Step:
         self.hit_pairs: dict[tuple[int, int], int] = {}  # how many times each pair hit
         self.hits = Hits()
         self.partners = None  # the pairs that may meet, per puck (see find_partners)
-        speed = float(np.sqrt(vectors.squared_abs(self.zvel).max())) if len(vel) else 0.0
+        speed = rules.speed_bound_mps
+        if not math.isfinite(speed):
+            speed = float(np.sqrt(vectors.squared_abs(self.zvel).max())) if len(vel) else 0.0
         self.travel = speed * dt  # the farthest any puck moves this step on its first path (m)
         # The pairs found hold every pair that can meet while each path stays within `covered`
         # of its puck's step end; `reach_out` is the farthest any present path strays.

@@ -388,6 +388,7 @@ class AirTable:
         self.notices: list[str] = []  # sentences for the user, appended once each (see _notice)
         self._noticed: set = set()
         self._spring_dt_s = 1 / 240  # the dt the springs' effective stiffness was last worked out for
+        self._speed_bound_mps = math.inf  # no speed is over this in the step (scratch, see _integrate)
         self._contacts.forget()
         self.time_s = 0.0
         self.steps = 0
@@ -480,11 +481,12 @@ class AirTable:
             self.force_N[:] = 0.0  # the accumulators hold one step's forces
             rest = self._rest_speeds(kick, dt)  # below these speeds contacts rest, not bounce
             wall_rest = None if rest is None else self._contacts.wall_rest(rest)
+            maybe_past = None
             if dt > 0.0:
-                self._hits_in_order(dt, rest, wall_rest)  # 3. hits, walls and pairs, in time order
+                maybe_past = self._hits_in_order(dt, rest, wall_rest)  # 3. hits, walls and pairs, in time order
                 self._wake_hit()
             near = self._near_walls()
-            past = self._resolve_walls(near, wall_rest)  # 3b. what is still past a wall
+            past = self._resolve_walls(near if maybe_past is None else maybe_past, wall_rest)  # 3b. still past a wall
             moved = np.empty(0, dtype=np.intp)
             if self.puck_collisions:  # 4. overlapping pairs (told what the walls moved if the list was just checked)
                 moved = self._resolve_pairs(dt, rest, None if near is None else past)
@@ -631,9 +633,12 @@ class AirTable:
             vel[self._sleepers] = 0.0  # sleepers stay where they are
         # A last guard against runaway values; a cheap bound first: a speed
         # over the limit has a component over limit / sqrt(2).
-        if float(np.abs(vel).max()) > MAX_SPEED_MPS / math.sqrt(2.0):
+        # A bound on every speed (sqrt 2 times the largest component): the hits' stage uses it too.
+        self._speed_bound_mps = math.sqrt(2.0) * float(np.abs(vel).max())
+        if self._speed_bound_mps > MAX_SPEED_MPS:
             speed = np.hypot(vel[:, 0], vel[:, 1])  # not lengths(): v^2 may overflow here
             vel *= np.minimum(1.0, MAX_SPEED_MPS / np.maximum(speed, 1e-300))[:, None]
+            self._speed_bound_mps = MAX_SPEED_MPS
         pos += vel * dt
         return kick
 
@@ -661,8 +666,9 @@ class AirTable:
         walls = (self.size_m, self.cr_wall)
         return implicit_solve.brace_walls(self.pos_m, self.vel_mps, dv, self.radius_m, walls, implicit, released, dt)
 
-    def _hits_in_order(self, dt: float, rest: np.ndarray | None, wall_rest: np.ndarray | None) -> None:
-        """Resolve the step's wall and pair hits in the order they happen (events.py)."""
+    def _hits_in_order(self, dt: float, rest: np.ndarray | None, wall_rest: np.ndarray | None) -> np.ndarray | None:
+        """Resolve the step's wall and pair hits in the order they happen (events.py); return the
+        rows that may still be past a wall (None: any)."""
         mode = self.puck_correction
         rules = events.Rules(
             self.cr_puck,
@@ -673,6 +679,7 @@ class AirTable:
             rest=rest,
             wall_rest=wall_rest,
             held=None if rest is None else self._contacts.held,
+            speed_bound_mps=self._speed_bound_mps,
         )
         near = self._near_walls()
         hits = events.resolve_hits(
@@ -684,6 +691,7 @@ class AirTable:
             self.collision_count += len(hits.rows)
         if hits.capped:
             self._notice("capped", events.CAPPED_NOTICE)
+        return hits.maybe_past
 
     def _rest_speeds(self, kick: np.ndarray | float | None, dt: float) -> np.ndarray | None:
         """Each puck's rest speed: rest_speed_mps, and where this step's forces gave it a kick,
