@@ -215,13 +215,14 @@ class NeighbourList:
         Every pair left out was reach + skin apart at the build: it can touch only once the two
         have strayed a skin from where they were then, half a skin each at the most.
         """
-        found = self.pairs(pos, radius)
-        moved = vectors.squared_lengths(pos - self._built_pos).max() if len(pos) else 0.0
-        if math.sqrt(moved) + stray_m < 0.5 * self._skin:
-            return found
-        if stray_m >= 0.5 * self._skin:
+        if self._built_pos is not None and len(pos) == len(self._built_pos) and len(pos):
+            if not np.count_nonzero(radius != self._built_radius):  # (a radius changed by hand: rebuild)
+                moved = float(vectors.squared_lengths(pos - self._built_pos).max())
+                if math.sqrt(moved) + stray_m < 0.5 * self._skin:  # (False for NaN: rebuild)
+                    return self._i, self._j, self._reach
+        if stray_m >= 0.5 * SKIN_RADII * float(radius.mean()):  # the skin a build would have
             return None
-        self._build(pos, radius)
+        self._build(pos, radius)  # now no puck has moved
         return self._i, self._j, self._reach
 
     def partners(self):

@@ -231,7 +231,7 @@ class _Step:
         ww, dw = vectors.squared_abs(w), vectors.dot(d, w)
         # Approaching at the start (dw at t = 0 < 0: on a straight line never later if not then),
         # and coming within reach: the closest point of the relative path over the step.
-        s = np.clip(dw / np.where(ww > 0.0, ww, 1.0), 0.0, self.dt)  # time back from the end
+        s = np.minimum(np.maximum(dw / np.where(ww > 0.0, ww, 1.0), 0.0), self.dt)  # time back from the end
         reach = self.radius.take(i) + self.radius.take(j)
         close = (dw - ww * self.dt < 0.0) & (vectors.squared_abs(d - w * s) < reach * reach)
         if self.rules.rest is not None:
