@@ -135,7 +135,7 @@ class _Step:
         self.hits = Hits()
         self.partners = None  # the pairs that may meet, per puck (see find_partners)
         speed = rules.speed_bound_mps
-        if not math.isfinite(speed):
+        if not math.isfinite(speed) or rules.pairs == "perfect-kiss":  # its pairs are found by the exact travel
             speed = float(np.sqrt(vectors.squared_abs(self.zvel).max())) if len(vel) else 0.0
         self.travel = speed * dt  # the farthest any puck moves this step on its first path (m)
         # The pairs found hold every pair that can meet while each path stays within `covered`
