@@ -233,7 +233,7 @@ def test_degenerate_scenes_stay_finite_and_inside(build, mode: str, dt: float) -
     table.puck_correction = mode
     pulls = build(table) or ()  # only the cursor scene pulls
     # A few steps: at dt 0.5 s a puck at 1e6 m/s already bounces off the walls
-    # up to the sweep's bound of swept events in each (physics/sweep.py).
+    # up to the bound of hits in one step (events.MAX_EVENTS).
     for _ in range(3 if dt < 0.1 else 2):
         table.step(dt, pulls)
         assert_sane(table)

@@ -13,6 +13,7 @@ sorted by (i, j).
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable
 
 import numpy as np
@@ -157,6 +158,20 @@ def _closer_than(pos: np.ndarray, i: np.ndarray, j: np.ndarray, reach: np.ndarra
     return (squared_distances(pos, i, j) < reach * reach).nonzero()[0]
 
 
+class Partners:
+    """Each puck's partners in the pairs (i, j), looked up by row (a CSR index)."""
+
+    def __init__(self, i: np.ndarray, j: np.ndarray, n: int) -> None:
+        self.i, self.j = i, j
+        rows = np.concatenate([i, j])
+        order = np.argsort(rows, kind="stable")
+        self._others = np.concatenate([j, i]).take(order)
+        self._starts = np.searchsorted(rows.take(order), np.arange(n + 1)).tolist()
+
+    def of(self, k: int) -> list[int]:
+        return self._others[self._starts[k] : self._starts[k + 1]].tolist()
+
+
 class NeighbourList:
     """The candidate pairs of a step, kept for as long as they stay valid (a Verlet list).
 
@@ -189,6 +204,32 @@ class NeighbourList:
         if not self._still_valid(pos, radius):
             self._build(pos, radius)
         return self._i, self._j, self._reach
+
+    def pairs_while_moving(
+        self, pos: np.ndarray, radius: np.ndarray, stray_m: float
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:
+        """pairs(pos, radius), if they hold every pair that can touch while each puck stays within
+        stray_m of pos (the hits of a step, events.py); None if no list can: stray_m is over half
+        the skin.
+
+        Every pair left out was reach + skin apart at the build: it can touch only once the two
+        have strayed a skin from where they were then, half a skin each at the most.
+        """
+        if self._built_pos is not None and len(pos) == len(self._built_pos) and len(pos):
+            if not np.count_nonzero(radius != self._built_radius):  # (a radius changed by hand: rebuild)
+                moved = float(vectors.squared_lengths(pos - self._built_pos).max())
+                if math.sqrt(moved) + stray_m < 0.5 * self._skin:  # (False for NaN: rebuild)
+                    return self._i, self._j, self._reach
+        if stray_m >= 0.5 * SKIN_RADII * float(radius.mean()):  # the skin a build would have
+            return None
+        self._build(pos, radius)  # now no puck has moved
+        return self._i, self._j, self._reach
+
+    def partners(self):
+        """Each puck's partners in the list (Partners), made once per build."""
+        if self._partners is None:
+            self._partners = Partners(self._i, self._j, len(self._built_pos))
+        return self._partners
 
     def near_walls(self, size_m: np.ndarray) -> np.ndarray:
         """The rows that were within a skin of a wall of the box [0, size_m] at the last build.
@@ -267,6 +308,7 @@ class NeighbourList:
                 i, j, reach = i.take(near), j.take(near), reach.take(near)
         self._i, self._j, self._reach = i, j, reach
         self._order: np.ndarray | None = None  # see sorted_order
+        self._partners = None  # see partners
         self._squared: dict[float, np.ndarray] = {}  # see reach_squared
         self._built_pos, self._built_radius = pos.copy(), radius.copy()
         self._skin, self._half_skin_sq = skin, (0.5 * skin) ** 2

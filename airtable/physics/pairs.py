@@ -508,15 +508,10 @@ def _unit_floats(d: complex, key: int) -> tuple[complex, float]:
     return complex(n0, n1), dist
 
 
-def _dot(z: complex, w: complex) -> float:
-    """vectors.dot for one pair of vectors."""
-    return z.real * w.real + z.imag * w.imag
-
-
 def _kiss_time(d: complex, vrel: complex, reach: float, dt_s: float) -> float | None:
     """`_time_since_contact` for one pair: the time back to first contact, None if the step cannot explain it."""
-    vv, dv = _dot(vrel, vrel), _dot(d, vrel)
-    disc = max(dv * dv - vv * (_dot(d, d) - reach * reach), 0.0)
+    vv, dv = vectors.dot_one(vrel, vrel), vectors.dot_one(d, vrel)
+    disc = max(dv * dv - vv * (vectors.dot_one(d, d) - reach * reach), 0.0)
     if not vv > REST_SPEED_MPS**2:
         return None
     t_back = (dv + math.sqrt(disc)) / vv
@@ -540,7 +535,7 @@ def _pair_in_floats(zpos, zvel, radius, mass, p, q, cr, mode, dt_s) -> tuple | N
     m_sum = m1 + m2
     share1, share2 = m2 / m_sum, m1 / m_sum
     vrel = v1 - v2
-    vn = _dot(vrel, n)
+    vn = vectors.dot_one(vrel, n)
     t_b = _kiss_time(d, vrel, reach, dt_s) if mode == "perfect-kiss" else None
     if t_b is None:  # as _round_two_step (and _round_off, which does not use `move`)
         approach = vn < -REST_SPEED_MPS
@@ -549,7 +544,7 @@ def _pair_in_floats(zpos, zvel, radius, mass, p, q, cr, mode, dt_s) -> tuple | N
     else:  # as _round_perfect_kiss
         c = x2 - t_b * v2
         n, _ = _unit_floats((x1 - t_b * v1) - c, p + q)
-        vn = _dot(vrel, n)
+        vn = vectors.dot_one(vrel, n)
         approach = vn < 0.0
         move = -(1.0 + cr) * vn * t_b
     jn = -(1.0 + cr) * vn if approach else 0.0  # collide_along_normal
@@ -568,7 +563,7 @@ def _separate_floats(x1, x2, n: complex, move: float, reach: float, share1: floa
     """`separate` for one pair: move it `move` apart along n, then push apart what still overlaps."""
     y1, y2 = x1 + (move * share1) * n, x2 - (move * share2) * n
     d = y1 - y2
-    if _dot(d, d) < reach * reach:
+    if vectors.dot_one(d, d) < reach * reach:
         n_now, dist = _unit_floats(d, key)
         left = max(reach - dist, 0.0)
         y1, y2 = y1 + (left * share1) * n_now, y2 - (left * share2) * n_now
@@ -598,7 +593,7 @@ def _since_floats(zpos, zvel, radius, p: int, q: int, dt_s: float) -> float:
     """`since_contact` for one pair."""
     d, w = zpos.item(p) - zpos.item(q), zvel.item(p) - zvel.item(q)
     reach = radius.item(p) + radius.item(q)
-    ww, dw = _dot(w, w), _dot(d, w)
-    disc = max(dw * dw - ww * (_dot(d, d) - reach * reach), 0.0)
+    ww, dw = vectors.dot_one(w, w), vectors.dot_one(d, w)
+    disc = max(dw * dw - ww * (vectors.dot_one(d, d) - reach * reach), 0.0)
     back = (dw + math.sqrt(disc)) / (ww if ww > 0.0 else 1.0)
     return back if ww > 0.0 and 0.0 <= back <= dt_s else dt_s

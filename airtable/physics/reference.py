@@ -1,8 +1,13 @@
-"""One puck pair, collided in plain Python floats: the course's equations, top to bottom.
+"""The collision formulas, each written once, in plain Python floats: read these first.
 
-`collide_pair` does for one pair what pairs.py does for thousands at once
-with numpy. It is slower and simpler; read it first, then pairs.py. The tests
-check that the two agree to round-off on random scenes.
+* `collide_1d`: the 1D collision along the normal (momentum kept, relative
+  speed reversed times the restitution);
+* `contact_time`: when two moving discs first touch (the time of first contact),
+  and `wall_time`: when a puck reaches a wall;
+these are the code: the hits in time order (events.py) call them for every
+hit. `collide_pair` does for one overlapping pair what the pair stage
+(pairs.py) does for thousands at once with numpy; the tests check that the two
+agree to round-off on random scenes.
 
 Vectors are (x, y) tuples in metres and m/s. Puck 1 and puck 2 overlap when
 their centres are closer than r1 + r2. The normal n is the unit vector from
@@ -61,6 +66,41 @@ def collide_1d(u1: float, u2: float, m1: float, m2: float, cr: float) -> tuple[f
     v1 = (p - m2 * cr * (u1 - u2)) / (m1 + m2)
     v2 = (p + m1 * cr * (u1 - u2)) / (m1 + m2)
     return v1, v2
+
+
+def contact_time(d: Vec, w: Vec, reach: float) -> tuple[float, float] | None:
+    """(t, u): how long until two discs touch, and how fast they then approach along the line of
+    centres (m/s); None if they never touch while approaching.
+
+    d = x1 - x2 (m) and w = v1 - v2 (m/s) now; they touch when |d + w t| = reach,
+    the smaller root of w.w t^2 + 2 d.w t + d.d - reach^2 = 0, written as
+    c / (sqrt(disc) - d.w) so that no digits cancel. Discs already touching or
+    overlapping (by round-off, or resting) that approach touch now: t = 0.
+    The one tolerance policy: none; round-off decides, as it would for the oracle.
+    """
+    dw = _dot(d, w)
+    if not dw < 0.0:
+        return None  # parting, or still: they never meet
+    dd = _dot(d, d)
+    c = dd - reach * reach
+    if c <= 0.0:
+        return 0.0, -dw / math.sqrt(dd)  # touching now (dd > 0: dw < 0 needs d != 0)
+    disc = dw * dw - _dot(w, w) * c
+    if not disc > 0.0:
+        return None  # they pass by (or only graze)
+    root = math.sqrt(disc)
+    return c / (root - dw), root / reach
+
+
+def wall_time(x: float, v: float, lo: float, hi: float) -> float | None:
+    """How long until a centre at x moving at v (along one axis) reaches lo (moving down) or hi
+    (moving up): where a puck of radius r touches the walls at 0 and size (lo = r, hi = size - r).
+    0 if it is there or past already; None if it does not move along this axis."""
+    if v < 0.0:
+        return max((lo - x) / v, 0.0)
+    if v > 0.0:
+        return max((hi - x) / v, 0.0)
+    return None
 
 
 def collide_along(n: Vec, v1: Vec, v2: Vec, m1: float, m2: float, cr: float) -> tuple[Vec, Vec]:

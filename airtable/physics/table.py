@@ -11,15 +11,17 @@ and the numpy work of each is in a module of its own:
    springs have beyond what an explicit step can hold is marked implicit;
 2. integrate, semi-implicit Euler: v += (F/m + g) dt, then x += v dt; the
    pulls' drag and the stiff springs' implicit parts are solved for
-   (implicit.py), so springs hold at any stiffness; then the fast pucks
-   (moving a good part of their radius) are swept over the step, their hits
-   resolved exactly at first contact, in time order (sweep.py), so they
-   never pass through;
-3. walls: push pucks back inside and bounce them (walls.py);
-4. puck pairs: the candidates from a neighbour list (broadphase.py), then
-   collision + position correction one pair at a time, in the order the
-   pairs met during the step (pairs.py), then a
-   second look at the pairs the corrections pushed into overlap;
+   (implicit.py), so springs hold at any stiffness;
+3. hits in time order (events.py): every wall hit and pair hit of the step,
+   found on the pucks' paths through it and resolved at the moment it
+   happens, earliest first, a puck's later hits on its new path (in perfect
+   kiss every pair hit; in two-step and off those of fast pucks, which the
+   overlap test at the step's end could miss). Then what is still past a
+   wall (walls.py: wall_correction off, or resting on it);
+4. puck pairs still overlapping: the candidates from a neighbour list
+   (broadphase.py), then the course's collision + position correction one
+   pair at a time (pairs.py), then a second look at the pairs the
+   corrections pushed into overlap;
 5. resting contacts: pucks pressing on each other or on a wall, approaching
    slower than the rest speed, held up together by impulses (contacts.py);
    stages 3 and 4 leave those to this one. Only when something presses:
@@ -44,7 +46,7 @@ from collections.abc import Callable, Sequence
 
 import numpy as np
 
-from airtable.physics import broadphase, contacts, forces, pairs, sleep, substeps, sweep, vectors, walls
+from airtable.physics import broadphase, contacts, events, forces, pairs, sleep, substeps, vectors, walls
 from airtable.physics import implicit as implicit_solve
 from airtable.physics.bodies import Puck, Spring, as_vector
 from airtable.physics.colors import rgb
@@ -101,18 +103,6 @@ def _non_negative(value, what: str) -> float:
     if not (math.isfinite(v) and v >= 0.0):
         raise ValueError(f"{what} must be zero or a positive number, not {value!r}")
     return v
-
-
-def _swept_record(s: sweep.Swept, radius: np.ndarray) -> pairs.Collisions:
-    """The sweep's puck hits as a collision record: the pucks where they touched, overlap 0."""
-    i, j = np.array(s.i), np.array(s.j)
-    xi, xj = (np.array([x[k] for x in s.x]) for k in (0, 1))
-    vi0, vj0 = (np.array([v[k] for v in s.v_before]) for k in (0, 1))
-    vi1, vj1 = (np.array([v[k] for v in s.v_after]) for k in (0, 1))
-    n = np.array(s.normal)
-    reach = radius.take(i) + radius.take(j)
-    contact = xj + n * radius.take(j)[:, None]
-    return pairs.Collisions(i, j, n, contact, np.zeros(len(i)), reach, xi, xj, xi, xj, vi0, vj0, vi1, vj1)
 
 
 def _farthest_move(pos: np.ndarray, rows: np.ndarray, before: np.ndarray) -> float:
@@ -399,6 +389,7 @@ class AirTable:
         self.notices: list[str] = []  # sentences for the user, appended once each (see _notice)
         self._noticed: set = set()
         self._spring_dt_s = 1 / 240  # the dt the springs' effective stiffness was last worked out for
+        self._speed_bound_mps = math.inf  # no speed is over this in the step (scratch, see _integrate)
         self._contacts.forget()
         self.time_s = 0.0
         self.steps = 0
@@ -408,7 +399,6 @@ class AirTable:
         self._last_collisions: pairs.Collisions | None = None
         self._world_key = ""  # what the sleepers fell asleep in (see _world): any change wakes them
         self._sleepers: np.ndarray | None = None  # this step's sleeping rows (scratch)
-        self._top_component_mps = math.inf  # the step's largest |velocity component| (scratch, see _integrate)
 
     def schedule(self, t_s: float, fn: Callable[[AirTable], None]) -> None:
         """Run fn(table) at the start of the first step at or after simulation time t_s."""
@@ -488,15 +478,17 @@ class AirTable:
             kick = None
             if dt > 0.0:
                 kick = self._forces_and_integrate(pulls, dt)  # 1-2. forces, semi-implicit Euler (substeps)
-                self._sweep_fast(dt)  # 2b. fast pucks: their hits in time order, exactly
-                self._wake_hit()
             self.force_N[:] = 0.0  # the accumulators hold one step's forces
             rest = self._rest_speeds(kick, dt)  # below these speeds contacts rest, not bounce: (pairs, walls)
             wall_rest = None if rest is None else self._contacts.wall_rest(rest[1])
+            maybe_past = None
+            if dt > 0.0:  # 3. hits, walls and pairs, in time order
+                maybe_past = self._hits_in_order(dt, None if rest is None else rest[0], wall_rest)
+                self._wake_hit()
             near = self._near_walls()
-            past = self._resolve_walls(near, wall_rest)  # 3. walls
+            past = self._resolve_walls(near if maybe_past is None else maybe_past, wall_rest)  # 3b. still past a wall
             moved = np.empty(0, dtype=np.intp)
-            if self.puck_collisions:  # 4. pairs (told what the walls moved if the list was just checked)
+            if self.puck_collisions:  # 4. overlapping pairs (told what the walls moved if the list was just checked)
                 moved = self._resolve_pairs(dt, None if rest is None else rest[0], None if near is None else past)
             self._wake_hit()
             if rest is not None and self._resolve_contacts(rest, dt):  # 5. resting contacts
@@ -658,11 +650,12 @@ class AirTable:
             vel[self._sleepers] = 0.0  # sleepers stay where they are
         # A last guard against runaway values; a cheap bound first: a speed
         # over the limit has a component over limit / sqrt(2).
-        self._top_component_mps = float(np.abs(vel).max())  # _sweep_fast uses it too
-        if self._top_component_mps > MAX_SPEED_MPS / math.sqrt(2.0):
+        # A bound on every speed (sqrt 2 times the largest component): the hits' stage uses it too.
+        self._speed_bound_mps = math.sqrt(2.0) * float(np.abs(vel).max())
+        if self._speed_bound_mps > MAX_SPEED_MPS:
             speed = np.hypot(vel[:, 0], vel[:, 1])  # not lengths(): v^2 may overflow here
             vel *= np.minimum(1.0, MAX_SPEED_MPS / np.maximum(speed, 1e-300))[:, None]
-            self._top_component_mps = math.inf
+            self._speed_bound_mps = MAX_SPEED_MPS
         pos += vel * dt
         return kick
 
@@ -690,25 +683,32 @@ class AirTable:
         walls = (self.size_m, self.cr_wall)
         return implicit_solve.brace_walls(self.pos_m, self.vel_mps, dv, self.radius_m, walls, implicit, released, dt)
 
-    def _sweep_fast(self, dt: float) -> None:
-        """Sweep the pucks that move a good part of their radius this step (sweep.py)."""
-        # No puck's speed is over sqrt(2) times the largest velocity component
-        # (_integrate's): below the limit, nobody is fast, and no speeds are needed.
-        top = self._top_component_mps
-        if 2.0 * top * top * dt * dt <= (sweep.FAST_FRACTION * float(self.radius_m.min())) ** 2:
-            return
-        movers = sweep.fast_rows(self.vel_mps, self.radius_m, dt)
-        if len(movers) == 0:
-            return
-        s = sweep.sweep(
-            self.pos_m, self.vel_mps, self.radius_m, self.mass_kg, self.size_m,
-            self.cr_puck, self.cr_wall, dt, pucks=self.puck_collisions, movers=movers,
-            leave=self.puck_correction != "perfect-kiss",
-        )  # fmt: skip
-        self.wall_collision_count += s.walls
-        if s.i:
-            self._collision_records.append(_swept_record(s, self.radius_m))
-            self.collision_count += len(s.i)
+    def _hits_in_order(self, dt: float, rest: np.ndarray | None, wall_rest: np.ndarray | None) -> np.ndarray | None:
+        """Resolve the step's wall and pair hits in the order they happen (events.py); return the
+        rows that may still be past a wall (None: any)."""
+        mode = self.puck_correction
+        rules = events.Rules(
+            self.cr_puck,
+            self.cr_wall,
+            pairs=mode if self.puck_collisions else "none",
+            walls=self.wall_correction,
+            accel_y_mps2=-self.gravity_mps2 if self.gravity_on else 0.0,
+            rest=rest,
+            wall_rest=wall_rest,
+            held=None if rest is None else self._contacts.held,
+            speed_bound_mps=self._speed_bound_mps,
+        )
+        near = self._near_walls()
+        hits = events.resolve_hits(
+            self.pos_m, self.vel_mps, self.radius_m, self.mass_kg, self.size_m, dt, rules, self._neighbours, near
+        )
+        self.wall_collision_count += hits.walls
+        if hits.rows:
+            self._collision_records.append(hits.collisions(self.radius_m))
+            self.collision_count += len(hits.rows)
+        if hits.capped:
+            self._notice("capped", events.CAPPED_NOTICE)
+        return hits.maybe_past
 
     def _rest_speeds(self, kick: np.ndarray | float | None, dt: float) -> tuple[np.ndarray, np.ndarray] | None:
         """Each puck's rest speeds towards other pucks and towards the walls; None: all zero.

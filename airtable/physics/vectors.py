@@ -133,6 +133,11 @@ def dot(z: np.ndarray, w: np.ndarray) -> np.ndarray:
     return xy[0::2] + xy[1::2]
 
 
+def dot_one(z: complex, w: complex) -> float:
+    """`dot` for one pair of vectors as Python complex numbers."""
+    return z.real * w.real + z.imag * w.imag
+
+
 def units(z: np.ndarray, keys) -> tuple[np.ndarray, np.ndarray]:
     """unit_vectors for complex z: (z / |z|, |z|), each part divided by the length.
 

@@ -1,0 +1,393 @@
+"""Hits in time order: every wall and pair hit of a step, resolved at the moment it happens.
+
+After the Euler update each puck moves on a straight line through the step: at
+time t (0 <= t <= dt) puck k is at o_k + v_k t, o_k being where its present path
+had it at t = 0 (its "origin"). A hit is an event at the time two paths first
+touch (reference.contact_time) or a path reaches a wall (reference.wall_time).
+The events wait in a queue by time, as in Rapaport's event-driven method: the
+earliest is resolved (the pucks where they touch, collided along the normal with
+reference.collide_1d, then on new paths from there), and only the hits of the
+pucks it changed are predicted again; a prediction made before one of its
+pucks changed is stale and dropped. So a puck's several hits, a hit just after
+a wall bounce and a pair squeezed against a wall all happen in their order: in
+perfect kiss the motion is that of hard discs, whatever the step.
+
+Which pairs can meet: those the neighbour list holds while every path stays
+near where the step ends (NeighbourList.pairs_while_moving); a puck given a
+path longer than that is checked against every puck.
+
+What is left to later stages: hits slower than a puck's rest speed, and pairs
+that pressed on each other in the last step (the contact stage holds those).
+In two-step, a pair hit that the step's end would catch overlapping and
+approaching is resolved the course's way, at dt - t_p (t_p = overlap / normal
+speed there) along the line of centres there: the pair ends where the
+two-step correction puts it, and a hit it would catch too late (past the
+closest approach, or through) is resolved at first contact. In "off", such a
+pair is left overlapping to the pair stage (velocities only: what it shows).
+Outside perfect kiss only fast pucks' pair hits are predicted (those moving
+FAST_FRACTION of their radius in a step: they could pass through); the pair
+stage sees the others overlapping.
+"""
+
+from __future__ import annotations
+
+import heapq
+import math
+from collections.abc import Callable
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from airtable.physics import broadphase, reference, vectors
+from airtable.physics.pairs import Collisions
+
+# A bound on the events of one step (the pi setup at 10^8:1 needs some hundreds).
+MAX_EVENTS = 100_000
+# Said once (table.notices) if a step ever reaches MAX_EVENTS.
+CAPPED_NOTICE = (
+    "A step had more hits than the engine resolves one by one; the rest of that step's hits"
+    " were left to the overlap correction."
+)
+# Below restitution 1, a pair hits at most this many times in one step; its further hits are
+# left to the pair and contact stages: else pucks that collide inelastically in a cluster hit
+# each other again and again at ever smaller speeds (inelastic collapse): 200000 events in
+# one step of a 300-puck gas at restitution 0.
+REPEAT_MAX = 3
+# In two-step, pair hits are predicted when some puck moves this share of the smallest radius
+# in a step; below it nobody can pass through a puck, and the pair stage sees every hit.
+FAST_FRACTION = 0.5
+
+
+@dataclass
+class Rules:
+    """What the step asks of its hits: restitutions, what to predict, the rest speeds."""
+
+    cr_puck: float
+    cr_wall: float
+    pairs: str  # the correction mode ("perfect-kiss", "two-step", "off"), or "none": no pair hits
+    walls: bool  # wall hits at their time (wall_correction); else the wall stage puts pucks back
+    accel_y_mps2: float = 0.0  # gravity's part of the step's velocity change (0 or -g)
+    rest: np.ndarray | None = None  # per puck: pair hits slower than this rest (contacts.py)
+    wall_rest: np.ndarray | None = None  # per puck (N,) or per puck and axis (N, 2), for walls
+    held: Callable[[np.ndarray, np.ndarray], np.ndarray] | None = None  # pairs (i < j) resting: the contacts'
+    speed_bound_mps: float = math.inf  # no puck is faster (inf: work it out)
+
+
+@dataclass
+class Hits:
+    """What the hits in time order did in one step: the pair hits as rows, the wall bounces."""
+
+    # (i, j, n, overlap, xi, xj before, xi, xj after, vi, vj before, after), vectors complex
+    rows: list = field(default_factory=list)
+    walls: int = 0
+    capped: bool = False
+    maybe_past: np.ndarray | None = None  # the rows that may still be past a wall (None: any)
+
+    def collisions(self, radius: np.ndarray) -> Collisions:
+        """The pair hits as a collision record: an exact hit where the pucks touched (overlap 0), a
+        two-step one where the step's end caught them overlapping, and where it moved them."""
+        if not self.rows:
+            return Collisions.empty()
+        i, j, n, overlap, *states = (np.array(column) for column in zip(*self.rows, strict=True))
+        reach = radius.take(i) + radius.take(j)
+        contact = states[1] + radius.take(j) * n
+        n, contact, *states = (vectors.as_rows(np.ascontiguousarray(z)) for z in (n, contact, *states))
+        return Collisions(i, j, n, contact, overlap, reach, *states)
+
+
+def resolve_hits(pos, vel, radius, mass, size_m, dt: float, rules: Rules, neighbours, near_walls=None) -> Hits:
+    """Resolve this step's hits in time order, in place (see the module docstring).
+
+    pos: positions at the end of the step (x0 + v dt, done); vel: the step's
+    velocities. neighbours: the table's NeighbourList; near_walls: the rows
+    that may be past a wall (None: every row).
+    """
+    step = _Step(pos, vel, radius, mass, size_m, dt, rules)
+    if len(pos) == 0 or dt <= 0.0:
+        return step.hits
+    past = step.past_walls(near_walls) if rules.walls else None
+    for k in past or ():
+        step.predict_walls(k)
+    if step.predicts_pairs():
+        step.find_partners(neighbours)
+        for a, b in step.first_pairs():
+            step.predict_pair(a, b)
+    step.run()
+    step.write_back()
+    if past is not None:  # only those past a wall, or on a new path, may still be (resting, landed)
+        step.hits.maybe_past = np.array(sorted(set(past) | step.origin.keys()), dtype=np.intp)
+    return step.hits
+
+
+class _Step:
+    """One step's event queue and the pucks' present paths (origins and velocities, complex x + iy)."""
+
+    def __init__(self, pos, vel, radius, mass, size_m, dt: float, rules: Rules) -> None:
+        self.zpos, self.zvel = vectors.as_complex(pos), vectors.as_complex(vel)
+        self.radius, self.mass, self.dt, self.rules = radius, mass, dt, rules
+        self.width, self.height = float(size_m[0]), float(size_m[1])
+        self.queue: list[tuple] = []
+        self.seq = 0  # breaks ties between events at one time: the earlier predicted first
+        self.t_now = 0.0
+        self.origin: dict[int, complex] = {}  # the pucks whose path changed, and their new origin
+        self.version: dict[int, int] = {}  # per puck: how many times its path changed
+        self.hit_pairs: dict[tuple[int, int], int] = {}  # how many times each pair hit
+        self.hits = Hits()
+        self.partners = None  # the pairs that may meet, per puck (see find_partners)
+        speed = rules.speed_bound_mps
+        if not math.isfinite(speed) or rules.pairs == "perfect-kiss":  # its pairs are found by the exact travel
+            speed = float(np.sqrt(vectors.squared_abs(self.zvel).max())) if len(vel) else 0.0
+        self.travel = speed * dt  # the farthest any puck moves this step on its first path (m)
+        # The pairs found hold every pair that can meet while each path stays within `covered`
+        # of its puck's step end; `reach_out` is the farthest any present path strays.
+        self.covered = self.reach_out = 2.0 * self.travel
+        self.extra: dict[int, set[int]] = {}  # partners found for paths that stray farther
+        self.offset: dict[int, complex] = {}  # added to a velocity at the end (bounce_under_gravity)
+
+    # ------------------------------------------------------------ paths
+
+    def at(self, k: int, t: float) -> complex:
+        """Where puck k is at time t of the step on its present path."""
+        o = self.origin.get(k)
+        if o is None:
+            return self.zpos.item(k) + self.zvel.item(k) * (t - self.dt)
+        return o + self.zvel.item(k) * t
+
+    def set_path(self, k: int, x: complex, v: complex) -> None:
+        """Puck k is at x at t_now and goes on at v: a new origin, and its old predictions stale."""
+        self.zvel[k] = v
+        self.origin[k] = x - v * self.t_now
+        self.version[k] = self.version.get(k, 0) + 1
+        if self.partners is None:
+            return
+        # The step's end of its first path (zpos, written back only at the end) and how far
+        # the new path strays from it: beyond what the pairs were found for, look at everyone.
+        end = self.zpos.item(k)
+        stray = max(abs(x - end), abs(x + v * (self.dt - self.t_now) - end))
+        if stray > self.covered:
+            self.reach_out = max(self.reach_out, stray)
+            self.add_everyone_near(k, end, stray)
+
+    def add_everyone_near(self, k: int, end: complex, stray: float) -> None:
+        """Puck k's path strays `stray` from its step end: its partners from every puck."""
+        reach = self.radius + (self.radius.item(k) + stray + self.reach_out)
+        near = (vectors.squared_abs(self.zpos - end) < reach * reach).nonzero()[0].tolist()
+        for other in near:
+            if other != k:
+                self.extra.setdefault(k, set()).add(other)
+                self.extra.setdefault(other, set()).add(k)
+
+    def partners_of(self, k: int) -> list[int]:
+        """The pucks k may meet this step."""
+        out = self.partners.of(k)
+        more = self.extra.get(k)
+        return out if not more else list(set(out) | more)
+
+    def write_back(self) -> None:
+        """The pucks whose path changed end the step where their present path has them."""
+        for k, o in self.origin.items():
+            self.zpos[k] = o + self.zvel.item(k) * self.dt
+        for k, dv in self.offset.items():
+            self.zvel[k] += dv
+
+    # ------------------------------------------------------------ predicting
+
+    def past_walls(self, near_walls) -> list[int]:
+        """The rows the step ends past a wall: each hit a wall during it (or was there already)."""
+        from airtable.physics.walls import room_to_walls  # walls imports nothing of this module
+
+        pos = vectors.as_rows(self.zpos)
+        rows = None if near_walls is None else near_walls
+        p, r = (pos, self.radius) if rows is None else (vectors.take(pos, rows), self.radius.take(rows))
+        out = (room_to_walls(p, r, (self.width, self.height)) < 0.0).nonzero()[0]
+        return (out if rows is None else rows.take(out)).tolist()
+
+    def predicts_pairs(self) -> bool:
+        if self.rules.pairs == "perfect-kiss":
+            return True
+        return self.rules.pairs != "none" and self.travel > FAST_FRACTION * float(self.radius.min())
+
+    def fast(self, k: int) -> bool:
+        """Whether puck k moves FAST_FRACTION of its radius in a step on its present path."""
+        return abs(self.zvel.item(k)) * self.dt > FAST_FRACTION * self.radius.item(k)
+
+    def find_partners(self, neighbours) -> None:
+        """The pairs that may meet during the step, on any path within 2 travels of the step's ends."""
+        pos = vectors.as_rows(self.zpos)
+        found = neighbours.pairs_while_moving(pos, self.radius, 2.0 * self.travel)
+        if found is None:  # paths longer than the list's skin: the pairs within reach of them now
+            margin = 4.0 * self.travel
+            i, j = broadphase.find_candidate_pairs(pos, self.radius, margin_m=margin, closer=True)
+            near = broadphase.squared_distances(pos, i, j) < (self.radius.take(i) + self.radius.take(j) + margin) ** 2
+            i, j = i.take(near.nonzero()[0]), j.take(near.nonzero()[0])
+            self.partners = broadphase.Partners(i, j, len(pos))
+        else:
+            self.partners = neighbours.partners()
+
+    def first_pairs(self) -> list[tuple[int, int]]:
+        """The pairs that on their first paths may touch during the step, approaching faster than they rest."""
+        i, j = self.partners.i, self.partners.j
+        d, w = self.zpos.take(i) - self.zpos.take(j), self.zvel.take(i) - self.zvel.take(j)
+        ww, dw = vectors.squared_abs(w), vectors.dot(d, w)
+        # Approaching at the start (dw at t = 0 < 0: on a straight line never later if not then),
+        # and coming within reach: the closest point of the relative path over the step.
+        s = np.minimum(np.maximum(dw / np.where(ww > 0.0, ww, 1.0), 0.0), self.dt)  # time back from the end
+        reach = self.radius.take(i) + self.radius.take(j)
+        close = (dw - ww * self.dt < 0.0) & (vectors.squared_abs(d - w * s) < reach * reach)
+        if self.rules.rest is not None:
+            close &= ww > np.maximum(self.rules.rest.take(i), self.rules.rest.take(j)) ** 2
+        if self.rules.pairs != "perfect-kiss":  # only where a puck is fast: the others are seen overlapping
+            lim = FAST_FRACTION * self.radius / self.dt
+            fast = vectors.squared_abs(self.zvel) > lim * lim
+            close &= fast.take(i) | fast.take(j)
+        k = close.nonzero()[0]
+        if self.rules.held is not None and len(k):
+            k = k.take((~self.rules.held(i.take(k), j.take(k))).nonzero()[0])
+        return list(zip(i.take(k).tolist(), j.take(k).tolist(), strict=True))
+
+    def predict_pair(self, a: int, b: int) -> None:
+        """Queue the next hit of a and b on their present paths, if it comes within the step."""
+        t_now, dt = self.t_now, self.dt
+        if self.rules.pairs != "perfect-kiss" and not (self.fast(a) or self.fast(b)):
+            return  # the pair stage sees this pair overlapping, if it hits
+        d, w = self.at(a, t_now) - self.at(b, t_now), self.zvel.item(a) - self.zvel.item(b)
+        reach = self.radius.item(a) + self.radius.item(b)
+        hit = reference.contact_time((d.real, d.imag), (w.real, w.imag), reach)
+        if hit is None or t_now + hit[0] > dt:
+            return
+        t, speed = t_now + hit[0], hit[1]
+        if self.rules.pairs != "perfect-kiss":
+            caught = _caught_overlapping(d + w * (dt - t_now), w, reach)
+            if caught is not None and self.rules.pairs == "off":
+                return  # seen overlapping: velocities only, at the step's end (the pair stage's)
+            if caught is not None:  # the course's case: resolved t_p before the step's end
+                t, speed = max(dt - caught[0], t_now), caught[1]
+        rest = self.rules.rest
+        if rest is not None and not speed > max(rest.item(a), rest.item(b)):
+            return  # a resting contact: the contact stage's
+        if self.rules.held is not None and self.rules.held(np.array([min(a, b)]), np.array([max(a, b)]))[0]:
+            return  # pressed on each other in the last step: resting, whatever the speed
+        if self.rules.cr_puck < 1.0 and self.hit_pairs.get((a, b), 0) >= REPEAT_MAX:
+            return
+        self.push(t, a, b)
+
+    def predict_walls(self, k: int) -> None:
+        """Queue puck k's next wall hit on its present path, if it comes within the step."""
+        x, v, r = self.at(k, self.t_now), self.zvel.item(k), self.radius.item(k)
+        for axis, (xa, va, size) in enumerate(((x.real, v.real, self.width), (x.imag, v.imag, self.height))):
+            t = reference.wall_time(xa, va, r, size - r)
+            if t is None or self.t_now + t > self.dt or not abs(va) > self._wall_rest(k, axis):
+                continue
+            self.push(self.t_now + t, k, -1 - axis)
+
+    def _wall_rest(self, k: int, axis: int) -> float:
+        rest = self.rules.wall_rest
+        if rest is None:
+            return 0.0
+        return rest.item(k) if rest.ndim == 1 else rest.item(k, axis)
+
+    def predict(self, k: int) -> None:
+        """Every next hit of puck k (its path just changed)."""
+        if self.rules.walls:
+            self.predict_walls(k)
+        if self.partners is not None:
+            for other in self.partners_of(k):
+                self.predict_pair(k, other)
+
+    def push(self, t: float, a: int, b: int) -> None:
+        """Queue a hit of a with b (b < 0: the wall across axis -1 - b), as their paths are now."""
+        versions = (self.version.get(a, 0), self.version.get(b, 0) if b >= 0 else 0)
+        self.seq += 1
+        heapq.heappush(self.queue, (t, self.seq, a, b, versions))
+
+    # ------------------------------------------------------------ resolving
+
+    def run(self) -> None:
+        """Resolve the queued hits, earliest first, predicting again for the pucks each changes."""
+        events = 0
+        while self.queue:
+            t, _, a, b, versions = heapq.heappop(self.queue)
+            if versions != (self.version.get(a, 0), self.version.get(b, 0) if b >= 0 else 0):
+                continue  # one of them changed path since: no longer its next hit
+            events += 1
+            if events > MAX_EVENTS:
+                self.hits.capped = True
+                return
+            self.t_now = t
+            if b < 0:
+                self.bounce(a, -1 - b)
+                self.predict(a)
+            else:
+                self.collide(a, b)
+                self.predict(a)
+                self.predict(b)
+
+    def bounce(self, k: int, axis: int) -> None:
+        """Puck k reaches the wall across `axis` now: its normal velocity reverses times cr_wall."""
+        x, v = self.at(k, self.t_now), self.zvel.item(k)
+        e, a = self.rules.cr_wall, self.rules.accel_y_mps2
+        self.hits.walls += 1
+        if axis == 0:
+            self.set_path(k, x, complex(-e * v.real, v.imag))
+        elif a == 0.0:
+            self.set_path(k, x, complex(v.real, -e * v.imag))
+        else:
+            vy, offset = self.bounce_under_gravity(v.imag, a)
+            self.set_path(k, x, complex(v.real, vy))
+            self.offset[k] = complex(0.0, offset)
+
+    def bounce_under_gravity(self, vy: float, a: float) -> tuple[float, float]:
+        """(velocity along y of the path to the step's end, what to add to it at the end) after a
+        floor or ceiling hit now, under a pull a (m/s^2) along y; vy: the step's velocity.
+
+        Semi-implicit Euler samples a parabola exactly: over a step whose end velocity is vy,
+        the puck is at y0 + (vy - a dt / 2) s + a s^2 / 2 at time s, and vy is that parabola's
+        velocity half a step before the end. So the hit is resolved on the parabola: the speed
+        there at contact reverses times e, a new parabola leaves the wall, and the step ends
+        on it with its velocity half a step back, as if the step had run continuously: bounce
+        heights fall by e^2. (A straight path is kept for the rest of the step's hits.)
+        """
+        s, left = self.t_now, self.dt - self.t_now
+        leave = -self.rules.cr_wall * (vy - a * (0.5 * self.dt - s))  # -e times the speed at contact
+        end = leave + a * (0.5 * self.dt - s)  # the new parabola's velocity half a step before the end
+        if left <= 0.0 and leave * vy < 0.0:
+            return leave, end - leave  # a hit at the very end
+        path = leave + 0.5 * a * left  # to where the new parabola is at the step's end
+        if path * vy >= 0.0 or left <= 0.0:
+            return 0.0, 0.0  # it would be back at the wall within the step: it lands there
+        return path, end - path
+
+    def collide(self, a: int, b: int) -> None:
+        """a and b hit now: their normal velocities collide in 1D (reference.collide_1d).
+
+        The normal is the line of centres now; in two-step, for a pair the end of
+        the step would catch overlapping and approaching, the line of centres there.
+        """
+        xa, xb = self.at(a, self.t_now), self.at(b, self.t_now)
+        va, vb = self.zvel.item(a), self.zvel.item(b)
+        n, overlap, seen = xa - xb, 0.0, (xa, xb)  # the record: where the hit was seen, how deep
+        if self.rules.pairs == "two-step":
+            left = self.dt - self.t_now
+            end, reach = n + (va - vb) * left, self.radius.item(a) + self.radius.item(b)
+            if _caught_overlapping(end, va - vb, reach) is not None:
+                n, overlap, seen = end, reach - abs(end), (xa + va * left, xb + vb * left)
+        n /= abs(n)
+        ua, ub = vectors.dot_one(va, n), vectors.dot_one(vb, n)
+        wa, wb = reference.collide_1d(ua, ub, self.mass.item(a), self.mass.item(b), self.rules.cr_puck)
+        new_a, new_b = va + (wa - ua) * n, vb + (wb - ub) * n
+        self.set_path(a, xa, new_a)
+        self.set_path(b, xb, new_b)
+        after = (self.at(a, self.dt), self.at(b, self.dt)) if overlap else seen
+        self.hits.rows.append((a, b, n, overlap, *seen, *after, va, vb, new_a, new_b))
+        self.hit_pairs[a, b] = self.hit_pairs.get((a, b), 0) + 1
+
+
+def _caught_overlapping(d: complex, w: complex, reach: float) -> tuple[float, float] | None:
+    """(t_p, u) for a pair d = x1 - x2 apart at the step's end, approaching at w = v1 - v2 there: the
+    two-step's penetration time t_p = overlap / u, u the approach speed along the line of centres;
+    None if the step does not end with the pair overlapping and approaching (two-step's case)."""
+    dist = abs(d)
+    if not (dist < reach and dist > 0.0):
+        return None
+    u = -vectors.dot_one(d, w) / dist
+    return ((reach - dist) / u, u) if u > 0.0 else None
