@@ -12,6 +12,7 @@ import time
 from collections.abc import Callable, Sequence
 
 from airtable.memory import keep_freed_memory
+from bench.classroom_link import classroom_section
 from bench.cpu import cpu_section
 from bench.frames import window_section
 from bench.hard import hard_section
@@ -26,6 +27,7 @@ SECTIONS: dict[str, Callable[[argparse.Namespace], bool]] = {
     "window": window_section,
     "snapshots": snapshot_section,
     "link": link_section,
+    "classroom": classroom_section,
     "hard": hard_section,
     "instructions": instructions_section,
 }
