@@ -4,7 +4,6 @@ menu, an Esc that never drops a class by accident, and the small things (keypad,
 from __future__ import annotations
 
 import os
-import socket
 import subprocess
 import sys
 from pathlib import Path
@@ -12,14 +11,12 @@ from pathlib import Path
 import numpy as np
 import pygame
 import pytest
-from conftest import FRAME_S, press, wait_until
+from conftest import FRAME_S, press
 
 from airtable.app.app import App
 from airtable.app.demo_loader import BUILTIN_DIR, DemoShelf, key_order
 from airtable.app.window import GameWindow
 from airtable.cli import main
-from airtable.net import protocol as proto
-from airtable.net.server import GameServer
 
 
 def demo_source(key: str, pucks: int = 1, build_line: str = "", title: str = "Mine") -> str:
@@ -190,37 +187,6 @@ def test_esc_on_a_press_any_key_notice_goes_on_without_quitting(tmp_path):
     assert app.panel() == "notice"
     press(app, pygame.K_ESCAPE)
     assert app.running and app.panel() is None
-
-
-def test_quitting_with_a_student_connected_takes_a_second_esc(demos):
-    with GameServer(host="127.0.0.1", port=0) as server:
-        app = App(demos, headless=True, server=server)
-        student = socket.create_connection(("127.0.0.1", server.port), timeout=5.0)
-        try:
-            student.sendall(proto.encode_hello("Ann"))
-
-            def joined() -> bool:
-                app.frame(FRAME_S)
-                return app.student_count() == 1
-
-            wait_until(joined, what="the student to join")
-            shown: list[tuple] = []
-            draw_question = app.window.draw_question
-            app.window.draw_question = lambda title, rows: (shown.append((title, rows)), draw_question(title, rows))
-            press(app, pygame.K_ESCAPE)
-            assert app.running and app.panel() == "quit"
-            assert shown[-1][0] == "Quit?" and "1 student will be dropped." in shown[-1][1]
-            press(app, pygame.K_SPACE)  # any other key: stay
-            assert app.running and app.panel() is None and not app.paused
-            press(app, pygame.K_ESCAPE)
-            app.run(seconds=5.0, frame_dt_s=FRAME_S)  # a second Esc long after the first only asks again
-            assert app.running and app.panel() is None
-            press(app, pygame.K_ESCAPE)
-            assert app.running and app.panel() == "quit"
-            press(app, pygame.K_ESCAPE)
-            assert not app.running
-        finally:
-            student.close()
 
 
 # ---------------------------------------------------------------- a quiet laptop
