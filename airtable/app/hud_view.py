@@ -166,9 +166,8 @@ def _draw_in_margins(surface, layout, style, title, lines, fps, paused) -> tuple
             boxes.append(surface.blit(font.render(text, True, color), (pad, y)))
             y += line_h
         y += pad // 2
-    right = [_fps_box(surface, style, fps, (w - pad, pad // 2))]
-    right = [box for box in right if box.width] or [pygame.Rect(w - pad, 0, 0, pad // 2)]
+    right = [] if fps is None else [_fps_box(surface, style, fps, (w - pad, pad // 2))]
     if paused:
-        big = style.big_font
-        right.append(_paused_box(surface, style, big, (w - pad, right[0].bottom + pad), column))
-    return boxes + right, max(y, right[-1].bottom)
+        top = (right[-1].bottom if right else pad // 2) + pad
+        right.append(_paused_box(surface, style, style.big_font, (w - pad, top), column))
+    return boxes + right, max([y, *(box.bottom for box in right)])
