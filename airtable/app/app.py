@@ -30,7 +30,7 @@ from airtable.app.lessons import Lessons
 from airtable.app.lessons_view import draw_lessons
 from airtable.app.loop import FixedStep, FpsCounter, IdlingLoop, signals_end_the_run
 from airtable.app.menu import DemoMenu
-from airtable.app.overlays import OverlayFlag, Overlays
+from airtable.app.overlays import OverlayFlag, Overlays, OverlayValue
 from airtable.app.predict_view import draw_predict
 from airtable.app.roster_view import ALERT_COLOR, draw_roster, room_alert
 from airtable.app.stats import RunStats
@@ -91,6 +91,9 @@ class App:
     show_help = OverlayFlag("help")
     show_notes = OverlayFlag("notes")
     show_chart = OverlayFlag("chart")
+    menu = OverlayValue("menu")  # a DemoMenu while the menu is open
+    build_error = OverlayValue("error")  # the demo's DemoError, shown instead of the demo while set
+    notice = OverlayValue("notice", empty=[])  # lines of a "press any key" notice
 
     def __init__(
         self,
@@ -141,9 +144,6 @@ class App:
         self.vectors = 0  # 0 off, 1 velocity, 2 momentum
         self.inspecting = False
         self._notices_seen = 0  # how many of table.notices were said
-        self._menu: DemoMenu | None = None
-        self._notice: list[str] = []
-        self._build_error: DemoError | None = None
         self.quit_armed_until = -1.0  # clock_s until which a second Esc quits
         self.collision_log = aids.CollisionLog()
         self.chart = aids.EnergyChart()
@@ -265,36 +265,6 @@ class App:
             self.report(error)
         items = [(key, demo.title) for key, demo in self.demos.items()]
         self.menu = DemoMenu(items, current=self.demo_key)
-
-    # The menu, the demo error and the notice are objects; each is shown while it is set.
-
-    @property
-    def menu(self) -> DemoMenu | None:
-        return self._menu if self.overlays.shown("menu") else None
-
-    @menu.setter
-    def menu(self, menu: DemoMenu | None) -> None:
-        self._menu = menu
-        self.overlays.set("menu", menu is not None)
-
-    @property
-    def build_error(self) -> DemoError | None:
-        """The demo's error, shown instead of the demo while set."""
-        return self._build_error if self.overlays.shown("error") else None
-
-    @build_error.setter
-    def build_error(self, error: DemoError | None) -> None:
-        self._build_error = error
-        self.overlays.set("error", error is not None)
-
-    @property
-    def notice(self) -> list[str]:
-        return self._notice if self.overlays.shown("notice") else []
-
-    @notice.setter
-    def notice(self, lines: list[str]) -> None:
-        self._notice = list(lines)
-        self.overlays.set("notice", bool(lines))
 
     def panel(self) -> str | None:
         """Which panel is in the middle of the window now, if any (the quit question lapses)."""

@@ -86,3 +86,27 @@ class OverlayFlag:
 
     def __set__(self, owner, shown: bool) -> None:
         owner.overlays.set(self.name, bool(shown))
+
+
+class OverlayValue:
+    """An attribute whose value is shown over the table while it is set (a menu, an error, a notice's
+    lines): setting a value opens overlay `name` on the owner's `overlays`, setting None or an empty
+    one closes it; reading gives the value while the overlay is open, else `empty`."""
+
+    def __init__(self, name: str, empty=None) -> None:
+        if name not in NAMES:
+            raise ValueError(f"no overlay called {name!r}")
+        self.name, self.empty = name, empty
+
+    def __set_name__(self, owner, attribute: str) -> None:
+        self.slot = f"_{attribute}"
+
+    def __get__(self, owner, kind=None):
+        if owner is None:
+            return self
+        shown = owner.overlays.shown(self.name)
+        return getattr(owner, self.slot, self.empty) if shown else self.empty
+
+    def __set__(self, owner, value) -> None:
+        setattr(owner, self.slot, value)
+        owner.overlays.set(self.name, bool(value))
