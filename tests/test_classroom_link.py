@@ -99,7 +99,9 @@ def _in_input(shaper, delay_s: float = 0.1, loss: float = 0.1, block_udp: bool =
             sent[x] = time.monotonic()
             net.update_input((x, 2.0))
             time.sleep(1 / 30)
-        time.sleep(2.0)
+        for _ in range(60):  # the hand rests; the window still calls update_input every frame
+            net.update_input((x, 2.0))
+            time.sleep(1 / 30)
         with room.lock:
             seen = dict(room.effects.get(f"{net.welcome.client} {net.name}", {}))
         delays = []

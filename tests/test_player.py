@@ -116,6 +116,17 @@ def test_input_throttle_sends_changes_at_most_60_a_second_and_a_heartbeat():
     assert throttle.due(a, 0.0)
 
 
+def test_a_cursor_that_stops_after_going_by_udp_alone_is_sent_once_more_reliably():
+    throttle = InputThrottle(max_hz=60, heartbeat_s=1.0, settle_s=0.1)
+    a = proto.InputRecord((1.0, 1.0), 0)
+    throttle.sent(a, 0.0, reliable=False)  # this datagram may be lost, and nothing newer follows
+    assert not throttle.due(a, 0.05) and not throttle.settling(a, 0.05)
+    assert throttle.due(a, 0.1) and throttle.settling(a, 0.1)
+    throttle.sent(a, 0.1)  # by TCP
+    assert not throttle.due(a, 0.5), "sent reliably: only the heartbeat is left"
+    assert not throttle.settling(proto.InputRecord((2.0, 1.0), 0), 0.5), "a new position is an ordinary send"
+
+
 def test_own_cursor_is_drawn_at_the_live_mouse_position_with_its_string():
     welcome = proto.Welcome("C2", (210, 180, 140), 10.0, 8.7556)
     other = CursorView("C1", (255, 52, 179), (1.0, 1.0), 1, 0)
