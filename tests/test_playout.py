@@ -8,8 +8,11 @@ import threading
 
 import numpy as np
 import pytest
+from hypothesis import given
+from hypothesis import strategies as st
 
 from airtable.model.scene import CursorView, Scene
+from airtable.net import playout
 from airtable.net import protocol as proto
 from airtable.net.codec import LAYOUT, SnapshotEncoder, Viewer
 from airtable.net.playout import PlayoutBuffer, SnapshotFeed
@@ -173,3 +176,8 @@ def test_jittered_snapshots_through_a_real_socket_play_evenly():
     assert abs(steps.mean() - 1e3 * SPEED_MPS / FPS) < 0.1
     assert steps.std() < 0.2  # quantised to 0.25 mm on the wire, still even
     assert feed.newest.pos_m[0, 0] == pytest.approx(1.0 + (i - 1) / HZ, abs=1e-3)  # the last one fed
+
+
+@given(st.lists(st.floats(-10, 10), min_size=1, max_size=80), st.floats(0, 1))
+def test_quantile_is_numpys_default(values, q):
+    assert playout.quantile(sorted(values), q) == pytest.approx(np.percentile(values, 100 * q), abs=1e-12)
