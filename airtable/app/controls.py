@@ -95,18 +95,21 @@ def demo_key_for(event: pygame.event.Event) -> str | None:
 
 
 class KeyTable:
-    """The owners' bindings as one table: `rows` for the help, `press` and `run_held` for the keys."""
+    """The owners' bindings as one dispatch: `press` and `run_held` (the help's rows are `help_rows`)."""
 
     def __init__(self, owners: Sequence[object]) -> None:
-        """`owners`: objects with `bindings` (the features and the app); each action is called with its owner."""
-        self.rows = help_rows(b for owner in owners for b in owner.bindings)
+        """`owners`: objects with `bindings` (the features and the app); each action is called with its owner.
+        A key bound twice raises ValueError (the second would silently win)."""
         self._press: dict[int, Callable[[], None]] = {}
         self._modified: dict[tuple[int, int], Callable[[], None]] = {}
         self._held: dict[int, Callable[[], None]] = {}
         for owner in owners:
             for b in owner.bindings:
                 for key, action in b.actions.items():
-                    self._table(key, b.held)[key] = _bound(action, owner)
+                    table = self._table(key, b.held)
+                    if key in table:
+                        raise ValueError(f"key table: {b.label!r} binds a key bound already")
+                    table[key] = _bound(action, owner)
 
     def _table(self, key: Key, held: bool) -> dict:
         if isinstance(key, tuple):
