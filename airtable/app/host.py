@@ -35,9 +35,7 @@ class Host(Protocol):
     build_error: DemoError | None
     paused: bool
     clock_s: float  # time the app has run
-    frame_dt_s: float  # the current frame's time
     mouse_px: Sequence[float]
-    keys_down: set[int]
 
     @property
     def demos(self) -> dict[str, Demo]: ...
