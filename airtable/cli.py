@@ -296,11 +296,9 @@ def main(argv: Sequence[str] | None = None) -> int:
 def write_outputs(app, args: argparse.Namespace) -> int:
     """At the end of a run: the --record files and the --save-demo file; 1 if one could not be written
     (said on stderr), else 0."""
-    from airtable.app.lessons import save_moment
-
     status = 0
     if args.save_demo is not None:
-        if save_moment(app, args.save_demo) is None:
+        if app.lessons.save_moment(args.save_demo) is None:
             print(f"airtable: {app.message}", file=sys.stderr)
             status = 1
         else:

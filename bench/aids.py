@@ -21,7 +21,6 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from airtable.app.aids_share import shared_aids
 from airtable.model.client import Client
 from airtable.net.codec import SnapshotEncoder, Viewer
 from airtable.net.protocol import AIDS, SNAPSHOT
@@ -59,10 +58,10 @@ def make_app(demo_key: str, aids_on: str = "", students: int = 0):
 
     found, _ = discover([BUILTIN_DIR])
     app = App(found, demo_key=demo_key, headless=True)
-    app.show_annotations = "a" in aids_on
-    app.vectors = 1 if "v" in aids_on else 0
-    app.show_chart = "c" in aids_on
-    app.trails = "e" in aids_on
+    app.aids.show_annotations = "a" in aids_on
+    app.aids.vectors = 1 if "v" in aids_on else 0
+    app.aids.show_chart = "c" in aids_on
+    app.aids.trails = "e" in aids_on
     centres = []
     for i in range(students):
         c = Client(name=f"C{i + 1}", color=(40 + 7 * i, 200, 90))
@@ -88,7 +87,7 @@ def measure(name: str, demo_key: str, aids_on: str, students: int = 0, ticks: in
         if frame % 2:
             continue
         scene = app.scene()
-        scene.aids = shared_aids(app)
+        scene.aids = app.shared_aids()
         enc.add(scene)
         sizes = frame_sizes(enc.frames_for(viewer))
         if frame:  # the first tick is a keyframe with the layout

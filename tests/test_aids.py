@@ -82,11 +82,11 @@ def test_annotations_fade_out(demos):
     app = make_app(demos, "2p")
     press(app, pygame.K_a)
     frames_until(app, lambda: app.table.collision_count, what="the first collision", max_frames=600)
-    assert len(app.collision_log.live(app.clock_s)) == 1
+    assert len(app.aids.collision_log.live(app.clock_s)) == 1
     app.paused = True
     for _ in range(int(aids.ANNOTATION_LIFE_S / FRAME_S) + 2):
         app.frame(FRAME_S)
-    assert app.collision_log.live(app.clock_s) == []
+    assert app.aids.collision_log.live(app.clock_s) == []
 
 
 def test_inspector_shows_the_puck_under_the_cursor(demos):
@@ -175,10 +175,10 @@ def test_energy_chart_numbers_match_a_hand_computation():
 def test_demo_5_without_damping_keeps_its_energy(demos):
     app = make_app(demos, "5")
     app.table.spring_damper_Nspm[:] = 0.0
-    app.chart.clear()
+    app.aids.chart.clear()
     for _ in range(20 * 60):  # 20 s
         app.frame(FRAME_S)
-    series = app.chart.series(window_s=25.0)
+    series = app.aids.chart.series(window_s=25.0)
     t, total = series["time_s"], series["total_J"]
     assert t[-1] - t[0] == pytest.approx(20.0, abs=0.01)
     m = 0.3 * math.pi * 0.4**2
@@ -195,7 +195,7 @@ def test_demo_5_without_damping_keeps_its_energy(demos):
     expected = omega * app.dt_s / 2
     wiggle = (total.max() - total.min()) / (2 * total.mean())
     assert 0.5 * expected < wiggle < 1.5 * expected
-    assert "does not drift" in app.chart.euler_wiggle_note(app.table)  # explained under the chart
+    assert "does not drift" in app.aids.chart.euler_wiggle_note(app.table)  # explained under the chart
 
 
 @pytest.mark.parametrize("key, mode", [("1p", "off"), ("2p", "two-step"), ("3p", "perfect-kiss")])
@@ -214,7 +214,7 @@ def test_annotation_numbers_are_the_physics_numbers(demos, key, mode):
             break
     assert hit is not None
     app.draw()
-    note = app.collision_log.items[-1]
+    note = app.aids.collision_log.items[-1]
     assert note.overlap_m == hit.overlap_m[0]
     assert note.separation_m == hit.separation_m[0]
     assert f"overlap {hit.overlap_m[0] * 1000:.1f} mm" in shown
@@ -239,9 +239,9 @@ def test_broken_teacher_demos_show_their_errors_and_the_app_goes_on(demos, tmp_p
     assert [(e.path.name, e.line) for e in errors] == [("syntax.py", 3)]
     app = make_app(found, "1", demo_errors=errors)
     app.frame(FRAME_S)
-    assert any("syntax.py, line 3: syntax error" in line for line in app.notice)
+    assert any("syntax.py, line 3: syntax error" in line for line in app.panels.notice)
     press(app, pygame.K_SPACE)  # any key dismisses the notice
-    assert app.notice == []
+    assert app.panels.notice == []
     app.start_demo("t9")
     app.frame(FRAME_S)
     assert app.build_error is not None
@@ -313,7 +313,7 @@ def test_the_target_leaves_at_its_angle_against_the_ideal(demos, key, actual, id
         if len(app.table.last_collisions):
             break
     app.draw()
-    push = app.collision_log.items[-1].target
+    push = app.aids.collision_log.items[-1].target
     assert push.ideal_deg == pytest.approx(math.degrees(math.asin(0.25)), abs=1e-9)
     assert push.actual_deg == pytest.approx(actual, abs=0.01)
     assert push.ideal_deg == pytest.approx(ideal, abs=0.01)
@@ -411,14 +411,14 @@ def test_demo_5_motion_matches_its_notes(demos):
     assert np.hypot(*(a.pos_m - b.pos_m)) == pytest.approx(1.5, abs=0.02)  # relaxed: no more bouncing
     moved = app.table.center_of_mass_m() - start
     np.testing.assert_allclose(moved / app.table.time_s, (0.2, 0.1), atol=1e-6)  # still drifting
-    assert app.chart.euler_wiggle_note(app.table) is None  # no "swings without drifting" claim here
+    assert app.aids.chart.euler_wiggle_note(app.table) is None  # no "swings without drifting" claim here
     # No damper (Right): the bouncing goes on and the total swings by about 3 % (omega dt / 2).
     press(app, pygame.K_RIGHT)
     assert "no damper" in app.window.caption
     for _ in range(3 * 60):
         app.frame(FRAME_S)
-    assert 0.03 < app.chart.total_wiggle(2.0) < 0.04
-    assert "does not drift" in app.chart.euler_wiggle_note(app.table)
+    assert 0.03 < app.aids.chart.total_wiggle(2.0) < 0.04
+    assert "does not drift" in app.aids.chart.euler_wiggle_note(app.table)
 
 
 @pytest.mark.parametrize("key", ["4", "7", "8"])

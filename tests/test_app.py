@@ -157,14 +157,14 @@ def test_help_screen_toggles_and_lists_every_key(app):
     app.frame(FRAME_S)
     before = pygame.surfarray.array3d(app.window.surface).copy()
     press(app, pygame.K_F1)
-    assert app.show_help
+    assert app.panels.show_help
     after = pygame.surfarray.array3d(app.window.surface)
     assert np.mean(np.any(before != after, axis=2)) > 0.3
     for _ in range(3):  # F1 turns the pages of a help that needs more than one, then closes it
         press(app, pygame.K_F1)
-        if not app.show_help:
+        if not app.panels.show_help:
             break
-    assert not app.show_help
+    assert not app.panels.show_help
 
 
 def test_mouse_drags_and_flings_a_puck(app):
@@ -234,7 +234,7 @@ def test_screenshot_key_saves_a_png(app, tmp_path, monkeypatch):
 
 def test_escape_asks_then_a_second_escape_quits(app):
     press(app, pygame.K_ESCAPE)
-    assert app.running and app.panel() == "quit"
+    assert app.running and app.panels.panel() == "quit"
     press(app, pygame.K_ESCAPE)
     assert not app.running
 

@@ -57,7 +57,7 @@ def test_no_text_crosses_a_wall_or_a_resting_puck(demos, server, size, demo):
     if window.layout.side_px:  # the chart and the values panel fit in the margins
         press(app, pygame.K_c)
         press(app, pygame.K_t)
-        assert app.show_chart and app.lessons.show_values
+        assert app.aids.show_chart and app.lessons.show_values
         assert not crossings(app, window.label_boxes), crossings(app, window.label_boxes)
 
 

@@ -12,7 +12,6 @@ from conftest import FRAME_S, press
 from airtable.app.app import App
 from airtable.app.lessons_paint import TOTAL_COLOR, fitting, momenta_scale, total_texts
 from airtable.app.panel_view import ACCENT
-from airtable.app.rewind import timeline_shown
 from airtable.model.momenta import (
     MomentaLog,
     MomentaView,
@@ -185,7 +184,7 @@ def test_the_panels_stand_clear_of_paused_and_the_timeline(demos, size):
         setattr(paint, name, lambda *a, _f=original, _n=name: drawn.setdefault(_n, _f(*a)))
     app.draw()
     others = [b for b in app.window.label_boxes if b not in drawn.values()]  # PAUSED, the bar, the HUD ...
-    assert len(drawn) == 2 and timeline_shown(app) is not None
+    assert len(drawn) == 2 and app.rewind.timeline_shown() is not None
     for rect in drawn.values():
         assert app.window.surface.get_rect().contains(rect)
         assert rect.collidelist(others) < 0, (rect, others)

@@ -76,9 +76,9 @@ def test_esc_closes_the_top_overlay_in_any_order_and_then_asks(demos, server, or
         press(app, pygame.K_ESCAPE)
         opened.remove(top)
         assert app.running and list(app.overlays) == opened
-    assert not app.show_chart and not app.lessons.show_values and not app.room.show_roster
+    assert not app.aids.show_chart and not app.lessons.show_values and not app.room.show_roster
     press(app, pygame.K_ESCAPE)
-    assert app.running and app.panel() == "quit"
+    assert app.running and app.panels.panel() == "quit"
     press(app, pygame.K_ESCAPE)
     assert not app.running
 
@@ -90,7 +90,7 @@ def test_f1_f1_esc_with_the_chart_open_closes_help_then_the_chart_and_quits_noth
     pygame.event.clear()
     for key in (pygame.K_c, pygame.K_F1, pygame.K_F1, pygame.K_ESCAPE):
         press(app, key)
-    assert app.running and not app.show_help and not app.show_chart
+    assert app.running and not app.panels.show_help and not app.aids.show_chart
     press(app, pygame.K_t)
     press(app, pygame.K_ESCAPE)
     assert app.running and not app.lessons.show_values
@@ -100,16 +100,16 @@ def test_the_quit_question_lapses_and_any_other_key_stays(demos):
     app = App(demos, demo_key="1", headless=True)
     pygame.event.clear()
     press(app, pygame.K_ESCAPE)
-    assert app.panel() == "quit"
+    assert app.panels.panel() == "quit"
     press(app, pygame.K_LSHIFT)  # a modifier alone answers nothing
-    assert app.panel() == "quit"
+    assert app.panels.panel() == "quit"
     press(app, pygame.K_SPACE)  # another key: stay, and the key does nothing else
-    assert app.running and app.panel() is None and not app.paused
+    assert app.running and app.panels.panel() is None and not app.paused
     press(app, pygame.K_ESCAPE)
     app.run(seconds=5.0, frame_dt_s=FRAME_S)  # the question lapses: a late Esc asks again
-    assert app.running and app.panel() is None
+    assert app.running and app.panels.panel() is None
     press(app, pygame.K_ESCAPE)
-    assert app.panel() == "quit"
+    assert app.panels.panel() == "quit"
 
 
 def close_window(app) -> None:
@@ -131,7 +131,7 @@ def test_closing_the_window_asks_while_recording_is_not_exported(demos, tmp_path
     for _ in range(180):  # three seconds of the demo, recorded
         app.frame(FRAME_S)
     close_window(app)
-    assert app.running and app.panel() == "quit"
+    assert app.running and app.panels.panel() == "quit"
     assert any("recording not exported" in line for line in app.quit_would_lose())
     press(app, pygame.K_SPACE)  # stay
     press(app, pygame.K_x)  # export: nothing would be lost now
@@ -158,7 +158,7 @@ def test_quitting_with_a_student_connected_asks_and_says_so(demos, how):
             app.window.draw_question = lambda title, rows: (shown.append((title, rows)), draw_question(title, rows))
             press(app, pygame.K_ESCAPE) if how == "esc" else close_window(app)
             app.frame(FRAME_S)
-            assert app.running and app.panel() == "quit"
+            assert app.running and app.panels.panel() == "quit"
             assert shown[-1][0] == "Quit?" and "1 student will be dropped." in shown[-1][1]
             press(app, pygame.K_ESCAPE) if how == "esc" else close_window(app)
             assert not app.running

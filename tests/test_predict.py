@@ -18,8 +18,6 @@ from airtable.app.app import App
 from airtable.app.demo_loader import BUILTIN_DIR, DemoShelf
 from airtable.app.environment import DEFAULT_SIZE_PX, Environment
 from airtable.app.predict import FROZEN_NOTICE, StudentGuesses, angle_deg, puck_summary, summarize
-from airtable.app.predict_view import draw_predict
-from airtable.app.rewind import timeline_shown
 from airtable.app.window import GameWindow
 from airtable.net import protocol as proto
 from airtable.net.player import NetPlayer, PlayerState
@@ -182,7 +180,7 @@ def test_three_students_predict_over_real_sockets_then_the_reveal_sums_them_up(s
             s.hello(name)
         frames_until(app, lambda: app.student_count() == 3, "three students at the table")
         press(app, pygame.K_F6)
-        assert app.predict.state == "open" and app.paused
+        assert app.predict.round.state == "open" and app.paused
         for s in students:
             info = next_round(s, lambda i: i.state == "open")
             assert (info.pucks, info.players, info.arrows) == (2, 3, ())
@@ -195,11 +193,11 @@ def test_three_students_predict_over_real_sockets_then_the_reveal_sums_them_up(s
         frames_until(app, lambda: app.table.time_s == t0, "the table stays frozen while the round is open")
 
         press(app, pygame.K_F6)  # reveal: the table plays until the collision is over
-        assert not app.paused and len(app.predict.arrows) == 3
-        frames_until(app, lambda: app.predict.settled, "the collision to be over", max_frames=600)
+        assert not app.paused and len(app.predict.round.arrows) == 3
+        frames_until(app, lambda: app.predict.round.settled, "the collision to be over", max_frames=600)
         assert app.paused and app.table.collision_count >= 1
-        assert app.predict.truth[1] == pytest.approx((1.0, 0.0), abs=1e-6)
-        assert app.predict.summary == (EXPECTED,)
+        assert app.predict.round.truth[1] == pytest.approx((1.0, 0.0), abs=1e-6)
+        assert app.predict.round.summary == (EXPECTED,)
         for s in students:
             info = next_round(s, lambda i: i.state == "revealed" and bool(i.truth))
             assert info.summary == (EXPECTED,) and len(info.arrows) == 3
@@ -211,7 +209,7 @@ def test_three_students_predict_over_real_sockets_then_the_reveal_sums_them_up(s
 
         press(app, pygame.K_F6)  # closes the round
         assert next_round(students[2], lambda i: i.state == "closed").arrows == ()
-        assert not app.predict.active and app.paused
+        assert not app.predict.round.active and app.paused
     finally:
         for s in students:
             s.close()
@@ -285,13 +283,13 @@ def test_the_local_mouse_predicts_on_the_teachers_window(tmp_path):
     post_mouse(pygame.MOUSEBUTTONUP, tip)
     app.frame(FRAME_S)
     assert app.local.held is None  # the drag drew an arrow; it grabbed nothing
-    assert app.predict.local[1] == pytest.approx(
+    assert app.predict.round.local[1] == pytest.approx(
         polar(1.1, 10.0), abs=2 * app.table.width_m / app.window.surface.get_width()
     )
     assert "PREDICT: 1 of 1 predicted" in app.status_line()
     press(app, pygame.K_F6)
-    frames_until(app, lambda: app.predict.settled, "the collision to be over", max_frames=600)
-    (line,) = app.predict.summary
+    frames_until(app, lambda: app.predict.round.settled, "the collision to be over", max_frames=600)
+    (line,) = app.predict.round.summary
     assert line == "puck 2: median 10 deg off; 0 of 1 within 5 deg; speeds within 20 %: 1 of 1"
 
 
@@ -306,8 +304,8 @@ def test_nobody_s_string_touches_the_pucks_while_the_reveal_plays(server, tmp_pa
         x, y = app.table.pos_m[1]
         student.send(proto.encode_input((x, y), 1))  # grab puck 2 ...
         student.send(proto.encode_input((x, y + 3.0), 1))  # ... and pull it up hard
-        frames_until(app, lambda: app.predict.settled, "the collision to be over", max_frames=600)
-        assert app.predict.truth[1] == pytest.approx((1.0, 0.0), abs=1e-6)  # as if nobody were there
+        frames_until(app, lambda: app.predict.round.settled, "the collision to be over", max_frames=600)
+        assert app.predict.round.truth[1] == pytest.approx((1.0, 0.0), abs=1e-6)  # as if nobody were there
     finally:
         student.close()
 
@@ -354,32 +352,32 @@ def test_space_cannot_resume_the_table_while_students_predict(tmp_path):
     press(app, pygame.K_F6)
     t0 = app.table.time_s
     press(app, pygame.K_SPACE, frames=10)
-    assert app.paused and app.table.time_s == t0 and app.predict.state == "open"
+    assert app.paused and app.table.time_s == t0 and app.predict.round.state == "open"
     assert app.message == FROZEN_NOTICE  # one line saying why, and what does reveal
-    assert timeline_shown(app) is None  # paused, but the history's keys are off: no timeline bar
+    assert app.rewind.timeline_shown() is None  # paused, but the history's keys are off: no timeline bar
     press(app, pygame.K_PERIOD)  # nor does a single step or the history move it
     press(app, pygame.K_COMMA, mod=pygame.KMOD_SHIFT)
-    assert app.table.time_s == t0 and app.history.at is None
+    assert app.table.time_s == t0 and app.rewind.history.at is None
     press(app, pygame.K_F6)  # the round key reveals, and the table plays
-    assert not app.paused and app.predict.state == "revealed"
+    assert not app.paused and app.predict.round.state == "revealed"
 
 
 def test_space_pauses_a_playing_reveal_and_after_the_freeze_closes_the_round(tmp_path):
     app = head_on_app(tmp_path)
     press(app, pygame.K_F6)
-    app.predict.local[1] = (1.0, 0.0)
+    app.predict.round.local[1] = (1.0, 0.0)
     press(app, pygame.K_F6)
     press(app, pygame.K_SPACE)  # the teacher stops the reveal to point at something
     t0 = app.table.time_s
     for _ in range(5):
         app.frame(FRAME_S)
-    assert app.paused and app.table.time_s == t0 and app.predict.state == "revealed"
+    assert app.paused and app.table.time_s == t0 and app.predict.round.state == "revealed"
     press(app, pygame.K_SPACE)  # and lets it play on
     assert not app.paused
-    frames_until(app, lambda: app.predict.settled, "the collision to be over", max_frames=600)
-    assert app.paused and app.predict.summary  # frozen on the truth
+    frames_until(app, lambda: app.predict.round.settled, "the collision to be over", max_frames=600)
+    assert app.paused and app.predict.round.summary  # frozen on the truth
     press(app, pygame.K_SPACE)  # the class has seen it: Space goes on with the lesson
-    assert app.predict.state == "closed" and not app.paused
+    assert app.predict.round.state == "closed" and not app.paused
     assert "round closed" in app.message
     t1 = app.table.time_s
     for _ in range(5):
@@ -414,14 +412,14 @@ def test_the_summary_wraps_to_the_teachers_window(tmp_path, size):
     app = App(DemoShelf([BUILTIN_DIR, tmp_path]), demo_key="5", headless=True, window_size_px=size)
     pygame.event.clear()
     press(app, pygame.K_F6)
-    app.predict.local[1] = polar(1.1, 10.0)
+    app.predict.round.local[1] = polar(1.1, 10.0)
     press(app, pygame.K_F6)
     app.paused = True
-    app.predict.settle(app.table)  # frozen on the truth at once: the wrapping, not the collision, is tested
-    app.predict.summary = (*app.predict.summary, *LONG_SUMMARY)
+    app.predict.round.settle(app.table)  # frozen on the truth at once: the wrapping, not the collision, is tested
+    app.predict.round.summary = (*app.predict.round.summary, *LONG_SUMMARY)
     app.draw()
     assert app.window.surface.get_size() == size
-    _check_fits(draw_predict(app), size[0], app.predict.summary)
+    _check_fits(app.predict.paint(), size[0], app.predict.round.summary)
 
 
 @pytest.mark.parametrize("size", [(480, 360), (640, 480), (1280, 720)])

@@ -78,7 +78,7 @@ def test_a_still_tables_chart_axis_reads_0_j(demos):
     app = App(demos, demo_key="1", headless=True)  # five pucks at rest: nothing has moved
     pygame.event.clear()
     press(app, pygame.K_c, frames=30)
-    series, latest = app.chart.series(), app.chart.latest()
+    series, latest = app.aids.chart.series(), app.aids.chart.latest()
     assert len(series["time_s"]) > 2 and latest["total_J"] == 0.0
     assert f"{chart_top(series['total_J'], latest['energy_scale_J']):.3g} J" == "0 J"  # not 1.1e-12 J
     assert chart_top(np.array([0.0, 2.0]), 1.0) == pytest.approx(2.2)
@@ -89,9 +89,10 @@ def test_the_values_panel_of_the_app_uses_the_scene_scale(demos):
     pygame.event.clear()
     press(app, pygame.K_t, frames=240)
     assert app.table.collision_count > 0
-    rows = values_for(app.table, None, app.chart.scale)
+    rows = values_for(app.table, None, app.aids.chart.scale)
     speeds = [r.speed_mps for r in rows[:-1]]
     assert sum(1 for s in speeds if s == 0.0) >= 1 and max(speeds) > 0.1
     raw = np.hypot(app.table.vel_mps[:, 0], app.table.vel_mps[:, 1])
     for r, v in zip(rows[:-1], raw, strict=True):
-        assert r.speed_mps == (0.0 if v * app.table.mass_kg[r.row] <= ROUND_OFF * app.chart.scale.momentum_Ns else v)
+        small = v * app.table.mass_kg[r.row] <= ROUND_OFF * app.aids.chart.scale.momentum_Ns
+        assert r.speed_mps == (0.0 if small else v)

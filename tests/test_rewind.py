@@ -47,7 +47,7 @@ def test_rewind_then_run_on_replays_bit_for_bit(app, cr):
     assert app.table.time_s == pytest.approx(end_t - 1.0)
     assert "rewound 1.00 s" in app.status_line()
     press(app, pygame.K_SPACE)  # run on from there: the same throw, the same collisions
-    assert app.history.timeline().newest_s == pytest.approx(end_t - 1.0 + FRAME_S)
+    assert app.rewind.history.timeline().newest_s == pytest.approx(end_t - 1.0 + FRAME_S)
     again = run_frames(app, 59)
     for (p1, v1), (p2, v2) in zip(future[1:], again, strict=True):
         assert same_bits(p1, p2) and same_bits(v1, v2)
@@ -57,19 +57,19 @@ def test_rewind_then_run_on_replays_bit_for_bit(app, cr):
 def test_comma_and_period_step_through_the_history_while_paused(app):
     frames = run_frames(app, 90)
     press(app, pygame.K_SPACE)
-    newest = len(app.history)
+    newest = len(app.rewind.history)
     for k in range(1, 11):
         press(app, pygame.K_COMMA)
-        assert app.history.in_past and same_bits(app.table.pos_m, frames[-1 - k][0])
-    assert len(app.history) == newest  # looking back keeps every moment
+        assert app.rewind.history.in_past and same_bits(app.table.pos_m, frames[-1 - k][0])
+    assert len(app.rewind.history) == newest  # looking back keeps every moment
     for k in range(9, -1, -1):
         press(app, pygame.K_PERIOD)
         assert same_bits(app.table.pos_m, frames[-1 - k][0]) and same_bits(app.table.vel_mps, frames[-1 - k][1])
-    assert not app.history.in_past
+    assert not app.rewind.history.in_past
     t = app.table.time_s
     press(app, pygame.K_PERIOD)  # at the newest moment: one new step, as before
     assert app.table.time_s == pytest.approx(t + app.dt_s)
-    assert len(app.history) == newest + 1 and not app.history.in_past
+    assert len(app.rewind.history) == newest + 1 and not app.rewind.history.in_past
     press(app, pygame.K_PERIOD, mod=SHIFT)  # nothing newer to jump to: it says so
     assert "newest moment" in app.message
 
@@ -77,20 +77,20 @@ def test_comma_and_period_step_through_the_history_while_paused(app):
 def test_comma_while_running_pauses_there(app):
     run_frames(app, 30)
     press(app, pygame.K_COMMA)
-    assert app.paused and app.history.in_past
+    assert app.paused and app.rewind.history.in_past
 
 
 def test_running_on_drops_the_future_from_the_history_the_recording_and_the_chart(app):
     run_frames(app, 120)
     press(app, pygame.K_SPACE)
-    kept = len(app.history)
+    kept = len(app.rewind.history)
     for _ in range(20):
         press(app, pygame.K_COMMA)
     t = app.table.time_s
     assert app.lessons.recorder.newest_s > t  # still there while only looking
     press(app, pygame.K_SPACE, frames=0)
     app.frame(FRAME_S)  # the frame that runs on
-    assert len(app.history) == kept - 20 + 1 and not app.history.in_past
+    assert len(app.rewind.history) == kept - 20 + 1 and not app.rewind.history.in_past
     assert "20 later frames dropped" in app.message
     rec = app.lessons.recorder
     rec.flush()
@@ -98,13 +98,13 @@ def test_running_on_drops_the_future_from_the_history_the_recording_and_the_char
         times = [float(line.split(",")[0]) for line in f.readlines()[1:]]
     assert times[-1] == round(app.table.time_s, 6) and np.all(np.diff(times) > 0)  # one story, no step twice
     assert len(times) == round(app.table.time_s / app.dt_s) + 1
-    chart_t = app.chart.series(100.0)["time_s"]
+    chart_t = app.aids.chart.series(100.0)["time_s"]
     assert chart_t[-1] == app.table.time_s and np.all(np.diff(chart_t) > 0)
 
 
 def test_the_timeline_bar_shows_while_paused(app):
     run_frames(app, 60)
-    bar = app.timeline_painter.bar_rect()
+    bar = app.rewind.painter.bar_rect()
     surface = app.window.surface
 
     def accent_pixels() -> int:

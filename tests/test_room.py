@@ -103,19 +103,19 @@ def test_the_count_is_always_shown_and_f2_lists_every_seat(served):
     squatter.drag((-40.0, -40.0), 0)
     assert "2 students (F2: roster)" in app.hud_lines()
     press(app, pygame.K_F2)
-    assert app.panel() == "roster"
+    assert app.panels.panel() == "roster"
     frames_until(app, lambda: len(server.roster()) == 2 and server.roster()[1].far_off, "the far-off cursor")
     assert [n for n, _ in app.room.row_boxes] == [1, 2]
     seat = server.roster()[1]
-    assert room.seat_flags(seat) == "cursor far off the table"
+    assert roster_view.seat_flags(seat) == "cursor far off the table"
     idle = type(seat)(**{**seat.__dict__, "idle_s": 75.0})
-    assert room.seat_flags(idle) == "squatting? idle 75 s, cursor far off the table"
+    assert roster_view.seat_flags(idle) == "squatting? idle 75 s, cursor far off the table"
     press(app, pygame.K_DOWN)
     assert app.room.selected == 1
     click(app, app.room.row_boxes[0][1].center)  # a click picks a row, not a puck
     assert app.room.selected == 0 and app.mouse_button == 0
     press(app, pygame.K_ESCAPE)
-    assert app.panel() is None and app.running
+    assert app.panels.panel() is None and app.running
 
 
 def test_a_failed_network_thread_shows_in_red(served):

@@ -11,7 +11,7 @@ from conftest import FRAME_S
 
 from airtable import cli
 from airtable.app.app import App
-from airtable.app.roster_view import ALERT_COLOR, room_alert
+from airtable.app.roster_view import ALERT_COLOR
 from airtable.net.server import GameServer
 
 
@@ -36,13 +36,13 @@ def test_a_busy_port_shows_on_the_projector_with_the_port_to_use(tmp_path, capsy
 def test_the_alert_is_the_servers_sentence_and_stays_until_it_starts(demos):
     app = App(demos, headless=True, server_problem="students cannot join: port 8888 is already in use")
     app.frame(FRAME_S)
-    assert room_alert(app) == "students cannot join: port 8888 is already in use"
+    assert app.room.alert() == "students cannot join: port 8888 is already in use"
     with GameServer(host="127.0.0.1", port=0) as server:
         running = App(demos, headless=True, server=server)
         running.frame(FRAME_S)
-        assert room_alert(running) is None
+        assert running.room.alert() is None
         server.failure = "students can no longer join: the network thread failed"
-        assert room_alert(running) == server.failure
+        assert running.room.alert() == server.failure
 
 
 def test_the_join_line_says_a_password_is_needed_and_never_shows_it():

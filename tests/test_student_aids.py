@@ -257,7 +257,7 @@ def _run_student(teacher, net, until, keys=()):
 
 def test_a_student_sees_the_teachers_vectors_annotations_and_chart(classroom):
     teacher, net = classroom
-    teacher.show_annotations, teacher.vectors, teacher.show_chart = True, 1, True
+    teacher.aids.show_annotations, teacher.aids.vectors, teacher.aids.show_chart = True, 1, True
     student = _run_student(teacher, net, lambda s: net.aids.annotations and len(net.aids.chart.series()["time_s"]) > 5)
     frame = net.aids.frame
     assert frame.vectors == 1 and frame.values.shape == (len(teacher.table.pos_m), 2)
@@ -275,10 +275,11 @@ def test_a_student_sees_the_teachers_vectors_annotations_and_chart(classroom):
 
 def test_a_student_toggles_aids_on_their_own_window_only(classroom):
     teacher, net = classroom
-    teacher.vectors, teacher.show_chart = 1, True
-    trails = teacher.trails  # Shift+1 starts with trails on
+    teacher.aids.vectors, teacher.aids.show_chart = 1, True
+    trails = teacher.aids.trails  # Shift+1 starts with trails on
     student = _run_student(teacher, net, lambda s: not net.aids.shows("v"), keys=(pygame.K_v, pygame.K_e))
-    assert teacher.vectors == 1 and teacher.show_chart and teacher.trails == trails, "the teacher's aids stay"
+    shown = teacher.aids
+    assert shown.vectors == 1 and shown.show_chart and shown.trails == trails, "the teacher's aids stay"
     assert net.aids.teacher & aids_wire.VELOCITY, "and the teacher still sends them"
     assert net.aids.shows("c") and net.aids.shows("e") != trails and not net.aids.shows("v")
     assert not {"v", "e"} & student.keys, "the toggles are not sent in INPUT"
@@ -300,7 +301,7 @@ def test_f1_opens_the_students_help_panel(classroom):
 
 def test_with_the_teachers_aids_off_a_student_draws_arrows_from_the_snapshots(classroom):
     teacher, net = classroom
-    teacher.trails = False  # every aid off: no AIDS frames at all
+    teacher.aids.trails = False  # every aid off: no AIDS frames at all
     student = _run_student(
         teacher, net, lambda s: net.aids.velocities(2) is not None and net.aids.shows("v"), keys=(pygame.K_v,)
     )
@@ -313,13 +314,13 @@ def test_with_the_teachers_aids_off_a_student_draws_arrows_from_the_snapshots(cl
 
 def test_a_student_sees_the_teachers_lecture_notes_panel(classroom):
     teacher, net = classroom
-    teacher.trails, teacher.show_notes = False, True
+    teacher.aids.trails, teacher.panels.show_notes = False, True
     seen = []
 
     def notes_then_none(student):
         if not seen and net.aids.teacher & aids_wire.NOTES and net.aids.notes is not None:
             seen.append(net.aids.notes)
-            teacher.show_notes = False  # the teacher closes them
+            teacher.panels.show_notes = False  # the teacher closes them
         return seen and net.aids.frame is None
 
     _run_student(teacher, net, notes_then_none)

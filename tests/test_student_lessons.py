@@ -14,12 +14,10 @@ from conftest import FRAME_S, WAIT_S, press, server_frames, teacher_and_student,
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from airtable.app.aids_share import shared_aids
 from airtable.app.app import App
 from airtable.app.demo_loader import BUILTIN_DIR, DemoShelf
 from airtable.app.environment import DEFAULT_SIZE_PX, Environment
 from airtable.app.lessons_paint import TOTAL_COLOR
-from airtable.app.lessons_view import draw_lessons
 from airtable.app.panel_view import ACCENT
 from airtable.app.window import GameWindow, LessonsPainter, TimelinePainter
 from airtable.model.momenta import MAX_DIAGRAM_PUCKS, MomentaView, values_for
@@ -296,7 +294,7 @@ def test_a_student_sees_the_timeline_while_the_teacher_is_back_in_the_history(cl
     press(teacher, pygame.K_SPACE)
     press(teacher, pygame.K_COMMA, mod=pygame.KMOD_SHIFT)  # a second back (or to the oldest moment)
     press(teacher, pygame.K_PERIOD)
-    want = teacher.history.timeline()
+    want = teacher.rewind.history.timeline()
     student = _student(teacher, net, lambda s: net.aids.timeline() == want)
     assert want.view_s < want.newest_s and 0.0 < want.fraction < 1.0
     bar = student.timeline_painter.bar_rect()
@@ -304,7 +302,7 @@ def test_a_student_sees_the_timeline_while_the_teacher_is_back_in_the_history(cl
     assert _pixels(student, ACCENT, area) > 0  # the mark on the student's bar
     assert student.timeline_painter.bar_rect().width > 0
     press(teacher, pygame.K_SPACE)  # running on from there: no bar, so no AIDS bytes at all
-    assert shared_aids(teacher) is None
+    assert teacher.shared_aids() is None
 
 
 def test_the_teacher_draws_from_the_same_view_the_students_get(classroom):
@@ -316,7 +314,7 @@ def test_the_teacher_draws_from_the_same_view_the_students_get(classroom):
     painter = teacher.lessons.painter
     original = painter.momenta_diagram
     painter.momenta_diagram = lambda m, corner: drawn.append(m) or original(m, corner)
-    draw_lessons(teacher)
+    teacher.lessons.draw()
     assert drawn == [teacher.lessons.momenta.latest.view]
     assert StudentAids().momenta_view(np.zeros((0, 3))) is None  # no frame: nothing drawn
 

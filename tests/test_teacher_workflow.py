@@ -53,13 +53,13 @@ def test_pressing_a_demo_key_reads_its_file_again_after_an_edit(tmp_path, capsys
 
     mine.write_text(SYNTAX_ERROR)
     press(app, pygame.K_5)
-    assert app.panel() == "error" and app.build_error.stage == "load"
+    assert app.panels.panel() == "error" and app.build_error.stage == "load"
     assert len(app.table.pucks) == 0  # not the built-in demo 5 in its place
     assert f"{mine}:3: syntax error" in capsys.readouterr().err
 
     press(app, pygame.K_6)
     press(app, pygame.K_5)  # from another demo, too: the error, not the built-in 5
-    assert app.panel() == "error" and len(app.table.pucks) == 0
+    assert app.panels.panel() == "error" and len(app.table.pucks) == 0
     mine.write_text(demo_source("5", pucks=4, build_line=RAISES))
     press(app, pygame.K_5)
     assert app.build_error is not None and app.build_error.stage == "build"
@@ -67,16 +67,16 @@ def test_pressing_a_demo_key_reads_its_file_again_after_an_edit(tmp_path, capsys
 
     mine.write_text(demo_source("5", pucks=4))  # fixed: the next press builds it
     press(app, pygame.K_5)
-    assert app.build_error is None and app.panel() is None and len(app.table.pucks) == 4
+    assert app.build_error is None and app.panels.panel() is None and len(app.table.pucks) == 4
 
 
 def test_a_file_that_failed_at_start_loads_once_fixed(tmp_path):
     broken = tmp_path / "late.py"
     broken.write_text("KEY = 't1'\nTITLE = 'x'\ndef build(table, variation=0)\n")
     app = make_app(tmp_path)
-    assert app.panel() == "notice"
+    assert app.panels.panel() == "notice"
     press(app, pygame.K_SPACE)  # any key goes on
-    assert app.panel() is None and "t1" not in app.demos
+    assert app.panels.panel() is None and "t1" not in app.demos
     broken.write_text(demo_source("t1", pucks=2))
     press(app, pygame.K_PAGEUP)  # from demo 1 back round to the last key, now t1
     assert app.demo_key == "t1" and len(app.table.pucks) == 2
@@ -99,15 +99,15 @@ def test_the_demo_menu_lists_every_demo_and_starts_the_one_picked(tmp_path):
         (tmp_path / f"demo_{key}.py").write_text(demo_source(key, pucks=int(key[1:])))
     app = make_app(tmp_path)
     press(app, pygame.K_TAB)
-    assert app.panel() == "menu"
-    assert [key for key, _ in app.menu.items] == list(app.demos)
+    assert app.panels.panel() == "menu"
+    assert [key for key, _ in app.panels.menu.items] == list(app.demos)
     press(app, pygame.K_t, unicode="t")
     press(app, pygame.K_2, unicode="2")  # "t2": no other key starts so, it starts at once
-    assert app.panel() is None and app.demo_key == "t2" and len(app.table.pucks) == 2
+    assert app.panels.panel() is None and app.demo_key == "t2" and len(app.table.pucks) == 2
     press(app, pygame.K_TAB)
     press(app, pygame.K_t, unicode="t")
     press(app, pygame.K_1, unicode="1")  # "t1" or "t10": wait for Enter
-    assert app.panel() == "menu" and app.demo_key == "t2"
+    assert app.panels.panel() == "menu" and app.demo_key == "t2"
     press(app, pygame.K_RETURN)
     assert app.demo_key == "t1"
     press(app, pygame.K_TAB)
@@ -116,10 +116,10 @@ def test_the_demo_menu_lists_every_demo_and_starts_the_one_picked(tmp_path):
     assert app.demo_key == "t2"
     press(app, pygame.K_TAB)
     press(app, pygame.K_ESCAPE)  # closes the menu, quits nothing
-    assert app.panel() is None and app.running and app.demo_key == "t2"
+    assert app.panels.panel() is None and app.running and app.demo_key == "t2"
     press(app, pygame.K_TAB)
     press(app, pygame.K_TAB)  # Tab again closes it too
-    assert app.panel() is None
+    assert app.panels.panel() is None
 
 
 # ---------------------------------------------------------------- errors reach the terminal
@@ -172,11 +172,11 @@ def test_a_headless_run_that_works_exits_0_in_simulated_time(capsys):
 def test_esc_closes_an_open_panel_first(demos, opener):
     app = App(demos, headless=True)
     press(app, opener)
-    assert app.panel() is not None
+    assert app.panels.panel() is not None
     press(app, pygame.K_ESCAPE)
-    assert app.panel() is None and app.running
+    assert app.panels.panel() is None and app.running
     press(app, pygame.K_ESCAPE)
-    assert app.panel() == "quit" and app.running
+    assert app.panels.panel() == "quit" and app.running
     press(app, pygame.K_ESCAPE)
     assert not app.running
 
@@ -184,9 +184,9 @@ def test_esc_closes_an_open_panel_first(demos, opener):
 def test_esc_on_a_press_any_key_notice_goes_on_without_quitting(tmp_path):
     (tmp_path / "bad.py").write_text("KEY = 't8'\n")
     app = make_app(tmp_path)
-    assert app.panel() == "notice"
+    assert app.panels.panel() == "notice"
     press(app, pygame.K_ESCAPE)
-    assert app.running and app.panel() is None
+    assert app.running and app.panels.panel() is None
 
 
 # ---------------------------------------------------------------- a quiet laptop

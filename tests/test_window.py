@@ -166,9 +166,9 @@ def test_the_apps_help_fits_one_page_on_common_screens(size) -> None:
 
     demos, _ = discover([BUILTIN_DIR])
     app = App(demos, headless=True, window_size_px=size)
-    app.show_help = True
+    app.panels.show_help = True
     app.frame(1 / 60)
-    assert app.help_pages == 1
+    assert app.panels.help_pages == 1
 
 
 def test_the_framebuffer_hint_is_set_only_by_the_entry_points_and_only_on_x11(monkeypatch) -> None:

@@ -1,22 +1,16 @@
-"""Drawing the teaching aids of a frame: collision annotations, vectors, the energy chart, the inspector.
+"""Drawing the teaching aids' arrows and the inspector's words: vectors, the centre of mass, forces.
 
-The numbers come from aids.py and the table; the pixels from the window's
-AidsPainter. The app calls `draw_aids(app)` after the table is drawn.
+The numbers come from model/aids.py and the table; the pixels from the
+window's AidsPainter. The Aids feature (teaching_aids.py) calls these after
+the table is drawn.
 """
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING
-
 import numpy as np
 
-from airtable.app.aids_paint import draw_annotations
 from airtable.model import aids
-from airtable.model.client import cursor_pulls
 from airtable.model.momenta import puck_number
-
-if TYPE_CHECKING:
-    from airtable.app.app import App
 
 DIM_FORCE = (200, 200, 200)
 COM_COLOR = (255, 255, 255)
@@ -25,23 +19,6 @@ FORCE_COLORS = {"cursor strings": (255, 120, 80), "springs": (255, 215, 0), "gra
 
 # A puck in a jelly can have a dozen springs; the inspector lists the first few.
 MAX_INSPECTED_SPRINGS = 4
-
-
-def draw_aids(app: App) -> None:
-    t, paint = app.table, app.painter
-    paint.note_pucks(t.pos_m, t.radius_m)  # the legend and the annotations keep clear of them
-    if app.show_chart:  # first: the labels below then find their places around it
-        paint.choose_chart_corner(app.env.to_screen(t.pos_m))
-        note = app.chart.euler_wiggle_note(t)
-        paint.energy_chart(app.chart.series(), app.chart.latest(), note)
-    if app.vectors and len(t.pos_m):  # before the annotations: its legend has a fixed place
-        _draw_vectors(app)
-    if app.show_annotations:
-        draw_annotations(paint, app.collision_log.live(app.clock_s), app.clock_s)
-    if app.inspecting:
-        puck = t.puck_at(app.env.to_world(app.mouse_px))
-        if puck is not None:
-            paint.inspector(puck.pos_m, inspector_lines(t, puck))
 
 
 def inspector_lines(table, puck) -> list[str]:
@@ -65,12 +42,12 @@ def inspector_lines(table, puck) -> list[str]:
     return lines
 
 
-def _draw_vectors(app: App) -> None:
-    """Arrows on the moving pucks at the demo's fixed round scale, the centre of mass, the forces on a held puck."""
-    t, paint = app.table, app.painter
+def draw_vectors(paint, t, which: int, held, forces) -> None:
+    """Arrows on the moving pucks of table `t` at the demo's fixed round scale (`which`: 1 velocity,
+    2 momentum), the centre of mass, and `forces` (source -> newtons) on the `held` puck."""
     speed = np.hypot(t.vel_mps[:, 0], t.vel_mps[:, 1])
     moving = speed >= aids.MIN_ARROW_SPEED_MPS  # a resting puck gets no arrow
-    if app.vectors == 1:
+    if which == 1:
         name, unit, values, color = "velocity", "m/s", t.vel_mps, (120, 220, 255)
     else:
         name, unit, values, color = "momentum", "N s", t.vel_mps * t.mass_kg[:, None], (230, 120, 230)
@@ -82,17 +59,14 @@ def _draw_vectors(app: App) -> None:
     _, m_per_mps = paint.vector_scale("velocity").update(t.vel_mps[moving])
     if np.hypot(*com_v) >= aids.MIN_ARROW_SPEED_MPS:
         paint.arrow(com, com_v * m_per_mps, COM_COLOR, width=paint.w.line_px(3))
-    held = app.local.held
-    if held is not None and held.alive:
-        legend.extend(_draw_forces(app, held))
+    if held is not None:
+        legend.extend(_draw_forces(paint, held, forces))
     paint.legend(legend)  # before the marker's label: the legend's place is fixed
     paint.marker(com, COM_COLOR, f"centre of mass, {np.hypot(*com_v):.2f} m/s")
 
 
-def _draw_forces(app: App, held) -> list[tuple[str, tuple[int, int, int]]]:
+def _draw_forces(paint, held, forces) -> list[tuple[str, tuple[int, int, int]]]:
     """Arrows of the forces on the held puck, scaled to round newtons; their legend lines."""
-    paint = app.painter
-    forces = app.table.forces_on(held, app.dt_s, cursor_pulls(app.clients))
     if not forces:
         return []
     biggest = max(float(np.hypot(*f)) for f in forces.values())

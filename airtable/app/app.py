@@ -1,17 +1,20 @@
-"""The teacher's app: one table, its clients, a window, and the frame that ties them together.
+"""The teacher's app: one table, its clients, a window, its features, and the frame that ties them together.
 
-Each frame (`App.frame`): input (controls.py), the network's joins and inputs,
-as many fixed physics steps as the frame's time allows (loop.py), a snapshot
-for the students, then drawing. `App.run` repeats frames with an IdlingLoop (loop.py),
-as the student's window does.
-Demo scenes come from demo files (demo_loader.py), read again when they
-change; the panels over the table (help, notes, the demo menu, errors) are
-opened and closed here.
+Each frame (`App.frame`): input (the features first, then the key table of
+controls.py and the mouse), the network's joins and inputs, as many fixed
+physics steps as the frame's time allows (loop.py), a snapshot for the
+students, then drawing. Everything else is a feature (feature.py) in one
+list, `features`, whose hooks the frame calls in turn: the panels, the room,
+predict-then-reveal, rewind, the lessons, the teaching aids and live edits.
+The app keeps the demo on the table, the clock, the view and the mouse.
+`App.run` repeats frames with an IdlingLoop (loop.py), as the student's window does.
+Demo scenes come from demo files (demo_loader.py), read again when they change.
 """
 
 from __future__ import annotations
 
 import dataclasses
+import math
 import sys
 import time
 from collections.abc import Callable
@@ -20,28 +23,28 @@ from pathlib import Path
 import numpy as np
 import pygame
 
-from airtable.app import controls, predict, rewind, room, world
-from airtable.app.aids_share import shared_aids
-from airtable.app.aids_view import draw_aids
+from airtable.app.aids_share import shared_aids, shared_lessons
+from airtable.app.controls import KeyTable, demo_key_for, help_rows
 from airtable.app.demo_loader import Demo, DemoError, DemoShelf, error_from_exception, key_label
 from airtable.app.environment import Environment
-from airtable.app.history import History
+from airtable.app.feature import Binding, Feature
 from airtable.app.lessons import Lessons
-from airtable.app.lessons_view import draw_lessons
 from airtable.app.loop import FixedStep, FpsCounter, IdlingLoop, signals_end_the_run
-from airtable.app.menu import DemoMenu
-from airtable.app.overlays import OverlayFlag, Overlays, OverlayValue
-from airtable.app.predict_view import draw_predict
-from airtable.app.roster_view import ALERT_COLOR, draw_roster, room_alert
+from airtable.app.overlays import Overlays, OverlayValue
+from airtable.app.panels import Panels
+from airtable.app.predict import Predict
+from airtable.app.rewind import Rewind
+from airtable.app.room import Room
 from airtable.app.stats import RunStats
-from airtable.app.window import AidsPainter, GameWindow, TimelinePainter
+from airtable.app.teaching_aids import Aids
+from airtable.app.window import AidsPainter, GameWindow
+from airtable.app.world import LiveEdits, gravity_label
 from airtable.model import aids
 from airtable.model.client import LOCAL_COLOR, Client, cursor_pulls
 from airtable.model.scene import STATUS_SEPARATOR, Scene
 from airtable.physics.table import TABLE_HEIGHT_M, TABLE_WIDTH_M, AirTable
 
 MESSAGE_S = 4.0
-QUIT_CONFIRM_S = 4.0  # the quit question waits this long for a second Esc (or window close)
 # Closing the window asks first when leaving would lose at least this much recording.
 UNEXPORTED_ASK_S = 2.0
 DEFAULT_FPS = 60.0  # when the display does not say its refresh rate
@@ -52,17 +55,9 @@ IDLE_FPS = 12.0
 IDLE_AFTER_S = 1.0  # input this recent keeps the full frame rate
 OUT_OF_VIEW = "the table is out of view: q brings it back"
 STILL_PX_PER_S = 0.5  # slower than this on screen, nothing visibly moves: the table idles
-ERROR_TITLES = {
-    "load": "Demo {key} could not be loaded",
-    "build": "Demo {key} could not be built",
-    "event": "Demo {key}: a timed event failed",
-}
-
-MODIFIER_KEYS = frozenset(
-    getattr(pygame, f"K_{side}{name}") for side in "LR" for name in ("SHIFT", "CTRL", "ALT", "META", "SUPER")
-)
-# Kept importable from here: the key table lives in controls.py.
-BINDINGS = controls.BINDINGS
+ZOOM_RATE_PER_S = 1.5  # held h / n: zoom factor e**1.5 per second
+WHEEL_ZOOM = 1.1
+MOUSE_EVENTS = (pygame.MOUSEMOTION, pygame.MOUSEBUTTONDOWN, pygame.MOUSEBUTTONUP, pygame.MOUSEWHEEL)
 
 
 def display_rate_hz() -> float:
@@ -85,15 +80,9 @@ def unused_path(folder: Path, stem: str, suffix: str = ".png") -> Path:
 
 
 class App:
-    """The teacher's table: one AirTable, its clients, a window and the loop."""
+    """The teacher's table: one AirTable, its clients, a window, the features and the loop."""
 
-    # What shows over the table lives in one stack, `overlays` (overlays.py).
-    show_help = OverlayFlag("help")
-    show_notes = OverlayFlag("notes")
-    show_chart = OverlayFlag("chart")
-    menu = OverlayValue("menu")  # a DemoMenu while the menu is open
     build_error = OverlayValue("error")  # the demo's DemoError, shown instead of the demo while set
-    notice = OverlayValue("notice", empty=[])  # lines of a "press any key" notice
 
     def __init__(
         self,
@@ -120,37 +109,24 @@ class App:
         self.window = GameWindow(self.env, headless=headless, size_px=window_size_px, fullscreen=fullscreen)
         self.window.show_fps = show_fps  # --stats: the frame rate in a corner too
         self.painter = AidsPainter(self.window)
-        self.timeline_painter = TimelinePainter(self.window)
         if not headless:
             pygame.mouse.set_visible(False)  # the local client's arrow is the pointer
         self.server = server
-        self.server_problem = server_problem  # why students cannot join, when the server did not start
         self.stats = RunStats()  # frames, steps and their cost, for --stats
         self._init_state()
+        self._init_features(server_problem)
         self.errors: list[DemoError] = []  # every error reported, in order
         for error in [*demo_errors, *self.shelf.errors]:
             self.report(error)
-        self.notice = [f"could not load {e}" for e in self.errors]
+        self.panels.notice = [f"could not load {e}" for e in self.errors]
         self.start_demo(demo_key if demo_key in self.demos else next(iter(self.demos)), variation)
 
     def _init_state(self) -> None:
-        self.overlays = Overlays()
+        self.overlays = Overlays()  # what shows over the table, in one stack (overlays.py)
         self.running = True
         self.paused = False
-        self.trails = False
         self.speed = 1.0
-        self.help_page, self.help_pages = 0, 1
-        self.show_annotations = False
-        self.vectors = 0  # 0 off, 1 velocity, 2 momentum
-        self.inspecting = False
         self._notices_seen = 0  # how many of table.notices were said
-        self.quit_armed_until = -1.0  # clock_s until which a second Esc quits
-        self.collision_log = aids.CollisionLog()
-        self.chart = aids.EnergyChart()
-        self.lessons = Lessons(overlays=self.overlays)  # recording, momenta, saving the moment (lessons.py)
-        self.room = room.Room(overlays=self.overlays)  # the roster, hands off, the floor, anonymous names (room.py)
-        self.history = History()  # the table's recent moments, for rewinding (history.py, rewind.py)
-        self.predict = predict.PredictRound()  # predict, then reveal (predict.py)
         self.keys_down: set[int] = set()
         self.mouse_px = (self.env.size_px[0] / 2, self.env.size_px[1] / 2)
         self.mouse_button = 0
@@ -168,6 +144,28 @@ class App:
         self.loop: IdlingLoop | None = None  # while run() runs
         self.demo_key = ""
         self.demo_path: Path | None = None
+        self.variation = 0
+
+    def _init_features(self, server_problem: str | None) -> None:
+        """The features, in the order they see events and write the status line; each draws in its draw_order."""
+        self.panels = Panels(self, BINDINGS)  # help, notes, the demo menu, errors, the quit question
+        self.room = Room(self, server_problem)  # the roster, hands off, the floor, anonymous names
+        self.predict = Predict(self, self.room)  # predict, then reveal
+        self.rewind = Rewind(self, self.predict)  # the table's recent moments, and the way back
+        self.aids = Aids(self)  # trails, vectors, annotations, the chart, the inspector
+        self.lessons = Lessons(self, self.aids)  # recording, momenta, values, saving the moment
+        self.live_edits = LiveEdits(self)  # gravity, restitution, correction, a puck's mass and radius
+        self.features: list[Feature] = [
+            self.panels,
+            self.room,
+            self.predict,
+            self.rewind,
+            self.lessons,
+            self.aids,
+            self.live_edits,
+        ]
+        self._drawn = sorted(self.features, key=lambda f: f.draw_order)
+        self.keys = KeyTable([self, *self.features])
 
     # ------------------------------------------------------------ demos
 
@@ -215,12 +213,9 @@ class App:
                 self._demo_failed(exc, "build")
                 self.table.clear()
         self.stepper.reset(demo.dt_s if demo else self.stepper.dt_s)
-        self.trails = demo.trails if demo else False
-        self.chart.sample(self.table)
-        self.lessons.start(self.table)
-        self.history.clear()
-        self.history.record(self.table)
-        predict.end_round(self)
+        self.aids.trails = demo.trails if demo else False
+        for feature in self.features:
+            feature.on_demo_start(self.table)
         self.window.set_caption(f"Air Table - {self.caption()}")
 
     def _clear_table(self) -> None:
@@ -229,9 +224,6 @@ class App:
         for client in self.clients:
             client.held = None
         self.window.clear_trails()
-        self.collision_log.clear()
-        self.chart.clear()
-        self.painter.new_demo()  # arrow scales are per demo
 
     def _demo_failed(self, exc: BaseException, stage: str) -> None:
         path = self.demo_path or Path(f"demo {self.demo_key}")
@@ -242,9 +234,6 @@ class App:
         if self.build_error is not None and self.build_error.stage == "load":
             return f"Demo {self.demo_key}: {self.build_error.path.name}"
         return self.demo.label(self.variation)
-
-    def press_demo_key(self, key: str) -> None:
-        self.start_demo(key)
 
     def next_variation(self, step: int) -> None:
         if not self.demo.variations:
@@ -258,72 +247,79 @@ class App:
         here = keys.index(self.demo_key) if self.demo_key in keys else -step
         self.start_demo(keys[(here + step) % len(keys)])
 
-    # ------------------------------------------------------------ panels and keys
+    # ------------------------------------------------------------ what the app's own keys do
 
-    def open_menu(self) -> None:
-        for error in self.shelf.refresh():
-            self.report(error)
-        items = [(key, demo.title) for key, demo in self.demos.items()]
-        self.menu = DemoMenu(items, current=self.demo_key)
+    def toggle_pause(self) -> None:
+        if not self.predict.pause_key():  # a prediction round decides what Space does while it is under way
+            self.paused = not self.paused
 
-    def panel(self) -> str | None:
-        """Which panel is in the middle of the window now, if any (the quit question lapses)."""
-        if self.overlays.shown("quit") and self.clock_s >= self.quit_armed_until:
-            self.overlays.close("quit")
-        return self.overlays.panel()
+    def next_slow_motion(self) -> None:
+        factors = aids.SLOW_MOTION_FACTORS
+        self.speed = factors[(factors.index(self.speed) + 1) % len(factors)] if self.speed in factors else 1.0
 
-    def close_panel(self) -> bool:
-        """Close what is on top (a panel, else the chart, values or momenta); False if nothing was open."""
-        self.panel()  # a lapsed quit question first
-        closing = self.overlays.top()
-        if closing == "help":
-            self.help_page = 0
-        return closing is not None and self.overlays.close(closing)
+    def zoom(self, factor: float) -> None:
+        self.env.zoom_about(self.mouse_px, factor)
+        self.window.clear_trails()
 
-    def take_key_for_overlay(self, event: pygame.event.Event) -> bool:
-        """A panel that waits for a key takes it first; True if it did."""
-        panel = self.panel()
-        if event.key == pygame.K_ESCAPE or panel not in ("quit", "menu", "notice"):
-            return False
-        if event.key in MODIFIER_KEYS:
-            return True  # Shift or Ctrl alone answers nothing: it starts a key
-        if panel == "menu" and event.key == pygame.K_TAB:
-            self.menu = None
-        elif panel == "menu":
-            picked = self.menu.press(pygame.key.name(event.key), getattr(event, "unicode", ""))
-            if picked is not None:
-                self.menu = None
-                self.start_demo(picked)
+    def zoom_in(self) -> None:
+        self.zoom(math.exp(ZOOM_RATE_PER_S * self.frame_dt_s))
+
+    def zoom_out(self) -> None:
+        self.zoom(math.exp(-ZOOM_RATE_PER_S * self.frame_dt_s))
+
+    def reset_view(self) -> None:
+        self.env.reset()
+        self.window.clear_trails()
+
+    def toggle_fullscreen(self) -> None:
+        self.window.toggle_fullscreen()
+
+    def save_screenshot(self) -> None:
+        path = unused_path(Path("screenshots"), time.strftime("airtable-%Y%m%d-%H%M%S"))
+        try:
+            saved = self.window.save_screenshot(path)
+        except (OSError, pygame.error) as exc:
+            self.say(f"could not save the screenshot: {exc}")
         else:
-            self.close_panel()  # "press any key to go on"; any key but Esc keeps the table running
-        return True
+            self.say(f"screenshot saved to {saved.resolve()}", lasting=True)
+
+    bindings = (
+        Binding("1-9, 0", "start (again: restart) that demo"),
+        Binding("Shift+1/2/3", "correction comparison: off, two-step, perfect kiss"),
+        Binding(
+            "Left / Right",
+            "previous / next variation",
+            {pygame.K_LEFT: lambda app: app.next_variation(-1), pygame.K_RIGHT: lambda app: app.next_variation(+1)},
+        ),
+        Binding(
+            "PageUp / PageDown",
+            "previous / next demo",
+            {pygame.K_PAGEUP: lambda app: app.next_demo(-1), pygame.K_PAGEDOWN: lambda app: app.next_demo(+1)},
+        ),
+        Binding("Space", "pause / resume", {pygame.K_SPACE: toggle_pause}),
+        Binding(
+            "h / n (hold)", "zoom in / out about the cursor", {pygame.K_h: zoom_in, pygame.K_n: zoom_out}, held=True
+        ),
+        Binding("mouse wheel", "zoom in / out about the cursor"),
+        Binding("Ctrl + mouse drag", "pan the view"),
+        Binding("q", "reset the view", {pygame.K_q: reset_view}),
+        Binding("mouse buttons 1 / 2 / 3", "grab a puck with the medium / soft / stiff cursor string"),
+        Binding("s", "slow motion: 1, 1/2, 1/4, 1/8, 1/16 of real time", {pygame.K_s: next_slow_motion}),
+        Binding("F11", "fullscreen on / off", {pygame.K_F11: toggle_fullscreen}),
+        Binding("F12", "save a screenshot PNG", {pygame.K_F12: save_screenshot}),
+    )
+
+    # ------------------------------------------------------------ what the features may ask
+
+    def say(self, text: str, *, lasting: bool = False) -> None:
+        """Show a one-line message on screen for a few seconds. It is about the demo on the table and goes
+        when another demo starts, unless `lasting` (it says where a file was written)."""
+        self.message = text
+        self.message_until = self.clock_s + MESSAGE_S
+        self.message_lasts = lasting
 
     def student_count(self) -> int:
         return len(self.clients) - 1
-
-    def escape(self) -> None:
-        """Esc: close what is on top; with nothing open, ask; Esc again while asked quits."""
-        if self.panel() == "quit":
-            self.quit_now()
-        elif not self.close_panel():
-            self.ask_to_quit()
-
-    def close_window(self) -> None:
-        """The window's close button: quit, asking first while leaving would drop students or
-        lose recording; closing again (or Esc) while asked quits."""
-        if self.panel() == "quit" or not self.quit_would_lose():
-            self.quit_now()
-        else:
-            self.ask_to_quit()
-
-    def quit_now(self) -> None:
-        """Quit after this frame, which is drawn without the question (--screenshot saves it)."""
-        self.overlays.close("quit")
-        self.running = False
-
-    def ask_to_quit(self) -> None:
-        self.quit_armed_until = self.clock_s + QUIT_CONFIRM_S
-        self.overlays.open("quit")
 
     def quit_would_lose(self) -> list[str]:
         """What quitting now drops, one sentence each (empty: nothing)."""
@@ -336,28 +332,53 @@ class App:
             lost.append(f"{unexported:.0f} s of recording not exported (x exports it).")
         return lost
 
-    def zoom(self, factor: float) -> None:
-        self.env.zoom_about(self.mouse_px, factor)
-        self.window.clear_trails()
+    def forget_after(self, t_s: float) -> None:
+        """The table runs on from `t_s` in the past: every feature forgets what came after it."""
+        for feature in self.features:
+            feature.forget_after(t_s)
 
-    def save_screenshot(self) -> None:
-        path = unused_path(Path("screenshots"), time.strftime("airtable-%Y%m%d-%H%M%S"))
-        try:
-            saved = self.window.save_screenshot(path)
-        except (OSError, pygame.error) as exc:
-            self.say(f"could not save the screenshot: {exc}")
-        else:
-            self.say(f"screenshot saved to {saved.resolve()}", lasting=True)
-
-    def say(self, text: str, *, lasting: bool = False) -> None:
-        """Show a one-line message on screen for a few seconds. It is about the demo on the table and goes
-        when another demo starts, unless `lasting` (it says where a file was written)."""
-        self.message = text
-        self.message_until = self.clock_s + MESSAGE_S
-        self.message_lasts = lasting
+    # ------------------------------------------------------------ input
 
     def handle_event(self, event: pygame.event.Event) -> None:
-        controls.handle_event(self, event)
+        """The features first (an open panel, the roster, a prediction round), then the key table and the
+        demo keys, the mouse, and the window's size."""
+        if event.type == pygame.KEYUP:
+            self.keys_down.discard(event.key)
+            return
+        if event.type == pygame.KEYDOWN:
+            self.keys_down.add(event.key)
+        if any(feature.handle_event(event) for feature in self.features):
+            return
+        if event.type == pygame.KEYDOWN and not self.keys.press(event):
+            key = demo_key_for(event)
+            if key is not None:
+                self.start_demo(key)
+        elif event.type in MOUSE_EVENTS:
+            self._handle_mouse(event)
+        elif event.type in (pygame.VIDEORESIZE, pygame.WINDOWSIZECHANGED):
+            self.window.handle_event(event)  # the table and the type follow the new size
+
+    def _handle_mouse(self, event: pygame.event.Event) -> None:
+        if event.type == pygame.MOUSEMOTION:
+            if self.panning:
+                self.env.pan(event.rel)
+                self.window.clear_trails()
+            self.mouse_px = event.pos
+        elif event.type == pygame.MOUSEWHEEL:
+            self.zoom(WHEEL_ZOOM**event.y)
+        elif event.button in (1, 2, 3):
+            self.mouse_px = event.pos
+            if event.type == pygame.MOUSEBUTTONUP:
+                self.panning = False
+                if event.button == self.mouse_button:
+                    self.mouse_button = 0
+            # Ctrl comes from the key events the app saw, never from a global read.
+            elif self.keys_down & {pygame.K_LCTRL, pygame.K_RCTRL}:
+                self.panning = True
+            else:
+                self.mouse_button = event.button
+                # Grab where the button went down: a press and a quick move can share one frame.
+                self.local.set_input(self.table, self.env.to_world(event.pos), event.button)
 
     # ------------------------------------------------------------ the frame
 
@@ -370,10 +391,8 @@ class App:
             self.paused = True
             return False
         self.stats.steps += 1
-        self.chart.sample(self.table)
-        self.lessons.after_step(self.table)
-        if self.show_annotations:
-            self.collision_log.add(self.table, self.clock_s)
+        for feature in self.features:
+            feature.after_step(self.table)
         return True
 
     def frame(self, frame_dt_s: float) -> None:
@@ -383,24 +402,34 @@ class App:
         for event in pygame.event.get():
             self.handle_event(event)
             self.last_input_s = self.clock_s
-        controls.run_held(self)
+        self.keys.run_held(self.keys_down)
         # Recomputed every frame: zooming moves the world under a still mouse.
         self.local.set_input(self.table, self.env.to_world(self.mouse_px), self.mouse_button)
         if self.server is not None:
             self.server.update_clients(self.clients, self.table)  # joins, leaves and inputs, even while paused
-        predict.hands_off(self)  # a reveal plays untouched
+        for feature in self.features:
+            feature.before_physics()
         if not self.paused:
-            self._run_physics(frame_dt_s)
+            for _ in range(self.stepper.steps(frame_dt_s, self.speed)):
+                if not self.physics_step():
+                    break
         self._say_new_notices()
-        predict.after_frame(self)  # a reveal freezes once its collision is over
+        for feature in self.features:
+            feature.after_physics()
         self.fps = self._fps_counter.tick(self.clock_s)
         scene = self.scene()
         if self.server is not None:
             shared = dataclasses.replace(scene, status=STATUS_SEPARATOR.join(self.status_parts(for_students=True)))
-            shared.aids = shared_aids(self)  # the students see the teacher's aids too
+            shared.aids = self.shared_aids()  # the students see the teacher's aids too
             self.server.publish(shared)
         self.draw(scene)
         self.stats.frame()
+
+    def shared_aids(self):
+        """What the students' windows show of the teacher's aids, notes and lesson panels (aids_share.py)."""
+        notes = (self.demo.notes or "(no notes)") if self.panels.show_notes and self.demo is not None else None
+        lessons = shared_lessons(self.lessons, self.rewind.timeline_shown(), self.table, self.clients)
+        return shared_aids(self.aids, self.table, self.painter, self.clock_s, notes, lessons)
 
     def _say_new_notices(self) -> None:
         """Each sentence the table adds to its notices (a softened spring, say) is said once, here and on stderr."""
@@ -411,17 +440,6 @@ class App:
             self.say(sentence)
             print(f"airtable: {sentence}", file=sys.stderr)
         self._notices_seen = len(notices)
-
-    def _run_physics(self, frame_dt_s: float) -> None:
-        """The frame's physics steps; the table as they left it joins the history."""
-        if self.history.in_past:
-            rewind.run_on(self)  # running again from a moment in the past: its future is dropped
-        steps = self.table.steps
-        for _ in range(self.stepper.steps(frame_dt_s, self.speed)):
-            if not self.physics_step():
-                break
-        if self.table.steps != steps:
-            self.history.record(self.table)
 
     def scene(self) -> Scene:
         return Scene.from_table(
@@ -439,17 +457,13 @@ class App:
         `for_students`: as the students' windows show it, without the teacher's keys."""
         t = self.table
         parts = ["PAUSED"] if self.paused else []
-        parts.extend(room.status_parts(self))  # hands off, the floor
-        if self.predict.active:
-            parts.append(predict.status_text(self, for_students))
-        timeline = self.history.timeline() if self.history.in_past else None
-        if timeline is not None:
-            parts.append(f"rewound {timeline.newest_s - timeline.view_s:.2f} s")
+        for feature in self.features:
+            parts.extend(feature.status_parts(for_students))  # hands off, the floor, the round, rewound
         if self.speed != 1.0:
             parts.append(f"slow motion x1/{round(1 / self.speed)}")
         parts.append(f"t = {t.time_s:.2f} s")
         parts.append("F1: help")  # the students' windows have their own F1
-        parts.append(world.gravity_label(t))
+        parts.append(gravity_label(t))
         parts.append(f"correction: {t.puck_correction}")
         n, hits = len(t.pos_m), t.collision_count
         parts.append(f"{n} puck{'' if n == 1 else 's'}")
@@ -464,13 +478,9 @@ class App:
         return STATUS_SEPARATOR.join(self.status_parts())
 
     def hud_lines(self) -> list:
-        """The heads-up lines under the title: why students cannot join (in red), the join line,
-        the student count, then the newest message."""
-        alert = room_alert(self)
-        lines: list = [(alert, ALERT_COLOR)] if alert else []
-        if self.server is not None:
-            lines.extend(self.server.join_lines())
-            lines.extend(room.hud_lines(self))
+        """The heads-up lines under the title: the features' (why students cannot join, in red, the join
+        line, the student count), then the newest message."""
+        lines: list = [line for feature in self.features for line in feature.hud_lines()]
         if self.message and self.clock_s < self.message_until:
             lines.append(self.message)
         elif not self.window.wall_rects():
@@ -478,48 +488,12 @@ class App:
         return lines
 
     def draw(self, scene: Scene | None = None) -> None:
-        """Draw `scene` (by default the table as it is now), the aids and the panel on top."""
+        """Draw `scene` (by default the table as it is now), then each feature in its draw_order."""
         projected = self.room.projected(scene or self.scene())  # names hidden if anonymous
-        self.window.draw(projected, trails=self.trails, hud=self.hud_lines())
-        self._draw_timeline()  # first: the lesson panels then stand clear of it
-        draw_lessons(self)  # before the aids: their labels then place themselves around its panels
-        draw_aids(self)
-        draw_predict(self)
-        self._draw_panel()
+        self.window.draw(projected, trails=self.aids.trails, hud=self.hud_lines())
+        for feature in self._drawn:
+            feature.draw()
         self.window.present()
-
-    def _draw_timeline(self) -> None:
-        """While paused (or in the past), where the view is in the history."""
-        timeline = rewind.timeline_shown(self)
-        if timeline is not None:
-            self.timeline_painter.timeline(timeline)
-
-    def _draw_panel(self) -> None:
-        panel, w = self.panel(), self.window
-        if panel == "quit":
-            w.draw_question("Quit?", [*self.quit_would_lose(), "Esc again to quit; any other key to stay."])
-        elif panel == "menu":
-            rows = self.menu.rows(visible=w.panel_rows() - 2, label=key_label)  # the footer under them
-            w.draw_panel("Demos", [*rows, self.menu.footer()])
-        elif panel == "error":
-            error = self.build_error
-            title = ERROR_TITLES[error.stage].format(key=key_label(self.demo_key))
-            label = key_label(self.demo_key)  # "7", "Shift+1"; keys like "t1" have no key of their own
-            again = (
-                f"press {label} again" if len(self.demo_key) == 1 or label != self.demo_key else "pick it in Tab's menu"
-            )
-            w.draw_panel(title, [str(error), f"Fix the file, then {again}. Esc hides this."])
-        elif panel == "notice":
-            w.draw_panel("Some demo files could not be loaded", [*self.notice, "Press any key to go on."])
-        elif panel == "help":
-            rows = [(key_label(k), d.title) for k, d in self.demos.items()]
-            self.help_pages = w.draw_panel(
-                "Keys", [(b.label, b.help) for b in BINDINGS], side_title="Demos", side_rows=rows, page=self.help_page
-            )
-        elif panel == "notes":
-            w.draw_panel(self.demo.label(self.variation), [self.demo.notes or "(no notes)"], large=True)
-        elif panel == "roster":
-            draw_roster(self)
 
     def still(self) -> bool:
         """Nothing to show that changes quickly: paused or motionless, and no input
@@ -570,3 +544,9 @@ class App:
         self.frame(dt_s)
         self.loop.after_frame()
         return self.running
+
+
+# The key table, in the help's order: F1 and README's table (tools/keytable.py) show it.
+BINDINGS = help_rows(
+    b for owner in (App, Panels, Room, Predict, Rewind, Lessons, Aids, LiveEdits) for b in owner.bindings
+)

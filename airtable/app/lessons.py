@@ -1,9 +1,5 @@
-"""The lesson tools of the teacher's app: record and export, save the moment, momenta, changing the world live.
-
-`Lessons` holds their state beside the App (`app.lessons`); the app calls
-`start(table)` when a demo starts and `after_step(table)` after every physics
-step. The actions below are functions of the app alone, `action(app)`, bound
-to keys in controls.py.
+"""The lesson tools of the teacher's app (`Lessons`): record and export, save the moment, the momenta
+diagram, the values panel and the puck numbers.
 """
 
 from __future__ import annotations
@@ -15,15 +11,21 @@ import time
 from pathlib import Path
 from typing import TYPE_CHECKING
 
+import pygame
+
 from airtable.app.demo_loader import BUILTIN_DIR
-from airtable.app.overlays import OverlayFlag, Overlays
+from airtable.app.feature import Binding, Feature
+from airtable.app.lessons_paint import VALUES_HINT, LessonsPainter
+from airtable.app.overlays import OverlayFlag
+from airtable.app.pucks_view import draw_numbers
 from airtable.app.recorder import Recorder, csv_pair, free_csv_pair
 from airtable.app.saved_demo import demo_source, free_key, save_folder, write_demo
-from airtable.model.momenta import MomentaLog
+from airtable.model.momenta import FEW_PUCKS, MomentaLog, puck_number, values_for
 from airtable.physics.table import AirTable
 
 if TYPE_CHECKING:
-    from airtable.app.app import App
+    from airtable.app.host import Host
+    from airtable.app.teaching_aids import Aids
 
 RECORDINGS_DIR = Path("recordings")  # where the export key writes, created on demand
 # The recording kept for x formats every puck's row every step (about 2 us a row): a table bigger than
@@ -33,8 +35,8 @@ SPOOL_MAX_PUCKS = 200
 SPOOL_MAX_BYTES = 4 * 2**30
 
 
-class Lessons:
-    """The state of the lesson tools: the recording, the latest collision's momenta, which panels show.
+class Lessons(Feature):
+    """The lesson tools (`app.lessons`): the recording, the latest collision's momenta, which panels show.
 
     Every demo start begins a recording streamed to disk (recorder.py): by default a
     spool file in a folder of its own that goes when the app ends, which the export
@@ -46,8 +48,11 @@ class Lessons:
     show_momenta = OverlayFlag("momenta")  # the momenta diagram (d)
     show_values = OverlayFlag("values")  # the values panel (t)
 
-    def __init__(self, overlays: Overlays | None = None) -> None:
-        self.overlays = Overlays() if overlays is None else overlays  # the app's, where its panels live
+    draw_order = 1  # before the aids: their labels then place themselves around its panels
+
+    def __init__(self, host: Host, aids: Aids) -> None:
+        super().__init__(host)
+        self.aids = aids  # the chart keeps its corner; the values panel shares its energy scale
         self._spool = tempfile.TemporaryDirectory(prefix="airtable-recording-")  # removed when the app ends
         self.record_to: Path | None = None  # --record's NAME.csv: recordings are kept there
         self.recorded: list[Recorder] = []  # the --record recordings of this run, the current one last
@@ -56,9 +61,9 @@ class Lessons:
         self.show_numbers = False  # each puck's number drawn on it (k); kept from demo to demo
         self.momenta = MomentaLog()
         self._hits_seen = 0  # the table's collision count when last looked at
-        self.painter = None  # the LessonsPainter, made on the first draw (lessons_view.py)
+        self.painter: LessonsPainter | None = None  # made on the first draw
 
-    def start(self, table: AirTable) -> None:
+    def on_demo_start(self, table: AirTable) -> None:
         """A demo (re)started: a new recording from its first moment, no collision seen yet."""
         self._begin_recording(table)
         self.exported_to_s = table.time_s
@@ -103,7 +108,7 @@ class Lessons:
             self.recorder.close()
         return list(self.recorded)
 
-    def drop_after(self, t_s: float) -> None:
+    def forget_after(self, t_s: float) -> None:
         """The table was rewound to `t_s` and runs on: what the recording and the diagram saw later did not happen."""
         self.recorder.drop_after(t_s)
         if self.momenta.latest is not None and self.momenta.latest.t_s > t_s:
@@ -123,42 +128,103 @@ class Lessons:
             self._hits_seen = table.collision_count
             self.momenta.observe(table)
 
+    def toggle_momenta(self) -> None:
+        self.show_momenta = not self.show_momenta
 
-def toggle_momenta(app: App) -> None:
-    app.lessons.show_momenta = not app.lessons.show_momenta
+    def toggle_values(self) -> None:
+        self.show_values = not self.show_values
 
+    def toggle_numbers(self) -> None:
+        self.show_numbers = not self.show_numbers
+        shown = "puck numbers shown, as values, predict and the CSV name them"
+        self.host.say(shown if self.show_numbers else "puck numbers hidden")
 
-def toggle_values(app: App) -> None:
-    app.lessons.show_values = not app.lessons.show_values
+    def export_recording(self) -> None:
+        """Copy the demo's recording so far to recordings/demo<key>-<time>.csv (and _energy.csv); say where."""
+        rec, say = self.recorder, self.host.say
+        stem = f"demo{self.host.demo_key}-{time.strftime('%Y%m%d-%H%M%S')}"
+        try:
+            RECORDINGS_DIR.mkdir(parents=True, exist_ok=True)
+            rec.flush()
+            pucks, energy = csv_pair(free_csv_pair(RECORDINGS_DIR, stem))
+            shutil.copyfile(rec.puck_path, pucks)
+            shutil.copyfile(rec.energy_path, energy)
+        except OSError as exc:
+            say(f"could not write the recording: {exc.strerror or exc}")
+            print(f"airtable: could not write the recording: {exc}", file=sys.stderr)
+            return
+        self.exported_to_s = self.host.table.time_s
+        stopped = f"; it stopped: {rec.error}" if rec.error else ""
+        print(f"recorded {rec.summary()} to {pucks.resolve()} and {energy.name}{stopped}", flush=True)
+        if rec.error:
+            say(f"recorded {rec.span_s:.2f} s to {short_path(pucks)} (stopped: {rec.error})", lasting=True)
+        else:
+            say(f"recorded {rec.span_s:.2f} s to {short_path(pucks)} (and _energy.csv)", lasting=True)
 
+    def save_moment(self, path: Path | None = None) -> Path | None:
+        """Write the table as it is now as a new demo file, under a new key; say where (None if it could not).
 
-def toggle_numbers(app: App) -> None:
-    app.lessons.show_numbers = not app.lessons.show_numbers
-    shown = app.lessons.show_numbers
-    app.say("puck numbers shown, as values, predict and the CSV name them" if shown else "puck numbers hidden")
+        Without `path` it goes to the teacher's demo folder (save_folder), which the
+        app then loads from, so the new key works at once and `--list-demos` lists it.
+        """
+        host = self.host
+        shelf = host.shelf
+        folder = save_folder(shelf.directories, BUILTIN_DIR) if path is None else Path(path).parent
+        key = free_key(host.demos, folder)
+        target = Path(path) if path is not None else folder / f"{key}.py"
+        title = f"{host.demo.title}, saved at t = {host.table.time_s:.2f} s"
+        source = demo_source(host.table, key=key, title=title, dt_s=host.dt_s, origin=f"from {host.caption()}")
+        try:
+            write_demo(target, source)
+        except OSError as exc:
+            host.say(f"could not save the demo: {exc}")
+            return None
+        if path is None:
+            if all(Path(d).resolve() != folder.resolve() for d in shelf.directories):
+                shelf.directories.append(folder)
+            for error in shelf.refresh():
+                host.report(error)
+        how = f"Tab, then {key}, starts it" if path is None else f"load it with --demos {target.parent}"
+        host.say(f"saved as demo {key} in {target.resolve()} ({how})", lasting=True)
+        return target
 
+    def draw(self) -> None:
+        """The puck numbers (k), then the momenta diagram (d) and the values panel (t) in free corners."""
+        t, env, window = self.host.table, self.host.env, self.host.window
+        if self.show_numbers and len(t.pos_m):
+            numbers = [puck_number(row) for row in range(len(t.pos_m))]
+            draw_numbers(window.surface, window.label_font, env.to_screen(t.pos_m), numbers)
+        if not (self.show_momenta or self.show_values):
+            return
+        if self.painter is None:
+            self.painter = LessonsPainter(window)
+        paint = self.painter
+        points = env.to_screen(t.pos_m) if len(t.pos_m) else t.pos_m
+        chart = self.aids.chart_corner(points)  # the chart keeps its corner; the panels take others
+        taken = [] if chart is None else [chart]
+        if self.show_momenta:
+            corner = paint.choose_corner("momenta", points, taken)
+            taken.append(corner)
+            latest = self.momenta.latest
+            paint.momenta_diagram(None if latest is None else latest.view, corner)
+        if self.show_values:
+            puck = t.puck_at(env.to_world(self.host.mouse_px)) if len(t.pos_m) > FEW_PUCKS else None
+            rows = values_for(t, None if puck is None else puck.index, self.aids.chart.scale)
+            colors = [t.color_rgb[r.row] if r.row is not None else None for r in rows]
+            paint.values_panel(rows, colors, VALUES_HINT, paint.choose_corner("values", points, taken))
 
-def export_recording(app: App) -> None:
-    """Copy the demo's recording so far to recordings/demo<key>-<time>.csv (and _energy.csv); say where."""
-    rec = app.lessons.recorder
-    stem = f"demo{app.demo_key}-{time.strftime('%Y%m%d-%H%M%S')}"
-    try:
-        RECORDINGS_DIR.mkdir(parents=True, exist_ok=True)
-        rec.flush()
-        pucks, energy = csv_pair(free_csv_pair(RECORDINGS_DIR, stem))
-        shutil.copyfile(rec.puck_path, pucks)
-        shutil.copyfile(rec.energy_path, energy)
-    except OSError as exc:
-        app.say(f"could not write the recording: {exc.strerror or exc}")
-        print(f"airtable: could not write the recording: {exc}", file=sys.stderr)
-        return
-    app.lessons.exported_to_s = app.table.time_s
-    stopped = f"; it stopped: {rec.error}" if rec.error else ""
-    print(f"recorded {rec.summary()} to {pucks.resolve()} and {energy.name}{stopped}", flush=True)
-    if rec.error:
-        app.say(f"recorded {rec.span_s:.2f} s to {short_path(pucks)} (stopped: {rec.error})", lasting=True)
-    else:
-        app.say(f"recorded {rec.span_s:.2f} s to {short_path(pucks)} (and _energy.csv)", lasting=True)
+    bindings = (
+        Binding(
+            "d / t / k",
+            "momenta before / after the latest collision; values of each puck; puck numbers",
+            {pygame.K_d: toggle_momenta, pygame.K_t: toggle_values, pygame.K_k: toggle_numbers},
+        ),
+        Binding(
+            "x / Ctrl+S",
+            "export the recording as CSV; save the moment as a new demo (s1, s2, ...)",
+            {pygame.K_x: export_recording, (pygame.KMOD_CTRL, pygame.K_s): save_moment},
+        ),
+    )
 
 
 def short_path(path: Path) -> str:
@@ -167,30 +233,3 @@ def short_path(path: Path) -> str:
         return str(path.resolve().relative_to(Path.cwd().resolve()))
     except ValueError:
         return str(path.resolve())
-
-
-def save_moment(app: App, path: Path | None = None) -> Path | None:
-    """Write the table as it is now as a new demo file, under a new key; say where (None if it could not).
-
-    Without `path` it goes to the teacher's demo folder (save_folder), which the
-    app then loads from, so the new key works at once and `--list-demos` lists it.
-    """
-    shelf = app.shelf
-    folder = save_folder(shelf.directories, BUILTIN_DIR) if path is None else Path(path).parent
-    key = free_key(app.demos, folder)
-    target = Path(path) if path is not None else folder / f"{key}.py"
-    title = f"{app.demo.title}, saved at t = {app.table.time_s:.2f} s"
-    source = demo_source(app.table, key=key, title=title, dt_s=app.dt_s, origin=f"from {app.caption()}")
-    try:
-        write_demo(target, source)
-    except OSError as exc:
-        app.say(f"could not save the demo: {exc}")
-        return None
-    if path is None:
-        if all(Path(d).resolve() != folder.resolve() for d in shelf.directories):
-            shelf.directories.append(folder)
-        for error in shelf.refresh():
-            app.report(error)
-    how = f"Tab, then {key}, starts it" if path is None else f"load it with --demos {target.parent}"
-    app.say(f"saved as demo {key} in {target.resolve()} ({how})", lasting=True)
-    return target

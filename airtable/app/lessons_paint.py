@@ -17,8 +17,10 @@ import pygame
 
 from airtable.app.aids_paint import CHART_COLORS, CHART_CORNERS, draw_arrow_px, place_in_corner
 from airtable.app.panel_view import ACCENT, DIM_TEXT, TEXT_COLOR, shorten
-from airtable.model.momenta import VALUE_HEADINGS, MomentaView, PuckValues, fit_chains, tip_to_tail
+from airtable.model.momenta import FEW_PUCKS, VALUE_HEADINGS, MomentaView, PuckValues, fit_chains, tip_to_tail
 from airtable.model.readout import readable
+
+VALUES_HINT = f"values: more than {FEW_PUCKS} pucks, so point at one"
 
 TOTAL_COLOR = CHART_COLORS["momentum_Ns"]  # the chart's |momentum| colour
 PANEL_FILL = (0, 0, 0, 255)  # opaque: nothing shows through the numbers

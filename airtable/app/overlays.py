@@ -7,8 +7,8 @@ layout and idling all know the same set. Panels (the boxes in the middle of
 the window) are drawn over the side overlays (chart, values, momenta), so
 the top one is the newest panel if one is open, else the newest side overlay.
 
-A feature keeps its flag as an `OverlayFlag`: `app.show_chart = True` opens
-"chart" on its owner's `overlays` stack, and reading the flag asks the stack.
+A feature keeps its flag as an `OverlayFlag`: `app.aids.show_chart = True` opens
+"chart" on its owner's `overlays` stack (the app's), and reading the flag asks the stack.
 """
 
 from __future__ import annotations

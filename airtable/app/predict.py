@@ -1,6 +1,6 @@
 """Predict, then reveal: a round of peer instruction on the shared table.
 
-One key (`predict_key`) steps a round along:
+The `Predict` feature owns the round; one key (F6, `predict_key`) steps it along:
 
     none -> open      the table freezes; students (and the local mouse) drag
                       arrows from pucks: the velocity each puck will have once
@@ -12,8 +12,9 @@ One key (`predict_key`) steps a round along:
     revealed -> none  the round closes; the table stays paused
 
 The guesses live in the server's PredictionBook (airtable/net/predictions.py)
-and in `local` here; nothing in them reaches the physics. `summarize` is the
-maths of the summary: angles between guess and truth, and speed ratios.
+and in the round's `local`; nothing in them reaches the physics. `summarize`
+is the maths of the summary: angles between guess and truth, and speed ratios.
+The drawing is predict_view.py's, the same on the students' windows.
 """
 
 from __future__ import annotations
@@ -24,19 +25,22 @@ from dataclasses import replace
 from typing import TYPE_CHECKING
 
 import numpy as np
+import pygame
 
+from airtable.app.feature import Binding, Feature
+from airtable.app.predict_view import paint_round
 from airtable.model.momenta import puck_number
-from airtable.model.rounds import MAX_ROUND_PUCKS, Arrow, RoundInfo, clamp_speed
+from airtable.model.rounds import ARROW_S, MAX_ROUND_PUCKS, Arrow, RoundInfo, clamp_speed
 
 if TYPE_CHECKING:
-    from airtable.app.app import App
+    from airtable.app.host import Host
+    from airtable.app.room import Room
 
 SETTLE_S = 0.3  # table time with no collision after which the collision is over
 TIMEOUT_S = 8.0  # table time after which the reveal freezes anyway
 WITHIN_DEG = 5.0  # "within 5 deg"
 WITHIN_SPEED = 0.2  # "speeds within 20 %"
 RESTING_MPS = 0.05  # a true speed below this: the puck stops, and direction means nothing
-ARROW_S = 1.0  # a prediction arrow is drawn as far as the puck would go in this time
 LOCAL_LABEL = "local"
 LOCAL_COLOR = (120, 255, 120)
 
@@ -79,7 +83,7 @@ def summarize(truth: Sequence[Sequence[float]], arrows: Sequence[Arrow]) -> list
 
 
 class PredictRound:
-    """The round's state on the teacher's side (`app.predict`)."""
+    """The round's state on the teacher's side (`Predict.round`)."""
 
     def __init__(self) -> None:
         self.round_id = 0
@@ -159,173 +163,185 @@ class PredictRound:
         return clamp_speed(((mouse_m[0] - puck_pos_m[0]) / ARROW_S, (mouse_m[1] - puck_pos_m[1]) / ARROW_S))
 
 
-# ---------------------------------------------------------------- the app side
-
-
-def _book(app: App):
-    return getattr(app.server, "predictions", None) if app.server is not None else None
-
-
-def _counts(app: App) -> tuple[int, int]:
-    """(who predicted, of how many): the students, plus the local mouse once it predicted."""
-    book = _book(app)
-    students = app.student_count()
-    predicted = book.count() if book is not None else 0
-    if app.predict.local:
-        return predicted + 1, students + 1
-    return predicted, students
-
-
-def count_text(app: App) -> str:
-    predicted, players = _counts(app)
-    return f"{predicted} of {players} predicted"
-
-
-def status_text(app: App, for_students: bool = False) -> str:
-    """The round in the status line; the teacher's keys only on the teacher's window."""
-    r = app.predict
-    if r.state == "open":
-        return f"PREDICT: {count_text(app)}" + ("" if for_students else " (F6 reveals)")
-    if r.settled:
-        return "REVEALED" + ("" if for_students else " (F6 closes the round)")
-    return "REVEALED: playing until the collision is over"
-
-
-def publish(app: App) -> None:
-    """Tell the students where the round is (a ROUND message to each)."""
-    book = _book(app)
-    if book is None:
-        return
-    r = app.predict
-    r.predicted, r.players = _counts(app)
-    r.names_sent = names_shown(app)
-    info = r.info(r.predicted, r.players, r.names_sent)
-    if info.state == "open" and book.accepts() != (info.round_id, info.pucks):
-        book.open(info.round_id, info.pucks)
-    elif info.state != "open":
-        book.set_state(info.state)
-    app.server.send_round(info)
-
-
-def predict_key(app: App) -> None:
-    """The round key: open a round, reveal it, close it."""
-    r = app.predict
-    if r.state == "closed":
-        if not len(app.table.pos_m):
-            app.say("no pucks on the table to predict")
-            return
-        r.open(app.table.pos_m)
-        app.paused = True
-        app.say("prediction round open: F6 again reveals")
-    elif r.state == "open":
-        book = _book(app)
-        r.reveal(book.arrows() if book is not None else (), app.table)
-        app.paused = False  # after_frame keeps everyone's strings off until the collision is over
-    else:
-        r.close()
-        app.paused = True
-    publish(app)
-
+# ---------------------------------------------------------------- the teacher's side
 
 FROZEN_NOTICE = "the table stays frozen while students predict: F6 reveals"
 
 
-def pause_key(app: App) -> bool:
-    """Space during a round; True if the round took it (else Space pauses and resumes as always).
+class Predict(Feature):
+    """Predict, then reveal, on the teacher's window (`app.predict`): the keys, the students' count, the freeze."""
 
-    Open: refused with a notice, since the table is what the students predict.
-    Revealed and frozen on the truth: the lesson goes on, so the round closes and
-    the table runs. While the reveal plays, Space pauses and resumes it as usual."""
-    r = app.predict
-    if r.state == "open":
-        app.say(FROZEN_NOTICE)
-        return True
-    if r.settled:
-        r.close()
-        publish(app)
-        app.paused = False
-        app.say("prediction round closed: the table runs on")
-        return True
-    return False
+    draw_order = 3  # over the aids
 
+    def __init__(self, host: Host, room: Room) -> None:
+        super().__init__(host)
+        self.room = room  # an anonymous projector hides the names on the arrows
+        self.round = PredictRound()
 
-def round_holds(app: App) -> bool:
-    """True while a round needs the table as it is: open, or revealed and still playing."""
-    r = app.predict
-    return r.state == "open" or (r.state == "revealed" and not r.settled)
+    def _book(self):
+        server = self.host.server
+        return getattr(server, "predictions", None) if server is not None else None
 
+    def _counts(self) -> tuple[int, int]:
+        """(who predicted, of how many): the students, plus the local mouse once it predicted."""
+        book = self._book()
+        students = self.host.student_count()
+        predicted = book.count() if book is not None else 0
+        if self.round.local:
+            return predicted + 1, students + 1
+        return predicted, students
 
-def holds_the_table(app: App) -> bool:
-    """True, and says why, while a round holds the table (round_holds): the rewind keys leave it alone."""
-    if not round_holds(app):
+    def count_text(self) -> str:
+        predicted, players = self._counts()
+        return f"{predicted} of {players} predicted"
+
+    def status_parts(self, for_students: bool) -> list[str]:
+        """The round in the status line; the teacher's keys only on the teacher's window."""
+        r = self.round
+        if r.state == "open":
+            return [f"PREDICT: {self.count_text()}" + ("" if for_students else " (F6 reveals)")]
+        if r.settled:
+            return ["REVEALED" + ("" if for_students else " (F6 closes the round)")]
+        return ["REVEALED: playing until the collision is over"] if r.active else []
+
+    def publish(self) -> None:
+        """Tell the students where the round is (a ROUND message to each)."""
+        book = self._book()
+        if book is None:
+            return
+        r = self.round
+        r.predicted, r.players = self._counts()
+        r.names_sent = self.names_shown()
+        info = r.info(r.predicted, r.players, r.names_sent)
+        if info.state == "open" and book.accepts() != (info.round_id, info.pucks):
+            book.open(info.round_id, info.pucks)
+        elif info.state != "open":
+            book.set_state(info.state)
+        self.host.server.send_round(info)
+
+    def predict_key(self) -> None:
+        """The round key: open a round, reveal it, close it."""
+        r, host = self.round, self.host
+        if r.state == "closed":
+            if not len(host.table.pos_m):
+                host.say("no pucks on the table to predict")
+                return
+            r.open(host.table.pos_m)
+            host.paused = True
+            host.say("prediction round open: F6 again reveals")
+        elif r.state == "open":
+            book = self._book()
+            r.reveal(book.arrows() if book is not None else (), host.table)
+            host.paused = False  # after_physics keeps everyone's strings off until the collision is over
+        else:
+            r.close()
+            host.paused = True
+        self.publish()
+
+    def pause_key(self) -> bool:
+        """Space during a round; True if the round took it (else Space pauses and resumes as always).
+
+        Open: refused with a notice, since the table is what the students predict.
+        Revealed and frozen on the truth: the lesson goes on, so the round closes and
+        the table runs. While the reveal plays, Space pauses and resumes it as usual."""
+        r = self.round
+        if r.state == "open":
+            self.host.say(FROZEN_NOTICE)
+            return True
+        if r.settled:
+            r.close()
+            self.publish()
+            self.host.paused = False
+            self.host.say("prediction round closed: the table runs on")
+            return True
         return False
-    if app.predict.state == "open":
-        app.say(FROZEN_NOTICE)
-    else:
-        app.say("the reveal plays until the collision is over; then , and . step through it")
-    return True
 
+    def holds(self) -> bool:
+        """True while the round needs the table as it is: open, or revealed and still playing."""
+        r = self.round
+        return r.state == "open" or (r.state == "revealed" and not r.settled)
 
-def names_shown(app: App) -> bool:
-    """Names on the revealed arrows: only when the teacher shows them (Shift+F6),
-    and never while the projector is anonymous (F5, room.py)."""
-    room = getattr(app, "room", None)
-    return app.predict.show_names and not (room is not None and room.anonymous)
+    def holds_the_table(self) -> bool:
+        """True, and says why, while the round holds the table (`holds`): the rewind keys leave it alone."""
+        if not self.holds():
+            return False
+        if self.round.state == "open":
+            self.host.say(FROZEN_NOTICE)
+        else:
+            self.host.say("the reveal plays until the collision is over; then , and . step through it")
+        return True
 
+    def names_shown(self) -> bool:
+        """Names on the revealed arrows: only when the teacher shows them (Shift+F6),
+        and never while the projector is anonymous (F5, room.py)."""
+        return self.round.show_names and not self.room.anonymous
 
-def toggle_names(app: App) -> None:
-    """Shift+F6: names on the revealed arrows, here and on the students' windows."""
-    app.predict.show_names = not app.predict.show_names
-    app.say(f"prediction names {'shown' if app.predict.show_names else 'hidden'}")
+    def toggle_names(self) -> None:
+        """Shift+F6: names on the revealed arrows, here and on the students' windows."""
+        r = self.round
+        r.show_names = not r.show_names
+        self.host.say(f"prediction names {'shown' if r.show_names else 'hidden'}")
 
+    def on_demo_start(self, table) -> None:
+        """A new demo: a round under way ends with it."""
+        if self.round.active:
+            self.round.close()
+            self.publish()
 
-def end_round(app: App) -> None:
-    """A new demo: a round under way ends with it."""
-    if app.predict.active:
-        app.predict.close()
-        publish(app)
+    def before_physics(self) -> None:
+        """While the reveal plays nobody's string holds a puck, so the truth is what the guesses were about."""
+        if self.round.state == "revealed" and not self.round.truth:
+            for client in self.host.clients:
+                client.release()
 
+    def after_physics(self) -> None:
+        """Freeze the reveal once the collision is over; keep the students' count fresh."""
+        r, host = self.round, self.host
+        if r.state == "revealed" and not r.truth and not host.paused and r.collision_over(host.table):
+            host.paused = True
+            r.settle(host.table)
+            self.publish()
+        elif r.state == "open" and self._counts() != (r.predicted, r.players):
+            self.publish()
+        elif r.state == "revealed" and self.names_shown() != r.names_sent:  # F5 (anonymous) or Shift+F6
+            self.publish()
 
-def hands_off(app: App) -> None:
-    """Before the physics steps: while the reveal plays nobody's string holds a puck,
-    so the truth is what the guesses were about."""
-    if app.predict.state == "revealed" and not app.predict.truth:
-        for client in app.clients:
-            client.release()
+    def handle_event(self, event: pygame.event.Event) -> bool:
+        """While a round is open the local mouse drags prediction arrows, not pucks; True if it took `event`."""
+        r, host = self.round, self.host
+        if r.state != "open" or event.type not in (pygame.MOUSEBUTTONDOWN, pygame.MOUSEMOTION, pygame.MOUSEBUTTONUP):
+            return False
+        host.mouse_px = event.pos
+        where = host.env.to_world(np.asarray(event.pos, dtype=float))
+        if event.type == pygame.MOUSEBUTTONDOWN and event.button == 1:
+            puck = host.table.puck_at(where)
+            if puck is not None and puck.index < r.pucks:
+                r.dragging = puck.index
+        elif r.dragging is not None and event.type != pygame.MOUSEBUTTONDOWN:
+            r.local[r.dragging] = r.guess_from_drag(host.table.pos_m[r.dragging], where)
+            if event.type == pygame.MOUSEBUTTONUP:
+                r.dragging = None
+                self.after_physics()
+        return True
 
+    def draw(self) -> None:
+        self.paint()
 
-def after_frame(app: App) -> None:
-    """Every frame: freeze the reveal once the collision is over; keep the students' count fresh."""
-    r = app.predict
-    if r.state == "revealed" and not r.truth and not app.paused and r.collision_over(app.table):
-        app.paused = True
-        r.settle(app.table)
-        publish(app)
-    elif r.state == "open" and _counts(app) != (r.predicted, r.players):
-        publish(app)
-    elif r.state == "revealed" and names_shown(app) != r.names_sent:  # F5 (anonymous) or Shift+F6
-        publish(app)
+    def paint(self) -> list[tuple[str, pygame.Rect]]:
+        """The round on the projector: a count while open, everything once revealed; returns the lines
+        of text written and where. The volunteer at the teacher's laptop sees their own arrows; the
+        students' stay hidden until the reveal."""
+        r = self.round
+        if not r.active:
+            return []
+        info = r.info(r.predicted, r.players, self.names_shown())
+        return paint_round(self.host.painter, info, r.local, LOCAL_COLOR, self.count_text())
 
-
-def take_mouse(app: App, event) -> bool:
-    """While a round is open the local mouse drags prediction arrows, not pucks; True if it took `event`."""
-    import pygame
-
-    r = app.predict
-    if r.state != "open" or event.type not in (pygame.MOUSEBUTTONDOWN, pygame.MOUSEMOTION, pygame.MOUSEBUTTONUP):
-        return False
-    app.mouse_px = event.pos
-    where = app.env.to_world(np.asarray(event.pos, dtype=float))
-    if event.type == pygame.MOUSEBUTTONDOWN and event.button == 1:
-        puck = app.table.puck_at(where)
-        if puck is not None and puck.index < r.pucks:
-            r.dragging = puck.index
-    elif r.dragging is not None and event.type != pygame.MOUSEBUTTONDOWN:
-        r.local[r.dragging] = r.guess_from_drag(app.table.pos_m[r.dragging], where)
-        if event.type == pygame.MOUSEBUTTONUP:
-            r.dragging = None
-            after_frame(app)
-    return True
+    bindings = (
+        Binding(
+            "F6", "predict, then reveal", {pygame.K_F6: predict_key, (pygame.KMOD_SHIFT, pygame.K_F6): toggle_names}
+        ),
+    )
 
 
 # ---------------------------------------------------------------- a student's side

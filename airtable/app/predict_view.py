@@ -1,7 +1,7 @@
 """Drawing a prediction round: the students' arrows, the truth and the summary.
 
-The same drawing serves the teacher's window (`draw_predict(app)`) and every
-student's (`paint_round`, from the ROUND messages): thin arrows, one colour
+The same drawing, `paint_round`, serves the teacher's window (the Predict
+feature of predict.py) and every student's (from the ROUND messages): thin arrows, one colour
 per student, from where each puck stood when the round opened; the true
 velocities bold in white once the collision is over; the summary lines at
 the left. Pixels come from the window's AidsPainter.
@@ -10,16 +10,11 @@ the left. Pixels come from the window's AidsPainter.
 from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
-from typing import TYPE_CHECKING
 
 import pygame
 
 from airtable.app.panel_view import wrap
-from airtable.app.predict import ARROW_S, LOCAL_COLOR, count_text, names_shown
-from airtable.model.rounds import RoundInfo
-
-if TYPE_CHECKING:
-    from airtable.app.app import App
+from airtable.model.rounds import ARROW_S, RoundInfo
 
 PROMPT_COLOR = (255, 220, 90)
 TRUTH_COLOR = (255, 255, 255)
@@ -119,14 +114,3 @@ def paint_round(
 
 def _tip(start: Sequence[float], vel: Sequence[float]) -> tuple[float, float]:
     return (start[0] + vel[0] * ARROW_S, start[1] + vel[1] * ARROW_S)
-
-
-def draw_predict(app: App) -> list[tuple[str, pygame.Rect]]:
-    """The round on the teacher's window (the projector): a count while open, everything once revealed.
-    Returns the lines of text written and where."""
-    r = app.predict
-    if not r.active:
-        return []
-    info = r.info(r.predicted, r.players, names_shown(app))
-    # The volunteer at the teacher's laptop sees their own arrows; the students' stay hidden until the reveal.
-    return paint_round(app.painter, info, r.local, LOCAL_COLOR, count_text(app))

@@ -1,11 +1,11 @@
-"""The teacher runs the room: the roster of students, removing one, hands off,
-the floor passed around, and an anonymous projector (no pygame here).
+"""The teacher runs the room (`Room`): the roster of students, removing one, hands off,
+the floor passed around, an anonymous projector, and who can join.
 
 The rules that decide whose cursor acts live on the server (`GameServer.hands_off`,
 `GameServer.floor`, `GameServer.may_act`), applied where students' inputs
-reach the game loop. This module keeps the teacher's side: what the keys do,
-the roster panel's selection, and the words the projector and the students
-see. Students learn of hands off and the floor from the status line that
+reach the game loop. This feature keeps the teacher's side: what the keys do,
+the roster panel's selection (drawn by roster_view.py), and the words the
+projector and the students see. Students learn of hands off and the floor from the status line that
 every snapshot carries: its part `HANDS_OFF` puts a banner on their windows
 (`student_banner`), and `floor: C3 Ann` says whose turn it is.
 """
@@ -13,20 +13,22 @@ every snapshot carries: its part `HANDS_OFF` puts a banner on their windows
 from __future__ import annotations
 
 import dataclasses
-from dataclasses import dataclass, field
 from typing import TYPE_CHECKING
 
-from airtable.app.overlays import OverlayFlag, Overlays
+import pygame
+
+from airtable.app.feature import Binding, Feature
+from airtable.app.overlays import OverlayFlag
+from airtable.app.roster_view import ALERT_COLOR, draw_roster
 from airtable.model.scene import Scene
 
 if TYPE_CHECKING:
-    from airtable.app.app import App
+    from airtable.app.host import Host
     from airtable.model.seats import Seat
 
 HANDS_OFF = "HANDS OFF"  # a status part: every student's window shows HANDS_OFF_BANNER
 HANDS_OFF_BANNER = "hands off: the teacher is explaining"
 FLOOR_PREFIX = "floor: "
-IDLE_FLAG_S = 60.0  # no input change for this long: "idle" in the roster
 REMOVE_CONFIRM_S = 4.0  # the second Delete within this time removes the student
 REMOVED_SENTENCE = "the teacher removed you from the table"
 
@@ -36,32 +38,25 @@ def student_banner(scene: Scene, me: str = "") -> str | None:
     return HANDS_OFF_BANNER if HANDS_OFF in scene.status_parts else None
 
 
-def seat_flags(seat: Seat) -> str:
-    """The roster's warnings for one seat: idle long, cursor far off, or both (a squatter)."""
-    idle = seat.idle_s >= IDLE_FLAG_S
-    if idle and seat.far_off:
-        return f"squatting? idle {seat.idle_s:.0f} s, cursor far off the table"
-    if idle:
-        return f"idle {seat.idle_s:.0f} s"
-    return "cursor far off the table" if seat.far_off else ""
-
-
 def anonymous_label(name: str) -> str:
     """ "C3 Ann" -> "C3": the player's id alone."""
     return name.split(" ", 1)[0]
 
 
-@dataclass
-class Room:
-    """The teacher's side of running the room."""
+class Room(Feature):
+    """The teacher's side of running the room (`app.room`)."""
 
-    show_roster = OverlayFlag("roster")  # not a field: the flag lives in `overlays`
-    overlays: Overlays = field(default_factory=Overlays)
-    selected: int = 0  # row of the roster panel
-    anonymous: bool = False  # names hidden on the projector (colours stay)
-    remove_armed: tuple[int, float] | None = None  # (player number, clock_s until which Delete removes)
-    row_boxes: list[tuple[int, object]] = field(default_factory=list)  # (number, pygame.Rect) drawn last frame
-    panel_box: object = None  # the roster panel's pygame.Rect as last drawn
+    show_roster = OverlayFlag("roster")
+    draw_order = 5  # a panel, over everything
+
+    def __init__(self, host: Host, server_problem: str | None = None) -> None:
+        super().__init__(host)
+        self.server_problem = server_problem  # why students cannot join, when the server did not start
+        self.selected = 0  # row of the roster panel
+        self.anonymous = False  # names hidden on the projector (colours stay)
+        self.remove_armed: tuple[int, float] | None = None  # (player number, clock_s until which Delete removes)
+        self.row_boxes: list[tuple[int, pygame.Rect]] = []  # (number, box) drawn last frame
+        self.panel_box: pygame.Rect | None = None  # the roster panel as last drawn
 
     def label(self, name: str) -> str:
         """A player's name as the projector shows it."""
@@ -74,116 +69,154 @@ class Room:
         cursors = tuple(dataclasses.replace(c, name=anonymous_label(c.name)) for c in scene.cursors)
         return dataclasses.replace(scene, cursors=cursors)
 
+    def seats(self) -> list[Seat]:
+        server = self.host.server
+        return server.roster() if server is not None else []
 
-# ---------------------------------------------------------------- what the app shows
+    # ------------------------------------------------------------ what the windows show
 
+    def alert(self) -> str | None:
+        """Why students cannot join, if they cannot: the server did not start, or its thread failed."""
+        server = self.host.server
+        return server.failure if server is not None else self.server_problem
 
-def _seats(app: App) -> list[Seat]:
-    return app.server.roster() if app.server is not None else []
+    def hud_lines(self) -> list:
+        """Why students cannot join (in red), the join line and the player count."""
+        alert, server = self.alert(), self.host.server
+        lines: list = [(alert, ALERT_COLOR)] if alert else []
+        if server is not None:
+            n = server.player_count
+            lines.extend(server.join_lines())
+            lines.append(f"{n} student{'' if n == 1 else 's'} (F2: roster)")
+        return lines
 
+    def status_parts(self, for_students: bool) -> list[str]:
+        """Hands off and the floor, for the status line every window shows."""
+        server = self.host.server
+        if server is None:
+            return []
+        parts = [HANDS_OFF] if server.hands_off else []
+        if server.floor is not None:
+            seat = next((s for s in self.seats() if s.number == server.floor), None)
+            if seat is None:  # the student with the floor left
+                server.floor = None
+                self.host.say("the student with the floor left: everyone's cursor acts again")
+            else:
+                parts.append(FLOOR_PREFIX + self.label(seat.name))
+        return parts
 
-def status_parts(app: App) -> list[str]:
-    """Hands off and the floor, for the status line every window shows."""
-    server = app.server
-    if server is None:
-        return []
-    parts = [HANDS_OFF] if server.hands_off else []
-    if server.floor is not None:
-        seat = next((s for s in _seats(app) if s.number == server.floor), None)
-        if seat is None:  # the student with the floor left
-            server.floor = None
-            app.say("the student with the floor left: everyone's cursor acts again")
-        else:
-            parts.append(FLOOR_PREFIX + app.room.label(seat.name))
-    return parts
+    def draw(self) -> None:
+        if self.overlays.panel() != "roster":
+            return
+        server = self.host.server
+        most = server.max_clients if server is not None else 0
+        seats, window = self.seats(), self.host.window
+        self.row_boxes, self.panel_box = draw_roster(
+            window, seats, selected=self.selected, label=self.label, most=most, anonymous=self.anonymous
+        )
 
+    # ------------------------------------------------------------ keys and clicks
 
-def hud_lines(app: App) -> list[str]:
-    """The player count, always there while the server is on."""
-    server = app.server
-    if server is None:
-        return []
-    n = server.player_count
-    return [f"{n} student{'' if n == 1 else 's'} (F2: roster)"]
+    def _need_server(self) -> bool:
+        if self.host.server is None:
+            self.host.say("no students: the table runs without its server (--no-server)")
+            return False
+        return True
 
+    def toggle_roster(self) -> None:
+        if self._need_server():
+            self.show_roster = not self.show_roster
+            self.remove_armed = None
 
-# ---------------------------------------------------------------- keys
+    def toggle_hands_off(self) -> None:
+        if self._need_server():
+            server = self.host.server
+            server.hands_off = not server.hands_off
+            self.host.say("hands off: students' cursors let go" if server.hands_off else "students' cursors act again")
 
+    def next_floor(self) -> None:
+        """The floor to the next student in seat order; after the last, back to everyone."""
+        if not self._need_server():
+            return
+        server = self.host.server
+        numbers = [s.number for s in self.seats()]
+        later = [n for n in numbers if server.floor is None or n > server.floor]
+        server.floor = later[0] if later else None
+        if server.floor is None:
+            self.host.say("the floor is back to everyone" if numbers else "no students to give the floor to")
 
-def _need_server(app: App) -> bool:
-    if app.server is None:
-        app.say("no students: the table runs without its server (--no-server)")
-        return False
-    return True
+    def toggle_anonymous(self) -> None:
+        self.anonymous = not self.anonymous
+        self.host.say("names hidden on the projector" if self.anonymous else "names shown on the projector")
 
+    def move_selection(self, step: int) -> None:
+        n = len(self.seats())
+        self.selected = min(max(0, self.selected + step), max(0, n - 1))
+        self.remove_armed = None
 
-def toggle_roster(app: App) -> None:
-    if _need_server(app):
-        app.room.show_roster = not app.room.show_roster
-        app.room.remove_armed = None
+    def selected_seat(self) -> Seat | None:
+        seats = self.seats()
+        if not seats:
+            return None
+        self.selected = min(self.selected, len(seats) - 1)
+        return seats[self.selected]
 
+    def remove_selected(self) -> None:
+        """Delete: arm the removal of the selected student; Delete again within a few seconds removes them."""
+        seat = self.selected_seat()
+        if seat is None:
+            return
+        name, now = self.label(seat.name), self.host.clock_s
+        if self.remove_armed is not None and self.remove_armed[0] == seat.number and now < self.remove_armed[1]:
+            self.remove_armed = None
+            if self.host.server.remove(seat.number):
+                self.host.say(f"removed {name}")
+            return
+        self.remove_armed = (seat.number, now + REMOVE_CONFIRM_S)
+        self.host.say(f"press Delete again to remove {name}")
 
-def toggle_hands_off(app: App) -> None:
-    if _need_server(app):
-        app.server.hands_off = not app.server.hands_off
-        app.say("hands off: students' cursors let go" if app.server.hands_off else "students' cursors act again")
+    def click(self, pos: tuple[int, int]) -> bool:
+        """A click on the roster panel selects the row under it; True if the panel took the click."""
+        for number, rect in self.row_boxes:
+            if rect.collidepoint(pos):
+                numbers = [s.number for s in self.seats()]
+                if number in numbers:
+                    self.selected = numbers.index(number)
+                    self.remove_armed = None
+                return True
+        return self.panel_box is not None and self.panel_box.collidepoint(pos)
 
-
-def next_floor(app: App) -> None:
-    """The floor to the next student in seat order; after the last, back to everyone."""
-    if not _need_server(app):
-        return
-    numbers = [s.number for s in _seats(app)]
-    current = app.server.floor
-    later = [n for n in numbers if current is None or n > current]
-    app.server.floor = later[0] if later else None
-    if app.server.floor is None:
-        app.say("the floor is back to everyone" if numbers else "no students to give the floor to")
-
-
-def toggle_anonymous(app: App) -> None:
-    app.room.anonymous = not app.room.anonymous
-    app.say("names hidden on the projector" if app.room.anonymous else "names shown on the projector")
-
-
-def move_selection(app: App, step: int) -> None:
-    n = len(_seats(app))
-    app.room.selected = min(max(0, app.room.selected + step), max(0, n - 1))
-    app.room.remove_armed = None
-
-
-def selected_seat(app: App) -> Seat | None:
-    seats = _seats(app)
-    if not seats:
-        return None
-    app.room.selected = min(app.room.selected, len(seats) - 1)
-    return seats[app.room.selected]
-
-
-def remove_selected(app: App) -> None:
-    """Delete: arm the removal of the selected student; Delete again within a few seconds removes them."""
-    seat = selected_seat(app)
-    if seat is None:
-        return
-    room = app.room
-    name = room.label(seat.name)
-    if room.remove_armed is not None and room.remove_armed[0] == seat.number and app.clock_s < room.remove_armed[1]:
-        room.remove_armed = None
-        if app.server.remove(seat.number):
-            app.say(f"removed {name}")
-        return
-    room.remove_armed = (seat.number, app.clock_s + REMOVE_CONFIRM_S)
-    app.say(f"press Delete again to remove {name}")
-
-
-def click(app: App, pos: tuple[int, int]) -> bool:
-    """A click on the roster panel selects the row under it; True if the panel took the click."""
-    room = app.room
-    for number, rect in room.row_boxes:
-        if rect.collidepoint(pos):
-            numbers = [s.number for s in _seats(app)]
-            if number in numbers:
-                room.selected = numbers.index(number)
-                room.remove_armed = None
+    def handle_event(self, event: pygame.event.Event) -> bool:
+        """While the roster is open: Up / Down / Delete, and clicks on it (not on the pucks beneath)."""
+        if self.overlays.panel() != "roster":
+            return False
+        if event.type == pygame.KEYDOWN and event.key in ROSTER_KEYS:
+            ROSTER_KEYS[event.key](self)
             return True
-    return room.panel_box is not None and room.panel_box.collidepoint(pos)
+        if event.type == pygame.MOUSEBUTTONDOWN and event.button in (1, 2, 3) and self.click(event.pos):
+            self.host.mouse_px = event.pos
+            return True
+        return False
+
+    # F2-F5 share F1's row (panels.py documents them): the help must fit one page on a 900 x 788
+    # window; the roster panel (F2) and the HUD's "3 students (F2: roster)" name them in full.
+    bindings = (
+        Binding(
+            "F1",
+            actions={
+                pygame.K_F2: toggle_roster,
+                pygame.K_F3: toggle_hands_off,
+                pygame.K_F4: next_floor,
+                pygame.K_F5: toggle_anonymous,
+            },
+        ),
+    )
+
+
+# Keys the roster panel takes while it is open (its hints say so).
+ROSTER_KEYS = {
+    pygame.K_UP: lambda room: room.move_selection(-1),
+    pygame.K_DOWN: lambda room: room.move_selection(+1),
+    pygame.K_DELETE: Room.remove_selected,
+    pygame.K_BACKSPACE: Room.remove_selected,
+}

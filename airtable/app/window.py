@@ -25,9 +25,9 @@ from airtable.app import panel_view
 from airtable.app.aids_paint import AidsPainter  # noqa: F401  (imported from here by the app)
 from airtable.app.environment import Environment, fitting_size_px
 from airtable.app.hud_view import HudLine, HudStyle, TextLayout, draw_hud, fit_parts, text_layout
-from airtable.app.lessons_paint import LessonsPainter  # noqa: F401  (imported from here by lessons_view)
+from airtable.app.lessons_paint import LessonsPainter  # noqa: F401  (imported from here by the student's window)
 from airtable.app.pucks_view import COLORKEY, MIN_PUCK_RADIUS_PX, PuckSprites, draw_pucks
-from airtable.app.timeline_paint import TimelinePainter  # noqa: F401  (imported from here by the app)
+from airtable.app.timeline_paint import TimelinePainter  # noqa: F401  (imported from here by the student's window)
 from airtable.assets import ASSETS_DIR
 from airtable.model.scene import Scene
 

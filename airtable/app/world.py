@@ -1,9 +1,12 @@
-"""Change the world live: restitution, the strength of gravity, and a puck's mass and radius, from keys.
+"""Change the world live (`LiveEdits`): freeze, time reversed, gravity, restitution, the correction
+mode, and a puck's mass and radius, from keys.
 
-The steps are pure functions (tested by hand numbers); the actions below
-apply them to the app's table and say the new value on the message line.
+The steps are pure functions (tested by hand numbers); the feature's actions
+apply them to the host's table and say the new value on the message line.
 The status line shows the restitution and the gravity (`gravity_label`).
 
+- f freezes every puck, r flips every velocity (time reversed);
+- g: gravity on or off (restitution 0.9 with it, 1.0 without); p, z: the correction mode;
 - restitution of pucks (u) and of walls (w): down a tenth, with Shift up, 0 to 1;
 - gravity (Shift+g): off, Moon, Mars, Earth, off, ...;
 - the mass (- / =) and radius ([ / ]) of the puck under the cursor (or the one
@@ -17,12 +20,15 @@ from __future__ import annotations
 import math
 from typing import TYPE_CHECKING
 
+import pygame
+
+from airtable.app.feature import Binding, Feature
 from airtable.model.momenta import puck_number
 from airtable.physics.forces import GRAVITY_MPS2
+from airtable.physics.pairs import CORRECTION_MODES
 from airtable.physics.table import AirTable
 
 if TYPE_CHECKING:
-    from airtable.app.app import App
     from airtable.physics.bodies import Puck
 
 GRAVITY_STEPS = ((0.0, "off"), (1.62, "Moon"), (3.71, "Mars"), (GRAVITY_MPS2, "Earth"))
@@ -69,79 +75,125 @@ def ladder_step(value: float, direction: int, lo: float, hi: float) -> float:
     return min(hi, max(lo, found))
 
 
-# ---------------------------------------------------------------- actions
+class LiveEdits(Feature):
+    """The keys that change the world while it runs; the state they change is the table's."""
 
+    def freeze(self) -> None:
+        self.host.table.vel_mps[:] = 0.0
 
-def _restitution(app: App, attr: str, what: str, direction: int) -> None:
-    t = app.table
-    setattr(t, attr, step_restitution(getattr(t, attr), direction))
-    app.say(f"restitution of {what}: {getattr(t, attr):g}")
+    def reverse_time(self) -> None:
+        self.host.table.vel_mps[:] *= -1.0
+        self.host.say("time reversed: every velocity flipped")
 
+    def toggle_gravity(self) -> None:
+        t = self.host.table
+        t.gravity_on = not t.gravity_on
+        t.cr_puck = t.cr_wall = 0.9 if t.gravity_on else 1.0
 
-def puck_restitution_down(app: App) -> None:
-    _restitution(app, "cr_puck", "pucks (puck on puck)", -1)
+    def toggle_correction(self) -> None:
+        """The next correction mode: off, two-step, perfect kiss, off, ..."""
+        t, modes = self.host.table, CORRECTION_MODES
+        t.puck_correction = modes[(modes.index(t.puck_correction) + 1) % len(modes)]
 
+    def toggle_perfect_kiss(self) -> None:
+        t = self.host.table
+        t.puck_correction = "two-step" if t.puck_correction == "perfect-kiss" else "perfect-kiss"
 
-def puck_restitution_up(app: App) -> None:
-    _restitution(app, "cr_puck", "pucks (puck on puck)", +1)
+    def cycle_gravity(self) -> None:
+        """Shift+g: off, Moon, Mars, Earth; the restitution stays as it is."""
+        t = self.host.table
+        strength, name = next_gravity(t.gravity_on, t.gravity_mps2)
+        t.gravity_on = strength > 0.0
+        if t.gravity_on:
+            t.gravity_mps2 = strength
+            self.host.say(f"gravity {strength:g} m/s² ({name})")
+        else:
+            self.host.say("gravity off")
 
+    def _restitution(self, attr: str, what: str, direction: int) -> None:
+        t = self.host.table
+        setattr(t, attr, step_restitution(getattr(t, attr), direction))
+        self.host.say(f"restitution of {what}: {getattr(t, attr):g}")
 
-def wall_restitution_down(app: App) -> None:
-    _restitution(app, "cr_wall", "walls", -1)
+    def puck_restitution_down(self) -> None:
+        self._restitution("cr_puck", "pucks (puck on puck)", -1)
 
+    def puck_restitution_up(self) -> None:
+        self._restitution("cr_puck", "pucks (puck on puck)", +1)
 
-def wall_restitution_up(app: App) -> None:
-    _restitution(app, "cr_wall", "walls", +1)
+    def wall_restitution_down(self) -> None:
+        self._restitution("cr_wall", "walls", -1)
 
+    def wall_restitution_up(self) -> None:
+        self._restitution("cr_wall", "walls", +1)
 
-def cycle_gravity(app: App) -> None:
-    """Shift+g: off, Moon, Mars, Earth; the restitution stays as it is."""
-    t = app.table
-    strength, name = next_gravity(t.gravity_on, t.gravity_mps2)
-    t.gravity_on = strength > 0.0
-    if t.gravity_on:
-        t.gravity_mps2 = strength
-        app.say(f"gravity {strength:g} m/s² ({name})")
-    else:
-        app.say("gravity off")
+    def target_puck(self) -> Puck | None:
+        """The puck the local user holds, else the one under the cursor."""
+        held = self.host.local.held
+        if held is not None and held.alive:
+            return held
+        return self.host.table.puck_at(self.host.env.to_world(self.host.mouse_px))
 
+    def _change_puck(self, what: str, direction: int) -> None:
+        puck, say = self.target_puck(), self.host.say
+        if puck is None:
+            say("put the cursor on a puck to change its mass (- / =) or radius ([ / ])")
+            return
+        t, row = self.host.table, puck.index
+        if what == "mass":
+            old = float(t.mass_kg[row])
+            t.mass_kg[row] = ladder_step(old, direction, *MASS_RANGE_KG)
+            say(f"puck {puck_number(row)}: mass {t.mass_kg[row]:g} kg (was {old:.3g} kg; its velocity kept)")
+        else:
+            old = float(t.radius_m[row])
+            top = min(RADIUS_RANGE_M[1], 0.45 * min(t.width_m, t.height_m))
+            t.radius_m[row] = ladder_step(old, direction, RADIUS_RANGE_M[0], top)
+            say(f"puck {puck_number(row)}: radius {t.radius_m[row]:g} m (was {old:.3g} m; its mass kept)")
 
-def target_puck(app: App) -> Puck | None:
-    """The puck the local user holds, else the one under the cursor."""
-    held = app.local.held
-    if held is not None and held.alive:
-        return held
-    return app.table.puck_at(app.env.to_world(app.mouse_px))
+    def mass_down(self) -> None:
+        self._change_puck("mass", -1)
 
+    def mass_up(self) -> None:
+        self._change_puck("mass", +1)
 
-def _change_puck(app: App, what: str, direction: int) -> None:
-    puck = target_puck(app)
-    if puck is None:
-        app.say("put the cursor on a puck to change its mass (- / =) or radius ([ / ])")
-        return
-    t, row = app.table, puck.index
-    if what == "mass":
-        old = float(t.mass_kg[row])
-        t.mass_kg[row] = ladder_step(old, direction, *MASS_RANGE_KG)
-        app.say(f"puck {puck_number(row)}: mass {t.mass_kg[row]:g} kg (was {old:.3g} kg; its velocity kept)")
-    else:
-        old = float(t.radius_m[row])
-        top = min(RADIUS_RANGE_M[1], 0.45 * min(t.width_m, t.height_m))
-        t.radius_m[row] = ladder_step(old, direction, RADIUS_RANGE_M[0], top)
-        app.say(f"puck {puck_number(row)}: radius {t.radius_m[row]:g} m (was {old:.3g} m; its mass kept)")
+    def radius_down(self) -> None:
+        self._change_puck("radius", -1)
 
+    def radius_up(self) -> None:
+        self._change_puck("radius", +1)
 
-def mass_down(app: App) -> None:
-    _change_puck(app, "mass", -1)
-
-
-def mass_up(app: App) -> None:
-    _change_puck(app, "mass", +1)
-
-
-def radius_down(app: App) -> None:
-    _change_puck(app, "radius", -1)
-
-
-def radius_up(app: App) -> None:
-    _change_puck(app, "radius", +1)
+    bindings = (
+        Binding("f", "freeze: all velocities to zero", {pygame.K_f: freeze}),
+        Binding("g", "gravity on/off (restitution 0.9 with gravity, 1.0 without)", {pygame.K_g: toggle_gravity}),
+        Binding("p", "correction: off, two-step, perfect kiss in turn", {pygame.K_p: toggle_correction}),
+        Binding("z", "perfect kiss on/off", {pygame.K_z: toggle_perfect_kiss}),
+        Binding("r", "reverse time: flip every velocity", {pygame.K_r: reverse_time}),
+        Binding(
+            "u / w",
+            "restitution of pucks / walls down a tenth (with Shift: up)",
+            {
+                pygame.K_u: puck_restitution_down,
+                (pygame.KMOD_SHIFT, pygame.K_u): puck_restitution_up,
+                pygame.K_w: wall_restitution_down,
+                (pygame.KMOD_SHIFT, pygame.K_w): wall_restitution_up,
+            },
+        ),
+        Binding(
+            "Shift+g",
+            "gravity: off, Moon 1.62, Mars 3.71, Earth 9.8 m/s²",
+            {(pygame.KMOD_SHIFT, pygame.K_g): cycle_gravity},
+        ),
+        Binding(
+            "- / =, [ / ]",
+            "mass, radius of the puck under the cursor: down / up",
+            {
+                pygame.K_MINUS: mass_down,
+                pygame.K_KP_MINUS: mass_down,
+                pygame.K_EQUALS: mass_up,
+                pygame.K_PLUS: mass_up,
+                pygame.K_KP_PLUS: mass_up,
+                pygame.K_LEFTBRACKET: radius_down,
+                pygame.K_RIGHTBRACKET: radius_up,
+            },
+        ),
+    )

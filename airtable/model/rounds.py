@@ -10,6 +10,7 @@ from dataclasses import dataclass, field
 STATES = ("open", "revealed", "closed")
 MAX_PREDICT_SPEED_MPS = 100.0  # far above any demo; a bigger guess is a mistake, not physics
 MAX_ROUND_PUCKS = 256  # pucks a round offers for prediction (a class predicts a handful)
+ARROW_S = 1.0  # a prediction arrow is drawn as far as the puck would go in this time
 
 
 @dataclass(frozen=True)

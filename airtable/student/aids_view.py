@@ -11,7 +11,7 @@ import numpy as np
 
 from airtable.app.aids_paint import AidsPainter, draw_annotations
 from airtable.app.aids_view import COM_COLOR
-from airtable.app.lessons_view import VALUES_HINT
+from airtable.app.lessons_paint import VALUES_HINT
 from airtable.model import aids
 from airtable.model import shared_aids as aids_wire
 from airtable.model.momenta import FEW_PUCKS, puck_number

@@ -1,0 +1,169 @@
+"""The panels in the middle of the teacher's window (`Panels`): help, notes, the demo menu, a demo's
+error, a notice, and the quit question, with their keys.
+
+What is open lives in the one overlay stack (overlays.py); this feature opens
+and closes its panels there and draws the one on top. Esc closes what is on
+top (any overlay: the roster, the chart, the lesson panels too); with nothing
+open it asks, and Esc again while asked quits.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from typing import TYPE_CHECKING
+
+import pygame
+
+from airtable.app.demo_loader import key_label
+from airtable.app.feature import Binding, Feature
+from airtable.app.menu import DemoMenu
+from airtable.app.overlays import OverlayFlag, OverlayValue
+
+if TYPE_CHECKING:
+    from airtable.app.host import Host
+
+QUIT_CONFIRM_S = 4.0  # the quit question waits this long for a second Esc (or window close)
+ERROR_TITLES = {
+    "load": "Demo {key} could not be loaded",
+    "build": "Demo {key} could not be built",
+    "event": "Demo {key}: a timed event failed",
+}
+MODIFIER_KEYS = frozenset(
+    getattr(pygame, f"K_{side}{name}") for side in "LR" for name in ("SHIFT", "CTRL", "ALT", "META", "SUPER")
+)
+
+
+class Panels(Feature):
+    """The panels' state (`app.panels`): which help page, the menu, the notice, the quit question."""
+
+    show_help = OverlayFlag("help")
+    show_notes = OverlayFlag("notes")
+    menu = OverlayValue("menu")  # a DemoMenu while the menu is open
+    notice = OverlayValue("notice", empty=[])  # lines of a "press any key" notice
+    draw_order = 4  # over the aids and the round; the roster (room.py) is a panel too
+
+    def __init__(self, host: Host, key_rows: Sequence[Binding]) -> None:
+        super().__init__(host)
+        self.key_rows = key_rows  # the help's rows: the app's whole key table
+        self.help_page, self.help_pages = 0, 1
+        self.quit_armed_until = -1.0  # clock_s until which a second Esc quits
+
+    def panel(self) -> str | None:
+        """Which panel is in the middle of the window now, if any (the quit question lapses)."""
+        if self.overlays.shown("quit") and self.host.clock_s >= self.quit_armed_until:
+            self.overlays.close("quit")
+        return self.overlays.panel()
+
+    def close_panel(self) -> bool:
+        """Close what is on top (a panel, else the chart, values or momenta); False if nothing was open."""
+        self.panel()  # a lapsed quit question first
+        closing = self.overlays.top()
+        if closing == "help":
+            self.help_page = 0
+        return closing is not None and self.overlays.close(closing)
+
+    def handle_event(self, event: pygame.event.Event) -> bool:
+        """The window's close button; and a key, while a panel that waits for one is open."""
+        if event.type == pygame.QUIT:
+            self.close_window()
+            return True
+        return event.type == pygame.KEYDOWN and self._take_key(event)
+
+    def _take_key(self, event: pygame.event.Event) -> bool:
+        """A panel that waits for a key takes it first; True if it did."""
+        panel = self.panel()
+        if event.key == pygame.K_ESCAPE or panel not in ("quit", "menu", "notice"):
+            return False
+        if event.key in MODIFIER_KEYS:
+            return True  # Shift or Ctrl alone answers nothing: it starts a key
+        if panel == "menu" and event.key == pygame.K_TAB:
+            self.menu = None
+        elif panel == "menu":
+            picked = self.menu.press(pygame.key.name(event.key), getattr(event, "unicode", ""))
+            if picked is not None:
+                self.menu = None
+                self.host.start_demo(picked)
+        else:
+            self.close_panel()  # "press any key to go on"; any key but Esc keeps the table running
+        return True
+
+    # ------------------------------------------------------------ quitting
+
+    def escape(self) -> None:
+        """Esc: close what is on top; with nothing open, ask; Esc again while asked quits."""
+        if self.panel() == "quit":
+            self.quit_now()
+        elif not self.close_panel():
+            self.ask_to_quit()
+
+    def close_window(self) -> None:
+        """The window's close button: quit, asking first while leaving would drop students or
+        lose recording; closing again (or Esc) while asked quits."""
+        if self.panel() == "quit" or not self.host.quit_would_lose():
+            self.quit_now()
+        else:
+            self.ask_to_quit()
+
+    def quit_now(self) -> None:
+        """Quit after this frame, which is drawn without the question (--screenshot saves it)."""
+        self.overlays.close("quit")
+        self.host.stop()
+
+    def ask_to_quit(self) -> None:
+        self.quit_armed_until = self.host.clock_s + QUIT_CONFIRM_S
+        self.overlays.open("quit")
+
+    # ------------------------------------------------------------ keys
+
+    def open_menu(self) -> None:
+        host = self.host
+        for error in host.shelf.refresh():
+            host.report(error)
+        self.menu = DemoMenu([(key, demo.title) for key, demo in host.demos.items()], current=host.demo_key)
+
+    def toggle_notes(self) -> None:
+        self.show_notes = not self.show_notes
+
+    def toggle_help(self) -> None:
+        """F1: help; again for its next page, if it has more than one; then closed."""
+        if not self.show_help:
+            self.show_help, self.help_page = True, 0
+        else:
+            self.help_page += 1
+            self.show_help = self.help_page < self.help_pages
+            self.help_page = self.help_page if self.show_help else 0
+
+    # ------------------------------------------------------------ drawing
+
+    def draw(self) -> None:
+        panel, w, host = self.panel(), self.host.window, self.host
+        if panel == "quit":
+            w.draw_question("Quit?", [*host.quit_would_lose(), "Esc again to quit; any other key to stay."])
+        elif panel == "menu":
+            rows = self.menu.rows(visible=w.panel_rows() - 2, label=key_label)  # the footer under them
+            w.draw_panel("Demos", [*rows, self.menu.footer()])
+        elif panel == "error":
+            w.draw_panel(*self._error_text())
+        elif panel == "notice":
+            w.draw_panel("Some demo files could not be loaded", [*self.notice, "Press any key to go on."])
+        elif panel == "help":
+            rows = [(key_label(k), d.title) for k, d in host.demos.items()]
+            keys = [(b.label, b.help) for b in self.key_rows]
+            self.help_pages = w.draw_panel("Keys", keys, side_title="Demos", side_rows=rows, page=self.help_page)
+        elif panel == "notes":
+            w.draw_panel(host.demo.label(host.variation), [host.demo.notes or "(no notes)"], large=True)
+
+    def _error_text(self) -> tuple[str, list[str]]:
+        """The demo error panel's title and lines: what failed, and how to try again."""
+        key = self.host.demo_key
+        title = ERROR_TITLES[self.host.build_error.stage].format(key=key_label(key))
+        label = key_label(key)  # "7", "Shift+1"; keys like "t1" have no key of their own
+        again = f"press {label} again" if len(key) == 1 or label != key else "pick it in Tab's menu"
+        return title, [str(self.host.build_error), f"Fix the file, then {again}. Esc hides this."]
+
+    bindings = (
+        Binding("Tab", "demo menu: every demo; arrows and Enter, or type its key", {pygame.K_TAB: open_menu}),
+        Binding("l", "lecture notes for this demo", {pygame.K_l: toggle_notes}),
+        Binding("F1", "this help screen (again: next page); F2-F5: the room", {pygame.K_F1: toggle_help}),
+        Binding("Esc", "close what is open (the newest first); else asks: Esc again quits", {pygame.K_ESCAPE: escape}),
+    )

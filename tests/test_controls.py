@@ -1,0 +1,39 @@
+"""The key table gathered from the features: every key bound once, every row placed in the help."""
+
+from __future__ import annotations
+
+import pygame
+import pytest
+
+from airtable.app.app import BINDINGS, App
+from airtable.app.controls import HELP_ORDER, KeyTable, help_rows
+from airtable.app.feature import Binding, Feature
+
+
+def test_the_help_lists_every_key_the_features_bind(demos):
+    app = App(demos, headless=True)
+    bound = {key for owner in (app, *app.features) for b in owner.bindings for key in b.actions}
+    listed = {key for row in BINDINGS for key in row.actions}
+    assert bound == listed
+    assert [row.label for row in BINDINGS] == list(HELP_ORDER)
+
+
+def test_a_row_without_help_joins_the_documented_row_of_its_label():
+    """The room's F2-F5 share F1's row, so the help fits one page."""
+    f1 = next(row for row in BINDINGS if row.label == "F1")
+    assert f1.help.startswith("this help screen") and {pygame.K_F1, pygame.K_F5} <= set(f1.actions)
+    with pytest.raises(ValueError, match="nobody documents"):
+        help_rows([Binding("F1", actions={pygame.K_F2: lambda feature: None})])
+
+
+def test_a_row_the_help_does_not_place_is_refused():
+    with pytest.raises(ValueError, match="HELP_ORDER"):
+        help_rows([Binding("F7", "nothing yet")])
+
+
+def test_a_key_bound_twice_is_refused():
+    class Twice(Feature):
+        bindings = (Binding("f", "again", {pygame.K_f: lambda feature: None}),)
+
+    with pytest.raises(ValueError, match="bound already"):
+        KeyTable([Twice(None), Twice(None)])
