@@ -18,7 +18,7 @@ from collections.abc import Callable
 
 import numpy as np
 
-from airtable.physics import vectors, walls
+from airtable.physics import vectors
 
 # Below this many pucks, checking every pair with one numpy expression is
 # cheaper than building a grid.
@@ -231,20 +231,6 @@ class NeighbourList:
             self._partners = Partners(self._i, self._j, len(self._built_pos))
         return self._partners
 
-    def near_walls(self, size_m: np.ndarray) -> np.ndarray:
-        """The rows that were within a skin of a wall of the box [0, size_m] at the last build.
-
-        Call `pairs` first. Until the list is rebuilt no puck moves half a skin
-        from where it was then, so no other puck can have reached a wall: the
-        wall stage checks only these (a few hundred of 10000 in a gas).
-        """
-        key = (float(size_m[0]), float(size_m[1]))
-        rows = self._near_walls.get(key)
-        if rows is None:
-            room = walls.room_to_walls(self._built_pos, self._built_radius, key)
-            rows = self._near_walls[key] = (~(room >= self._skin)).nonzero()[0]  # NaN counts as near
-        return rows
-
     def sorted_order(self) -> np.ndarray:
         """The permutation that sorts the pairs by (i, j), worked out the first time it is asked for."""
         if self._order is None:
@@ -262,17 +248,6 @@ class NeighbourList:
             r = (self._reach if self._one_reach is None else self._one_reach) - less_m
             sq = self._squared[less_m] = r * r
         return sq
-
-    def reach_squared_of(self, k: np.ndarray, less_m: float = 0.0) -> np.ndarray | float:
-        """reach_squared(less_m) of the pairs k only (the one number, where it is one)."""
-        sq = self.reach_squared(less_m)
-        return sq if self._one_reach is not None else sq.take(k)
-
-    def within(self, dsq: np.ndarray, extra_m: float) -> np.ndarray:
-        """Indices k of the pairs whose squared distance dsq[k] (one per pair of the list) is
-        under (reach + extra_m)^2."""
-        r = (self._reach if self._one_reach is None else self._one_reach) + extra_m
-        return (dsq < r * r).nonzero()[0]
 
     def _still_valid(self, pos: np.ndarray, radius: np.ndarray, rows: np.ndarray | None = None) -> bool:
         """Whether no puck moved half a skin since the build (`rows`: pos and radius are just those rows)."""
@@ -312,7 +287,6 @@ class NeighbourList:
         self._squared: dict[float, np.ndarray] = {}  # see reach_squared
         self._built_pos, self._built_radius = pos.copy(), radius.copy()
         self._skin, self._half_skin_sq = skin, (0.5 * skin) ** 2
-        self._near_walls: dict[tuple[float, float], np.ndarray] = {}  # see near_walls
         self.builds += 1
 
 

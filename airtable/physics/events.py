@@ -3,10 +3,10 @@
 After the Euler update each puck moves on a straight line through the step: at
 time t (0 <= t <= dt) puck k is at o_k + v_k t, o_k being where its present path
 had it at t = 0 (its "origin"). A hit is an event at the time two paths first
-touch (reference.contact_time) or a path reaches a wall (reference.wall_time).
+touch (collision.contact_time) or a path reaches a wall (collision.wall_time).
 The events wait in a queue by time, as in Rapaport's event-driven method: the
 earliest is resolved (the pucks where they touch, collided along the normal with
-reference.collide_1d, then on new paths from there), and only the hits of the
+collision.collide_along, then on new paths from there), and only the hits of the
 pucks it changed are predicted again; a prediction made before one of its
 pucks changed is stale and dropped. So a puck's several hits, a hit just after
 a wall bounce and a pair squeezed against a wall all happen in their order: in
@@ -38,8 +38,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from airtable.physics import broadphase, reference, vectors
-from airtable.physics.pairs import Collisions
+from airtable.physics import broadphase, collision, vectors
+from airtable.physics.collision import Collisions
 
 # A bound on the events of one step (the pi setup at 10^8:1 needs some hundreds).
 MAX_EVENTS = 100_000
@@ -77,7 +77,8 @@ class Rules:
 class Hits:
     """What the hits in time order did in one step: the pair hits as rows, the wall bounces."""
 
-    # (i, j, n, overlap, xi, xj before, xi, xj after, vi, vj before, after), vectors complex
+    # (i, j, n, xj at contact, overlap, xi, xj before, xi, xj after, vi, vj before, after): the fields of
+    # Collisions.of_pairs, one hit each, vectors complex
     rows: list = field(default_factory=list)
     walls: int = 0
     capped: bool = False
@@ -88,24 +89,20 @@ class Hits:
         two-step one where the step's end caught them overlapping, and where it moved them."""
         if not self.rows:
             return Collisions.empty()
-        i, j, n, overlap, *states = (np.array(column) for column in zip(*self.rows, strict=True))
-        reach = radius.take(i) + radius.take(j)
-        contact = states[1] + radius.take(j) * n
-        n, contact, *states = (vectors.as_rows(np.ascontiguousarray(z)) for z in (n, contact, *states))
-        return Collisions(i, j, n, contact, overlap, reach, *states)
+        i, j, n, touch_j, overlap, *states = (np.array(column) for column in zip(*self.rows, strict=True))
+        return Collisions.of_pairs(i, j, n, touch_j, overlap, radius, *states)
 
 
-def resolve_hits(pos, vel, radius, mass, size_m, dt: float, rules: Rules, neighbours, near_walls=None) -> Hits:
+def resolve_hits(pos, vel, radius, mass, size_m, dt: float, rules: Rules, neighbours) -> Hits:
     """Resolve this step's hits in time order, in place (see the module docstring).
 
     pos: positions at the end of the step (x0 + v dt, done); vel: the step's
-    velocities. neighbours: the table's NeighbourList; near_walls: the rows
-    that may be past a wall (None: every row).
+    velocities. neighbours: the table's NeighbourList.
     """
     step = _Step(pos, vel, radius, mass, size_m, dt, rules)
     if len(pos) == 0 or dt <= 0.0:
         return step.hits
-    past = step.past_walls(near_walls) if rules.walls else None
+    past = step.past_walls() if rules.walls else None
     for k in past or ():
         step.predict_walls(k)
     if step.predicts_pairs():
@@ -192,15 +189,12 @@ class _Step:
 
     # ------------------------------------------------------------ predicting
 
-    def past_walls(self, near_walls) -> list[int]:
+    def past_walls(self) -> list[int]:
         """The rows the step ends past a wall: each hit a wall during it (or was there already)."""
         from airtable.physics.walls import room_to_walls  # walls imports nothing of this module
 
-        pos = vectors.as_rows(self.zpos)
-        rows = None if near_walls is None else near_walls
-        p, r = (pos, self.radius) if rows is None else (vectors.take(pos, rows), self.radius.take(rows))
-        out = (room_to_walls(p, r, (self.width, self.height)) < 0.0).nonzero()[0]
-        return (out if rows is None else rows.take(out)).tolist()
+        room = room_to_walls(vectors.as_rows(self.zpos), self.radius, (self.width, self.height))
+        return (room < 0.0).nonzero()[0].tolist()
 
     def predicts_pairs(self) -> bool:
         if self.rules.pairs == "perfect-kiss":
@@ -252,10 +246,10 @@ class _Step:
             return  # the pair stage sees this pair overlapping, if it hits
         d, w = self.at(a, t_now) - self.at(b, t_now), self.zvel.item(a) - self.zvel.item(b)
         reach = self.radius.item(a) + self.radius.item(b)
-        hit = reference.contact_time((d.real, d.imag), (w.real, w.imag), reach)
-        if hit is None or t_now + hit[0] > dt:
+        t, speed = collision.contact_time(d, w, reach)
+        t = t_now + (t if t > 0.0 else 0.0)  # overlapping and approaching (by round-off): they hit now
+        if t > dt:  # inf where they never meet
             return
-        t, speed = t_now + hit[0], hit[1]
         if self.rules.pairs != "perfect-kiss":
             caught = _caught_overlapping(d + w * (dt - t_now), w, reach)
             if caught is not None and self.rules.pairs == "off":
@@ -275,7 +269,7 @@ class _Step:
         """Queue puck k's next wall hit on its present path, if it comes within the step."""
         x, v, r = self.at(k, self.t_now), self.zvel.item(k), self.radius.item(k)
         for axis, (xa, va, size) in enumerate(((x.real, v.real, self.width), (x.imag, v.imag, self.height))):
-            t = reference.wall_time(xa, va, r, size - r)
+            t = collision.wall_time(xa, va, r, size - r)
             if t is None or self.t_now + t > self.dt or not abs(va) > self._wall_rest(k, axis):
                 continue
             self.push(self.t_now + t, k, -1 - axis)
@@ -328,9 +322,9 @@ class _Step:
         e, a = self.rules.cr_wall, self.rules.accel_y_mps2
         self.hits.walls += 1
         if axis == 0:
-            self.set_path(k, x, complex(-e * v.real, v.imag))
+            self.set_path(k, x, complex(collision.bounce(v.real, e), v.imag))
         elif a == 0.0:
-            self.set_path(k, x, complex(v.real, -e * v.imag))
+            self.set_path(k, x, complex(v.real, collision.bounce(v.imag, e)))
         else:
             vy, offset = self.bounce_under_gravity(v.imag, a)
             self.set_path(k, x, complex(v.real, vy))
@@ -348,7 +342,7 @@ class _Step:
         heights fall by e^2. (A straight path is kept for the rest of the step's hits.)
         """
         s, left = self.t_now, self.dt - self.t_now
-        leave = -self.rules.cr_wall * (vy - a * (0.5 * self.dt - s))  # -e times the speed at contact
+        leave = collision.bounce(vy - a * (0.5 * self.dt - s), self.rules.cr_wall)  # off the speed at contact
         end = leave + a * (0.5 * self.dt - s)  # the new parabola's velocity half a step before the end
         if left <= 0.0 and leave * vy < 0.0:
             return leave, end - leave  # a hit at the very end
@@ -358,7 +352,7 @@ class _Step:
         return path, end - path
 
     def collide(self, a: int, b: int) -> None:
-        """a and b hit now: their normal velocities collide in 1D (reference.collide_1d).
+        """a and b hit now: they collide along the normal (collision.collide_along).
 
         The normal is the line of centres now; in two-step, for a pair the end of
         the step would catch overlapping and approaching, the line of centres there.
@@ -372,13 +366,11 @@ class _Step:
             if _caught_overlapping(end, va - vb, reach) is not None:
                 n, overlap, seen = end, reach - abs(end), (xa + va * left, xb + vb * left)
         n /= abs(n)
-        ua, ub = vectors.dot_one(va, n), vectors.dot_one(vb, n)
-        wa, wb = reference.collide_1d(ua, ub, self.mass.item(a), self.mass.item(b), self.rules.cr_puck)
-        new_a, new_b = va + (wa - ua) * n, vb + (wb - ub) * n
+        new_a, new_b = collision.collide_along(n, va, vb, self.mass.item(a), self.mass.item(b), self.rules.cr_puck)
         self.set_path(a, xa, new_a)
         self.set_path(b, xb, new_b)
         after = (self.at(a, self.dt), self.at(b, self.dt)) if overlap else seen
-        self.hits.rows.append((a, b, n, overlap, *seen, *after, va, vb, new_a, new_b))
+        self.hits.rows.append((a, b, n, seen[1], overlap, *seen, *after, va, vb, new_a, new_b))
         self.hit_pairs[a, b] = self.hit_pairs.get((a, b), 0) + 1
 
 
@@ -389,5 +381,5 @@ def _caught_overlapping(d: complex, w: complex, reach: float) -> tuple[float, fl
     dist = abs(d)
     if not (dist < reach and dist > 0.0):
         return None
-    u = -vectors.dot_one(d, w) / dist
+    u = -vectors.dot(d, w) / dist
     return ((reach - dist) / u, u) if u > 0.0 else None

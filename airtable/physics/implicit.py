@@ -21,7 +21,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from airtable.physics import vectors
+from airtable.physics import collision, vectors
 from airtable.physics.forces import Implicit
 
 # Up to this many pucks joined by implicit springs, solve the system directly
@@ -99,7 +99,7 @@ def brace_walls(
     below, above = (ends < lo) & (v1 < 0.0) & fresh, (ends > hi) & (v1 > 0.0) & fresh
     if not (below.any() or above.any()):
         return False
-    bounce = -cr_wall * v1
+    bounce = collision.bounce(v1, cr_wall)
     target = np.where(below, np.maximum(bounce, (lo - x) / dt), np.minimum(bounce, (hi - x) / dt))
     hit = below | above
     implicit.fixed[rows] |= hit

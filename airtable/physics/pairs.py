@@ -8,9 +8,9 @@ keeps their order); pairs in one round cannot affect each other, so resolving
 a round at once gives exactly the result of resolving its pairs one by one.
 
 A round is resolved by the function of the table's correction mode, all three
-built from the same two pieces: `collide_along_normal` (the 1D collision with
-restitution along the line of centres; the tangential velocity is kept) and
-`separate` (move the pair apart along a normal, then push apart what still
+built from the same two pieces: `collision.collide_along` (the 1D collision
+with restitution along the line of centres; the tangential velocity is kept)
+and `separate` (move the pair apart along a normal, then push apart what still
 overlaps).
 
 * "off": velocities only; the pucks stay overlapping ("stickiness").
@@ -20,89 +20,28 @@ overlaps).
   overlap, so it ends e times the overlap apart (as far apart as it
   overlapped at e = 1, touching at e = 0).
 * "perfect-kiss": back the pair up along its full relative motion to the
-  moment of first contact, take the normal there, collide, and go forward
-  again by the same time.
+  moment of first contact (`collision.contact_time`), take the normal there,
+  collide, and go forward again by the same time.
 
-reference.py does the same for one pair in plain Python floats, equation by
-equation; the tests check the two agree.
+One pair or a thousand, a round takes the same path: the formulas are those
+of collision.py, on numpy arrays.
 """
 
 from __future__ import annotations
 
-import math
 from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
 
-from airtable.physics import vectors
+from airtable.physics import collision, vectors
+from airtable.physics.collision import Collisions
 
 CORRECTION_MODES = ("off", "two-step", "perfect-kiss")
 
 # A relative normal speed smaller than this (m/s) counts as "not moving": such
 # an overlap cannot be explained by the last step's motion.
 REST_SPEED_MPS = 1e-9
-# Rounds of at most this many pairs are resolved one pair at a time in plain
-# floats (`_resolve_few`): a numpy call costs about a microsecond however few
-# rows it has, and a round makes some forty of them, while a gas mostly has
-# rounds of one to five pairs. The floats do the arrays' arithmetic in the
-# same order, so both paths give the same numbers (tests/test_few_in_floats.py).
-FEW_PAIRS = 8
-
-
-@dataclass
-class Collisions:
-    """What the pair resolution of one step did, for diagnostics and drawing.
-
-    One row per collision (an approaching pair whose velocities were changed):
-    puck rows i and j, the contact normal (unit, from j to i), the contact
-    point, the overlap when detected, the pair's reach (sum of the radii) and
-    both pucks' positions and velocities before and after this collision.
-    """
-
-    i: np.ndarray
-    j: np.ndarray
-    normal: np.ndarray
-    contact_m: np.ndarray
-    overlap_m: np.ndarray
-    reach_m: np.ndarray
-    pos_i_before: np.ndarray
-    pos_j_before: np.ndarray
-    pos_i_after: np.ndarray
-    pos_j_after: np.ndarray
-    vel_i_before: np.ndarray
-    vel_j_before: np.ndarray
-    vel_i_after: np.ndarray
-    vel_j_after: np.ndarray
-
-    @property
-    def separation_m(self) -> np.ndarray:
-        """The gap the position correction left (m); negative: still overlapping."""
-        return vectors.lengths(self.pos_i_after - self.pos_j_after) - self.reach_m
-
-    @classmethod
-    def empty(cls) -> Collisions:
-        z = np.empty(0)
-        zi = np.empty(0, dtype=np.intp)
-        z2 = np.empty((0, 2))
-        return cls(zi, zi, z2, z2, z, z, *([z2] * 8))
-
-    def __len__(self) -> int:
-        return len(self.i)
-
-    @classmethod
-    def concatenate(cls, parts: list[Recorded]) -> Collisions:
-        """One record of all the parts (each a Collisions, or a round's record made into one now)."""
-        if not parts:
-            return cls.empty()
-        parts = [p if isinstance(p, Collisions) else p.collisions() for p in parts]
-        if len(parts) == 1:
-            return parts[0]
-        return cls(*(np.concatenate([getattr(p, f) for p in parts]) for f in cls.__dataclass_fields__))
-
-    def take(self, k: np.ndarray) -> Collisions:
-        """Only the collisions k (indices into this record)."""
-        return Collisions(*(getattr(self, f).take(k, axis=0) for f in self.__dataclass_fields__))
 
 
 def sharing_pairs(i: np.ndarray, j: np.ndarray) -> np.ndarray:
@@ -153,15 +92,13 @@ def _chain_levels(i: list[int], j: list[int]) -> list[int]:
     return levels
 
 
-def since_contact(pos, vel, radius, i, j, dt_s: float) -> np.ndarray:
-    """How long ago each pair (i, j) first touched during the step (dt_s if its motion does not explain it)."""
-    d = vectors.take(pos, i) - vectors.take(pos, j)
-    w = vectors.take(vel, i) - vectors.take(vel, j)
-    reach = radius.take(i) + radius.take(j)
-    ww, dw = vectors.squared_lengths(w), vectors.dot_rows(d, w)
-    disc = np.maximum(dw * dw - ww * (vectors.squared_lengths(d) - reach * reach), 0.0)
-    back = (dw + np.sqrt(disc)) / np.where(ww > 0.0, ww, 1.0)
-    return np.where((ww > 0.0) & (back >= 0.0) & (back <= dt_s), back, dt_s)
+def time_back_to_contact(d, w, reach, dt_s: float) -> tuple[np.ndarray, np.ndarray]:
+    """(t, explained): how long ago (s) each overlapping pair d = x1 - x2 apart, moving at
+    w = v1 - v2, first touched (collision.contact_time), and whether this step's motion explains
+    it (it touched at most dt_s ago). t is 0 where it does not."""
+    t, _ = collision.contact_time(d, w, reach)
+    explained = (t <= 0.0) & (t >= -dt_s)
+    return np.where(explained, -t, 0.0), explained
 
 
 def resolve_pairs(
@@ -175,7 +112,7 @@ def resolve_pairs(
     mode: str,
     dt_s: float,
     in_time_order: bool = False,
-) -> list[Recorded]:
+) -> list[Collisions]:
     """Collide the overlapping pairs (i, j) in order, in place (see the module docstring).
 
     in_time_order: pairs that share a puck go in the order they met during
@@ -184,42 +121,21 @@ def resolve_pairs(
     """
     if mode not in CORRECTION_MODES:
         raise ValueError(f"puck_correction must be one of {CORRECTION_MODES}, not {mode!r}")
-
-    def since(k):
-        return since_contact(pos, vel, radius, i.take(k), j.take(k), dt_s)
-
     zpos, zvel = vectors.as_complex(pos), vectors.as_complex(vel)  # the rounds' vectors (see _Round)
-    if len(i) <= FEW_PAIRS:
-        return _resolve_few_in_order(zpos, zvel, radius, mass, i, j, cr_puck, mode, dt_s, in_time_order)
-    shared = sharing_pairs(i, j)
-    if len(shared) <= FEW_PAIRS:
-        # A gas's usual case. The pairs whose pucks are in no other pair
-        # cannot change the others: one round for them, then the few that
-        # share a puck, one by one in floats, in their rounds' order.
-        alone = np.ones(len(i), dtype=bool)
-        alone[shared] = False
-        alone, few = alone.nonzero()[0], shared
-        c = _resolve_round(zpos, zvel, radius, mass, i.take(alone), j.take(alone), cr_puck, mode, dt_s)
-        few_records = _resolve_few_in_order(
-            zpos, zvel, radius, mass, i.take(few), j.take(few), cr_puck, mode, dt_s, in_time_order
+
+    def since(k):  # how long ago the pairs k met (dt_s where the step does not explain it)
+        a, b = i.take(k), j.take(k)
+        t, explained = time_back_to_contact(
+            zpos.take(a) - zpos.take(b), zvel.take(a) - zvel.take(b), radius.take(a) + radius.take(b), dt_s
         )
-        return ([] if c is None else [c]) + few_records
+        return np.where(explained, t, dt_s)
+
     records = []
-    for r in disjoint_rounds(i, j, since if in_time_order else None, shared):
+    for r in disjoint_rounds(i, j, since if in_time_order else None):
         c = _resolve_round(zpos, zvel, radius, mass, i.take(r), j.take(r), cr_puck, mode, dt_s)
         if c is not None:
             records.append(c)
     return records
-
-
-def _resolve_few_in_order(zpos, zvel, radius, mass, i, j, cr_puck, mode, dt_s, in_time_order) -> list[Recorded]:
-    """resolve_pairs for a few pairs, in floats: in the order of their rounds, one by one."""
-    il, jl = i.tolist(), j.tolist()
-    order = _few_in_order(zpos, zvel, radius, il, jl, dt_s if in_time_order else None)
-    if order is not None:
-        il, jl = [il[k] for k in order], [jl[k] for k in order]
-    c = _resolve_few(zpos, zvel, radius, mass, il, jl, cr_puck, mode, dt_s)
-    return [] if c is None else [c]
 
 
 def push_apart(pos: np.ndarray, radius: np.ndarray, mass: np.ndarray, i: np.ndarray, j: np.ndarray) -> None:
@@ -260,8 +176,10 @@ class _Round:
     x2: np.ndarray
     v1: np.ndarray  # velocities
     v2: np.ndarray
-    share1: np.ndarray  # a puck's part of a change in relative motion: m2 / (m1 + m2) for puck 1,
-    share2: np.ndarray  # m1 / (m1 + m2) for puck 2 (the lighter one moves more)
+    m1: np.ndarray  # masses
+    m2: np.ndarray
+    share1: np.ndarray  # a puck's part of a change in relative motion (collision.mass_shares)
+    share2: np.ndarray
     r2: np.ndarray
     reach: np.ndarray  # r1 + r2
     d: np.ndarray  # x1 - x2
@@ -312,22 +230,17 @@ def _gather(zpos, zvel, radius, mass, a, b) -> _Round | None:
         a, b, x1, x2, d, r2, reach, n, overlap = (v.take(keep) for v in (a, b, x1, x2, d, r2, reach, n, overlap))
     v1, v2 = zvel.take(a), zvel.take(b)
     m1, m2 = mass.take(a), mass.take(b)
-    m_sum = m1 + m2
     vrel = v1 - v2
-    return _Round(a, b, x1, x2, v1, v2, m2 / m_sum, m1 / m_sum, r2, reach, d, n, overlap, vrel, vectors.dot(vrel, n))
+    shares = collision.mass_shares(m1, m2)
+    return _Round(a, b, x1, x2, v1, v2, m1, m2, *shares, r2, reach, d, n, overlap, vrel, vectors.dot(vrel, n))
 
 
-def collide_along_normal(g: _Round, n: np.ndarray, vn: np.ndarray, only: np.ndarray | None, cr: float):
-    """(v1, v2) after the 1D collision with restitution cr along the normal n.
-
-    only: which pairs collide, None for all. The relative normal speed vn
-    becomes -cr vn, shared so that momentum is kept (the lighter puck takes
-    more of the change); the tangential velocities are untouched.
-    """
-    jn = -(1.0 + cr) * vn  # change of relative normal speed
-    if only is not None:
-        jn = np.where(only, jn, 0.0)
-    return g.v1 + (jn * g.share1) * n, g.v2 - (jn * g.share2) * n
+def _collide(g: _Round, n: np.ndarray, only: np.ndarray | None, cr: float):
+    """(v1, v2) after the pairs (only those in `only`, if given) collide along n (collision.collide_along)."""
+    v1, v2 = collision.collide_along(n, g.v1, g.v2, g.m1, g.m2, cr)
+    if only is None:
+        return v1, v2
+    return np.where(only, v1, g.v1), np.where(only, v2, g.v2)
 
 
 def separate(g: _Round, n: np.ndarray, move: np.ndarray, only: np.ndarray | None):
@@ -352,7 +265,7 @@ def _round_off(g: _Round, cr: float, dt_s: float) -> _Outcome:
     """Velocities only: the overlap stays, which is what this mode shows."""
     approach = g.vn < -REST_SPEED_MPS
     count, only = _approaching(approach)
-    v1, v2 = collide_along_normal(g, g.n, g.vn, only, cr)
+    v1, v2 = _collide(g, g.n, only, cr)
     return _Outcome(g.n, g.x2, approach, count, v1, v2, g.x1, g.x2)
 
 
@@ -371,47 +284,28 @@ def _two_step_move(g: _Round, cr: float, dt_s: float) -> np.ndarray:
 def _round_two_step(g: _Round, cr: float, dt_s: float) -> _Outcome:
     approach = g.vn < -REST_SPEED_MPS
     count, only = _approaching(approach)
-    v1, v2 = collide_along_normal(g, g.n, g.vn, only, cr)
+    v1, v2 = _collide(g, g.n, only, cr)
     x1, x2 = separate(g, g.n, _two_step_move(g, cr, dt_s), only)
     return _Outcome(g.n, g.x2, approach, count, v1, v2, x1, x2)
 
 
-def _time_since_contact(g: _Round, dt_s: float) -> tuple[np.ndarray, np.ndarray]:
-    """(t, ok): how long ago each pair first touched, and whether this step's motion explains it.
-
-    Solves |d - vrel t| = reach for the larger root t, with d = x1 - x2.
-    """
-    vv = vectors.squared_abs(g.vrel)
-    dv = vectors.dot(g.d, g.vrel)
-    disc = np.maximum(dv * dv - vv * (vectors.squared_abs(g.d) - g.reach * g.reach), 0.0)
-    moving = vv > REST_SPEED_MPS**2
-    all_moving = np.count_nonzero(moving) == len(vv)  # as they mostly are; the count costs a quarter of np.where
-    t_back = (dv + np.sqrt(disc)) / (vv if all_moving else np.where(moving, vv, 1.0))
-    ok = moving & (t_back >= 0.0) & (t_back <= dt_s * (1.0 + 1e-9) + 1e-15)
-    return t_back, ok
-
-
 def _round_perfect_kiss(g: _Round, cr: float, dt_s: float) -> _Outcome:
     """Collide at first contact; pairs whose overlap this step cannot explain get the two-step correction."""
-    t_back, kiss = _time_since_contact(g, dt_s)
+    t_b, kiss = time_back_to_contact(g.d, g.vrel, g.reach, dt_s)
     kissing = np.count_nonzero(kiss)
     if not kissing:
         return _round_two_step(g, cr, dt_s)
-    t_b = t_back if kissing == len(kiss) else np.where(kiss, t_back, 0.0)
     c1, c2 = g.x1 - t_b * g.v1, g.x2 - t_b * g.v2  # both centres at first contact
     n, _ = vectors.units(c1 - c2, g.keys)
-    vn = vectors.dot(g.vrel, n)
-    # Approaching is judged at the contact time: a fast pair is often caught
-    # after its closest approach. Going forward t_b with the new velocities
-    # parts the pair by (1 + cr) |vn| t_b.
-    contact_from, approach, move = c2, vn < 0.0, -(1.0 + cr) * vn * t_b
-    if kissing < len(kiss):  # the others: the two-step's normal, speed and move
+    # They approach now, so they approached at contact (on straight paths d.w only grows). Going
+    # forward t_b with the new velocities parts the pair by (1 + cr) |vn| t_b, vn the normal speed there.
+    contact_from, approach, move = c2, kiss, -(1.0 + cr) * vectors.dot(g.vrel, n) * t_b
+    if kissing < len(kiss):  # the others: the two-step's normal, approach and move
         n, contact_from = np.where(kiss, n, g.n), np.where(kiss, contact_from, g.x2)
-        vn = np.where(kiss, vn, g.vn)
-        approach = np.where(kiss, approach, g.vn < -REST_SPEED_MPS)
+        approach = kiss | (g.vn < -REST_SPEED_MPS)
         move = np.where(kiss, move, _two_step_move(g, cr, dt_s))
     count, only = _approaching(approach)
-    v1, v2 = collide_along_normal(g, n, vn, only, cr)
+    v1, v2 = _collide(g, n, only, cr)
     x1, x2 = separate(g, n, move, only)
     return _Outcome(n, contact_from, approach, count, v1, v2, x1, x2)
 
@@ -423,14 +317,12 @@ _ROUND_BY_MODE: dict[str, Callable[[_Round, float, float], _Outcome]] = {
 }
 
 
-def _resolve_round(zpos, zvel, radius, mass, a, b, cr, mode, dt_s) -> Recorded | None:
+def _resolve_round(zpos, zvel, radius, mass, a, b, cr, mode, dt_s) -> Collisions | None:
     """Resolve pairs that share no puck, all at once, in place (see `disjoint_rounds`), on the
     table's positions and velocities as complex numbers (vectors.as_complex).
 
     Returns the record of the pairs that collided, None if none did.
     """
-    if len(a) <= FEW_PAIRS:
-        return _resolve_few(zpos, zvel, radius, mass, a.tolist(), b.tolist(), cr, mode, dt_s)
     g = _gather(zpos, zvel, radius, mass, a, b)
     if g is None:
         return None
@@ -439,161 +331,11 @@ def _resolve_round(zpos, zvel, radius, mass, a, b, cr, mode, dt_s) -> Recorded |
     zvel[g.a], zvel[g.b] = out.v1, out.v2
     if mode != "off":
         zpos[g.a], zpos[g.b] = out.x1, out.x2
-    return _RoundRecord(g, out) if out.count else None
-
-
-@dataclass
-class _RoundRecord:
-    """A round's collisions, kept as the round left them: made into `Collisions` only when read
-    (most steps nobody reads them)."""
-
-    g: _Round
-    out: _Outcome
-
-    def __len__(self) -> int:
-        return self.out.count
-
-    def collisions(self) -> Collisions:
-        g, out = self.g, self.out
-        contact = out.contact_from + g.r2 * out.n
-        record = Collisions(
-            g.a, g.b, vectors.as_rows(out.n), vectors.as_rows(contact), g.overlap, g.reach,
-            *(vectors.as_rows(z) for z in (g.x1, g.x2, out.x1, out.x2, g.v1, g.v2, out.v1, out.v2)),
-        )  # fmt: skip
-        return record if out.count == len(g.a) else record.take(out.approach.nonzero()[0])
-
-
-# ---------------------------------------------------------------- a few pairs, in floats
-
-
-def _resolve_few(zpos, zvel, radius, mass, a: list[int], b: list[int], cr, mode, dt_s) -> Recorded | None:
-    """`_resolve_round` for a few pairs: the same steps, pair by pair, in Python numbers."""
-    rows, hit = [], []
-    for p, q in zip(a, b, strict=True):
-        row = _pair_in_floats(zpos, zvel, radius, mass, p, q, cr, mode, dt_s)
-        if row is not None:
-            rows.append(row)
-            hit.append((p, q))
-    return _FewRecord(hit, rows) if rows else None
-
-
-@dataclass
-class _FewRecord:
-    """The record rows of `_resolve_few`, made into `Collisions` only when read."""
-
-    hit: list[tuple[int, int]]
-    rows: list[tuple]  # overlap, reach, then normal, contact and 8 positions and velocities, as complex x + iy
-
-    def __len__(self) -> int:
-        return len(self.rows)
-
-    def collisions(self) -> Collisions:
-        ij = np.array(self.hit, dtype=np.intp)
-        overlap, reach, n, contact, *states = (np.array(column) for column in zip(*self.rows, strict=True))
-        n, contact, *states = (vectors.as_rows(z) for z in (n, contact, *states))
-        return Collisions(ij[:, 0], ij[:, 1], n, contact, overlap, reach, *states)
-
-
-# What a round or a few pairs record: `Collisions`, or what makes them when read.
-Recorded = Collisions | _RoundRecord | _FewRecord
-
-
-def _unit_floats(d: complex, key: int) -> tuple[complex, float]:
-    """vectors.units for one vector: (d / |d|, |d|), each part divided by the length."""
-    dx, dy = d.real, d.imag
-    dist = math.sqrt(dx * dx + dy * dy)
-    if dist != 0.0:
-        return complex(dx / dist, dy / dist), dist
-    n0, n1 = vectors.fallback_directions(np.array([key]))[0].tolist()
-    return complex(n0, n1), dist
-
-
-def _kiss_time(d: complex, vrel: complex, reach: float, dt_s: float) -> float | None:
-    """`_time_since_contact` for one pair: the time back to first contact, None if the step cannot explain it."""
-    vv, dv = vectors.dot_one(vrel, vrel), vectors.dot_one(d, vrel)
-    disc = max(dv * dv - vv * (vectors.dot_one(d, d) - reach * reach), 0.0)
-    if not vv > REST_SPEED_MPS**2:
+    if not out.count:
         return None
-    t_back = (dv + math.sqrt(disc)) / vv
-    return t_back if 0.0 <= t_back <= dt_s * (1.0 + 1e-9) + 1e-15 else None
-
-
-def _pair_in_floats(zpos, zvel, radius, mass, p, q, cr, mode, dt_s) -> tuple | None:
-    """Collide and part the pair (p, q) in place, as `_gather`, the mode's round function and
-    `separate` would, on the table's complex views zpos and zvel; return its record row (see
-    _FewRecord), None if it did not collide."""
-    x1, x2 = zpos.item(p), zpos.item(q)
-    r2 = radius.item(q)
-    reach = radius.item(p) + r2
-    d = x1 - x2
-    n, dist = _unit_floats(d, p + q)
-    overlap = reach - dist
-    if not overlap > 0.0:
-        return None
-    v1, v2 = zvel.item(p), zvel.item(q)
-    m1, m2 = mass.item(p), mass.item(q)
-    m_sum = m1 + m2
-    share1, share2 = m2 / m_sum, m1 / m_sum
-    vrel = v1 - v2
-    vn = vectors.dot_one(vrel, n)
-    t_b = _kiss_time(d, vrel, reach, dt_s) if mode == "perfect-kiss" else None
-    if t_b is None:  # as _round_two_step (and _round_off, which does not use `move`)
-        approach = vn < -REST_SPEED_MPS
-        move = (1.0 + cr) * min(overlap, vn * -dt_s)
-        c = x2
-    else:  # as _round_perfect_kiss
-        c = x2 - t_b * v2
-        n, _ = _unit_floats((x1 - t_b * v1) - c, p + q)
-        vn = vectors.dot_one(vrel, n)
-        approach = vn < 0.0
-        move = -(1.0 + cr) * vn * t_b
-    jn = -(1.0 + cr) * vn if approach else 0.0  # collide_along_normal
-    w1, w2 = v1 + (jn * share1) * n, v2 - (jn * share2) * n
-    zvel[p], zvel[q] = w1, w2
-    y1, y2 = x1, x2
-    if mode != "off":
-        y1, y2 = _separate_floats(x1, x2, n, move if approach else 0.0, reach, share1, share2, p + q)
-        zpos[p], zpos[q] = y1, y2
-    if not approach:
-        return None
-    return overlap, reach, n, c + r2 * n, x1, x2, y1, y2, v1, v2, w1, w2
-
-
-def _separate_floats(x1, x2, n: complex, move: float, reach: float, share1: float, share2: float, key: int):
-    """`separate` for one pair: move it `move` apart along n, then push apart what still overlaps."""
-    y1, y2 = x1 + (move * share1) * n, x2 - (move * share2) * n
-    d = y1 - y2
-    if vectors.dot_one(d, d) < reach * reach:
-        n_now, dist = _unit_floats(d, key)
-        left = max(reach - dist, 0.0)
-        y1, y2 = y1 + (left * share1) * n_now, y2 - (left * share2) * n_now
-    return y1, y2
-
-
-def _few_in_order(zpos, zvel, radius, il: list[int], jl: list[int], dt_s: float | None) -> list[int] | None:
-    """The order in which `disjoint_rounds`' rounds would take the pairs (il, jl): round by round,
-    in the given order within a round (None: the given order). With dt_s, pairs sharing a puck
-    go as they met (since_contact)."""
-    if len(set(il + jl)) == 2 * len(il):
-        return None  # the usual case: no puck in two pairs, one round in the given order
-    uses: dict[int, int] = {}
-    for p in il + jl:
-        uses[p] = uses.get(p, 0) + 1
-    shared = [k for k in range(len(il)) if uses[il[k]] > 1 or uses[jl[k]] > 1]
-    if dt_s is not None:
-        since = {k: _since_floats(zpos, zvel, radius, il[k], jl[k], dt_s) for k in shared}
-        shared.sort(key=lambda k: -since[k])  # stable, as np.argsort(kind="stable")
-    level = [0] * len(il)
-    for k, lvl in zip(shared, _chain_levels([il[k] for k in shared], [jl[k] for k in shared]), strict=True):
-        level[k] = lvl
-    return sorted(range(len(il)), key=level.__getitem__)
-
-
-def _since_floats(zpos, zvel, radius, p: int, q: int, dt_s: float) -> float:
-    """`since_contact` for one pair."""
-    d, w = zpos.item(p) - zpos.item(q), zvel.item(p) - zvel.item(q)
-    reach = radius.item(p) + radius.item(q)
-    ww, dw = vectors.dot_one(w, w), vectors.dot_one(d, w)
-    disc = max(dw * dw - ww * (vectors.dot_one(d, d) - reach * reach), 0.0)
-    back = (dw + math.sqrt(disc)) / (ww if ww > 0.0 else 1.0)
-    return back if ww > 0.0 and 0.0 <= back <= dt_s else dt_s
+    record = (g.a, g.b, out.n, out.contact_from, g.overlap, g.x1, g.x2, out.x1, out.x2, g.v1, g.v2, out.v1, out.v2)
+    if out.count < len(g.a):  # only those that collided
+        k = out.approach.nonzero()[0]
+        record = tuple(f.take(k) for f in record)
+    i, j, n, touch_j, overlap, *states = record
+    return Collisions.of_pairs(i, j, n, touch_j, overlap, radius, *states)

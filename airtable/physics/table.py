@@ -46,7 +46,7 @@ from collections.abc import Callable, Sequence
 
 import numpy as np
 
-from airtable.physics import broadphase, contacts, events, forces, pairs, sleep, substeps, vectors, walls
+from airtable.physics import broadphase, collision, contacts, events, forces, pairs, sleep, substeps, vectors, walls
 from airtable.physics import implicit as implicit_solve
 from airtable.physics.bodies import Puck, Spring, as_vector
 from airtable.physics.colors import rgb
@@ -59,14 +59,6 @@ TABLE_HEIGHT_M = 8.7556
 # over the pairs the corrections pushed into overlap: collisions again, then a
 # last pass that only pushes apart.
 EXTRA_PASSES = 2
-# From this many candidate pairs on (a gas of some 3000 pucks), the second and third
-# looks for overlaps check only the pairs the passes' moves may have brought within reach
-# (see AirTable._candidates_of); on fewer, picking them out costs more than it saves.
-LOOK_AT_MOVED_MIN_PAIRS = 5000
-# From this many pucks on, the wall stage checks only those the neighbour list keeps near a
-# wall: on 10000 a pass over every puck costs 20 us, the few hundred near a wall 6 us. On
-# fewer, picking them out and checking the list first cost as much as they save.
-WALL_BAND_MIN_PUCKS = 4000
 # A pressed contact (one whose pucks this step's forces push: gravity, springs, pulls)
 # approaching slower than this (m/s) rests instead of bouncing: the speed of a 2 mm fall.
 # Without it a pile's pucks, shaken at a few cm/s by their neighbours, bounce off each
@@ -103,11 +95,6 @@ def _non_negative(value, what: str) -> float:
     if not (math.isfinite(v) and v >= 0.0):
         raise ValueError(f"{what} must be zero or a positive number, not {value!r}")
     return v
-
-
-def _farthest_move(pos: np.ndarray, rows: np.ndarray, before: np.ndarray) -> float:
-    """The farthest any of the pucks `rows` is now from where it was (`before`: their positions then)."""
-    return math.sqrt(float(vectors.squared_lengths(vectors.take(pos, rows) - before).max()))
 
 
 class _Columns:
@@ -396,7 +383,7 @@ class AirTable:
         self.collision_count = 0  # puck-puck collisions since the start
         self.wall_collision_count = 0  # bounces off a wall since the start
         self._collision_records: list[pairs.Recorded] = []
-        self._last_collisions: pairs.Collisions | None = None
+        self._last_collisions: collision.Collisions | None = None
         self._world_key = ""  # what the sleepers fell asleep in (see _world): any change wakes them
         self._sleepers: np.ndarray | None = None  # this step's sleeping rows (scratch)
 
@@ -454,10 +441,10 @@ class AirTable:
         return self.momentum_Ns() / self.mass_kg.sum()
 
     @property
-    def last_collisions(self) -> pairs.Collisions:
-        """What the puck-puck collisions of the last step did (pairs.Collisions)."""
+    def last_collisions(self) -> collision.Collisions:
+        """What the puck-puck collisions of the last step did (collision.Collisions)."""
         if self._last_collisions is None:  # joined on first read: most steps nobody asks
-            self._last_collisions = pairs.Collisions.concatenate(self._collision_records)
+            self._last_collisions = collision.Collisions.concatenate(self._collision_records)
         return self._last_collisions
 
     # ------------------------------------------------------------ the step
@@ -485,11 +472,10 @@ class AirTable:
             if dt > 0.0:  # 3. hits, walls and pairs, in time order
                 maybe_past = self._hits_in_order(dt, None if rest is None else rest[0], wall_rest)
                 self._wake_hit()
-            near = self._near_walls()
-            past = self._resolve_walls(near if maybe_past is None else maybe_past, wall_rest)  # 3b. still past a wall
+            self._resolve_walls(maybe_past, wall_rest)  # 3b. still past a wall
             moved = np.empty(0, dtype=np.intp)
             if self.puck_collisions:  # 4. overlapping pairs (told what the walls moved if the list was just checked)
-                moved = self._resolve_pairs(dt, None if rest is None else rest[0], None if near is None else past)
+                moved = self._resolve_pairs(dt, None if rest is None else rest[0])
             self._wake_hit()
             if rest is not None and self._resolve_contacts(rest, dt):  # 5. resting contacts
                 self._resolve_walls(rest=self._contacts.wall_rest(rest[1]), hold=True)  # 6. walls again
@@ -698,9 +684,8 @@ class AirTable:
             held=None if rest is None else self._contacts.held,
             speed_bound_mps=self._speed_bound_mps,
         )
-        near = self._near_walls()
         hits = events.resolve_hits(
-            self.pos_m, self.vel_mps, self.radius_m, self.mass_kg, self.size_m, dt, rules, self._neighbours, near
+            self.pos_m, self.vel_mps, self.radius_m, self.mass_kg, self.size_m, dt, rules, self._neighbours
         )
         self.wall_collision_count += hits.walls
         if hits.rows:
@@ -738,18 +723,6 @@ class AirTable:
         pucks = (self.pos_m, self.vel_mps, self.radius_m, self.mass_kg)
         return self._contacts.solve(*pucks, self.size_m, candidates, rest[0], dt, asleep, rest_walls=rest[1])
 
-    def _near_walls(self) -> np.ndarray | None:
-        """The rows that may be past a wall: those the neighbour list keeps near one (None: every row).
-
-        Where pucks collide, the pair stage needs the neighbour list anyway;
-        checking it here, before the walls move anyone, lets the wall stage
-        skip the pucks it knows are far from every wall.
-        """
-        if not self.puck_collisions or self._pucks.n < WALL_BAND_MIN_PUCKS:
-            return None
-        self._neighbours.pairs(self.pos_m, self.radius_m)
-        return self._neighbours.near_walls(self.size_m)
-
     def _resolve_walls(self, only: np.ndarray | None = None, rest: np.ndarray | None = None, hold=False) -> np.ndarray:
         """Push pucks back inside the walls and bounce them (only the rows `only`, if given); return
         the rows that were past a wall.
@@ -771,26 +744,21 @@ class AirTable:
         self.wall_collision_count += bounced
         return past
 
-    def _resolve_pairs(self, dt: float, rest: np.ndarray | None = None, moved: np.ndarray | None = None) -> np.ndarray:
+    def _resolve_pairs(self, dt: float, rest: np.ndarray | None = None) -> np.ndarray:
         """Collide and part the overlapping pairs; return the rows they moved (a row may repeat).
 
         With `rest`, pairs approaching slower than their rest speed are left to
-        the contact stage. `moved`: the only rows moved since the neighbour
-        list was last checked (NeighbourList.pairs).
+        the contact stage.
         """
         pos, vel, radius, mass = self.pos_m, self.vel_mps, self.radius_m, self.mass_kg
-        ci, cj, _ = self._neighbours.pairs(pos, radius, moved)
-        dsq = broadphase.squared_distances(pos, ci, cj)  # kept: later looks pick their candidates by it
-        close = dsq < self._neighbours.reach_squared()
+        ci, cj, _ = self._neighbours.pairs(pos, radius)
+        close = broadphase.squared_distances(pos, ci, cj) < self._neighbours.reach_squared()
         i, j = self._colliding(rest, *broadphase.pairs_where(close, ci, cj, len(pos), self._neighbours.sorted_order))
-        records, moved, drift = [], [], 0.0
+        records, moved = [], []
         for attempt in range(1 + EXTRA_PASSES):
             if len(i) == 0:
                 break
             look_again = self.puck_correction != "off" and attempt < EXTRA_PASSES
-            near_only = look_again and len(ci) >= LOOK_AT_MOVED_MIN_PAIRS  # see _candidates_of
-            rows = np.concatenate([i, j]) if near_only else None
-            before = vectors.take(pos, rows) if near_only else None
             if attempt < EXTRA_PASSES:
                 records += pairs.resolve_pairs(
                     pos, vel, radius, mass, i, j, self.cr_puck, self.puck_correction, dt, in_time_order=True
@@ -804,27 +772,13 @@ class AirTable:
             # was already handled: look again among the same candidates (those
             # that may have come within reach: nothing else changed), collide
             # those pairs too, and at last just push apart what is left.
-            if near_only:
-                drift += _farthest_move(pos, rows, before)
-            ni, nj, near_sq = self._candidates_of(ci, cj, dsq, drift)
-            i, j = self._colliding(rest, *broadphase.overlapping_pairs(pos, ni, nj, None, reach_sq=near_sq))
+            near_sq = self._neighbours.reach_squared(OVERLAP_SLOP_M)
+            i, j = self._colliding(rest, *broadphase.overlapping_pairs(pos, ci, cj, None, reach_sq=near_sq))
         if not moved:
             return np.empty(0, dtype=np.intp)
         self._collision_records += records
         self.collision_count += sum(len(r) for r in records)
         return np.concatenate(moved)
-
-    def _candidates_of(self, ci: np.ndarray, cj: np.ndarray, dsq: np.ndarray, drift: float):
-        """(i, j, (reach - OVERLAP_SLOP_M)^2) of the candidate pairs that may overlap now, `dsq`
-        being their squared distances when the pair stage began and `drift` the farthest any
-        puck has moved since (NeighbourList.within): on a small table all of them, where
-        picking them out costs more than checking them all."""
-        if len(ci) < LOOK_AT_MOVED_MIN_PAIRS:
-            return ci, cj, self._neighbours.reach_squared(OVERLAP_SLOP_M)
-        # Two pucks that each moved at most `drift` came at most 2 drift closer (a
-        # micrometre more against rounding): pairs farther apart than that cannot touch.
-        k = self._neighbours.within(dsq, 2.0 * drift + 1e-6)
-        return ci.take(k), cj.take(k), self._neighbours.reach_squared_of(k, OVERLAP_SLOP_M)
 
     def _colliding(self, rest: np.ndarray | None, i: np.ndarray, j: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """The pairs (i, j) that collide: all of them if rest is None, else those that approach

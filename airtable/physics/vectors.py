@@ -127,15 +127,13 @@ def squared_abs(z: np.ndarray) -> np.ndarray:
     return xy[0::2] + xy[1::2]
 
 
-def dot(z: np.ndarray, w: np.ndarray) -> np.ndarray:
-    """The dot product of the vectors z and w (complex, one per row): zx wx + zy wy."""
+def dot(z, w):
+    """The dot product of the vectors z and w, zx wx + zy wy: complex arrays (one vector per row),
+    or two Python complex numbers (then a float, by the same arithmetic)."""
+    if isinstance(z, complex):
+        return z.real * w.real + z.imag * w.imag
     xy = z.view(np.float64) * w.view(np.float64)
     return xy[0::2] + xy[1::2]
-
-
-def dot_one(z: complex, w: complex) -> float:
-    """`dot` for one pair of vectors as Python complex numbers."""
-    return z.real * w.real + z.imag * w.imag
 
 
 def units(z: np.ndarray, keys) -> tuple[np.ndarray, np.ndarray]:

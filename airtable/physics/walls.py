@@ -4,12 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from airtable.physics import vectors
-
-# Up to this many pucks past a wall are bounced one at a time in plain floats
-# (`_bounce_in_floats`): in a gas one or two are, and a dozen numpy calls on
-# one or two rows cost more than the arithmetic (as pairs.FEW_PAIRS).
-FEW_PUCKS = 8
+from airtable.physics import collision, vectors
 
 
 def resolve_walls(
@@ -55,8 +50,6 @@ def resolve_walls(
         out = out.take(fast.nonzero()[0])
         if len(out) == 0:
             return 0, past  # a pile's usual case: every puck past a wall rests there
-    if len(out) <= FEW_PUCKS:
-        return sum(_bounce_in_floats(pos, vel, radius, size_m, cr_wall, correction, k) for k in out.tolist()), past
     # `only` may name a row twice (the rows the pairs moved): bounced, and counted, once.
     return _bounce_rows(pos, vel, radius, size_m, cr_wall, correction, np.unique(out)), past
 
@@ -77,7 +70,7 @@ def _bounce_rows(pos, vel, radius, size_m, cr_wall: float, correction: bool, out
     hi = size_m - lo
     below, above = p < lo, p > hi
     into = (below & (v < 0.0)) | (above & (v > 0.0))
-    vectors.put(vel, out, np.where(into, -cr_wall * v, v))
+    vectors.put(vel, out, np.where(into, collision.bounce(v, cr_wall), v))
     # Mirrored by the penetration, or else left for the clamp below to put on the surface.
     target = np.where(below, 2.0 * lo - p, np.where(above, 2.0 * hi - p, p)) if correction else p
     # Clamp into [lo, hi]: a mirror of a huge penetration can land past the
@@ -85,23 +78,6 @@ def _bounce_rows(pos, vel, radius, size_m, cr_wall: float, correction: bool, out
     half = 0.5 * size_m
     vectors.put(pos, out, np.minimum(np.maximum(target, np.minimum(lo, half)), np.maximum(hi, half)))
     return int(np.count_nonzero(into))
-
-
-def _bounce_in_floats(pos, vel, radius, size_m, cr_wall: float, correction: bool, k: int) -> int:
-    """What `_bounce_rows` does, for the one puck k, in plain floats; return how many walls it bounced off."""
-    p, v, lo = pos[k].tolist(), vel[k].tolist(), radius.item(k)
-    bounced = 0
-    for axis, size in enumerate(size_m.tolist()):
-        hi, half = size - lo, 0.5 * size
-        below, above = p[axis] < lo, p[axis] > hi
-        if (below and v[axis] < 0.0) or (above and v[axis] > 0.0):
-            v[axis] = -cr_wall * v[axis]
-            bounced += 1
-        if correction and (below or above):
-            p[axis] = 2.0 * lo - p[axis] if below else 2.0 * hi - p[axis]
-        p[axis] = min(max(p[axis], min(lo, half)), max(hi, half))
-    pos[k], vel[k] = p, v
-    return bounced
 
 
 def _fast_ones(pos, vel, radius, size_m, rest, out: np.ndarray) -> np.ndarray:
