@@ -260,9 +260,12 @@ class ContactSolver:
         if asleep is not None:
             awake = np.flatnonzero(~(asleep.take(ci) & asleep.take(cj)))
             ci, cj, reach = ci.take(awake), cj.take(awake), reach.take(awake)
-        pc = _pair_contacts(pos, vel, ci, cj, reach, rest, self.held, margin)
+        # The contacts as they were when the step began, on each puck's present path (the
+        # step moved it by vel dt): see "Where the contacts are" above.
+        start = pos - vel * dt
+        pc = _pair_contacts(start, vel, ci, cj, reach, rest, self.held, margin)
         rest_walls = rest if rest_walls is None else rest_walls
-        wc = _wall_contacts(pos, vel, radius, size_m, self.wall_rest(rest_walls), margin)
+        wc = _wall_contacts(start, vel, radius, size_m, self.wall_rest(rest_walls), margin)
         if asleep is not None:
             wc = _Contacts(*(getattr(wc, f).take(np.flatnonzero(~asleep.take(wc.a))) for f in _FIELDS))
         c = _Contacts(*(np.concatenate([getattr(pc, f), getattr(wc, f)]) for f in _FIELDS))
@@ -270,7 +273,7 @@ class ContactSolver:
         if self.count == 0:
             self._keys, self._impulses = np.empty(0, dtype=np.int64), np.empty((0, 2))
             return False
-        self._y, self._r_mean = pos[:, 1], float(radius.mean())
+        self._y, self._r_mean = start[:, 1], float(radius.mean())
         inv = np.append(1.0 / mass, 0.0)  # the walls never move, nor do sleepers
         if asleep is not None:
             inv[:-1][asleep] = 0.0
@@ -291,13 +294,12 @@ class ContactSolver:
         filled into the layouts of the rounds of the first iteration and of the later ones (colouring
         the contacts anew if they changed)."""
         rows = len(inv) - 1
-        # Where the pair was at the start of the step, if it approached: the
-        # velocity bound keeps it from closing more than that gap.
-        s0 = c.gap - np.minimum(c.vn, 0.0) * dt
+        # The gaps where the step began: the velocity bound keeps a pair from closing more
+        # than its gap, and the pseudo-velocity pushes out a share of its overlap.
         target = np.column_stack(
             [
-                -np.maximum(s0, 0.0) / dt,
-                np.minimum(POSITION_FRACTION * np.maximum(-s0 - SLOP_M, 0.0) / dt, MAX_PUSH_MPS),
+                -np.maximum(c.gap, 0.0) / dt,
+                np.minimum(POSITION_FRACTION * np.maximum(-c.gap - SLOP_M, 0.0) / dt, MAX_PUSH_MPS),
             ]
         )
         impulse = np.zeros((len(c.keys), 2))  # pseudo-velocities start from nothing each step
