@@ -475,7 +475,7 @@ class AirTable:
         self._run_due_events()
         self._collision_records, self._last_collisions = [], None
         if self._pucks.n and not self._wake(pulls, dt):  # 0b. sleepers: wake those disturbed
-            kick = None
+            kick, self._began = None, self.pos_m.copy()  # where the step began (the contacts start there)
             if dt > 0.0:
                 kick = self._forces_and_integrate(pulls, dt)  # 1-2. forces, semi-implicit Euler (substeps)
             self.force_N[:] = 0.0  # the accumulators hold one step's forces
@@ -736,7 +736,9 @@ class AirTable:
             candidates = (none, none, np.empty(0))
         asleep = None if self._sleepers is None else self._pucks.view("asleep")
         pucks = (self.pos_m, self.vel_mps, self.radius_m, self.mass_kg)
-        return self._contacts.solve(*pucks, self.size_m, candidates, rest[0], dt, asleep, rest_walls=rest[1])
+        return self._contacts.solve(
+            *pucks, self.size_m, candidates, rest[0], dt, asleep, rest_walls=rest[1], began=self._began
+        )
 
     def _near_walls(self) -> np.ndarray | None:
         """The rows that may be past a wall: those the neighbour list keeps near one (None: every row).
