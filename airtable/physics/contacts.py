@@ -37,6 +37,16 @@ within its step.
 Order of the step: positions have already moved with the velocities when
 this stage runs, so a velocity change dv also moves the puck by dv dt: the
 stage gives the same result as solving contacts before the position update.
+
+Where the contacts are: where the step began (pos - vel dt), as Box2D finds
+its speculative contacts before it moves the bodies. Their normals and gaps
+are then the ones the velocities act across; taken where the free motion
+ends, a pair landing fast is found deep inside each other, with a normal
+turned by as much: solved along it, a restitution-0 pile sank millimetres
+into itself (30 mm at dt 1/60), and pushing that overlap out again raised
+pucks and the pile's energy. A puck an earlier stage bounced did not begin
+its present path anywhere real: its contacts are taken where the step ends,
+at the gap it had if it approached.
 """
 
 from __future__ import annotations
@@ -242,7 +252,9 @@ class ContactSolver:
         """Drop the kept impulses (pucks were added, removed or moved by hand)."""
         self.__init__()
 
-    def solve(self, pos, vel, radius, mass, size_m, candidates, rest, dt, asleep=None, rest_walls=None) -> bool:
+    def solve(
+        self, pos, vel, radius, mass, size_m, candidates, rest, dt, asleep=None, rest_walls=None, began=None
+    ) -> bool:
         """Solve the resting contacts in place; return whether there were any.
 
         candidates: (i, j, reach) pairs that may touch; rest: each puck's rest
@@ -250,7 +262,8 @@ class ContactSolver:
         the walls, rest_walls if given); asleep:
         which pucks sleep (sleep.py), or None: to the awake pucks a sleeper is
         immovable, and its contacts with the walls and with other sleepers are
-        left out.
+        left out. began: the positions when the step began (None: unknown, every contact
+        is taken where the step ends).
         """
         if len(pos) != self._rows:
             self.forget()
@@ -260,17 +273,27 @@ class ContactSolver:
         if asleep is not None:
             awake = np.flatnonzero(~(asleep.take(ci) & asleep.take(cj)))
             ci, cj, reach = ci.take(awake), cj.take(awake), reach.take(awake)
-        pc = _pair_contacts(pos, vel, ci, cj, reach, rest, self.held, margin)
+        # The contacts where the step began, for the pucks still on the path they began it on
+        # (see "Where the contacts are" above); `moved` is what the others' positions hold already.
+        moved = vel.copy()
+        if began is not None:
+            plain = np.abs(pos - vel * dt - began).max(axis=1) <= 1e-9 * (1.0 + np.abs(began).max(axis=1))
+            moved[plain] = 0.0
+        start = pos - (vel - moved) * dt
+        pc = _pair_contacts(start, vel, ci, cj, reach, rest, self.held, margin)
         rest_walls = rest if rest_walls is None else rest_walls
-        wc = _wall_contacts(pos, vel, radius, size_m, self.wall_rest(rest_walls), margin)
+        wc = _wall_contacts(start, vel, radius, size_m, self.wall_rest(rest_walls), margin)
         if asleep is not None:
             wc = _Contacts(*(getattr(wc, f).take(np.flatnonzero(~asleep.take(wc.a))) for f in _FIELDS))
         c = _Contacts(*(np.concatenate([getattr(pc, f), getattr(wc, f)]) for f in _FIELDS))
+        if began is None or not plain.all():  # where they were at the start if they approached
+            zm = np.append(vectors.as_complex(np.ascontiguousarray(moved)), 0.0)
+            c.gap = c.gap - np.minimum((c.n.conjugate() * (zm.take(c.a) - zm.take(c.b))).real, 0.0) * dt
         self.count = len(c.a)
         if self.count == 0:
             self._keys, self._impulses = np.empty(0, dtype=np.int64), np.empty((0, 2))
             return False
-        self._y, self._r_mean = pos[:, 1], float(radius.mean())
+        self._y, self._r_mean = start[:, 1], float(radius.mean())
         inv = np.append(1.0 / mass, 0.0)  # the walls never move, nor do sleepers
         if asleep is not None:
             inv[:-1][asleep] = 0.0
@@ -291,13 +314,12 @@ class ContactSolver:
         filled into the layouts of the rounds of the first iteration and of the later ones (colouring
         the contacts anew if they changed)."""
         rows = len(inv) - 1
-        # Where the pair was at the start of the step, if it approached: the
-        # velocity bound keeps it from closing more than that gap.
-        s0 = c.gap - np.minimum(c.vn, 0.0) * dt
+        # The gaps where the step began: the velocity bound keeps a pair from closing more
+        # than its gap, and the pseudo-velocity pushes out a share of its overlap.
         target = np.column_stack(
             [
-                -np.maximum(s0, 0.0) / dt,
-                np.minimum(POSITION_FRACTION * np.maximum(-s0 - SLOP_M, 0.0) / dt, MAX_PUSH_MPS),
+                -np.maximum(c.gap, 0.0) / dt,
+                np.minimum(POSITION_FRACTION * np.maximum(-c.gap - SLOP_M, 0.0) / dt, MAX_PUSH_MPS),
             ]
         )
         impulse = np.zeros((len(c.keys), 2))  # pseudo-velocities start from nothing each step

@@ -462,7 +462,7 @@ class AirTable:
         self._run_due_events()
         self._collision_records, self._last_collisions = [], None
         if self._pucks.n and not self._wake(pulls, dt):  # 0b. sleepers: wake those disturbed
-            kick = None
+            kick, began = None, self.pos_m.copy()  # where the step began (the contacts start there)
             if dt > 0.0:
                 kick = self._forces_and_integrate(pulls, dt)  # 1-2. forces, semi-implicit Euler (substeps)
             self.force_N[:] = 0.0  # the accumulators hold one step's forces
@@ -477,7 +477,7 @@ class AirTable:
             if self.puck_collisions:  # 4. overlapping pairs (told what the walls moved if the list was just checked)
                 moved = self._resolve_pairs(dt, None if rest is None else rest[0])
             self._wake_hit()
-            if rest is not None and self._resolve_contacts(rest, dt):  # 5. resting contacts
+            if rest is not None and self._resolve_contacts(rest, dt, began):  # 5. resting contacts
                 self._resolve_walls(rest=self._contacts.wall_rest(rest[1]), hold=True)  # 6. walls again
             elif len(moved):
                 self._resolve_walls(only=moved)  # 6. walls again, for the pucks the pairs moved
@@ -711,9 +711,11 @@ class AirTable:
             np.maximum(rest, np.where(kick > 0.0, np.maximum(2.0 * kick, PRESSED_REST_MPS), 0.0), out=rest)
         return contacts.rest_for_restitution(rest, self.cr_puck), contacts.rest_for_restitution(rest, self.cr_wall)
 
-    def _resolve_contacts(self, rest: tuple[np.ndarray, np.ndarray], dt: float) -> bool:
-        """Hold resting contacts (contacts.py), `rest` being the rest speeds (pairs, walls); return whether
-        there were any."""
+    def _resolve_contacts(
+        self, rest: tuple[np.ndarray, np.ndarray], dt: float, began: np.ndarray | None = None
+    ) -> bool:
+        """Hold resting contacts (contacts.py), `rest` being the rest speeds (pairs, walls) and `began`
+        the positions when the step began; return whether there were any."""
         if self.puck_collisions:
             candidates = self._neighbours.pairs(self.pos_m, self.radius_m)
         else:
@@ -721,7 +723,9 @@ class AirTable:
             candidates = (none, none, np.empty(0))
         asleep = None if self._sleepers is None else self._pucks.view("asleep")
         pucks = (self.pos_m, self.vel_mps, self.radius_m, self.mass_kg)
-        return self._contacts.solve(*pucks, self.size_m, candidates, rest[0], dt, asleep, rest_walls=rest[1])
+        return self._contacts.solve(
+            *pucks, self.size_m, candidates, rest[0], dt, asleep, rest_walls=rest[1], began=began
+        )
 
     def _resolve_walls(self, only: np.ndarray | None = None, rest: np.ndarray | None = None, hold=False) -> np.ndarray:
         """Push pucks back inside the walls and bounce them (only the rows `only`, if given); return
