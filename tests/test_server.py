@@ -860,19 +860,17 @@ def test_a_stalled_client_only_misses_snapshots(make_server, make_loop, clients)
             return len(seats) == 2 and seats["C1"].snapshots_per_s < 0.5 * seats["C2"].snapshots_per_s
 
         wait_until(missing, what="the stalled player to miss snapshots")
-        # Meanwhile the reading client gets its snapshots and the game loop never waits:
-        # 30 snapshots (half a second at 60 a second) while the loop keeps at least half speed.
+        # Meanwhile the reading client gets its snapshots and the game loop never waits: had a
+        # publish blocked on the full socket, the loop would stop and no snapshot would come.
         frames0 = loop.frames
-        start = time.monotonic()
         received = 0
         for _ in range(1000):
             if reader.next_frame()[0] == proto.SNAPSHOT:
                 received += 1
                 if received == 30:
                     break
-        elapsed = time.monotonic() - start
         assert received == 30, "the reading client still gets snapshots"
-        assert loop.frames - frames0 >= 0.5 * 60 * elapsed, "the game loop never waited for the stalled client"
+        wait_until(lambda: loop.frames >= frames0 + 30, what="the game loop to go on beside the stalled client")
         assert server.connection_count == 2
     finally:
         sock.close()

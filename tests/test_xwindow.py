@@ -295,6 +295,8 @@ def test_the_taskbar_calls_the_teachers_and_the_students_window_air_table(displa
     teacher = [sys.executable, "-m", "airtable", "--no-server", "--seconds", "60"]
     with running(display, teacher) as (_, wid):
         assert window_class(display, wid) == 'WM_CLASS(STRING) = "Air Table", "Air Table"'
+    # The killed teacher's window can outlive it a moment; the student's is the next one found.
+    wait_for(lambda: find_window(display) is None, what="the teacher's window to go")
     server = GameServer(host="127.0.0.1", port=0)
     server.start()
     try:
