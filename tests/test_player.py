@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 import os
 import socket
 import struct
@@ -116,15 +117,13 @@ def test_input_throttle_sends_changes_at_most_60_a_second_and_a_heartbeat():
     assert throttle.due(a, 0.0)
 
 
-def test_a_cursor_that_stops_after_going_by_udp_alone_is_sent_once_more_reliably():
-    throttle = InputThrottle(max_hz=60, heartbeat_s=1.0, settle_s=0.1)
+def test_a_cursor_at_rest_is_sent_again_until_its_datagram_is_acknowledged():
+    throttle = InputThrottle(max_hz=60, heartbeat_s=1.0, resend_s=0.05)
     a = proto.InputRecord((1.0, 1.0), 0)
-    throttle.sent(a, 0.0, reliable=False)  # this datagram may be lost, and nothing newer follows
-    assert not throttle.due(a, 0.05) and not throttle.settling(a, 0.05)
-    assert throttle.due(a, 0.1) and throttle.settling(a, 0.1)
-    throttle.sent(a, 0.1)  # by TCP
-    assert not throttle.due(a, 0.5), "sent reliably: only the heartbeat is left"
-    assert not throttle.settling(proto.InputRecord((2.0, 1.0), 0), 0.5), "a new position is an ordinary send"
+    throttle.sent(a, 0.0)  # by UDP; this datagram may be lost, and nothing newer follows
+    assert not throttle.due(a, 0.04, unacked=True), "not before resend_s"
+    assert throttle.due(a, 0.05, unacked=True)
+    assert not throttle.due(a, 0.5, unacked=False), "acknowledged: only the heartbeat is left"
 
 
 def test_own_cursor_is_drawn_at_the_live_mouse_position_with_its_string():
@@ -701,3 +700,59 @@ def test_the_client_command_starts_with_its_own_line_not_pygames_banner():
     out = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True, timeout=60)
     assert out.returncode == 1
     assert out.stdout == "" and out.stderr.startswith("airtable-client: connection refused by 127.0.0.1:1"), out
+
+
+def test_the_last_cursor_reaches_the_table_though_its_datagram_was_lost(cleanup):
+    """Real sockets on 127.0.0.1: once UDP is confirmed, a moving cursor goes by datagrams alone.
+    The datagram of the position where the hand stops is dropped; it is sent again, unacknowledged,
+    without waiting for the heartbeat (switched off here)."""
+    server, loop = start_table(cleanup)
+    net = player(cleanup, server.port, name="Ann")
+    net.connect()
+    x = 1.0
+
+    def moved_by_udp() -> bool:  # moving: UDP is confirmed and the table follows the cursor
+        nonlocal x
+        x = round(x + 0.01, 4)
+        net.update_input((x, 2.0))
+        time.sleep(0.02)
+        return net._udp.confirmed(time.monotonic()) and _table_cursor_x(loop) == x
+
+    wait_until(moved_by_udp, what="inputs over UDP")
+    sock, sent = net._udp.sock, []
+    net._udp.sock = _DroppingSocket(sock, drop=1, sent=sent)  # the next datagram is lost
+    net._throttle = InputThrottle(heartbeat_s=math.inf)  # no heartbeat (by UDP or TCP) to make up for it
+    net._tcp_input_at = math.inf
+    stop_x = round(x + 0.5, 4)
+    net.update_input((stop_x, 2.0))
+
+    def arrived() -> bool:
+        net.update_input((stop_x, 2.0))  # the window calls this every frame, the hand at rest
+        time.sleep(0.01)
+        return _table_cursor_x(loop) == stop_x
+
+    wait_until(arrived, what="the resting cursor on the table")
+    assert len(sent) >= 2, "the lost datagram was sent again"
+
+
+def _table_cursor_x(loop) -> float | None:
+    with loop.lock:
+        players = loop.clients[1:]
+        return round(float(players[0].cursor_m[0]), 4) if players else None
+
+
+class _DroppingSocket:
+    """A UDP socket whose first `drop` datagrams are lost on the way (the rest go out)."""
+
+    def __init__(self, sock, drop: int, sent: list) -> None:
+        self._sock, self._drop, self._sent = sock, drop, sent
+
+    def send(self, data: bytes) -> int:
+        self._sent.append(data)
+        if self._drop > 0:
+            self._drop -= 1
+            return len(data)
+        return self._sock.send(data)
+
+    def __getattr__(self, name):
+        return getattr(self._sock, name)

@@ -34,7 +34,7 @@ CONNECT_TIMEOUT_S = 5.0
 SILENCE_S = 10.0  # no snapshot for this long: the server is gone (snapshots come 30 times a second)
 MAX_INPUT_HZ = 60.0
 HEARTBEAT_S = 1.0
-SETTLE_S = 0.1  # a cursor sent only by UDP and then still this long goes once more by TCP
+RESEND_S = 0.05  # an input whose datagram is not yet acknowledged goes again after this
 FIRST_BACKOFF_S = 0.25
 FIRST_FULL_BACKOFF_S = 1.0  # the table is full: ask again after this, then less and less often
 MAX_BACKOFF_S = 4.0
@@ -78,35 +78,30 @@ class InputThrottle:
     """When to send INPUT: when it changed, at most max_hz times a second, and
     at least every heartbeat_s so the server knows the player is still there.
 
-    An input sent only by UDP may be lost; while the cursor moves the next one makes up for
-    it, but the last one before the hand stops has no next. So an unchanged input that went
-    by UDP alone is due once more after settle_s, to go by TCP (`settling`)."""
+    An input sent by UDP may be lost; while the cursor moves the next one makes up for it,
+    but the last one before the hand stops has no next. So an unchanged input whose datagram
+    the server has not acknowledged is due again every resend_s (`unacked`), until one is."""
 
-    def __init__(self, max_hz: float = MAX_INPUT_HZ, heartbeat_s: float = HEARTBEAT_S, settle_s: float = SETTLE_S):
+    def __init__(self, max_hz: float = MAX_INPUT_HZ, heartbeat_s: float = HEARTBEAT_S, resend_s: float = RESEND_S):
         self.min_gap_s = 1.0 / max_hz
         self.heartbeat_s = heartbeat_s
-        self.settle_s = settle_s
+        self.resend_s = resend_s
         self.reset()
 
     def reset(self) -> None:
         """Forget what was sent (after a reconnect the next input goes out at once)."""
         self.last: proto.InputRecord | None = None
         self.last_t = -math.inf
-        self.reliable = True  # whether the last input went by TCP
 
-    def settling(self, record: proto.InputRecord, now: float) -> bool:
-        """`record` is the last input, sent by UDP alone, and has not changed for settle_s."""
-        return not self.reliable and record == self.last and now - self.last_t >= self.settle_s
-
-    def due(self, record: proto.InputRecord, now: float) -> bool:
+    def due(self, record: proto.InputRecord, now: float, unacked: bool = False) -> bool:
         gap = now - self.last_t
-        if gap >= self.heartbeat_s or self.settling(record, now):
+        if gap >= self.heartbeat_s or (unacked and gap >= self.resend_s):
             return True
         # A 1 ms allowance, so a 60 fps loop is not held to 30 sends a second by jitter.
         return record != self.last and gap >= self.min_gap_s - 0.001
 
-    def sent(self, record: proto.InputRecord, now: float, reliable: bool = True) -> None:
-        self.last, self.last_t, self.reliable = record, now, reliable
+    def sent(self, record: proto.InputRecord, now: float) -> None:
+        self.last, self.last_t = record, now
 
 
 def empty_scene(width_m: float, height_m: float) -> Scene:
@@ -518,7 +513,9 @@ class NetPlayer:
         at least once a second. Returns True when something was sent."""
         now = time.monotonic() if now is None else now
         record = self._record(cursor_m, button, keys)
-        if not self._throttle.due(record, now):
+        udp = self._udp
+        unacked = udp is not None and udp.confirmed(now) and not udp.delivered
+        if not self._throttle.due(record, now, unacked):
             return False
         return self._send(record, now)
 
@@ -537,11 +534,11 @@ class NetPlayer:
     def _send(self, record: proto.InputRecord, now: float) -> bool:
         frame = proto.encode_input(record.cursor_m, record.button, record.keys)
         udp = self._udp
-        if udp is not None and self.state == PlayerState.CONNECTED and not self._throttle.settling(record, now):
+        if udp is not None and self.state == PlayerState.CONNECTED:
             udp.send(frame[5:])  # the INPUT's JSON, without the frame's envelope
             if udp.confirmed(now) and now - self._tcp_input_at < HEARTBEAT_S:
-                self._throttle.sent(record, now, reliable=False)
-                return True  # UDP gets through: TCP carries only a heartbeat a second and the cursor at rest
+                self._throttle.sent(record, now)
+                return True  # UDP gets through: TCP carries only a heartbeat a second
 
         def sent() -> None:
             self._throttle.sent(record, now)

@@ -17,7 +17,8 @@ class UdpInputs:
 
     def __init__(self, peer: tuple, key: str, number: int) -> None:
         self.key, self.number = key, number
-        self.sequence = 0
+        self.sequence = 0  # of the last datagram sent
+        self.acked = 0  # the newest sequence the server acknowledged
         self.acked_at = -math.inf
         family = socket.AF_INET6 if ":" in str(peer[0]) else socket.AF_INET
         self.sock = socket.socket(family, socket.SOCK_DGRAM)
@@ -43,8 +44,13 @@ class UdpInputs:
                 break
             d = datagrams.parse(data)
             if d is not None and d.kind == datagrams.INPUT_ACK and d.number == self.number and d.verify(self.key):
-                self.acked_at = now
+                self.acked_at, self.acked = now, max(self.acked, d.sequence)
         return now - self.acked_at < CONFIRMED_S
+
+    @property
+    def delivered(self) -> bool:
+        """Whether the server acknowledged the last datagram sent (as of the last `confirmed`)."""
+        return self.acked >= self.sequence
 
     def close(self) -> None:
         self.sock.close()
