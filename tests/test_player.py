@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import contextlib
 import math
 import os
 import socket
@@ -261,7 +262,7 @@ def test_a_full_table_is_waited_for_on_screen_and_joined_when_a_place_frees(caps
     first.hello()
     assert main([f"127.0.0.1:{server.port}", "--headless", "--seconds", "0.1"]) == 0
     out = capsys.readouterr().out
-    assert "server full" in out and "waiting for a place" in out
+    assert "server full" in out and "tries again by itself" in out and "(Esc quits)" in out
     net = player(cleanup, server.port)
     assert net.connect() is None and net.state == net.WAITING
     assert net.banner_text.startswith("the table is full: asking again in")
@@ -756,3 +757,56 @@ class _DroppingSocket:
 
     def __getattr__(self, name):
         return getattr(self._sock, name)
+
+
+def test_a_hello_lost_on_a_quick_link_is_tried_again_not_the_end(cleanup):
+    """The server's HELLO deadline passed on a link that looks quick (the HELLO was lost, or the
+    laptop stalled between connecting and saying it): the student joins on the next try."""
+    server, _ = start_table(cleanup, hello_timeout_s=0.2)
+    relay = _HoldFirstHello(server.port)
+    cleanup(relay.close)
+    net = player(cleanup, relay.port, name="Ann")
+    assert net.connect() is None and net.state == net.WAITING  # told to try again, not ended
+    assert "no HELLO came within 0.2 s" in net.waiting_because
+    assert net.banner_text.startswith("no HELLO came within 0.2 s of connecting (lost on the way?): asking again in")
+    wait_until(lambda: net.state == net.CONNECTED, what="the second try to join")
+    assert net.welcome.client == "C1"
+
+
+class _HoldFirstHello:
+    """A relay on 127.0.0.1 that swallows what the first connection sends (its HELLO is lost)
+    and passes the server's answer back; later connections pass both ways."""
+
+    def __init__(self, server_port: int) -> None:
+        self._listener = socket.create_server(("127.0.0.1", 0))
+        self.port = self._listener.getsockname()[1]
+        self._server_port, self._socks, self._closed = server_port, [], threading.Event()
+        threading.Thread(target=self._accept, daemon=True).start()
+
+    def _accept(self) -> None:
+        for k in range(20):  # bounded: a test makes a few connections
+            try:
+                client, _ = self._listener.accept()
+            except OSError:
+                return
+            upstream = socket.create_connection(("127.0.0.1", self._server_port))
+            self._socks += [client, upstream]
+            threading.Thread(target=self._pipe, args=(client, upstream, k == 0), daemon=True).start()
+            threading.Thread(target=self._pipe, args=(upstream, client, False), daemon=True).start()
+
+    def _pipe(self, src: socket.socket, dst: socket.socket, lose: bool) -> None:
+        for _ in range(100_000):  # bounded
+            try:
+                data = src.recv(65536)
+                if not data:
+                    break
+                if not lose:
+                    dst.sendall(data)
+            except OSError:
+                break
+        with contextlib.suppress(OSError):
+            dst.shutdown(socket.SHUT_WR)
+
+    def close(self) -> None:
+        for sock in (self._listener, *self._socks):
+            sock.close()

@@ -69,7 +69,7 @@ class PlayerState(enum.Enum):
     CONNECTING = "connecting"
     CONNECTED = "connected"
     RETRYING = "retrying"  # the server went away: reconnecting with backoff
-    WAITING = "waiting"  # the table is full or busy: asking again with backoff
+    WAITING = "waiting"  # the server asked us to try again (full, busy, HELLO lost): asking with backoff
     FAILED = "failed"
     CLOSED = "closed"
 
@@ -202,8 +202,10 @@ class NetPlayer:
         wait = max(0, math.ceil(self.next_try - time.monotonic()))
         if self.state == PlayerState.RETRYING:
             return self.waiting_because or RECONNECTING
-        if self.state == PlayerState.WAITING:
-            return f"the table is full: asking again in {wait} s (Esc quits)"
+        if self.state == PlayerState.WAITING:  # the server's reason, up to its advice
+            reason = (self.waiting_because or "the table cannot take you yet").split(";")[0]
+            reason = "the table is full" if reason.startswith("server full") else reason
+            return f"{reason}: asking again in {wait} s (Esc quits)"
         if self.state == PlayerState.FAILED:
             return self.error
         return None

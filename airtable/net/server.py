@@ -974,8 +974,10 @@ class GameServer:
 
     def _hello_missing(self, conn: Connection, now: float) -> None:
         """The HELLO deadline passed. On a slow link (long round trip, bytes lost and sent again) the HELLO
-        may still be on its way: wait up to SLOW_HELLO_S, then ask the client to try again. On a quick
-        link this is not an airtable client."""
+        may still be on its way: wait up to SLOW_HELLO_S. Either way the ERROR asks the client to try
+        again: a HELLO lost on a link that looks quick (only the handshake's few packets crossed it)
+        is the same silence as a program that is not an airtable client, and a student's session
+        must not end on it; anything else ignores the `retry`."""
         slow = pacing.link_is_slow(conn.sock)
         if slow and now - conn.opened < SLOW_HELLO_S:
             return
@@ -984,14 +986,12 @@ class GameServer:
                 f"the network is slow: your HELLO did not arrive within {SLOW_HELLO_S:g} s; "
                 "your client tries again by itself"
             )
-            self._fail(conn, sentence, retry=True, quiet=True)
-            return
-        self._fail(
-            conn,
-            f"no HELLO came within {self.hello_timeout_s:g} s of connecting; "
-            "join with airtable-client, which says HELLO at once",
-            quiet=True,
-        )
+        else:
+            sentence = (
+                f"no HELLO came within {self.hello_timeout_s:g} s of connecting (lost on the way?); "
+                "airtable-client tries again by itself, other programs cannot join"
+            )
+        self._fail(conn, sentence, retry=True, quiet=True)
 
     def _dead_sentence(self, conn: Connection, now: float) -> str | None:
         """Why a connection counts as dead (a player's seat is then held; the ERROR carries retry), or None."""

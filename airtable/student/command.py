@@ -50,7 +50,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     except KeyboardInterrupt:
         return 1
     if welcome is None:
-        print(f"airtable-client: {net.waiting_because}; waiting for a place (Esc quits)")
+        print(f"airtable-client: {net.waiting_because} (Esc quits)")
     else:
         print(f"airtable-client: connected to {net.address}; you are {welcome.label}")
     if args.headless:

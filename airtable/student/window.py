@@ -139,7 +139,7 @@ class PlayerApp:
         return self.env
 
     def _caption(self) -> str:
-        return f"Air Table - {self._welcome.label}" if self._welcome else "Air Table - waiting for a place"
+        return f"Air Table - {self._welcome.label}" if self._welcome else "Air Table - joining"
 
     def _handle_events(self, events) -> bool:
         """Mouse buttons and keys; False when the user quits (window closed or Esc)."""
