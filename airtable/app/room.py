@@ -81,9 +81,10 @@ class Room(Feature):
         return server.failure if server is not None else self.server_problem
 
     def hud_lines(self) -> list:
-        """Why students cannot join (in red), the join line and the player count."""
-        alert, server = self.alert(), self.host.server
-        lines: list = [(alert, ALERT_COLOR)] if alert else []
+        """Why students cannot join and who was turned away (in red), the join line and the player count."""
+        server = self.host.server
+        alerts = [self.alert(), server.door_notice if server is not None else None]
+        lines: list = [(alert, ALERT_COLOR) for alert in alerts if alert]  # first: a narrow band keeps the first
         if server is not None:
             n = server.player_count
             lines.extend(server.join_lines())

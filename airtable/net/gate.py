@@ -95,9 +95,10 @@ class Gate:
         if not self.turned_away:
             return None
         host, count = self.turned_away.most_common(1)[0]
+        # Short enough for one line of a 4:3 projector's top band.
         return (
-            f"{count} student{'' if count == 1 else 's'} at {host} could not join: one address may have "
-            f"{self.players_per_address} seats; a class behind one router? {ALLOW_A_CLASS}"
+            f"{count} student{'' if count == 1 else 's'} at {host} could not join: "
+            "a class behind one router? start with --per-address 40"
         )
 
     @property

@@ -371,15 +371,20 @@ class GameServer:
         return self._thread is not None and self._thread.is_alive() and not self._stopping.is_set()
 
     def join_lines(self) -> list[str]:
-        """What students type to join, e.g. ["join with: airtable-client 192.168.1.23"], and, for
-        NOTICE_S after students were turned away per address, the line that says how to let them in.
+        """What students type to join, e.g. ["join with: airtable-client 192.168.1.23"].
 
         Worked out once per port and cached, since the app may ask every frame."""
         if self._join_lines is None or self._join_lines[0] != self.port:
             self._join_lines = (self.port, self._make_join_lines())
+        return list(self._join_lines[1])
+
+    @property
+    def door_notice(self) -> str | None:
+        """For NOTICE_S after students were turned away per address, the line that says how to let
+        them in (the projector shows it as an alert), else None."""
         with self._lock:
             notice, until = self._door_notice
-        return list(self._join_lines[1]) + ([notice] if notice and time.monotonic() < until else [])
+        return notice if notice and time.monotonic() < until else None
 
     def _make_join_lines(self) -> list[str]:
         host = self.host or "0.0.0.0"
