@@ -59,6 +59,9 @@ def test_the_look_alike_letters_of_these_tests_are_cyrillic_or_greek():
         "s 12",
         "Ann \u0441.3",
         "C\u2082",  # subscript two
+        "CI Ann",  # capital i: reads "C1 Ann"
+        "Cl Ann",  # small L
+        "S|2",
     ],
 )
 def test_a_name_that_reads_like_a_seat_label_is_refused_with_a_sentence(name):
@@ -68,7 +71,9 @@ def test_a_name_that_reads_like_a_seat_label_is_refused_with_a_sentence(name):
     assert "looks like a player label" in str(err.value) and "pick a name" in str(err.value)
 
 
-@pytest.mark.parametrize("name", ["Ann", "C3PO", "Claire 2", "Scott", "Cs", "Class 5b", "\u03a9mega 2", "S\u00f8ren"])
+@pytest.mark.parametrize(
+    "name", ["Ann", "C3PO", "Claire 2", "Scott", "Cs", "Class 5b", "\u03a9mega 2", "S\u00f8ren", "Sol", "Col", "Cliff"]
+)
 def test_names_that_only_contain_c_or_s_and_a_number_are_welcome(name):
     assert not looks_like_label(name)
     assert proto.check_name(name) == name
@@ -90,6 +95,9 @@ def test_look_alike_names_get_a_number_and_the_numbers_themselves_stay_distinct(
     assert distinct_name("Ian", ["lan"]) == "Ian 2"  # capital I and small l
     assert distinct_name("Ann\u2014Lee", ["Ann-Lee"]) == "Ann\u2014Lee 2"  # em dash
     assert distinct_name("Ann  Lee", ["Ann Lee"]) == "Ann  Lee 2"
+    assert distinct_name("B0b", ["Bob"]) == "B0b 2"  # a zero for an o
+    assert distinct_name("Ann2", ["Ann", "Ann 2"]) == "Ann2 2"  # "Ann2" reads as "Ann 2"; "Ann22" does not
+    assert distinct_name("Al1", ["All"]) == "Al1 2"
 
 
 def test_a_numbered_name_fits_twenty_characters_and_never_reads_as_a_label():

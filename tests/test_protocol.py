@@ -264,3 +264,9 @@ def test_parse_host_port(text, expected):
 def test_parse_host_port_refuses(text):
     with pytest.raises(ValueError):
         proto.parse_host_port(text)
+
+
+def test_runs_of_spaces_in_a_name_become_one():
+    # "Ann  2" would show as "Ann  2 2" beside an "Ann 2", reading like a third Ann numbered twice.
+    assert proto.check_name("Ann  2") == "Ann 2"
+    assert proto.check_name(" Mary   Jo ") == "Mary Jo"

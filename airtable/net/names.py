@@ -56,23 +56,37 @@ def skeleton(name: str) -> str:
     return _SPACES.sub(" ", text).strip()
 
 
+# Letters and digits that pass for each other, one way for each question: a seat label is
+# made of digits, so for it the bars (I, l, |) read as 1; names are made of letters, so for
+# them 0 and 1 read as o and l ("B0b" beside "Bob"). Not o as 0 for labels: "Sol" is a name.
+_AS_DIGITS = str.maketrans({"l": "1", "|": "1"})
+_AS_LETTERS = str.maketrans({"0": "o", "1": "l", "|": "l"})
+
+
 def looks_like_label(name: str) -> bool:
-    """Whether `name` holds something that reads like a seat label, C7 or S7 (in any look-alike letters)."""
-    return _LABEL.search(skeleton(name)) is not None
+    """Whether `name` holds something that reads like a seat label, C7 or S7 (in any look-alike
+    letters, "Cl" with a small L or "CI" with a capital i too)."""
+    return _LABEL.search(skeleton(name).translate(_AS_DIGITS)) is not None
+
+
+def _reads_as(name: str) -> str:
+    """What a name reads as beside others: its skeleton, digits as the letters they pass for, and
+    no spaces ("Ann2" beside "Ann 2")."""
+    return skeleton(name).translate(_AS_LETTERS).replace(" ", "")
 
 
 def distinct_name(name: str, taken: Iterable[str]) -> str:
     """`name`, or "name 2" (3, ...) when it reads like one of the names `taken` ("Ann" -> "Ann 2").
 
     At most MAX_NAME_CHARS characters: a long name is cut to make room for the number."""
-    seen = {skeleton(t) for t in taken}
-    if skeleton(name) not in seen:
+    seen = {_reads_as(t) for t in taken}
+    if _reads_as(name) not in seen:
         return name
     for k in range(2, len(seen) + 3):  # len(seen) + 1 numbers cannot all be taken
         candidate = _numbered(name, f" {k}")
         if looks_like_label(candidate):  # "C" -> "C 2" would read as a seat label: "C (2)"
             candidate = _numbered(name, f" ({k})")
-        if skeleton(candidate) not in seen:
+        if _reads_as(candidate) not in seen:
             return candidate
     raise AssertionError("unreachable: more numbers were tried than names are taken")
 
