@@ -124,7 +124,22 @@ def _in_bad_join(shaper, students: int = 6) -> dict:
         room.close()
 
 
+def _in_no_route(shaper) -> dict:
+    from airtable.net.server import lan_addresses
+
+    return {"addresses": lan_addresses()}
+
+
 # ----------------------------------------------------------------- shaped-link tests
+
+
+@needs_link
+def test_the_join_line_names_the_classroom_address_where_no_route_leads_out():
+    """A classroom network or a hotspot with no internet: no default route. The namespace has only
+    its link's addresses; the join line named 127.0.0.1, which no student can reach."""
+    addresses = linkshaper.run_isolated("test_classroom_link", "_in_no_route", 30.0)["addresses"]
+    # Each interface's first address (the link's device has two).
+    assert addresses and set(addresses) <= {linkshaper.CLIENT_HOST, linkshaper.SERVER_HOST}
 
 
 @needs_link

@@ -296,7 +296,8 @@ def check_name(name: object) -> str:
         raise ProtocolError(
             f"the name {_short(name)} has no visible letter or digit; pick a name others can read, like Ann"
         )
-    name = " ".join(part for part in name.split(" ") if part)  # spaces squeezed: "Ann  2" would show as "Ann 2" beside the real one
+    # Runs of spaces squeezed: "Ann  2" would show as "Ann 2" beside the real one.
+    name = " ".join(part for part in name.split(" ") if part)
     if looks_like_label(name):  # also in look-alike letters: "С1" with a Cyrillic С, "C-1", "C¹"
         raise ProtocolError(
             f"the name {_short(name)} looks like a player label such as C7; pick a name without C and a number"

@@ -34,6 +34,7 @@ import logging
 import math
 import selectors
 import socket
+import struct
 import threading
 import time
 from collections.abc import Callable
@@ -110,8 +111,8 @@ def lan_addresses() -> list[str]:
     """This machine's IPv4 LAN addresses, without any network traffic.
 
     Uses the host name's addresses plus the address the OS would route private
-    networks from (connecting a UDP socket sends no packet). Falls back to
-    127.0.0.1 when the machine has no network.
+    networks from (connecting a UDP socket sends no packet); with no route, the
+    interfaces' addresses. Falls back to 127.0.0.1 when the machine has no network.
     """
     found: list[str] = []
     try:
@@ -127,7 +128,32 @@ def lan_addresses() -> list[str]:
         except OSError:
             continue
     usable = [a for a in dict.fromkeys(found) if not a.startswith(("127.", "0.", "169.254."))]
+    if not usable:  # no route out (a classroom network or a hotspot with no internet): ask each interface
+        usable = [a for a in dict.fromkeys(interface_addresses()) if not a.startswith(("127.", "0.", "169.254."))]
     return usable or ["127.0.0.1"]
+
+
+SIOCGIFADDR = 0x8915  # Linux's ioctl for an interface's IPv4 address
+
+
+def interface_addresses() -> list[str]:
+    """The IPv4 address of each network interface (Linux; elsewhere none): what lan_addresses falls
+    back on when no route says which one faces the class."""
+    try:
+        import fcntl
+
+        names = [name for _, name in socket.if_nameindex()]
+    except (ImportError, OSError, AttributeError):
+        return []
+    found = []
+    with socket.socket(socket.AF_INET, socket.SOCK_DGRAM) as s:
+        for name in names:
+            try:
+                answer = fcntl.ioctl(s.fileno(), SIOCGIFADDR, struct.pack("256s", name.encode()[:15]))
+            except OSError:
+                continue  # no IPv4 address on this one
+            found.append(socket.inet_ntoa(answer[20:24]))
+    return found
 
 
 def validate_server_options(
