@@ -1,5 +1,6 @@
 """Test set-up: every test runs headless unless it asks for a real X display; shared helpers."""
 
+import math
 import os
 import sys
 from pathlib import Path
@@ -96,6 +97,17 @@ def press(app, key: int, mod: int = 0, frames: int = 1, unicode: str = "") -> No
     post_key(key, down=False, mod=mod, unicode=unicode)
     for _ in range(frames):
         app.frame(FRAME_S)
+
+
+def escape_again(app) -> None:
+    """Esc as a person answers the quit question: after a pause (a burst of Escs answers nothing)."""
+    import pygame
+
+    from airtable.app.overlays import ESC_PAUSE_S
+
+    for _ in range(math.ceil(ESC_PAUSE_S / FRAME_S)):
+        app.frame(FRAME_S)
+    press(app, pygame.K_ESCAPE)
 
 
 def wait_until(

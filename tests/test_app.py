@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pygame
 import pytest
-from conftest import FRAME_S, press
+from conftest import FRAME_S, escape_again, press
 
 from airtable.app.app import App
 from airtable.cli import main
@@ -235,7 +235,7 @@ def test_screenshot_key_saves_a_png(app, tmp_path, monkeypatch):
 def test_escape_asks_then_a_second_escape_quits(app):
     press(app, pygame.K_ESCAPE)
     assert app.running and app.panels.panel() == "quit"
-    press(app, pygame.K_ESCAPE)
+    escape_again(app)
     assert not app.running
 
 

@@ -12,7 +12,7 @@ import socket
 
 import pygame
 import pytest
-from conftest import FRAME_S, press, wait_until
+from conftest import FRAME_S, escape_again, press, wait_until
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
@@ -79,7 +79,7 @@ def test_esc_closes_the_top_overlay_in_any_order_and_then_asks(demos, server, or
     assert not app.aids.show_chart and not app.lessons.show_values and not app.room.show_roster
     press(app, pygame.K_ESCAPE)
     assert app.running and app.panels.panel() == "quit"
-    press(app, pygame.K_ESCAPE)
+    escape_again(app)
     assert not app.running
 
 
@@ -160,7 +160,7 @@ def test_quitting_with_a_student_connected_asks_and_says_so(demos, how):
             app.frame(FRAME_S)
             assert app.running and app.panels.panel() == "quit"
             assert shown[-1][0] == "Quit?" and "1 student will be dropped." in shown[-1][1]
-            press(app, pygame.K_ESCAPE) if how == "esc" else close_window(app)
+            escape_again(app) if how == "esc" else close_window(app)
             assert not app.running
         finally:
             student.close()
@@ -189,3 +189,18 @@ def test_a_signal_ends_the_app_at_once_without_asking(sig, tmp_path):
             app.kill()
     assert app.returncode == 0, err
     assert "frames" in out and "Traceback" not in err  # the --stats line: it ended the usual way
+
+
+def test_mashing_esc_clears_the_screen_and_asks_but_never_quits(demos):
+    """The user test: six overlays open, Esc pressed 12 times quickly (one a frame): the sixth
+    closes the last, the seventh asks, and the rest of the burst answers nothing."""
+    app = App(demos, demo_key="6", headless=True, window_size_px=(1920, 1080))
+    pygame.event.clear()
+    for key in (pygame.K_c, pygame.K_t, pygame.K_d, pygame.K_l, pygame.K_TAB):
+        press(app, key)
+    assert len(list(app.overlays)) >= 4
+    for _ in range(12):
+        press(app, pygame.K_ESCAPE)
+    assert app.running and app.panels.panel() == "quit" and list(app.overlays) == ["quit"]
+    escape_again(app)  # after a pause, Esc answers
+    assert not app.running

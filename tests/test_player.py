@@ -20,6 +20,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 from test_server import RawClient
 
+from airtable.app.overlays import ESC_PAUSE_S
 from airtable.app.window import background_for
 from airtable.model.scene import CursorView, Scene
 from airtable.net import protocol as proto
@@ -371,6 +372,7 @@ def test_escape_asks_then_a_second_escape_sends_bye_and_quits(cleanup):
         frames = app.frames
         wait_until(lambda: app.frames > frames + 2, what="a few frames asking")
         assert net.state == PlayerState.CONNECTED
+        time.sleep(ESC_PAUSE_S)  # a person reads the question, then answers (a burst of Escs does not)
         escape()
 
     t = threading.Thread(target=press_escape)

@@ -11,7 +11,7 @@ from pathlib import Path
 import numpy as np
 import pygame
 import pytest
-from conftest import FRAME_S, press
+from conftest import FRAME_S, escape_again, press
 
 from airtable.app.app import App
 from airtable.app.demo_loader import BUILTIN_DIR, DemoShelf, key_order
@@ -177,7 +177,7 @@ def test_esc_closes_an_open_panel_first(demos, opener):
     assert app.panels.panel() is None and app.running
     press(app, pygame.K_ESCAPE)
     assert app.panels.panel() == "quit" and app.running
-    press(app, pygame.K_ESCAPE)
+    escape_again(app)
     assert not app.running
 
 

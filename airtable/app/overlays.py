@@ -13,6 +13,7 @@ A feature keeps its flag as an `OverlayFlag`: `app.aids.show_chart = True` opens
 
 from __future__ import annotations
 
+import math
 from collections.abc import Iterator
 
 # Drawn in the middle of the window, one at a time, over everything else.
@@ -110,3 +111,20 @@ class OverlayValue:
     def __set__(self, owner, value) -> None:
         setattr(owner, self.slot, value)
         owner.overlays.set(self.name, bool(value))
+
+
+ESC_PAUSE_S = 0.5  # an Esc this soon after the last one is part of a burst
+
+
+class EscapeBurst:
+    """Esc pressed again and again to clear the screen must not answer the quit question it
+    opens: an Esc counts as that answer only after a pause (ESC_PAUSE_S since the last one)."""
+
+    def __init__(self) -> None:
+        self._last_s = -math.inf
+
+    def deliberate(self, now_s: float) -> bool:
+        """Note an Esc at `now_s`; whether it came after a pause."""
+        paused = now_s - self._last_s >= ESC_PAUSE_S
+        self._last_s = now_s
+        return paused

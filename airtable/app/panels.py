@@ -17,7 +17,7 @@ import pygame
 from airtable.app.demo_loader import key_label
 from airtable.app.feature import Binding, Feature
 from airtable.app.menu import DemoMenu
-from airtable.app.overlays import OverlayFlag, OverlayValue
+from airtable.app.overlays import EscapeBurst, OverlayFlag, OverlayValue
 
 if TYPE_CHECKING:
     from airtable.app.host import Host
@@ -47,6 +47,7 @@ class Panels(Feature):
         self.key_rows = key_rows  # the help's rows: the app's whole key table
         self.help_page, self.help_pages = 0, 1
         self.quit_armed_until = -1.0  # clock_s until which a second Esc quits
+        self._escapes = EscapeBurst()
 
     def panel(self) -> str | None:
         """Which panel is in the middle of the window now, if any (the quit question lapses)."""
@@ -90,9 +91,14 @@ class Panels(Feature):
     # ------------------------------------------------------------ quitting
 
     def escape(self) -> None:
-        """Esc: close what is on top; with nothing open, ask; Esc again while asked quits."""
+        """Esc: close what is on top; with nothing open, ask; Esc again while asked quits, once
+        the Escs that closed things and asked have paused (EscapeBurst)."""
+        deliberate = self._escapes.deliberate(self.host.clock_s)
         if self.panel() == "quit":
-            self.quit_now()
+            if deliberate:
+                self.quit_now()
+            else:
+                self.ask_to_quit()  # still asking, for as long again
         elif not self.close_panel():
             self.ask_to_quit()
 

@@ -17,6 +17,7 @@ from collections.abc import Callable, Sequence
 import numpy as np
 
 from airtable.app.loop import IdlingLoop, signals_end_the_run
+from airtable.app.overlays import EscapeBurst
 from airtable.app.predict import StudentGuesses
 from airtable.app.predict_view import paint_round
 from airtable.app.room import student_banner
@@ -55,6 +56,7 @@ class PlayerApp:
         self.keys: set[str] = set()
         self.show_help = False  # F1: the keys of this window
         self.leave_asked_until = -math.inf  # time.monotonic() until which a second Esc leaves
+        self._escapes = EscapeBurst()
         self.ended: str | None = None  # why the session ended for good, shown until a key is pressed
         self.status = 0  # what run() returns: 1 once the session ended for good
         self.painter = None  # the AidsPainter, once the window is open
@@ -190,9 +192,10 @@ class PlayerApp:
         self.leave_asked_until = -math.inf
         if not escape:
             return True
+        deliberate = self._escapes.deliberate(now)  # a burst of Escs does not answer (overlays.py)
         if self.show_help:
             self.show_help = False
-        elif asked:
+        elif asked and deliberate:
             return False
         else:
             self.leave_asked_until = now + LEAVE_CONFIRM_S
