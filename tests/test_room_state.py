@@ -11,6 +11,7 @@ from conftest import FRAME_S
 
 from airtable import cli
 from airtable.app.app import App
+from airtable.app.hud_view import BAND_LINES, fold_lines
 from airtable.app.roster_view import ALERT_COLOR
 from airtable.net.server import GameServer
 
@@ -20,7 +21,7 @@ def alert_pixels(path) -> int:
     return int(np.all(picture == ALERT_COLOR, axis=-1).sum())
 
 
-def test_a_busy_port_shows_on_the_projector_with_the_port_to_use(tmp_path, capsys):
+def test_a_busy_port_shows_on_the_projector_with_the_port_to_use(tmp_path, capsys, demos):
     shot = tmp_path / "projector.png"
     with socket.create_server(("127.0.0.1", 0)) as busy:
         port = busy.getsockname()[1]
@@ -31,6 +32,12 @@ def test_a_busy_port_shows_on_the_projector_with_the_port_to_use(tmp_path, capsy
     suggested = int(err.split("start with --port ")[1].split()[0])
     assert suggested != port
     assert alert_pixels(shot) > 200  # the sentence, in the alert colour, on the picture of the window
+    # The port to use is the line's beginning, which even a small window's band keeps.
+    problem = next(line for line in err.splitlines() if "already in use" in line).removeprefix("airtable: ")
+    app = App(demos, headless=True, server_problem=problem, window_size_px=(640, 480))
+    window = app.window
+    width = window.surface.get_width() - window.font.get_height()
+    assert f"--port {suggested}" in fold_lines(app.hud_lines(), BAND_LINES - 1, window.font, width)[0][0]
 
 
 def test_the_alert_is_the_servers_sentence_and_stays_until_it_starts(demos):

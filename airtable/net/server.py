@@ -356,7 +356,8 @@ class GameServer:
         if e.errno in (errno.EADDRINUSE, getattr(errno, "WSAEADDRINUSE", -1)):
             other = free_port_after(host, self.port)
             instead = f"start with --port {other}" if other else "pick another port with --port"
-            return f"port {self.port} is already in use (another airtable?); {instead}"
+            # What to do first: a narrow window's line keeps its beginning.
+            return f"{instead} (port {self.port} is already in use: another airtable?)"
         if e.errno in (errno.EACCES, errno.EPERM):
             return f"not allowed to listen on {host}:{self.port}; use a port above 1023 with --port"
         if e.errno == errno.EADDRNOTAVAIL:
