@@ -26,7 +26,8 @@ def test_the_inspector_shows_the_stiffness_a_softened_spring_acts_with() -> None
     table.step(1 / 240)
     assert spring.k_effective_Npm < spring.k_Npm
     lines = inspector_lines(table, a)
-    assert f"spring k {TOO_STIFF_NPM:.4g} N/m, acts with {spring.k_effective_Npm:.4g} N/m (softened)" in lines
+    softened = f"acts with {spring.k_effective_Npm:.4g} N/m (softened)"
+    assert f"spring to puck 2: k {TOO_STIFF_NPM:.4g} N/m, {softened}" in lines
 
 
 def test_an_ordinary_spring_is_listed_without_softening() -> None:
@@ -35,7 +36,27 @@ def test_an_ordinary_spring_is_listed_without_softening() -> None:
     b = table.add_puck(pos_m=(5.5, 4.0))
     table.add_spring(a, b, k_Npm=20.0)
     table.step(1 / 240)
-    assert inspector_lines(table, a)[-1] == "spring k 20 N/m"
+    assert inspector_lines(table, a)[-1] == "spring to puck 2: k 20 N/m"
+
+
+def test_the_inspector_shows_round_off_as_zero() -> None:
+    """A settled demo 6 showed "speed 3.293e-14 m/s" and "kinetic energy 8.624e-28 J" (user test)."""
+    from airtable.model.readout import SceneScale
+
+    table = AirTable()
+    a = table.add_puck(pos_m=(4.0, 4.0), vel_mps=(3.0e-14, -1.0e-14))
+    scale = SceneScale()
+    scale.observe((2.0, 0.0, 0.0), 1.5, float(table.mass_kg.sum()))  # the scene once had 2 J
+    lines = inspector_lines(table, a, scale)
+    assert "speed 0 m/s" in lines and "velocity (0.000, 0.000) m/s" in lines and "kinetic energy 0 J" in lines
+    a.vel_mps = (0.25, 0.0)  # a real speed stays
+    assert "speed 0.25 m/s" in inspector_lines(table, a, scale)
+
+
+def test_a_gap_of_round_off_is_never_minus_zero() -> None:
+    from airtable.model.readout import fixed
+
+    assert fixed(-1e-9, 1) == "0.0" and fixed(-0.04, 1) == "0.0" and fixed(-0.06, 1) == "-0.1"
 
 
 def test_the_app_says_each_notice_once(demos, capsys) -> None:

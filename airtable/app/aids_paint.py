@@ -18,7 +18,7 @@ import pygame
 from airtable.app.panel_view import DIM_TEXT, TEXT_COLOR
 from airtable.app.panel_view import wrap as _wrap
 from airtable.model.aids import VectorScale
-from airtable.model.readout import readable
+from airtable.model.readout import fixed, readable
 
 ANNOTATION_NORMAL = (255, 230, 90)
 ANNOTATION_TANGENT = (90, 200, 255)
@@ -278,8 +278,8 @@ class AidsPainter:
     @staticmethod
     def _annotation_lines(a, alpha: float) -> list[tuple[str, tuple[int, int, int]]]:
         lines = [
-            (f"overlap {a.overlap_m * 1000:.1f} mm", OVERLAP_COLOR),
-            (f"separation {a.separation_m * 1000:.1f} mm", SEPARATION_COLOR),
+            (f"overlap {fixed(a.overlap_m * 1000, 1)} mm", OVERLAP_COLOR),
+            (f"separation {fixed(a.separation_m * 1000, 1)} mm", SEPARATION_COLOR),
         ]
         if a.ratio is not None:
             lines.append((f"ratio {a.ratio:.4f}", TEXT_COLOR))

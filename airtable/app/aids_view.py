@@ -11,6 +11,7 @@ import numpy as np
 
 from airtable.model import aids
 from airtable.model.momenta import puck_number
+from airtable.model.readout import SceneScale, fixed
 
 DIM_FORCE = (200, 200, 200)
 COM_COLOR = (255, 255, 255)
@@ -21,21 +22,24 @@ FORCE_COLORS = {"cursor strings": (255, 120, 80), "springs": (255, 215, 0), "gra
 MAX_INSPECTED_SPRINGS = 4
 
 
-def inspector_lines(table, puck) -> list[str]:
-    """What `i` tells about a puck: mass, speed, energy, and each spring on it with the stiffness it acts with."""
-    v = puck.vel_mps
+def inspector_lines(table, puck, scale: SceneScale | None = None) -> list[str]:
+    """What `i` tells about a puck: mass, speed, energy, and each spring on it with the stiffness it acts
+    with. Round-off shows as 0 by the scene's `scale` (readout.py): a speed by the momentum it gives."""
+    scale, m = scale or SceneScale(), puck.mass_kg
+    v = [scale.momentum(m * c) / m if m > 0 else float(c) for c in puck.vel_mps]
     speed = float(np.hypot(*v))
     lines = [
         f"puck {puck_number(puck.index)}",
-        f"mass {puck.mass_kg:.4g} kg   radius {puck.radius_m:.4g} m",
+        f"mass {m:.4g} kg   radius {puck.radius_m:.4g} m",
         f"speed {speed:.4g} m/s",
-        f"velocity ({v[0]:.3f}, {v[1]:.3f}) m/s",
-        f"kinetic energy {0.5 * puck.mass_kg * speed**2:.4g} J",
+        f"velocity ({fixed(v[0], 3)}, {fixed(v[1], 3)}) m/s",
+        f"kinetic energy {scale.energy(0.5 * m * speed**2):.4g} J",
     ]
     if table.asleep[puck.index]:  # the engine's sleeping, made visible (physics/sleep.py)
         lines.append("asleep: the step skips it until disturbed")
     for spring in table.springs_on(puck)[:MAX_INSPECTED_SPRINGS]:
-        line = f"spring k {spring.k_Npm:.4g} N/m"
+        other = spring.p2 if spring.p1.index == puck.index else spring.p1
+        line = f"spring to puck {puck_number(other.index)}: k {spring.k_Npm:.4g} N/m"
         if spring.k_effective_Npm != spring.k_Npm:
             line += f", acts with {spring.k_effective_Npm:.4g} N/m (softened)"
         lines.append(line)

@@ -79,7 +79,7 @@ class Aids(Feature):
         if self.inspecting:
             puck = t.puck_at(host.env.to_world(host.mouse_px))
             if puck is not None:
-                paint.inspector(puck.pos_m, inspector_lines(t, puck))
+                paint.inspector(puck.pos_m, inspector_lines(t, puck, self.chart.scale))
         self.inspecting = False  # until the held key says so again
 
     # ------------------------------------------------------------ keys

@@ -18,6 +18,11 @@ from dataclasses import dataclass
 ROUND_OFF = 1e-9
 
 
+def fixed(value: float, decimals: int) -> str:
+    """`value` with `decimals` decimals, never "-0.0" (a gap of -1e-9 mm is no gap)."""
+    return f"{round(float(value), decimals) + 0.0:.{decimals}f}"
+
+
 def readable(value: float, scale: float) -> float:
     """`value`, or 0.0 when it is within ROUND_OFF times `scale` of 0 (never -0.0)."""
     value = float(value)
