@@ -18,6 +18,9 @@ import pytest
 from conftest import FRAME_S, press
 
 from airtable.app.app import App
+from airtable.app.panel_view import wrap
+from airtable.app.predict_view import paint_round
+from airtable.model.rounds import RoundInfo
 from airtable.net.server import GameServer
 
 SIZES = [(640, 480), (1280, 720), (1920, 1080), (3840, 2160)]
@@ -72,3 +75,94 @@ def test_the_whole_table_shows_between_the_text(demos, server, size):
     assert height >= 0.75 * h  # the text takes a band, not the table's room
     walls = app.window.wall_rects()
     assert len(walls) == 4 and all(np.all(np.array(r.size) > 0) for r in walls)
+
+
+def inside_window(app, boxes) -> list[pygame.Rect]:
+    """The text boxes not wholly inside the window."""
+    window = pygame.Rect((0, 0), app.window.surface.get_size())
+    return [box for box in boxes if not window.contains(box)]
+
+
+def wrong_places(app) -> list:
+    boxes = list(app.window.label_boxes)
+    return crossings(app, boxes) + [(box, "outside the window") for box in inside_window(app, boxes)]
+
+
+LONG_PATH = "saved recordings/demo2-20261127-102233-four-pucks-and-a-long-name-for-the-file.csv (12 s)"
+
+
+@pytest.mark.parametrize("size", SIZES, ids=lambda s: f"{s[0]}x{s[1]}")
+@pytest.mark.parametrize("case", ["values hint 3", "values hint 8", "long path", "predict"])
+def test_long_text_stays_in_its_box_and_off_the_table(demos, server, size, case):
+    # User test: in 16:9 windows the values hint, a file's path and the PREDICT lines ran out of
+    # their boxes in the side margins and across the table's left wall.
+    demo = {"values hint 3": "3", "values hint 8": "8"}.get(case, "2")
+    app = App(demos, demo_key=demo, headless=True, server=server, window_size_px=size)
+    pygame.event.clear()
+    press(app, pygame.K_SPACE)
+    if case == "long path":
+        app.say(LONG_PATH)
+    elif case == "predict":
+        press(app, pygame.K_F6)
+        assert app.predict.round.state == "open"
+    else:
+        press(app, pygame.K_t)
+        assert app.lessons.show_values
+    app.frame(FRAME_S)
+    assert app.paused
+    wrong = wrong_places(app)
+    if case.startswith("values") and not app.window.layout.side_px:
+        # No margins: the panel is an opaque box at the window's edge, over the table by
+        # necessity (see above); its text must stay inside it.
+        panel = max((box for box, _ in wrong), key=lambda box: box.width * box.height)
+        wrong = [(box, what) for box, what in wrong if not panel.contains(box) or what == "outside the window"]
+        assert panel.height > 2 * app.window.label_font.get_linesize()  # the hint wrapped, not cut
+    assert not wrong, wrong
+
+
+@pytest.mark.parametrize("size", SIZES, ids=lambda s: f"{s[0]}x{s[1]}")
+def test_the_reveal_summary_stays_off_the_table(demos, server, size):
+    # User test at 1280x720: "puck 4: comes to rest; 0 of 2 predicted..." reached into the table.
+    app = App(demos, demo_key="8", headless=True, server=server, window_size_px=size)
+    pygame.event.clear()
+    press(app, pygame.K_SPACE)
+    info = RoundInfo(
+        1,
+        "revealed",
+        pucks=5,
+        truth=((0.0, 0.0),) * 5,
+        summary=tuple(f"puck {k}: comes to rest; 0 of 2 predicted it, the nearest 0.4 m/s off" for k in range(5)),
+        from_m=tuple(map(tuple, app.table.pos_m[:5])),
+    )
+    app.window.label_boxes.clear()
+    app.painter.note_pucks(app.table.pos_m, app.table.radius_m)
+    placed = paint_round(app.painter, info, {}, (255, 255, 255))
+    assert len(placed) >= 6 and any("comes to rest" in text for text, _ in placed)
+    assert not wrong_places(app), wrong_places(app)
+    assert not inside_window(app, [rect for _, rect in placed])
+
+
+@pytest.mark.parametrize("size", SIZES, ids=lambda s: f"{s[0]}x{s[1]}")
+def test_the_velocity_legend_keeps_off_the_momenta_panel(demos, server, size):
+    # User test at 640x480, demo 8 paused with the momenta diagram (d) on: the legend lay over its title.
+    app = App(demos, demo_key="8", headless=True, server=server, window_size_px=size)
+    pygame.event.clear()
+    for key in (pygame.K_SPACE, pygame.K_v, pygame.K_d):
+        press(app, key)
+    app.frame(FRAME_S)
+    boxes = app.window.label_boxes
+    overlaps = [
+        (a, b)
+        for i, a in enumerate(boxes)
+        for b in boxes[i + 1 :]
+        if a.colliderect(b) and not (a.contains(b) or b.contains(a))
+    ]
+    assert not overlaps, overlaps
+
+
+def test_a_word_wider_than_the_line_is_broken_not_cut():
+    font = pygame.font.Font(None, 24)
+    lines = wrap(font, LONG_PATH, 150)
+    assert all(font.size(line)[0] <= 150 for line in lines)
+    assert "".join(lines).replace(" ", "") == LONG_PATH.replace(" ", "")
+    assert lines[0] == "saved" and len(lines) >= 5

@@ -458,3 +458,28 @@ def test_the_students_status_line_has_no_teacher_keys(demos):
             teacher, lambda: (s := net.latest()) is not None and "PREDICT" in s.status and s, "the round's status"
         )
         assert "F6" not in scene.status and "PREDICT: 0 of 1 predicted" in scene.status
+
+
+@pytest.mark.parametrize("size", [(640, 480), (1280, 720), (1920, 1080)], ids=lambda s: f"{s[0]}x{s[1]}")
+def test_the_students_predict_lines_are_on_an_opaque_box_clear_of_the_walls(server, tmp_path, size):
+    # User test: on a student's window the PREDICT lines lay over the top-left wall with no box under them.
+    app = head_on_app(tmp_path, server)
+    net = NetPlayer("127.0.0.1", server.port, name="Gus")
+    try:
+        open_round_for(app, net)
+        player = PlayerApp(net, headless=True)
+        player.run(seconds=WAIT_S, until=lambda: player.frames >= 2)
+        win = player.window
+        win.resize(size)
+        win.label_boxes.clear()
+        win.draw(net.latest())
+        placed = player._draw_round((200, 200, 200))
+        assert placed and placed[0][0].startswith("PREDICT")
+        block = win.label_boxes[-1]  # the lines' panel
+        assert all(block.contains(rect) for _, rect in placed)
+        assert block.collidelist(win.wall_rects()) < 0, (block, win.wall_rects())
+        assert pygame.Rect((0, 0), size).contains(block)
+        # Opaque: between the lines the panel's ground is black, whatever lies beneath.
+        assert win.surface.get_at((block.right - 2, block.bottom - 2))[:3] == (0, 0, 0)
+    finally:
+        net.close()

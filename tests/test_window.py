@@ -188,3 +188,25 @@ def test_the_framebuffer_hint_is_set_only_by_the_entry_points_and_only_on_x11(mo
     assert prefer_plain_framebuffer() is False and FRAMEBUFFER_HINT not in os.environ  # the dummy driver: left alone
     assert cli.main(["--headless", "--no-server", "--seconds", "0.05"]) == 0
     assert FRAMEBUFFER_HINT not in os.environ  # no window, no hint
+
+
+def test_f11_twice_brings_back_the_windowed_size(monkeypatch) -> None:
+    # A real display window on the dummy driver; leaving fullscreen, SDL under a window manager
+    # first hands back the desktop's size (user test: 740x648 came back 1280x720): mimic that.
+    env = Environment(width_m=TABLE[0], height_m=TABLE[1])
+    win = GameWindow(env, size_px=(740, 648))
+    before = win.surface.get_size()
+    assert before == (740, 648)
+    real_set_mode, asked = pygame.display.set_mode, []
+
+    def set_mode_under_a_wm(size, flags=0):
+        left_fullscreen = asked and asked[-1] & pygame.FULLSCREEN and not flags & pygame.FULLSCREEN
+        asked.append(flags)
+        return real_set_mode((1280, 720) if left_fullscreen else size, flags)
+
+    monkeypatch.setattr(pygame.display, "set_mode", set_mode_under_a_wm)
+    for event in (pygame.event.Event(pygame.KEYDOWN, key=pygame.K_F11, mod=0),) * 2:
+        assert win.handle_event(event)
+    assert not win.fullscreen
+    assert win.surface.get_size() == before == win.env.size_px
+    assert win.windowed_size_px == before

@@ -276,6 +276,31 @@ def test_f11_in_the_app_fills_the_screen(display, tmp_path):
     assert_table_fills_the_height(shot, (1024, 900))
 
 
+@pytest.mark.skipif(not shutil.which("openbox"), reason="needs a window manager (apt-get install openbox)")
+def test_f11_twice_under_a_window_manager_brings_back_the_window(display, tmp_path):
+    # User test: under a window manager the window came back at the desktop's size, partly off screen.
+    wm = subprocess.Popen(
+        ["openbox"], env={**os.environ, "DISPLAY": display}, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL
+    )
+    try:
+        with running(display, demo_2(tmp_path / "shot.png"), cwd=tmp_path) as (app, wid):
+            before = wait_for(lambda: window_size(display, wid), what="the window's size")
+            assert before != (1024, 900)
+            key_taken(display, wid, "F11")
+            wid = wait_for(lambda: sized_window(display, (1024, 900)), what="the fullscreen window")
+            # SDL takes keys again once it has settled into fullscreen: a screenshot (F12) tells.
+            shots = tmp_path / "screenshots"
+            wait_for(lambda: key_taken(display, wid, "F12") and any(shots.glob("*.png")), what="a screenshot")
+            xdotool(display, "key", "F11")
+            wid = wait_for(lambda: sized_window(display, before), what="the window at its size again")
+            for _ in range(10):  # and it stays so once the window manager is done
+                assert window_size(display, wid) == before
+            quit_with_escape(display, wid, app)
+    finally:
+        wm.terminate()
+        wm.wait(timeout=10)
+
+
 def test_on_x11_the_window_keeps_its_pixels_in_the_plain_framebuffer(display):
     # The entry points ask for it on X11 (a flip of software OpenGL costs 11-35 ms at 1920x1080); a user's value stays.
     code = (

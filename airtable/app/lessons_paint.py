@@ -16,7 +16,7 @@ import numpy as np
 import pygame
 
 from airtable.app.aids_paint import CHART_COLORS, CHART_CORNERS, draw_arrow_px, place_in_corner
-from airtable.app.panel_view import ACCENT, DIM_TEXT, TEXT_COLOR, shorten
+from airtable.app.panel_view import ACCENT, DIM_TEXT, TEXT_COLOR, shorten, wrap
 from airtable.model.momenta import FEW_PUCKS, VALUE_HEADINGS, MomentaView, PuckValues, fit_chains, tip_to_tail
 from airtable.model.readout import readable
 
@@ -109,7 +109,18 @@ class LessonsPainter:
 
     def _text(self, text: str, pos, color, font=None) -> pygame.Rect:
         font = font or self.w.label_font
-        return self.w.surface.blit(font.render(text, True, color), pos)
+        rect = self.w.surface.blit(font.render(text, True, color), pos)
+        self.w.label_boxes.append(rect)  # where the text really is: the layout test reads it
+        return rect
+
+    def text_width_px(self) -> int:
+        """The widest line a panel holds: half the window, or a side margin where there is one
+        (corner_rect and place_in_corner cut a panel to that)."""
+        w, pad = self.w.surface.get_width(), self.w.line_px(4)
+        widest = w // 2 - 2 * pad
+        if self.w.layout.side_px:
+            widest = min(widest, self.w.layout.side_px - 2 * pad)
+        return widest - 2 * pad
 
     def _arrow_px(self, a, b, color, width: int) -> None:
         draw_arrow_px(self.w.surface, color, a, b, width, head_widths=4.0)
@@ -168,8 +179,9 @@ class LessonsPainter:
     def values_size(self, rows: Sequence[PuckValues], hint: str) -> tuple[tuple[int, ...], tuple[int, int]]:
         """Column widths and the panel's size for `rows` (or the one-line `hint` if there are none)."""
         font, pad = self.w.label_font, self.w.line_px(4)
-        if not rows:
-            return (), (font.size(hint)[0] + 2 * pad, font.get_linesize() + 2 * pad)
+        if not rows:  # the hint wrapped to the panel's room: a margin is narrower than the line
+            lines = wrap(font, hint, self.text_width_px())
+            return (), (max(font.size(t)[0] for t in lines) + 2 * pad, font.get_linesize() * len(lines) + 2 * pad)
         swatch = font.get_height()
         table = [VALUE_HEADINGS, *(r.cells() for r in rows)]
         widths = tuple(max(font.size(row[c])[0] for row in table) + 2 * pad for c in range(len(VALUE_HEADINGS)))
@@ -184,7 +196,8 @@ class LessonsPainter:
         font, pad = self.w.label_font, self.w.line_px(4)
         line_h = font.get_linesize()
         if not rows:
-            self._text(hint, (rect.x + pad, rect.y + pad), DIM_TEXT)
+            for k, text in enumerate(wrap(font, hint, self.text_width_px())):
+                self._text(text, (rect.x + pad, rect.y + pad + k * line_h), DIM_TEXT)
             return rect
         swatch = font.get_height()
         table = [(VALUE_HEADINGS, DIM_TEXT, None)]

@@ -31,10 +31,15 @@ def shorten(font: pygame.font.Font, text: str, width: int) -> str:
 
 
 def wrap(font: pygame.font.Font, text: str, width: int) -> list[str]:
-    """Split text into lines that fit `width` pixels (a word longer than that is cut at the edge)."""
+    """Split text into lines that fit `width` pixels (a word longer than that is broken across lines)."""
     lines: list[str] = []
     current = ""
-    for word in text.split():
+    for long_word in text.split():
+        # A word wider than the line (a file's path) is broken into pieces that fit, not left to run out.
+        *pieces, word = _break_word(font, long_word, width)
+        if pieces:
+            lines.extend([current, *pieces] if current else pieces)
+            current = ""
         trial = f"{current} {word}".strip()
         if current and font.size(trial)[0] > width:
             lines.append(current)
@@ -44,6 +49,18 @@ def wrap(font: pygame.font.Font, text: str, width: int) -> list[str]:
     if current:
         lines.append(current)
     return lines
+
+
+def _break_word(font: pygame.font.Font, word: str, width: int) -> list[str]:
+    """`word` in pieces no wider than `width` pixels (at least one character each)."""
+    pieces = []
+    while font.size(word)[0] > width and len(word) > 1:
+        n = 1
+        while n < len(word) - 1 and font.size(word[: n + 1])[0] <= width:
+            n += 1
+        pieces.append(word[:n])
+        word = word[n:]
+    return [*pieces, word]
 
 
 @dataclass(frozen=True)

@@ -4,7 +4,7 @@ The same drawing, `paint_round`, serves the teacher's window (the Predict
 feature of predict.py) and every student's (from the ROUND messages): thin arrows, one colour
 per student, from where each puck stood when the round opened; the true
 velocities bold in white once the collision is over; the summary lines at
-the left. Pixels come from the window's AidsPainter.
+the top left, in the margin or inside the walls. Pixels come from the window's AidsPainter.
 """
 
 from __future__ import annotations
@@ -22,7 +22,7 @@ PROMPT = ("PREDICT: drag an arrow from a puck,", "its velocity once the collisio
 INDENT = "    "  # before the second and later lines of a wrapped line
 
 
-LEGEND_FILL = (0, 0, 0, 190)  # behind the round's lines: dark enough to read, a puck beneath still shows
+LEGEND_FILL = (0, 0, 0)  # behind the round's lines: opaque, a wall or an arrow beneath must not muddle them
 
 
 def _clauses(font, text: str, width_px: int) -> list[str]:
@@ -56,28 +56,35 @@ def fit_lines(font, lines, width_px: int) -> list[tuple[str, tuple[int, int, int
 
 
 def _legend(painter, lines) -> list[tuple[str, pygame.Rect]]:
-    """The round's lines at the left, under the HUD (below whatever is there), each within the window's
-    width, on a translucent panel; returns each line and where it went."""
+    """The round's lines on an opaque panel at the top left, each line wrapped to fit: in the left
+    margin where the window has one, else inside the table's walls (a wall must stay seen), below
+    whatever text is there and past the pucks; returns each line and where it went."""
     w = painter.w
     font, pad = w.font, w.line_px(4)
-    lines = fit_lines(font, lines, w.surface.get_width() - 4 * pad)  # 2 pads in; as much room on the right
     line_h = font.get_linesize()
+    walls = w.wall_rects()
+    if w.layout.side_px:  # the margin, a pad clear of the left wall
+        room = pygame.Rect(2 * pad, w.hud_bottom_px + pad, w.layout.side_px - 5 * pad, w.surface.get_height())
+        avoid = list(painter._taken)
+    else:  # inside the walls: not over the pucks either (the panel is opaque)
+        inset = pad + max((min(r.width, r.height) for r in walls), default=0)
+        left, top, width, height = (int(v) for v in w.env.table_rect_px)
+        room = pygame.Rect(left + inset + pad, max(top + inset, w.hud_bottom_px + pad), width - 2 * inset - 2 * pad, 0)
+        avoid = painter._taken + [r for r in painter.puck_boxes if r not in walls]
+    lines = fit_lines(font, lines, max(room.width, 1))
     width = max(font.size(t)[0] for t, _ in lines)
-    block = pygame.Rect(2 * pad, w.hud_bottom_px + pad, width, line_h * len(lines)).inflate(pad, pad // 2)
-    taken = painter._taken
-    for _ in range(len(taken)):  # slide down past whatever is in the way
-        hit = block.collidelist(taken)
+    block = pygame.Rect(room.left, room.top, width, line_h * len(lines)).inflate(pad, pad // 2)
+    for _ in range(len(avoid)):  # slide down past whatever is in the way
+        hit = block.collidelist(avoid)
         if hit < 0:
             break
-        block.top = taken[hit].bottom + pad
-    back = pygame.Surface(block.size, pygame.SRCALPHA)
-    back.fill(LEGEND_FILL)
-    w.surface.blit(back, block)
+        block.top = avoid[hit].bottom + pad
+    pygame.draw.rect(w.surface, LEGEND_FILL, block)
     placed = []
     for k, (text, color) in enumerate(lines):
-        rect = w.surface.blit(font.render(text, True, color), (2 * pad, block.top + pad // 4 + k * line_h))
+        rect = w.surface.blit(font.render(text, True, color), (room.left, block.top + pad // 4 + k * line_h))
         placed.append((text, rect))
-    taken.append(block)
+    painter._taken.append(block)
     return placed
 
 

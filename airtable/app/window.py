@@ -15,6 +15,7 @@ teaching aids by aids_paint.py. On X11 the programs' entry points call
 from __future__ import annotations
 
 import os
+import warnings
 from collections.abc import Sequence
 from pathlib import Path
 
@@ -141,7 +142,13 @@ class GameWindow:
             # Size (0, 0) with FULLSCREEN: the desktop's own mode, no mode switch.
             self.surface = pygame.display.set_mode((0, 0), pygame.FULLSCREEN)
         else:
-            self.surface = pygame.display.set_mode(self.windowed_size_px, pygame.RESIZABLE)
+            with warnings.catch_warnings():  # a window manager may keep the fullscreen size at first
+                warnings.simplefilter("ignore", RuntimeWarning)
+                self.surface = pygame.display.set_mode(self.windowed_size_px, pygame.RESIZABLE)
+                if self.surface.get_size() != self.windowed_size_px:
+                    # Leaving fullscreen, SDL restores the size it had set for fullscreen (the
+                    # desktop's); once windowed, the window takes the size asked for again.
+                    self.surface = pygame.display.set_mode(self.windowed_size_px, pygame.RESIZABLE)
         self.fullscreen = fullscreen
 
     def toggle_fullscreen(self) -> None:
