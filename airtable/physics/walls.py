@@ -2,9 +2,40 @@
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
 
 from airtable.physics import collision, vectors
+
+if TYPE_CHECKING:
+    from airtable.physics.context import StepContext
+    from airtable.physics.storage import Storage
+
+
+def still_past(table: Storage, ctx: StepContext) -> None:
+    """Stage 3b: put back what is still past a wall after the hits (wall_correction off, or resting on
+    it); slow pucks are left to the contact stage."""
+    push_back(table, ctx.maybe_past, ctx.wall_rest)
+
+
+def again(table: Storage, ctx: StepContext, contacts_held: bool) -> None:
+    """Stage 6: walls again, since parting pairs can push a puck into a wall: every puck, put on the wall
+    without a bounce where it rests, if the contacts held some (`contacts_held`); else only the pucks
+    the pair stage moved."""
+    if contacts_held:
+        push_back(table, rest=table.contact_solver.wall_rest(ctx.rest_walls), hold=True)
+    elif len(ctx.moved):
+        push_back(table, only=ctx.moved)
+
+
+def push_back(table: Storage, only: np.ndarray | None = None, rest: np.ndarray | None = None, hold=False) -> None:
+    """resolve_walls on the table's pucks (only the rows `only`, if given), counting the bounces."""
+    pucks = (table.pos_m, table.vel_mps, table.radius_m)
+    bounced, _ = resolve_walls(
+        *pucks, table.size_m, table.cr_wall, table.wall_correction, only=only, rest=rest, hold_slow=hold
+    )
+    table.wall_collision_count += bounced
 
 
 def resolve_walls(
