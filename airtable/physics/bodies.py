@@ -11,12 +11,12 @@ and a new radius wakes every sleeper (the table `changed`).
 
 from __future__ import annotations
 
-import math
 from typing import TYPE_CHECKING
 
 import numpy as np
 
 from airtable.physics.colors import rgb
+from airtable.physics.storage import positive
 
 if TYPE_CHECKING:
     from airtable.physics.storage import Storage
@@ -78,10 +78,7 @@ class Puck:
     @radius_m.setter
     def radius_m(self, value: float) -> None:
         """A new radius (m), the mass kept; what sleepers rest on may change: every one wakes."""
-        r = float(value)
-        if not (math.isfinite(r) and r > 0.0):
-            raise ValueError(f"radius_m must be a positive number, not {value!r}")
-        self._table.radius_m[self.index] = r
+        self._table.radius_m[self.index] = positive(value, "radius_m")
         self._table.changed = True
 
     @property

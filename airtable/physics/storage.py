@@ -72,6 +72,11 @@ def _marking(name: str, check: Callable | None = None) -> property:
     return property(get, set_)
 
 
+def _view(columns: str, name: str, doc: str) -> property:
+    """A property: the live rows of one column of `columns` (a view: writes go to the table)."""
+    return property(lambda self: getattr(self, columns).view(name), doc=doc)
+
+
 class Notices(list):
     """Sentences for the user (a list of str), each said once (`say`, by key) until cleared."""
 
@@ -161,8 +166,8 @@ class Storage:
         self.contact_solver = contacts.ContactSolver()
         self.timed = Schedule()
         self.notices = Notices()
-        self.width_m = positive(width_m, "width_m")
-        self.height_m = positive(height_m, "height_m")
+        self.width_m = width_m
+        self.height_m = height_m
         self.reset_settings()
 
     def reset_settings(self) -> None:
@@ -198,8 +203,8 @@ class Storage:
 
     gravity_on = _marking("gravity_on")
     gravity_mps2 = _marking("gravity_mps2")
-    width_m = _marking("width_m")
-    height_m = _marking("height_m")
+    width_m = _marking("width_m", lambda v: positive(v, "width_m"))
+    height_m = _marking("height_m", lambda v: positive(v, "height_m"))
     puck_correction = _marking("puck_correction", _correction_mode)
     puck_collisions = _marking("puck_collisions")
 
@@ -217,56 +222,22 @@ class Storage:
     def n_springs(self) -> int:
         return self.spring_columns.n
 
-    @property
-    def pos_m(self) -> np.ndarray:
-        """(N, 2) positions, a live view (rows in creation order)."""
-        return self.puck_columns.view("pos")
-
-    @property
-    def vel_mps(self) -> np.ndarray:
-        return self.puck_columns.view("vel")
-
-    @property
-    def force_N(self) -> np.ndarray:
-        """(N, 2) force accumulators: add to them before `step` to push pucks."""
-        return self.puck_columns.view("force")
-
-    @property
-    def radius_m(self) -> np.ndarray:
-        return self.puck_columns.view("radius")
-
-    @property
-    def mass_kg(self) -> np.ndarray:
-        return self.puck_columns.view("mass")
-
-    @property
-    def color_rgb(self) -> np.ndarray:
-        return self.puck_columns.view("color")
+    pos_m = _view("puck_columns", "pos", "(N, 2) positions, a live view (rows in creation order).")
+    vel_mps = _view("puck_columns", "vel", "(N, 2) velocities, a live view.")
+    force_N = _view("puck_columns", "force", "(N, 2) force accumulators: add to them before `step` to push pucks.")
+    radius_m = _view("puck_columns", "radius", "(N,) radii, a live view (set one through its Puck to wake sleepers).")
+    mass_kg = _view("puck_columns", "mass", "(N,) masses, a live view.")
+    color_rgb = _view("puck_columns", "color", "(N, 3) colours, a live view.")
+    spring_length_m = _view("spring_columns", "length", "(S,) relaxed lengths, a live view.")
+    spring_k_Npm = _view("spring_columns", "k", "(S,) stiffnesses asked for, a live view.")
+    spring_damper_Nspm = _view("spring_columns", "damper", "(S,) dampers, a live view.")
+    spring_width_m = _view("spring_columns", "width", "(S,) drawn widths, a live view.")
+    spring_color_rgb = _view("spring_columns", "color", "(S, 3) colours, a live view.")
 
     @property
     def spring_ends(self) -> tuple[np.ndarray, np.ndarray]:
         """(S,) rows of each spring's p1 and (S,) rows of its p2 (live views)."""
         return self.spring_columns.view("i"), self.spring_columns.view("j")
-
-    @property
-    def spring_length_m(self) -> np.ndarray:
-        return self.spring_columns.view("length")
-
-    @property
-    def spring_k_Npm(self) -> np.ndarray:
-        return self.spring_columns.view("k")
-
-    @property
-    def spring_damper_Nspm(self) -> np.ndarray:
-        return self.spring_columns.view("damper")
-
-    @property
-    def spring_width_m(self) -> np.ndarray:
-        return self.spring_columns.view("width")
-
-    @property
-    def spring_color_rgb(self) -> np.ndarray:
-        return self.spring_columns.view("color")
 
     @property
     def spring_k_effective_Npm(self) -> np.ndarray:
