@@ -17,7 +17,7 @@ from airtable.physics.collision import Collisions
 from airtable.physics.forces import Pull
 
 
-@dataclass
+@dataclass(slots=True)
 class StepContext:
     dt: float  # the step's length (s)
     pulls: Sequence[Pull]  # the cursor strings acting in this step
@@ -29,5 +29,5 @@ class StepContext:
     rest_walls: np.ndarray | None = None  # ... and towards the walls
     wall_rest: np.ndarray | None = None  # rest_walls where the contacts held a puck on a wall last step
     maybe_past: np.ndarray | None = None  # the rows that may be past a wall after the hits (None: any)
-    moved: np.ndarray = field(default_factory=lambda: np.empty(0, dtype=np.intp))  # rows the pair stage moved
+    moved: np.ndarray | None = None  # the rows the pair stage moved (a row may repeat; None: none)
     records: list[Collisions] = field(default_factory=list)  # what this step's puck-puck collisions did

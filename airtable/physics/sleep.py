@@ -146,10 +146,12 @@ def wake(table: Storage, ctx: StepContext) -> bool:
     comparing the sleeper with where it sleeps (written_from_outside).
     """
     columns = table.puck_columns
-    asleep, touched = columns.view("asleep"), columns.view("touched")
+    asleep, marked = columns.view("asleep"), None
     changed, table.changed = table.changed, False
-    marked = touched.nonzero()[0]
-    touched[marked] = False
+    if table.any_touched:
+        touched, table.any_touched = columns.view("touched"), False
+        marked = touched.nonzero()[0]
+        touched[marked] = False
     if not np.count_nonzero(asleep):
         return True
     if changed or not (table.sleeping and table.gravity_on):
@@ -158,7 +160,7 @@ def wake(table: Storage, ctx: StepContext) -> bool:
     pos, vel = table.pos_m, table.vel_mps
     sleepers = np.flatnonzero(asleep)
     woken = written_from_outside(pos, vel, table.force_N, columns.view("rest_pos"), sleepers)
-    if len(marked):
+    if marked is not None:
         woken = np.union1d(woken, marked.take(np.flatnonzero(asleep.take(marked))))
     pulled = np.array([p.row for p in ctx.pulls], dtype=np.intp)
     set_awake(table, np.concatenate([woken, pulled]))

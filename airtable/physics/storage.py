@@ -24,6 +24,7 @@ from __future__ import annotations
 import heapq
 import itertools
 import math
+import operator
 from collections.abc import Callable
 
 import numpy as np
@@ -62,19 +63,21 @@ def _marking(name: str, check: Callable | None = None) -> property:
     """A setting whose setter marks the table `changed` (sleepers depend on it: sleep.py); kept in `_name`."""
     private = "_" + name
 
-    def get(self):
-        return getattr(self, private)
-
     def set_(self, value) -> None:
         setattr(self, private, value if check is None else check(value))
         self.changed = True
 
-    return property(get, set_)
+    return property(operator.attrgetter(private), set_)  # (attrgetter: the step reads these often)
 
 
-def _view(columns: str, name: str, doc: str) -> property:
-    """A property: the live rows of one column of `columns` (a view: writes go to the table)."""
-    return property(lambda self: getattr(self, columns).view(name), doc=doc)
+def _puck_view(name: str, doc: str) -> property:
+    """A property: the live rows of one puck column (a view: writes go to the table)."""
+    return property(lambda self: self.puck_columns.view(name), doc=doc)
+
+
+def _spring_view(name: str, doc: str) -> property:
+    """A property: the live rows of one spring column (a view: writes go to the table)."""
+    return property(lambda self: self.spring_columns.view(name), doc=doc)
 
 
 class Notices(list):
@@ -197,7 +200,8 @@ class Storage:
         self.steps = 0
         self.collision_count = 0  # puck-puck collisions since the start
         self.wall_collision_count = 0  # bounces off a wall since the start
-        self.changed = True
+        self.changed = True  # a setting, the pucks or the springs changed since the last step (sleep.wake)
+        self.any_touched = False  # some puck was set through its handle since the last step (touch)
 
     # ------------------------------------------------------------ settings that wake every sleeper
 
@@ -222,17 +226,17 @@ class Storage:
     def n_springs(self) -> int:
         return self.spring_columns.n
 
-    pos_m = _view("puck_columns", "pos", "(N, 2) positions, a live view (rows in creation order).")
-    vel_mps = _view("puck_columns", "vel", "(N, 2) velocities, a live view.")
-    force_N = _view("puck_columns", "force", "(N, 2) force accumulators: add to them before `step` to push pucks.")
-    radius_m = _view("puck_columns", "radius", "(N,) radii, a live view (set one through its Puck to wake sleepers).")
-    mass_kg = _view("puck_columns", "mass", "(N,) masses, a live view.")
-    color_rgb = _view("puck_columns", "color", "(N, 3) colours, a live view.")
-    spring_length_m = _view("spring_columns", "length", "(S,) relaxed lengths, a live view.")
-    spring_k_Npm = _view("spring_columns", "k", "(S,) stiffnesses asked for, a live view.")
-    spring_damper_Nspm = _view("spring_columns", "damper", "(S,) dampers, a live view.")
-    spring_width_m = _view("spring_columns", "width", "(S,) drawn widths, a live view.")
-    spring_color_rgb = _view("spring_columns", "color", "(S, 3) colours, a live view.")
+    pos_m = _puck_view("pos", "(N, 2) positions, a live view (rows in creation order).")
+    vel_mps = _puck_view("vel", "(N, 2) velocities, a live view.")
+    force_N = _puck_view("force", "(N, 2) force accumulators: add to them before `step` to push pucks.")
+    radius_m = _puck_view("radius", "(N,) radii, a live view (set one through its Puck to wake sleepers).")
+    mass_kg = _puck_view("mass", "(N,) masses, a live view.")
+    color_rgb = _puck_view("color", "(N, 3) colours, a live view.")
+    spring_length_m = _spring_view("length", "(S,) relaxed lengths, a live view.")
+    spring_k_Npm = _spring_view("k", "(S,) stiffnesses asked for, a live view.")
+    spring_damper_Nspm = _spring_view("damper", "(S,) dampers, a live view.")
+    spring_width_m = _spring_view("width", "(S,) drawn widths, a live view.")
+    spring_color_rgb = _spring_view("color", "(S, 3) colours, a live view.")
 
     @property
     def spring_ends(self) -> tuple[np.ndarray, np.ndarray]:
@@ -266,8 +270,9 @@ class Storage:
             fn(self)
 
     def touch(self, row: int) -> None:
-        """Mark a puck written through its handle: if it sleeps, it wakes at the next step."""
+        """Mark a puck set through its handle: if it sleeps, it wakes at the next step."""
         self.puck_columns.view("touched")[row] = True
+        self.any_touched = True  # some row is: the wake stage looks at the column only then
 
     # ------------------------------------------------------------ saving (state.py)
 

@@ -25,7 +25,7 @@ def again(table: Storage, ctx: StepContext, contacts_held: bool) -> None:
     the pair stage moved."""
     if contacts_held:
         push_back(table, rest=table.contact_solver.wall_rest(ctx.rest_walls), hold=True)
-    elif len(ctx.moved):
+    elif ctx.moved is not None:
         push_back(table, only=ctx.moved)
 
 
