@@ -53,6 +53,10 @@ class Puck:
     def alive(self) -> bool:
         return self._index is not None
 
+    def is_on(self, table: Storage) -> bool:
+        """Whether this puck is on `table` (not removed)."""
+        return self._table is table and self._index is not None
+
     @property
     def pos_m(self) -> np.ndarray:
         return self._table.pos_m[self.index].copy()

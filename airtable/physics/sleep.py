@@ -141,9 +141,11 @@ def wake(table: Storage, ctx: StepContext) -> bool:
     """Wake the sleepers that must wake; return whether any puck is awake (if none, the step only
     advances time). Sets ctx.sleepers to the rows that sleep through this step.
 
-    A sleeper wakes when its handle's setters touched it, and when a velocity, position or force was
-    written into the arrays: numpy arrays written from outside run no setter, so those are found by
-    comparing the sleeper with where it sleeps (written_from_outside).
+    Every sleeper wakes when the table `changed` (a setting, the pucks or the springs: their setters
+    mark it, storage.py). A sleeper wakes, with its island, when its handle's setters touched it, and
+    when a velocity, position or force was written into the arrays: numpy arrays written from outside
+    run no setter, so those are found by comparing the sleeper with where it sleeps
+    (written_from_outside); when a cursor string pulls it, or an awake puck comes fast within reach.
     """
     columns = table.puck_columns
     asleep, marked = columns.view("asleep"), None

@@ -107,7 +107,7 @@ class AirTable(Storage):
     ) -> Spring:
         """Join two pucks with a spring (relaxed length length_m) and a damper."""
         for p in (p1, p2):
-            if not isinstance(p, Puck) or p._table is not self or not p.alive:
+            if not isinstance(p, Puck) or not p.is_on(self):
                 raise ValueError("a spring must join two pucks of this table")
         if p1 is p2:
             raise ValueError("a spring needs two different pucks")
@@ -127,7 +127,7 @@ class AirTable(Storage):
 
     def remove_puck(self, puck: Puck) -> None:
         """Remove a puck and every spring attached to it."""
-        if not isinstance(puck, Puck) or puck._table is not self or not puck.alive:
+        if not isinstance(puck, Puck) or not puck.is_on(self):
             raise ValueError("that puck is not on this table")
         row = puck.index
         si, sj = self.spring_ends
