@@ -278,8 +278,8 @@ class Storage:
 
     # The parts that save and restore their own state (`save(like)`, `restore(saved)`; state.py).
     PARTS = ("puck_columns", "spring_columns", "neighbour_list", "contact_solver", "timed", "notices")
-    # Neither parts nor settings: what the last step did (not kept).
-    NOT_SAVED = ("_last_records", "_last_collisions")
+    # Attributes that are neither parts nor settings (AirTable's: what the last step did, not kept).
+    NOT_SAVED: tuple[str, ...] = ()
 
     def save_settings(self) -> tuple[tuple[str, ...], tuple]:
         """The names and values of the plain attributes: settings, counters and marks (taken by type, so a

@@ -16,7 +16,8 @@ if TYPE_CHECKING:
 def still_past(table: Storage, ctx: StepContext) -> None:
     """Stage 3b: put back what is still past a wall after the hits (wall_correction off, or resting on
     it); slow pucks are left to the contact stage."""
-    push_back(table, ctx.maybe_past, ctx.wall_rest)
+    bounced, _ = resolve_walls(*_table_walls(table), only=ctx.maybe_past, rest=ctx.wall_rest)
+    table.wall_collision_count += bounced
 
 
 def again(table: Storage, ctx: StepContext, contacts_held: bool) -> None:
@@ -24,18 +25,18 @@ def again(table: Storage, ctx: StepContext, contacts_held: bool) -> None:
     without a bounce where it rests, if the contacts held some (`contacts_held`); else only the pucks
     the pair stage moved."""
     if contacts_held:
-        push_back(table, rest=table.contact_solver.wall_rest(ctx.rest_walls), hold=True)
+        rest = table.contact_solver.wall_rest(ctx.rest_walls)
+        bounced, _ = resolve_walls(*_table_walls(table), rest=rest, hold_slow=True)
     elif ctx.moved is not None:
-        push_back(table, only=ctx.moved)
-
-
-def push_back(table: Storage, only: np.ndarray | None = None, rest: np.ndarray | None = None, hold=False) -> None:
-    """resolve_walls on the table's pucks (only the rows `only`, if given), counting the bounces."""
-    pucks = (table.pos_m, table.vel_mps, table.radius_m)
-    bounced, _ = resolve_walls(
-        *pucks, table.size_m, table.cr_wall, table.wall_correction, only=only, rest=rest, hold_slow=hold
-    )
+        bounced, _ = resolve_walls(*_table_walls(table), only=ctx.moved)
+    else:
+        return
     table.wall_collision_count += bounced
+
+
+def _table_walls(table: Storage) -> tuple:
+    """resolve_walls' first arguments for the table's pucks and walls."""
+    return table.pos_m, table.vel_mps, table.radius_m, table.size_m, table.cr_wall, table.wall_correction
 
 
 def resolve_walls(
