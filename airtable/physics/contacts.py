@@ -396,7 +396,7 @@ class ContactSolver:
         unknown = set(vars(self)) - set(self.KEPT) - self.NOT_KEPT
         if unknown:
             raise TypeError(f"the contact solver keeps {sorted(unknown)}: ContactSolver.save must learn to save it")
-        kept = [tuple(v) if name in self.ROUND_LISTS else v for name, v in ((k, getattr(self, k)) for k in self.KEPT)]
+        kept = [tuple(getattr(self, k)) if k in self.ROUND_LISTS else getattr(self, k) for k in self.KEPT]
         if like is None:
             return tuple(kept)
         same = [_same_part(a, b) for a, b in zip(kept, like, strict=True)]
@@ -405,6 +405,7 @@ class ContactSolver:
         return tuple(old if s else new for new, old, s in zip(kept, like, same, strict=True))
 
     def restore(self, saved: tuple) -> None:
+        """Back to a save: the same impulses and rounds (the rounds as lists again)."""
         for name, value in zip(self.KEPT, saved, strict=True):
             setattr(self, name, list(value) if name in self.ROUND_LISTS else value)
 
