@@ -7,8 +7,7 @@ import math
 import numpy as np
 import pytest
 
-from airtable.physics import broadphase, contacts
-from airtable.physics import table as table_module
+from airtable.physics import broadphase, contacts, resting
 from airtable.physics.forces import GRAVITY_MPS2
 from airtable.physics.table import AirTable
 
@@ -116,7 +115,7 @@ def test_a_fall_under_the_pressed_rest_speed_rests_and_a_faster_one_bounces(drop
     # under PRESSED_REST_MPS = 0.2: it rests at once. From 10 mm (0.44 m/s) it bounces at
     # cr_wall = 0.9, back up to 0.81 h = 8.1 mm (to within what steps of 1/240 s see), and
     # so on until it lands slower than 0.2 m/s, from 2.04 mm or less: then it rests.
-    assert math.sqrt(2 * GRAVITY_MPS2 * 1e-3) < table_module.PRESSED_REST_MPS < math.sqrt(2 * GRAVITY_MPS2 * 1e-2)
+    assert math.sqrt(2 * GRAVITY_MPS2 * 1e-3) < resting.PRESSED_REST_MPS < math.sqrt(2 * GRAVITY_MPS2 * 1e-2)
     table = AirTable()
     table.gravity_on, table.sleeping, table.cr_wall = True, False, 0.9
     puck = table.add_puck(pos_m=(5.0, 0.1 + 1e-3 * drop_mm), radius_m=0.1)

@@ -68,9 +68,6 @@ def import_graph(type_hints: bool) -> dict[str, set[str]]:
 
 GRAPH = import_graph(type_hints=False)
 EVERY_IMPORT = import_graph(type_hints=True)
-# physics/ is another engineer's: a Puck's hints name the AirTable that makes the handles (bodies.py
-# imports table.py for hints only). The one circle allowed, until physics breaks it.
-KNOWN_CIRCLES = {("airtable.physics.bodies", "airtable.physics.table")}
 
 
 def package_of(module: str) -> str | None:
@@ -127,11 +124,9 @@ def test_no_two_modules_import_each_other():
 
 
 def test_no_circle_even_through_type_hints():
-    """No two modules name each other, not even for type hints (but the one known circle of physics)."""
-    found = [" -> ".join([*c, c[0]]) for c in circles(EVERY_IMPORT) if tuple(sorted(c)) not in KNOWN_CIRCLES]
+    """No two modules name each other, not even for type hints."""
+    found = [" -> ".join([*c, c[0]]) for c in circles(EVERY_IMPORT)]
     assert not found, "import circles (type hints included):\n" + "\n".join(found)
-    for a, b in KNOWN_CIRCLES:  # a circle broken leaves the list
-        assert b in EVERY_IMPORT[a] and a in EVERY_IMPORT[b], f"{a} <-> {b} is gone: drop it from KNOWN_CIRCLES"
 
 
 def test_the_rules_see_the_packages():

@@ -91,6 +91,18 @@ def test_a_velocity_or_position_written_into_a_sleeper_wakes_it() -> None:
     assert b.pos_m[0] == 7.5
 
 
+def test_a_handle_setter_wakes_its_sleeper_even_with_the_same_value() -> None:
+    # The setter marks the puck (as Box2D's b2Body_SetLinearVelocity wakes the body); an array
+    # written directly is found by comparing it with where the puck sleeps, so only a change shows.
+    table = floor_table(xs=(3.0, 7.0))
+    steps(table, 144)
+    a, b = table.pucks
+    a.pos_m = a.pos_m
+    table.vel_mps[1] = 0.0
+    table.step(DT_S)
+    assert list(table.asleep) == [False, True]
+
+
 def test_a_slow_drag_wakes_the_sleepers_it_pushes() -> None:
     # A cursor string of 1 N with 20 N s/m of drag moves a puck at most
     # 1 / 20 = 0.05 m/s, slower than WAKE_MPS: it still wakes the puck it
@@ -110,7 +122,7 @@ def test_a_slow_drag_wakes_the_sleepers_it_pushes() -> None:
     assert 3.505 + 0.005 < table.pos_m[1, 0] < 3.505 + 0.03
 
 
-@pytest.mark.parametrize("change", ["off", "stronger", "wider", "added"])
+@pytest.mark.parametrize("change", ["off", "stronger", "wider", "added", "correction", "radius", "spring"])
 def test_a_change_of_the_world_wakes_every_puck(change) -> None:
     table = floor_table(xs=(3.0, 7.0))
     steps(table, 144)
@@ -121,6 +133,12 @@ def test_a_change_of_the_world_wakes_every_puck(change) -> None:
         table.gravity_mps2 = 20.0
     elif change == "wider":
         table.width_m = 12.0
+    elif change == "correction":
+        table.puck_correction = "two-step"
+    elif change == "radius":
+        table.pucks[0].radius_m = 0.3
+    elif change == "spring":
+        table.add_spring(*table.pucks, length_m=4.0)
     else:
         table.add_puck(pos_m=(5.0, 4.0), radius_m=R_M)
     table.step(DT_S)

@@ -15,8 +15,7 @@ from airtable.demos.demo_0p_gas import gas_scene
 
 from airtable import AirTable, Client
 from airtable.model.client import cursor_pulls
-from airtable.physics.forces import Pull
-from airtable.physics.table import GRAVITY_MPS2
+from airtable.physics.forces import GRAVITY_MPS2, Pull
 
 
 def assert_sane(table: AirTable) -> None:

@@ -147,7 +147,7 @@ class LiveEdits(Feature):
         else:
             old = float(t.radius_m[row])
             top = min(RADIUS_RANGE_M[1], 0.45 * min(t.width_m, t.height_m))
-            t.radius_m[row] = ladder_step(old, direction, RADIUS_RANGE_M[0], top)
+            puck.radius_m = ladder_step(old, direction, RADIUS_RANGE_M[0], top)  # wakes the sleepers
             say(f"puck {puck_number(row)}: radius {t.radius_m[row]:g} m (was {old:.3g} m; its mass kept)")
 
     def mass_down(self) -> None:

@@ -4,6 +4,9 @@ The table stores all pucks as rows of numpy arrays (structure of arrays) so the
 physics step is vectorised. A handle remembers its row and reads and writes
 that row, so demo code can still say `puck.vel_mps = (1, 0)`. Getters return
 copies: change a puck through its setters (`p.pos_m += (0.1, 0)` works).
+Setters say what they changed, as Box2D's b2Body_SetLinearVelocity wakes the
+body: a puck set through its handle wakes at the next step (Storage.touch),
+and a new radius wakes every sleeper (the table `changed`).
 """
 
 from __future__ import annotations
@@ -13,9 +16,10 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from airtable.physics.colors import rgb
+from airtable.physics.storage import positive
 
 if TYPE_CHECKING:
-    from airtable.physics.table import AirTable
+    from airtable.physics.storage import Storage
 
 
 def as_vector(value, what: str) -> np.ndarray:
@@ -34,7 +38,7 @@ class Puck:
 
     __slots__ = ("_table", "_index")
 
-    def __init__(self, table: AirTable, index: int) -> None:
+    def __init__(self, table: Storage, index: int) -> None:
         self._table = table
         self._index: int | None = index
 
@@ -49,6 +53,10 @@ class Puck:
     def alive(self) -> bool:
         return self._index is not None
 
+    def is_on(self, table: Storage) -> bool:
+        """Whether this puck is on `table` (not removed)."""
+        return self._table is table and self._index is not None
+
     @property
     def pos_m(self) -> np.ndarray:
         return self._table.pos_m[self.index].copy()
@@ -56,6 +64,7 @@ class Puck:
     @pos_m.setter
     def pos_m(self, value) -> None:
         self._table.pos_m[self.index] = as_vector(value, "pos_m")
+        self._table.touch(self.index)
 
     @property
     def vel_mps(self) -> np.ndarray:
@@ -64,10 +73,17 @@ class Puck:
     @vel_mps.setter
     def vel_mps(self, value) -> None:
         self._table.vel_mps[self.index] = as_vector(value, "vel_mps")
+        self._table.touch(self.index)
 
     @property
     def radius_m(self) -> float:
         return float(self._table.radius_m[self.index])
+
+    @radius_m.setter
+    def radius_m(self, value: float) -> None:
+        """A new radius (m), the mass kept; what sleepers rest on may change: every one wakes."""
+        self._table.radius_m[self.index] = positive(value, "radius_m")
+        self._table.changed = True
 
     @property
     def mass_kg(self) -> float:
@@ -93,7 +109,7 @@ class Spring:
 
     __slots__ = ("_table", "_index", "p1", "p2")
 
-    def __init__(self, table: AirTable, index: int, p1: Puck, p2: Puck) -> None:
+    def __init__(self, table: Storage, index: int, p1: Puck, p2: Puck) -> None:
         self._table = table
         self._index: int | None = index
         self.p1 = p1
@@ -141,3 +157,37 @@ class Spring:
         if self._index is None:
             return "<Spring (removed)>"
         return f"<Spring #{self._index} L={self.length_m} m k={self.k_Npm} N/m>"
+
+
+class Handles(list):
+    """A table's handles (Puck or Spring), in row order: handle k has row k."""
+
+    def renumber(self, remap: np.ndarray) -> None:
+        """After rows were deleted (remap: old row -> new row, -1 for deleted): each handle gets its new
+        row; those of deleted rows are marked removed and dropped."""
+        kept = []
+        for h in self:
+            h._index = new = int(remap[h._index])
+            if new < 0:
+                h._index = None
+            else:
+                kept.append(h)
+        self[:] = kept
+
+    def clear(self) -> None:
+        for h in self:
+            h._index = None
+        super().clear()
+
+    def save(self, like: tuple | None = None) -> tuple:
+        """The handles in row order (the very objects: a demo's code keeps them)."""
+        saved = tuple(self)
+        return like if like == saved else saved
+
+    def restore(self, saved: tuple) -> None:
+        """The handles of `saved` get their rows back (their place in it); the others are marked removed."""
+        for h in self:
+            h._index = None
+        for row, h in enumerate(saved):
+            h._index = row
+        self[:] = saved

@@ -19,6 +19,7 @@ from collections.abc import Callable
 import numpy as np
 
 from airtable.physics import vectors
+from airtable.physics.columns import frozen, same_bits
 
 # Below this many pucks, checking every pair with one numpy expression is
 # cheaper than building a grid.
@@ -264,6 +265,28 @@ class NeighbourList:
         moved *= moved  # vectors.squared_lengths, without a second array
         moved_sq = moved[:, 0] + moved[:, 1]
         return bool(moved_sq.max() < self._half_skin_sq)  # NaN: not valid
+
+    def save(self, like: tuple | None = None, radius: np.ndarray | None = None) -> tuple | None:
+        """Where the pucks were at the last build (positions, radii; None: never built), read-only.
+
+        Which pairs a step looks at depends on that: a stale list can miss a pair a correction pushed
+        into overlap where a fresh one sees it, and a build from the same positions gives the same
+        list again (restore). `radius`: the saved radius column, shared if the same.
+        """
+        if self._built_pos is None:
+            return None
+        radius = radius if radius is not None and same_bits(self._built_radius, radius) else frozen(self._built_radius)
+        if like is not None and like[1] is radius and same_bits(self._built_pos, like[0]):
+            return like
+        return frozen(self._built_pos, None if like is None else like[0]), radius
+
+    def restore(self, saved: tuple | None) -> None:
+        builds = self.builds
+        if saved is None:
+            self._built_pos = None
+        else:
+            self._build(*saved)
+        self.builds = builds
 
     def _build(self, pos: np.ndarray, radius: np.ndarray) -> None:
         skin = SKIN_RADII * float(radius.mean()) if len(radius) else 0.0

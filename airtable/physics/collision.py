@@ -29,6 +29,9 @@ import numpy as np
 
 from airtable.physics import vectors
 
+# How a pair stage corrects the positions of a colliding pair (pairs.py; DESIGN.md 3).
+CORRECTION_MODES = ("off", "two-step", "perfect-kiss")
+
 
 def mass_shares(m1, m2):
     """(m2 / (m1 + m2), m1 / (m1 + m2)): each body's part of a change in their relative motion.

@@ -378,6 +378,46 @@ class ContactSolver:
         order = self._key_order  # c.keys are _round_keys: sorted once per colouring
         self._keys, self._impulses = c.keys.take(order), impulses.take(order, axis=0)
 
+    # What the solver keeps from step to step: its impulses by contact (the warm start), and the
+    # rounds it solves in, kept while the contacts stay the same (their order depends on where the
+    # pucks were when they were formed, so they change results). The solver replaces these arrays
+    # each step and never changes them in place, so a save keeps references.
+    KEPT = (
+        "_keys", "_impulses", "_rows", "_round_keys", "_round_sleepers", "_key_order", "_rounds", "_free_rounds",
+        "count", "iterations",
+    )  # fmt: skip
+    ROUND_LISTS = ("_rounds", "_free_rounds")  # lists of arrays, saved as tuples
+    # Worked out afresh in each solve, or from kept values while those are the very same objects
+    # (restored ones are other objects): they change no result, so a save need not keep them.
+    NOT_KEPT = frozenset({"_y", "_r_mean", "_warm", "_layouts", "_wall_rest"})
+
+    def save(self, like: tuple | None = None) -> tuple:
+        """The KEPT values (references), for state.py; `like`'s parts where they are the same objects."""
+        unknown = set(vars(self)) - set(self.KEPT) - self.NOT_KEPT
+        if unknown:
+            raise TypeError(f"the contact solver keeps {sorted(unknown)}: ContactSolver.save must learn to save it")
+        kept = [tuple(getattr(self, k)) if k in self.ROUND_LISTS else getattr(self, k) for k in self.KEPT]
+        if like is None:
+            return tuple(kept)
+        same = [_same_part(a, b) for a, b in zip(kept, like, strict=True)]
+        if all(same):
+            return like
+        return tuple(old if s else new for new, old, s in zip(kept, like, same, strict=True))
+
+    def restore(self, saved: tuple) -> None:
+        """Back to a save: the same impulses and rounds (the rounds as lists again)."""
+        for name, value in zip(self.KEPT, saved, strict=True):
+            setattr(self, name, list(value) if name in self.ROUND_LISTS else value)
+
+
+def _same_part(a, b) -> bool:
+    """Arrays and tuples of arrays are the same only if they are the same objects; plain values if equal."""
+    if isinstance(a, np.ndarray) or isinstance(b, np.ndarray):
+        return a is b
+    if isinstance(a, tuple):
+        return isinstance(b, tuple) and len(a) == len(b) and all(x is y for x, y in zip(a, b, strict=True))
+    return a == b
+
 
 class _Layout:
     """One colouring's rounds laid out once: index arrays, buffers, and each round's views into them.

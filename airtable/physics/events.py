@@ -35,11 +35,16 @@ import heapq
 import math
 from collections.abc import Callable
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from airtable.physics import broadphase, collision, vectors
 from airtable.physics.collision import Collisions
+
+if TYPE_CHECKING:
+    from airtable.physics.context import StepContext
+    from airtable.physics.storage import Storage
 
 # A bound on the events of one step (the pi setup at 10^8:1 needs some hundreds).
 MAX_EVENTS = 100_000
@@ -91,6 +96,31 @@ class Hits:
             return Collisions.empty()
         i, j, n, touch_j, overlap, *states = (np.array(column) for column in zip(*self.rows, strict=True))
         return Collisions.of_pairs(i, j, n, touch_j, overlap, radius, *states)
+
+
+def hits_in_order(table: Storage, ctx: StepContext) -> None:
+    """Stage 3: resolve the step's wall and pair hits in the order they happen; set ctx.maybe_past to the
+    rows that may still be past a wall (None: any)."""
+    rules = Rules(
+        table.cr_puck,
+        table.cr_wall,
+        pairs=table.puck_correction if table.puck_collisions else "none",
+        walls=table.wall_correction,
+        accel_y_mps2=-table.gravity_mps2 if table.gravity_on else 0.0,
+        rest=ctx.rest,
+        wall_rest=ctx.wall_rest,
+        held=None if ctx.rest is None else table.contact_solver.held,
+        speed_bound_mps=ctx.speed_bound_mps,
+    )
+    pucks = (table.pos_m, table.vel_mps, table.radius_m, table.mass_kg)
+    hits = resolve_hits(*pucks, table.size_m, ctx.dt, rules, table.neighbour_list)
+    table.wall_collision_count += hits.walls
+    if hits.rows:
+        ctx.records.append(hits.collisions(table.radius_m))
+        table.collision_count += len(hits.rows)
+    if hits.capped:
+        table.notices.say("capped", CAPPED_NOTICE)
+    ctx.maybe_past = hits.maybe_past
 
 
 def resolve_hits(pos, vel, radius, mass, size_m, dt: float, rules: Rules, neighbours) -> Hits:

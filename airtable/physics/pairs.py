@@ -31,17 +31,74 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 
-from airtable.physics import collision, vectors
-from airtable.physics.collision import Collisions
+from airtable.physics import broadphase, collision, vectors
+from airtable.physics.collision import CORRECTION_MODES, Collisions
 
-CORRECTION_MODES = ("off", "two-step", "perfect-kiss")
+if TYPE_CHECKING:
+    from airtable.physics.context import StepContext
+    from airtable.physics.storage import Storage
+
+# After the first pass over the overlapping pairs, up to this many more passes
+# over the pairs the corrections pushed into overlap: collisions again, then a
+# last pass that only pushes apart.
+EXTRA_PASSES = 2
+# Overlaps smaller than this (m) are left to the next step: round-off only.
+OVERLAP_SLOP_M = 1e-9
 
 # A relative normal speed smaller than this (m/s) counts as "not moving": such
 # an overlap cannot be explained by the last step's motion.
 REST_SPEED_MPS = 1e-9
+
+
+def overlapping(table: Storage, ctx: StepContext) -> None:
+    """Stage 4: collide and part the pairs still overlapping (the candidates from the neighbour list),
+    then look again at those the corrections pushed into overlap; ctx.moved gets the rows moved (a row
+    may repeat). Pairs approaching slower than their rest speed (ctx.rest) are left to the contact stage.
+    """
+    if not table.puck_collisions:
+        return
+    pos, vel, radius, mass, nl = table.pos_m, table.vel_mps, table.radius_m, table.mass_kg, table.neighbour_list
+    ci, cj, _ = nl.pairs(pos, radius)
+    close = broadphase.squared_distances(pos, ci, cj) < nl.reach_squared()
+    i, j = _colliding(table, ctx.rest, *broadphase.pairs_where(close, ci, cj, len(pos), nl.sorted_order))
+    records, moved, mode = [], [], table.puck_correction
+    for attempt in range(1 + EXTRA_PASSES):
+        if len(i) == 0:
+            break
+        if attempt < EXTRA_PASSES:
+            records += resolve_pairs(pos, vel, radius, mass, i, j, table.cr_puck, mode, ctx.dt, in_time_order=True)
+        else:
+            push_apart(pos, radius, mass, i, j)
+        moved += [i, j]
+        if mode == "off" or attempt == EXTRA_PASSES:
+            break  # the last pass; or "off", where overlaps stay: that is what it shows
+        # Parting a pair can push one of its pucks into a third one that
+        # was already handled: look again among the same candidates (those
+        # that may have come within reach: nothing else changed), collide
+        # those pairs too, and at last just push apart what is left.
+        near_sq = nl.reach_squared(OVERLAP_SLOP_M)
+        i, j = _colliding(table, ctx.rest, *broadphase.overlapping_pairs(pos, ci, cj, None, reach_sq=near_sq))
+    if moved:
+        ctx.records += records
+        table.collision_count += sum(len(r) for r in records)
+        ctx.moved = np.concatenate(moved)
+
+
+def _colliding(table: Storage, rest: np.ndarray | None, i: np.ndarray, j: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The pairs (i, j) that collide: all of them if rest is None, else those that approach
+    faster than their rest speed and did not press on each other in the last step."""
+    if rest is None or len(i) == 0:
+        return i, j
+    pos, vel = table.pos_m, table.vel_mps
+    n, _ = vectors.unit_vectors(vectors.take(pos, i) - vectors.take(pos, j), i + j)
+    vn = vectors.dot_rows(vectors.take(vel, i) - vectors.take(vel, j), n)
+    fast = (vn < -np.maximum(rest.take(i), rest.take(j))).nonzero()[0]  # few: look only these up
+    fast = fast.take((~table.contact_solver.held(i.take(fast), j.take(fast))).nonzero()[0])
+    return i.take(fast), j.take(fast)
 
 
 def sharing_pairs(i: np.ndarray, j: np.ndarray) -> np.ndarray:

@@ -18,18 +18,27 @@ while; we do the same, puck by puck (Box2D does it per island):
   with it every sleeper joined to it by touching sleepers (its island, as
   Box2D wakes islands), so that none stays up when what held it moves.
   Everything wakes when the world changes: gravity, the table's size, a puck
-  or spring added or removed, a radius, the correction mode.
+  or spring added or removed, a radius, the correction mode (their setters
+  mark the table `changed`, storage.py).
 
-The state of sleep is three columns of the pucks: `still` (seconds), `asleep`,
-and `rest_pos` (where a sleeper sleeps, or where an awake puck's still time
-began), so capture and restore keep it with the rest of a puck's row.
+The state of sleep is four columns of the pucks: `still` (seconds), `asleep`,
+`rest_pos` (where a sleeper sleeps, or where an awake puck's still time
+began) and `touched` (set by the puck's setters), so capture and restore keep
+it with the rest of a puck's row. The stage's three steps are `wake` (the
+step's start), `wake_hit` (after the collisions) and `fall_asleep` (its end).
 """
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
 
 from airtable.physics import vectors
+
+if TYPE_CHECKING:
+    from airtable.physics.context import StepContext
+    from airtable.physics.storage import Storage
 
 # A puck slower than this (m/s) for SLEEP_S seconds, all the while within SLEEP_DRIFT_M of
 # where that time began, falls asleep (with its neighbours). Box2D's default threshold is
@@ -126,3 +135,90 @@ def with_still_neighbours(pos, ready, asleep, candidates) -> np.ndarray:
     blocked[i.take(np.flatnonzero(~ok.take(j)))] = True
     blocked[j.take(np.flatnonzero(~ok.take(i)))] = True
     return np.flatnonzero(ready & ~asleep & ~blocked)
+
+
+def wake(table: Storage, ctx: StepContext) -> bool:
+    """Wake the sleepers that must wake; return whether any puck is awake (if none, the step only
+    advances time). Sets ctx.sleepers to the rows that sleep through this step.
+
+    Every sleeper wakes when the table `changed` (a setting, the pucks or the springs: their setters
+    mark it, storage.py). A sleeper wakes, with its island, when its handle's setters touched it, and
+    when a velocity, position or force was written into the arrays: numpy arrays written from outside
+    run no setter, so those are found by comparing the sleeper with where it sleeps
+    (written_from_outside); when a cursor string pulls it, or an awake puck comes fast within reach.
+    """
+    columns = table.puck_columns
+    asleep, marked = columns.view("asleep"), None
+    changed, table.changed = table.changed, False
+    if table.any_touched:
+        touched, table.any_touched = columns.view("touched"), False
+        marked = touched.nonzero()[0]
+        touched[marked] = False
+    if not np.count_nonzero(asleep):
+        return True
+    if changed or not (table.sleeping and table.gravity_on):
+        set_awake(table, np.flatnonzero(asleep), with_island=False)
+        return True
+    pos, vel = table.pos_m, table.vel_mps
+    sleepers = np.flatnonzero(asleep)
+    woken = written_from_outside(pos, vel, table.force_N, columns.view("rest_pos"), sleepers)
+    if marked is not None:
+        woken = np.union1d(woken, marked.take(np.flatnonzero(asleep.take(marked))))
+    pulled = np.array([p.row for p in ctx.pulls], dtype=np.intp)
+    set_awake(table, np.concatenate([woken, pulled]))
+    if np.count_nonzero(asleep) < table.n_pucks:  # someone is awake: is it coming near a sleeper?
+        candidates = table.neighbour_list.pairs(pos, table.radius_m)
+        set_awake(table, near_movers(pos, vel, asleep, candidates, ctx.dt, pulled))
+    sleepers = np.flatnonzero(asleep)
+    if len(sleepers) == table.n_pucks:
+        return False
+    ctx.sleepers = sleepers if len(sleepers) else None
+    return True
+
+
+def set_awake(table: Storage, rows: np.ndarray, with_island: bool = True) -> None:
+    """Wake the pucks in `rows` (their still time starts again) and, `with_island`, every sleeper
+    touching them, and every one touching those, and so on (see island)."""
+    if len(rows) == 0:
+        return
+    columns = table.puck_columns
+    asleep = columns.view("asleep")
+    if with_island and len(rows) < table.n_pucks:
+        rows = island(table.pos_m, rows, asleep, table.neighbour_list.pairs(table.pos_m, table.radius_m))
+    asleep[rows] = False
+    columns.view("still")[rows] = 0.0
+
+
+def wake_hit(table: Storage, ctx: StepContext) -> None:
+    """Wake the sleepers a collision gave a velocity (this step's later stages then move them)."""
+    if ctx.sleepers is None:
+        return
+    v = vectors.take(table.vel_mps, ctx.sleepers)
+    hit = ctx.sleepers.take(np.flatnonzero((v[:, 0] != 0.0) | (v[:, 1] != 0.0)))
+    if len(hit):
+        set_awake(table, hit)
+        keep = np.flatnonzero(table.puck_columns.view("asleep").take(ctx.sleepers))
+        ctx.sleepers = ctx.sleepers.take(keep) if len(keep) else None
+
+
+def fall_asleep(table: Storage, ctx: StepContext) -> None:
+    """Put to sleep the pucks that have been still for long enough (still_for_long), with their neighbours."""
+    ctx.sleepers = None
+    if not (table.sleeping and table.gravity_on):
+        return
+    columns, pos, vel = table.puck_columns, table.pos_m, table.vel_mps
+    asleep = columns.view("asleep")
+    free = np.ones(table.n_pucks, dtype=bool)
+    a, b = table.spring_ends
+    free[a] = False
+    free[b] = False
+    free[[p.row for p in ctx.pulls]] = False
+    still, anchor = columns.view("still"), columns.view("rest_pos")
+    ready = still_for_long(pos, vel, still, anchor, asleep, free, ctx.dt)
+    if ready is not None:
+        candidates = table.neighbour_list.pairs(pos, table.radius_m)
+        asleep[with_still_neighbours(pos, ready, asleep, candidates)] = True
+    sleepers = np.flatnonzero(asleep)
+    if len(sleepers):
+        vel[sleepers] = 0.0
+        anchor[sleepers] = pos[sleepers]

@@ -2,9 +2,41 @@
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
 
 from airtable.physics import collision, vectors
+
+if TYPE_CHECKING:
+    from airtable.physics.context import StepContext
+    from airtable.physics.storage import Storage
+
+
+def still_past(table: Storage, ctx: StepContext) -> None:
+    """Stage 3b: put back what is still past a wall after the hits (wall_correction off, or resting on
+    it); slow pucks are left to the contact stage."""
+    bounced, _ = resolve_walls(*_table_walls(table), only=ctx.maybe_past, rest=ctx.wall_rest)
+    table.wall_collision_count += bounced
+
+
+def again(table: Storage, ctx: StepContext, contacts_held: bool) -> None:
+    """Stage 6: walls again, since parting pairs can push a puck into a wall: every puck, put on the wall
+    without a bounce where it rests, if the contacts held some (`contacts_held`); else only the pucks
+    the pair stage moved."""
+    if contacts_held:
+        rest = table.contact_solver.wall_rest(ctx.rest_walls)
+        bounced, _ = resolve_walls(*_table_walls(table), rest=rest, hold_slow=True)
+    elif ctx.moved is not None:
+        bounced, _ = resolve_walls(*_table_walls(table), only=ctx.moved)
+    else:
+        return
+    table.wall_collision_count += bounced
+
+
+def _table_walls(table: Storage) -> tuple:
+    """resolve_walls' first arguments for the table's pucks and walls."""
+    return table.pos_m, table.vel_mps, table.radius_m, table.size_m, table.cr_wall, table.wall_correction
 
 
 def resolve_walls(

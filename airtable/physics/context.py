@@ -1,0 +1,33 @@
+"""StepContext: what the stages of one step hand each other (step.py).
+
+Built at the start of a step and dropped at its end (but for the collision
+records, which `AirTable.last_collisions` reads), so the table keeps no
+scratch between steps: Box2D v3 passes its b2StepContext the same way.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from airtable.physics.collision import Collisions
+from airtable.physics.forces import Pull
+
+
+@dataclass(slots=True)
+class StepContext:
+    dt: float  # the step's length (s)
+    pulls: Sequence[Pull]  # the cursor strings acting in this step
+    began: np.ndarray | None = None  # the positions when the step began (the contacts start there)
+    sleepers: np.ndarray | None = None  # the rows that sleep through this step (None: none)
+    kick: np.ndarray | float | None = None  # the speed the forces gave each puck (a number: all; None: nothing)
+    speed_bound_mps: float = math.inf  # no puck is faster after the integration
+    rest: np.ndarray | None = None  # each puck's rest speed towards other pucks (None: every contact collides)
+    rest_walls: np.ndarray | None = None  # ... and towards the walls
+    wall_rest: np.ndarray | None = None  # rest_walls where the contacts held a puck on a wall last step
+    maybe_past: np.ndarray | None = None  # the rows that may be past a wall after the hits (None: any)
+    moved: np.ndarray | None = None  # the rows the pair stage moved (a row may repeat; None: none)
+    records: list[Collisions] = field(default_factory=list)  # what this step's puck-puck collisions did
