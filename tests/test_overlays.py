@@ -204,3 +204,15 @@ def test_mashing_esc_clears_the_screen_and_asks_but_never_quits(demos):
     assert app.running and app.panels.panel() == "quit" and list(app.overlays) == ["quit"]
     escape_again(app)  # after a pause, Esc answers
     assert not app.running
+
+
+def test_esc_ends_a_prediction_round_before_it_asks_to_quit(demos):
+    """A round is under way over the table (F6): Esc ends it, as it closes an overlay; the next Esc asks."""
+    app = App(demos, demo_key="3", headless=True)
+    pygame.event.clear()
+    press(app, pygame.K_F6)
+    assert app.predict.round.state == "open" and app.paused
+    press(app, pygame.K_ESCAPE)
+    assert app.running and app.predict.round.state == "closed" and app.panels.panel() is None and app.paused
+    press(app, pygame.K_ESCAPE)
+    assert app.running and app.panels.panel() == "quit"

@@ -337,6 +337,10 @@ class App:
         for feature in self.features:
             feature.forget_after(t_s)
 
+    def escape_features(self) -> bool:
+        """Esc with no overlay open: the first feature with something under way ends it; True if one did."""
+        return any(feature.on_escape() for feature in self.features)
+
     # ------------------------------------------------------------ input
 
     def handle_event(self, event: pygame.event.Event) -> None:

@@ -10,7 +10,8 @@ The frame calls, in this order: `handle_event` for each event (a feature that
 takes one stops it there), `before_physics`, `after_step` after every physics
 step, `after_physics`, then `status_parts` and `hud_lines` for the text, and
 `draw` in `draw_order`. `on_demo_start` runs when a demo (re)starts and
-`forget_after` when the table runs on from a moment in the past.
+`forget_after` when the table runs on from a moment in the past; `on_escape` when Esc finds no
+overlay open (a prediction round under way ends before the app asks to quit).
 """
 
 from __future__ import annotations
@@ -77,6 +78,11 @@ class Feature:
 
     def forget_after(self, t_s: float) -> None:
         """The table runs on from `t_s`, a moment in the past: what came later did not happen."""
+
+    def on_escape(self) -> bool:
+        """Esc with no overlay open: end what the feature has under way (a prediction round) before
+        the app asks to quit; True if it ended something."""
+        return False
 
     def status_parts(self, for_students: bool) -> list[str]:
         """Its parts of the status line; `for_students`: without the teacher's keys."""

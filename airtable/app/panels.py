@@ -99,7 +99,7 @@ class Panels(Feature):
                 self.quit_now()
             else:
                 self.ask_to_quit()  # still asking, for as long again
-        elif not self.close_panel():
+        elif not self.close_panel() and not self.host.escape_features():
             self.ask_to_quit()
 
     def close_window(self) -> None:

@@ -238,6 +238,16 @@ class Predict(Feature):
             host.paused = True
         self.publish()
 
+    def on_escape(self) -> bool:
+        """Esc during a round ends it, as closing an overlay would; the table stays paused."""
+        if not self.round.active:
+            return False
+        self.round.close()
+        self.publish()
+        self.host.paused = True
+        self.host.say("prediction round closed (Esc)")
+        return True
+
     def pause_key(self) -> bool:
         """Space during a round; True if the round took it (else Space pauses and resumes as always).
 
