@@ -262,6 +262,8 @@ def main(argv: Sequence[str] | None = None) -> int:
         os.environ.setdefault("SDL_VIDEODRIVER", "dummy")  # no screen: pygame's events still need a driver
     if not args.no_server:  # refuse what the server would, in the server's own words
         validate_server_options(args.port, args.max_clients, args.snapshot_hz, error=parser.error)
+    if args.password == "":  # would silently mean no password at all
+        parser.error("--password needs at least one character; leave it out for a table anyone may join")
     keep_freed_memory()  # the step's big temporary arrays are reused, not re-faulted (35 % at 10000 pucks)
     if args.new_demo:
         try:

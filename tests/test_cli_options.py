@@ -63,6 +63,8 @@ BAD_ARGUMENTS = [
     (cli.main, "airtable", ["--variation", "0"], "'0' is not a positive whole number"),
     (cli.main, "airtable", ["--demo", "5", "--variation", "3"], "demo 5 has variations 1 to 2"),
     (cli.main, "airtable", ["--demo", "1", "--variation", "2"], "demo 1 has no variations"),
+    (cli.main, "airtable", ["--password", ""], "--password needs at least one character"),
+    (cli.main, "airtable", ["--snapshot-hz", "0.001"], "--snapshot-hz must be 1-1000 a second"),
     (client_cli.main, "airtable-client", [], "the following arguments are required: HOST[:PORT]"),
     (client_cli.main, "airtable-client", ["localhost", "--bogus"], "unrecognized arguments: --bogus"),
     (client_cli.main, "airtable-client", ["localhost", "--seconds"], "--seconds: expected one argument"),

@@ -822,7 +822,8 @@ def test_more_players_than_descriptors_gives_one_warning_not_a_flood(caplog):
     [
         ({"max_clients": 5000}, "--max-clients must be 1-1000, not 5000"),
         ({"max_clients": 0}, "--max-clients must be 1-1000"),
-        ({"snapshot_hz": 2000.0}, "--snapshot-hz must be above 0 and at most 1000, not 2000.0"),
+        ({"snapshot_hz": 2000.0}, "--snapshot-hz must be 1-1000 a second, not 2000.0"),
+        ({"snapshot_hz": 0.001}, "--snapshot-hz must be 1-1000 a second, not 0.001"),
         ({"snapshot_hz": float("nan")}, "--snapshot-hz"),
         ({"port": 70000}, "port must be 0-65535"),
     ],
