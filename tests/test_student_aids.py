@@ -326,3 +326,20 @@ def test_a_student_sees_the_teachers_lecture_notes_panel(classroom):
     _run_student(teacher, net, notes_then_none)
     assert seen == [teacher.demo.notes] and len(seen[0]) > 20
     assert net.aids.teacher == 0, "notes closed and every other aid off: no AIDS frames"
+
+
+def test_a_student_turns_puck_numbers_on_for_their_own_window(classroom):
+    """A reveal's summary says "puck 4": k shows the numbers on the student's window (the teacher's
+    k is the projector's alone)."""
+    teacher, net = classroom
+    teacher.paused = True  # the same picture twice, but for the numbers
+    plain = _run_student(teacher, net, lambda s: True)
+    before = pygame.surfarray.array3d(plain.window.surface).copy()
+    student = _run_student(teacher, net, lambda s: net.aids.shows("k"), keys=(pygame.K_k,))
+    assert net.aids.shows("k") and not teacher.lessons.show_numbers
+    assert "k" not in student.keys, "the toggle is not sent in INPUT"
+    after = pygame.surfarray.array3d(student.window.surface)
+    # Each puck's number is drawn on it: pixels change at every puck's centre.
+    centres = student.window.env.to_screen(teacher.table.pos_m).astype(int)
+    for x, y in centres:
+        assert (after[x - 6 : x + 7, y - 6 : y + 7] != before[x - 6 : x + 7, y - 6 : y + 7]).any(), (x, y)

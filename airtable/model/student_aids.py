@@ -17,7 +17,7 @@ from airtable.model.momenta import MomentaView, PuckValues, every_puck_values, p
 from airtable.model.shared_aids import AidsFrame, annotation_of
 from airtable.model.timeline import Timeline
 
-LOCAL_KEYS = ("v", "c", "i", "e")  # the aids a student may turn on or off on their own window
+LOCAL_KEYS = ("v", "c", "i", "e", "k")  # the aids a student may turn on or off on their own window
 
 
 class StudentAids:

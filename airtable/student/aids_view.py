@@ -27,6 +27,7 @@ STUDENT_KEYS = (
     ("c", "hide or show the teacher's energy and momentum chart on your window"),
     ("i", "inspect the puck under your cursor, on or off"),
     ("e", "trails on your window, on or off"),
+    ("k", "puck numbers on your window (as the teacher's summaries count them), on or off"),
     ("F1", "this help (again: close it)"),
     ("F11", "fullscreen on / off"),
     ("Esc", "close this help; else leave the table (Esc twice)"),
