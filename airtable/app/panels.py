@@ -3,8 +3,9 @@ error, a notice, and the quit question, with their keys.
 
 What is open lives in the one overlay stack (overlays.py); this feature opens
 and closes its panels there and draws the one on top. Esc closes what is on
-top (any overlay: the roster, the chart, the lesson panels too); with nothing
-open it asks, and Esc again while asked quits.
+top (any overlay: the roster, the chart, the lesson panels too), then a
+prediction round under way; with nothing left it asks, and Esc again while
+asked quits, once the burst of Escs that got there has paused.
 """
 
 from __future__ import annotations
