@@ -20,7 +20,7 @@ from airtable.app.overlays import OverlayFlag
 from airtable.app.pucks_view import draw_numbers
 from airtable.app.recorder import Recorder, csv_pair, free_csv_pair
 from airtable.app.saved_demo import demo_source, free_key, save_folder, write_demo
-from airtable.model.momenta import FEW_PUCKS, MomentaLog, puck_number, values_for
+from airtable.model.momenta import FEW_PUCKS, MomentaLog, values_for
 from airtable.physics.table import AirTable
 
 if TYPE_CHECKING:
@@ -192,8 +192,7 @@ class Lessons(Feature):
         """The puck numbers (k), then the momenta diagram (d) and the values panel (t) in free corners."""
         t, env, window = self.host.table, self.host.env, self.host.window
         if self.show_numbers and len(t.pos_m):
-            numbers = [puck_number(row) for row in range(len(t.pos_m))]
-            draw_numbers(window.surface, window.label_font, env.to_screen(t.pos_m), numbers)
+            draw_numbers(window.surface, window.label_font, env.to_screen(t.pos_m))
         if not (self.show_momenta or self.show_values):
             return
         if self.painter is None:

@@ -27,6 +27,8 @@ from collections import OrderedDict
 import numpy as np
 import pygame
 
+from airtable.model.momenta import puck_number
+
 MIN_PUCK_RADIUS_PX = 2
 SPRITE_MAX_RADIUS_PX = 96
 SPRITE_CACHE_BYTES = 16 * 1024 * 1024
@@ -224,8 +226,9 @@ MAX_NUMBERED_PUCKS = 120  # more pucks on screen than this: their numbers would 
 NUMBER_FILL = (0, 0, 0)
 
 
-def draw_numbers(target: pygame.Surface, font: pygame.font.Font, centers_px: np.ndarray, numbers) -> int:
-    """Each puck's number (as the values panel, the momenta diagram, predict and the CSV name it), in white
+def draw_numbers(target: pygame.Surface, font: pygame.font.Font, centers_px: np.ndarray) -> int:
+    """Each puck's number (`puck_number` of its row, as the values panel, the momenta diagram, predict
+    and the CSV name it), in white
     on a small dark box at its centre, for the pucks whose centre is on `target`; returns how many were
     drawn (none when more than MAX_NUMBERED_PUCKS would be)."""
     w, h = target.get_size()
@@ -236,7 +239,7 @@ def draw_numbers(target: pygame.Surface, font: pygame.font.Font, centers_px: np.
     if len(on) > MAX_NUMBERED_PUCKS:
         return 0
     for k in on.tolist():
-        text = font.render(str(numbers[k]), True, (255, 255, 255))
+        text = font.render(str(puck_number(k)), True, (255, 255, 255))
         box = text.get_rect(center=(round(centers_px[k, 0]), round(centers_px[k, 1])))
         target.fill(NUMBER_FILL, box.inflate(4, 0))
         target.blit(text, box)

@@ -22,7 +22,6 @@ from airtable.app.predict import StudentGuesses
 from airtable.app.predict_view import paint_round
 from airtable.app.pucks_view import draw_numbers
 from airtable.app.room import student_banner
-from airtable.model.momenta import puck_number
 from airtable.model.scene import CursorView, Scene
 from airtable.model.shared_aids import NOTES
 from airtable.model.student_aids import LOCAL_KEYS
@@ -297,8 +296,7 @@ class PlayerApp:
         draw_student_lessons(self.lessons_painter, self.timeline_painter, scene, net.aids, cursor_m)
         draw_student_aids(self.painter, scene, net.aids, time.monotonic(), cursor_m)
         if net.aids.shows("k") and len(scene.pos_m):  # "puck 3" of a reveal's summary, found on the table
-            numbers = [puck_number(row) for row in range(len(scene.pos_m))]
-            draw_numbers(win.surface, win.label_font, win.env.to_screen(scene.pos_m), numbers)
+            draw_numbers(win.surface, win.label_font, win.env.to_screen(scene.pos_m))
         if extra and me:  # not in the snapshots yet: the arrow alone
             win.draw_cursor(me, color, cursor_m)
         self._draw_round(color)
