@@ -127,10 +127,12 @@ def lan_addresses() -> list[str]:
                 found.append(s.getsockname()[0])
         except OSError:
             continue
-    usable = [a for a in dict.fromkeys(found) if not a.startswith(("127.", "0.", "169.254."))]
-    if not usable:  # no route out (a classroom network or a hotspot with no internet): ask each interface
-        usable = [a for a in dict.fromkeys(interface_addresses()) if not a.startswith(("127.", "0.", "169.254."))]
-    return usable or ["127.0.0.1"]
+
+    def usable(addresses: list[str]) -> list[str]:  # once each, without loopback and link-local ones
+        return [a for a in dict.fromkeys(addresses) if not a.startswith(("127.", "0.", "169.254."))]
+
+    # With no route out (a classroom network or a hotspot with no internet), each interface's address.
+    return usable(found) or usable(interface_addresses()) or ["127.0.0.1"]
 
 
 SIOCGIFADDR = 0x8915  # Linux's ioctl for an interface's IPv4 address
