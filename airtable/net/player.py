@@ -515,8 +515,8 @@ class NetPlayer:
         at least once a second. Returns True when something was sent."""
         now = time.monotonic() if now is None else now
         record = self._record(cursor_m, button, keys)
-        udp = self._udp
-        unacked = udp is not None and udp.confirmed(now) and not udp.delivered
+        udp = self._udp  # an unacknowledged datagram matters only for a cursor at rest (InputThrottle)
+        unacked = record == self._throttle.last and udp is not None and udp.confirmed(now) and not udp.delivered
         if not self._throttle.due(record, now, unacked):
             return False
         return self._send(record, now)
