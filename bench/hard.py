@@ -255,25 +255,14 @@ def pile_case(engine_name: str, seconds: float = 10.0, seed: int = 0) -> tuple[s
 
 def active_pile_ms(use_pymunk: bool, seed: int = 0, start_s: float = 1.5, seconds: float = 0.5) -> list[float]:
     """Mean ms per step of the pile while it settles (from `start_s` after the drop, for `seconds`):
-    ours, then pymunk's on the same drop. The engines take turns in blocks of 30 steps (a burst of
-    load from elsewhere hits them alike), garbage collection off."""
+    ours, then pymunk's on the same drop, taking turns (`block_ms`)."""
     table = AirTable()
     pile_scene(table, seed=seed)
     engines = [table, PymunkMirror(table, 0.5)] if use_pymunk else [table]
     for engine in engines:
         _run(engine, int(start_s / DT_S), DT_S)
-    blocks = max(1, round(seconds / DT_S / 30))
-    total = [0.0] * len(engines)
-    gc_was_on = gc.isenabled()
-    gc.disable()
-    try:
-        for _ in range(blocks):
-            for k, engine in enumerate(engines):
-                total[k] += _run(engine, 30, DT_S) / blocks
-    finally:
-        if gc_was_on:
-            gc.enable()
-    return total
+    times = block_ms(engines, blocks=max(1, round(seconds / DT_S / 30)), steps=30)
+    return [sum(blocks) / len(blocks) for blocks in times]
 
 
 def awake_copy(table: AirTable) -> AirTable:
@@ -286,19 +275,24 @@ def awake_copy(table: AirTable) -> AirTable:
 
 
 def step_ms(engines: list, blocks: int = 7, steps: int = 30) -> list[float]:
-    """Best (minimum) ms per step of each engine over `blocks` blocks, the engines taking turns block by
-    block (a burst of load from elsewhere hits them alike), garbage collection off."""
-    best = [math.inf] * len(engines)
+    """Best (minimum) ms per step of each engine over `blocks` blocks (`block_ms`)."""
+    return [min(times) for times in block_ms(engines, blocks, steps)]
+
+
+def block_ms(engines: list, blocks: int, steps: int) -> list[list[float]]:
+    """Each engine's ms per step in each of `blocks` blocks of `steps` steps, the engines taking turns
+    block by block (a burst of load from elsewhere hits them alike), garbage collection off."""
+    times: list[list[float]] = [[] for _ in engines]
     gc_was_on = gc.isenabled()
     gc.disable()
     try:
         for _ in range(blocks):
             for k, engine in enumerate(engines):
-                best[k] = min(best[k], _run(engine, steps, DT_S))
+                times[k].append(_run(engine, steps, DT_S))
     finally:
         if gc_was_on:
             gc.enable()
-    return best
+    return times
 
 
 def springs_case(build: Callable[[AirTable], None], engine_name: str) -> str:
