@@ -88,7 +88,8 @@ class AidsPainter:
         self.chart_corner: int | None = None  # index into CHART_CORNERS; None: pick one clear of pucks
         self.chart_small = False
         self._vector_scales: dict[str, VectorScale] = {}
-        self.puck_boxes: list[pygame.Rect] = []  # this frame's pucks on screen (note_pucks)
+        self._noted: tuple[np.ndarray, np.ndarray] | None = None  # this frame's pucks (note_pucks)
+        self._puck_boxes: list[pygame.Rect] | None = None  # and their boxes, once asked for
 
     def new_demo(self) -> None:
         """A demo (re)started: arrow scales start afresh, and the chart picks its corner again."""
@@ -106,18 +107,28 @@ class AidsPainter:
         return self.w.label_boxes
 
     def note_pucks(self, pos_m: np.ndarray, radius_m: np.ndarray) -> None:
-        """Where this frame's pucks and the table's walls are on screen: annotation boxes and the legend
-        keep clear of them. Only pucks on screen count, at most MAX_AVOIDED_PUCKS (a gas has no room
-        for boxes anyway)."""
-        self.puck_boxes = self.w.wall_rects()
-        if not len(pos_m):
-            return
+        """This frame's pucks: annotation boxes and the legend keep clear of them and of the walls
+        (`puck_boxes`, worked out only if a label asks: most frames of a gas draw none)."""
+        self._noted = (np.array(pos_m, dtype=float), np.array(radius_m, dtype=float))
+        self._puck_boxes = None
+
+    @property
+    def puck_boxes(self) -> list[pygame.Rect]:
+        """The walls' and the noted pucks' boxes on screen: only pucks on screen count, at most
+        MAX_AVOIDED_PUCKS (a gas has no room for boxes anyway)."""
+        if self._puck_boxes is not None:
+            return self._puck_boxes
+        boxes = self._puck_boxes = self.w.wall_rects()
+        if self._noted is None or not len(self._noted[0]):
+            return boxes
+        pos_m, radius_m = self._noted
         centers = self.w.env.to_screen(pos_m)
         r = np.clip(self.w.env.length_to_px(radius_m), 1.0, 1e6)
         w, h = self.w.surface.get_size()
         seen = (centers[:, 0] + r > 0) & (centers[:, 0] - r < w) & (centers[:, 1] + r > 0) & (centers[:, 1] - r < h)
         for (x, y), rad in zip(centers[seen][:MAX_AVOIDED_PUCKS], r[seen][:MAX_AVOIDED_PUCKS]):
-            self.puck_boxes.append(pygame.Rect(int(x - rad), int(y - rad), int(2 * rad) + 1, int(2 * rad) + 1))
+            boxes.append(pygame.Rect(int(x - rad), int(y - rad), int(2 * rad) + 1, int(2 * rad) + 1))
+        return boxes
 
     def _px(self, point_m) -> tuple[float, float]:
         x, y = self.w.env.to_screen(np.asarray(point_m, dtype=float))

@@ -49,6 +49,10 @@ __all__ = ["TableState", "capture", "restore", "own_nbytes", "unchanged", "same_
 STATE_OVERHEAD_BYTES = 1600
 # A numpy array's own object beside its data (sys.getsizeof of an empty array).
 ARRAY_HEADER_BYTES = 112
+# The parts whose save is a tuple of handle objects (bodies.Handles.save): counted as that one
+# tuple, not looked into (the handles are the table's own, shared by every state; a 10000-puck
+# table would cost 10000 looks per state, and the history sizes a state at every capture).
+HANDLE_PARTS = frozenset({"puck_handles", "spring_handles"})
 
 
 @dataclass(frozen=True, eq=False)
@@ -82,8 +86,11 @@ class TableState:
     def parts(self) -> Iterator[tuple[object, int]]:
         """(object, bytes) of every sizeable part: the arrays, and the tuples holding arrays or
         handles (some may be shared)."""
-        for saved in self.saved.values():
-            yield from _sized(saved)
+        for name, saved in self.saved.items():
+            if name in HANDLE_PARTS:
+                yield saved, sys.getsizeof(saved)
+            else:
+                yield from _sized(saved)
 
     @property
     def nbytes(self) -> int:
