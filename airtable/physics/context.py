@@ -7,7 +7,6 @@ scratch between steps: Box2D v3 passes its b2StepContext the same way.
 
 from __future__ import annotations
 
-import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 
@@ -24,7 +23,6 @@ class StepContext:
     began: np.ndarray | None = None  # the positions when the step began (the contacts start there)
     sleepers: np.ndarray | None = None  # the rows that sleep through this step (None: none)
     kick: np.ndarray | float | None = None  # the speed the forces gave each puck (a number: all; None: nothing)
-    speed_bound_mps: float = math.inf  # no puck is faster after the integration
     rest: np.ndarray | None = None  # each puck's rest speed towards other pucks (None: every contact collides)
     rest_walls: np.ndarray | None = None  # ... and towards the walls
     wall_rest: np.ndarray | None = None  # rest_walls where the contacts held a puck on a wall last step

@@ -75,7 +75,6 @@ class Rules:
     rest: np.ndarray | None = None  # per puck: pair hits slower than this rest (contacts.py)
     wall_rest: np.ndarray | None = None  # per puck (N,) or per puck and axis (N, 2), for walls
     held: Callable[[np.ndarray, np.ndarray], np.ndarray] | None = None  # pairs (i < j) resting: the contacts'
-    speed_bound_mps: float = math.inf  # no puck is faster (inf: work it out)
 
 
 @dataclass
@@ -110,7 +109,6 @@ def hits_in_order(table: Storage, ctx: StepContext) -> None:
         rest=ctx.rest,
         wall_rest=ctx.wall_rest,
         held=None if ctx.rest is None else table.contact_solver.held,
-        speed_bound_mps=ctx.speed_bound_mps,
     )
     pucks = (table.pos_m, table.vel_mps, table.radius_m, table.mass_kg)
     hits = resolve_hits(*pucks, table.size_m, ctx.dt, rules, table.neighbour_list)
@@ -161,9 +159,8 @@ class _Step:
         self.hit_pairs: dict[tuple[int, int], int] = {}  # how many times each pair hit
         self.hits = Hits()
         self.partners = None  # the pairs that may meet, per puck (see find_partners)
-        speed = rules.speed_bound_mps
-        if not math.isfinite(speed) or rules.pairs == "perfect-kiss":  # its pairs are found by the exact travel
-            speed = float(np.sqrt(vectors.squared_abs(self.zvel).max())) if len(vel) else 0.0
+        self.speed_sq = vectors.squared_abs(self.zvel)  # each puck's speed squared on its first path
+        speed = math.sqrt(float(self.speed_sq.max())) if len(vel) else 0.0
         self.travel = speed * dt  # the farthest any puck moves this step on its first path (m)
         # The pairs found hold every pair that can meet while each path stays within `covered`
         # of its puck's step end; `reach_out` is the farthest any present path strays.
@@ -227,9 +224,16 @@ class _Step:
         return (room < 0.0).nonzero()[0].tolist()
 
     def predicts_pairs(self) -> bool:
+        """Whether any pair hit is this stage's: in perfect kiss every one; in the other modes only
+        those of fast pucks (a gas whose pucks all move under FAST_FRACTION of their radius has none)."""
         if self.rules.pairs == "perfect-kiss":
             return True
-        return self.rules.pairs != "none" and self.travel > FAST_FRACTION * float(self.radius.min())
+        return self.rules.pairs != "none" and bool(self.fast_rows().any())
+
+    def fast_rows(self) -> np.ndarray:
+        """Which pucks move FAST_FRACTION of their radius in the step on their first paths."""
+        lim = FAST_FRACTION * self.radius / self.dt
+        return self.speed_sq > lim * lim
 
     def fast(self, k: int) -> bool:
         """Whether puck k moves FAST_FRACTION of its radius in a step on its present path."""
@@ -261,8 +265,7 @@ class _Step:
         if self.rules.rest is not None:
             close &= ww > np.maximum(self.rules.rest.take(i), self.rules.rest.take(j)) ** 2
         if self.rules.pairs != "perfect-kiss":  # only where a puck is fast: the others are seen overlapping
-            lim = FAST_FRACTION * self.radius / self.dt
-            fast = vectors.squared_abs(self.zvel) > lim * lim
+            fast = self.fast_rows()
             close &= fast.take(i) | fast.take(j)
         k = close.nonzero()[0]
         if self.rules.held is not None and len(k):

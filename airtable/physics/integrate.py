@@ -90,20 +90,16 @@ def integrate(table: Storage, ctx: StepContext, parts: forces.Implicit | None, d
         kick = table.gravity_mps2 * dt
     if ctx.sleepers is not None:
         vel[ctx.sleepers] = 0.0  # sleepers stay where they are
-    ctx.speed_bound_mps = _cap_speeds(vel)
+    _cap_speeds(vel)
     pos += vel * dt
     return kick
 
 
-def _cap_speeds(vel: np.ndarray) -> float:
-    """A last guard against runaway values: slow down what is faster than MAX_SPEED_MPS; return a bound
-    on every speed (sqrt 2 times the largest component), which the hits' stage uses too."""
-    bound = math.sqrt(2.0) * float(np.abs(vel).max())
-    if bound > MAX_SPEED_MPS:
+def _cap_speeds(vel: np.ndarray) -> None:
+    """A last guard against runaway values: slow down what is faster than MAX_SPEED_MPS."""
+    if math.sqrt(2.0) * float(np.abs(vel).max()) > MAX_SPEED_MPS:  # sqrt 2 x the largest component: a bound
         speed = np.hypot(vel[:, 0], vel[:, 1])  # not lengths(): v^2 may overflow here
         vel *= np.minimum(1.0, MAX_SPEED_MPS / np.maximum(speed, 1e-300))[:, None]
-        bound = MAX_SPEED_MPS
-    return bound
 
 
 def implicit_velocity_change(table: Storage, parts: forces.Implicit, rhs: np.ndarray, dt: float) -> np.ndarray:
