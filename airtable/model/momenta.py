@@ -93,7 +93,11 @@ def momenta_around_collisions(table: AirTable) -> MomentaAround | None:
     c = table.last_collisions
     if len(c) == 0:
         return None
-    vel_after = table.vel_mps.copy()
+    return _momenta_around(float(table.time_s), c, table.vel_mps.copy(), table.mass_kg, table.color_rgb.copy())
+
+
+def _momenta_around(t_s: float, c, vel_after: np.ndarray, mass_kg: np.ndarray, colors: np.ndarray) -> MomentaAround:
+    """The momenta around the collisions `c` of a step that ended at t_s with velocities `vel_after`."""
     vel_before = vel_after.copy()
     # Each puck's velocity when its first collision of the step found it.
     rows = np.stack([c.i, c.j], axis=1).ravel()
@@ -102,23 +106,36 @@ def momenta_around_collisions(table: AirTable) -> MomentaAround | None:
     vel_before[rows[first]] = vels[first]
     collided = np.zeros(len(vel_after), dtype=bool)
     collided[rows] = True
-    mass = table.mass_kg[:, None]
-    return MomentaAround(float(table.time_s), mass * vel_before, mass * vel_after, collided, table.color_rgb.copy())
+    mass = mass_kg[:, None]
+    return MomentaAround(t_s, mass * vel_before, mass * vel_after, collided, colors)
 
 
 class MomentaLog:
-    """The momenta around the latest collision seen (kept until the next one, or a new demo)."""
+    """The momenta around the latest collision seen (kept until the next one, or a new demo).
+
+    `observe` runs after every step and only keeps what the diagram will need;
+    the momenta are worked out when asked for (a 10000-puck gas collides every
+    step, and the diagram is drawn at most once a frame, often never)."""
 
     def __init__(self) -> None:
-        self.latest: MomentaAround | None = None
+        self._seen: tuple | None = None  # (_momenta_around's arguments) of the latest collision
+        self._latest: MomentaAround | None = None
 
     def clear(self) -> None:
-        self.latest = None
+        self._seen = self._latest = None
 
     def observe(self, table: AirTable) -> None:
-        found = momenta_around_collisions(table)
-        if found is not None:
-            self.latest = found
+        c = table.last_collisions
+        if len(c):
+            mass = table.mass_kg.copy()
+            self._seen = (float(table.time_s), c, table.vel_mps.copy(), mass, table.color_rgb.copy())
+            self._latest = None
+
+    @property
+    def latest(self) -> MomentaAround | None:
+        if self._latest is None and self._seen is not None:
+            self._latest = _momenta_around(*self._seen)
+        return self._latest
 
 
 def tip_to_tail(momenta_Ns: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
