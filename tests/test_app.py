@@ -293,3 +293,28 @@ def test_importing_the_package_and_the_app_changes_no_environment_variable():
     done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=60)
     assert done.returncode == 0, done.stderr
     assert done.stdout.strip().splitlines()[-1] == "[]"
+
+
+def test_a_table_too_heavy_for_real_time_runs_in_slow_motion_and_says_so(app):
+    """Frames whose steps take longer than their budget drop the rest (slow motion, a steady frame
+    rate) and the status line says how much of real time the physics keeps up with."""
+    clock = [0.0]
+
+    def slow_step() -> bool:  # each step takes 5 ms of the stepper's clock
+        clock[0] += 0.005
+        return App.physics_step(app)
+
+    app.stepper.clock = lambda: clock[0]
+    app.stepper.budget_s = 0.008
+    app.physics_step = slow_step
+    start = app.table.steps
+    for _ in range(60):
+        app.frame(FRAME_S)
+        clock[0] += FRAME_S
+    assert app.table.steps - start == 60 * 2  # 2 of the 4 steps each frame asks for
+    assert "physics at 50% of real time" in app.status_line()
+    app.stepper.budget_s = None  # the computer keeps up again
+    for _ in range(90):
+        app.frame(FRAME_S)
+        clock[0] += FRAME_S
+    assert "of real time" not in app.status_line()

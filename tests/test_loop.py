@@ -47,6 +47,36 @@ def test_a_stalled_frame_runs_at_most_a_tenth_of_a_second():
     assert step.steps(1 / 60) in (4, 5)
 
 
+def test_a_frames_steps_stop_at_the_budget_and_the_table_runs_in_slow_motion():
+    clock = FakeClock()
+    ran: list[float] = []
+
+    def heavy_step() -> bool:  # 4 ms of the clock a step: 240 steps a second would need 0.96 s of every 1
+        ran.append(clock.now)
+        clock.now += 0.004
+        return True
+
+    stepper = FixedStep(1 / 240, budget_s=0.010, clock=clock)
+    counts = []
+    for _ in range(120):  # two seconds of 1/60 s frames, each asking 4 steps
+        counts.append(stepper.run(1 / 60, 1.0, heavy_step))
+        clock.now += 1 / 60
+    assert set(counts) == {3}  # 8 and 12 ms are within 10 ms; the third step passes it
+    assert stepper.real_time_share == pytest.approx(0.75)
+    assert stepper.accumulator_s < 1 / 240  # the dropped steps are not carried over to pile up
+
+    free = FixedStep(1 / 240, clock=clock)  # no budget (simulated time): every step runs, whatever the clock
+    assert [free.run(1 / 60, 1.0, heavy_step) for _ in range(30)] == [4] * 30
+    assert free.real_time_share == 1.0
+
+
+def test_a_failed_step_ends_the_frames_steps():
+    calls = []
+    stepper = FixedStep(1 / 240)
+    assert stepper.run(1 / 60, 1.0, lambda: calls.append(1) or len(calls) < 2) == 1
+    assert len(calls) == 2
+
+
 def test_fps_counts_the_frames_of_the_last_second():
     counter = FpsCounter()
     for i in range(90):

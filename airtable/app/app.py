@@ -52,6 +52,11 @@ MAX_FPS = 240.0
 # A still table (paused, or nothing moving) with nobody at it redraws this often,
 # and wakes at once on input: a laptop projecting all lesson stays quiet.
 IDLE_FPS = 12.0
+# A frame's physics steps stop after this share of the frame period (the rest is for
+# drawing): a table too heavy to step in real time runs in slow motion, not at a few frames a second.
+PHYSICS_SHARE = 0.6
+# Below this share of real time over the last second, the status line says the physics is behind.
+SLOW_SHARE = 0.95
 IDLE_AFTER_S = 1.0  # input this recent keeps the full frame rate
 OUT_OF_VIEW = "the table is out of view: q brings it back"
 STILL_PX_PER_S = 0.5  # slower than this on screen, nothing visibly moves: the table idles
@@ -414,9 +419,7 @@ class App:
         for feature in self.features:
             feature.before_physics()
         if not self.paused:
-            for _ in range(self.stepper.steps(frame_dt_s, self.speed)):
-                if not self.physics_step():
-                    break
+            self.stepper.run(frame_dt_s, self.speed, self.physics_step)
         self._say_new_notices()
         for feature in self.features:
             feature.after_physics()
@@ -465,6 +468,9 @@ class App:
             parts.extend(feature.status_parts(for_students))  # hands off, the floor, the round, rewound
         if self.speed != 1.0:
             parts.append(f"slow motion x1/{round(1 / self.speed)}")
+        share = self.stepper.real_time_share
+        if share < SLOW_SHARE and not self.paused:
+            parts.append(f"physics at {share:.0%} of real time (the computer's most)")
         parts.append(f"t = {t.time_s:.2f} s")
         parts.append("F1: help")  # the students' windows have their own F1
         parts.append(gravity_label(t))
@@ -532,6 +538,10 @@ class App:
         IDLE_FPS and wakes on input. `started` is called once signals end the run (see loop.py).
         """
         self.loop = IdlingLoop(display_rate_hz(), IDLE_FPS, self.still, self.window.headless, fixed_dt_s=frame_dt_s)
+        # In real time a frame's physics stops after its share of a 60 Hz frame (of a display's slower
+        # frame), to leave time to draw it; a faster display draws fewer frames before the physics slows.
+        frame_s = 1.0 / min(display_rate_hz(), DEFAULT_FPS)
+        self.stepper.budget_s = None if frame_dt_s is not None else PHYSICS_SHARE * frame_s
         try:
             with signals_end_the_run(self.stop):
                 if started is not None:

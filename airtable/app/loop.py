@@ -48,17 +48,58 @@ MAX_FRAME_S = 0.25
 
 
 class FixedStep:
-    """Fixed physics steps of `dt_s` out of variable frame times."""
+    """Fixed physics steps of `dt_s` out of variable frame times.
 
-    def __init__(self, dt_s: float, max_sim_per_frame_s: float = MAX_SIM_PER_FRAME_S) -> None:
+    In real time (`budget_s` set, with the clock that measures it) a frame's
+    steps stop once they have taken budget_s, and the steps left are dropped:
+    a table heavier than the computer can step in real time (a 10000-puck gas)
+    then runs in slow motion at a steady frame rate, instead of a frame that
+    takes ever longer to catch up. Each step is the same fixed step either way,
+    so the results do not change; `real_time_share` says how much of real time
+    the physics kept up with over the last second (1 when it kept up).
+    """
+
+    def __init__(
+        self,
+        dt_s: float,
+        max_sim_per_frame_s: float = MAX_SIM_PER_FRAME_S,
+        budget_s: float | None = None,
+        clock: Callable[[], float] = time.perf_counter,
+    ) -> None:
         self.dt_s = dt_s
         self.max_sim_per_frame_s = max_sim_per_frame_s
         self.accumulator_s = 0.0
+        self.budget_s = budget_s
+        self.clock = clock
+        self._asked: deque[tuple[float, int, int]] = deque()  # (clock, steps asked, steps run) per frame
 
     def reset(self, dt_s: float | None = None) -> None:
         if dt_s is not None:
             self.dt_s = dt_s
         self.accumulator_s = 0.0
+        self._asked.clear()
+
+    def run(self, frame_dt_s: float, speed: float, step: Callable[[], bool]) -> int:
+        """Run this frame's steps (`steps`) with `step`, until one returns False or the budget is
+        spent; returns how many ran."""
+        asked = self.steps(frame_dt_s, speed)
+        start = self.clock()
+        ran = 0
+        while ran < asked and step():
+            ran += 1
+            if self.budget_s is not None and self.clock() - start > self.budget_s:
+                break
+        now = self.clock()
+        self._asked.append((now, asked, ran))
+        while self._asked[0][0] < now - 1.0:
+            self._asked.popleft()
+        return ran
+
+    @property
+    def real_time_share(self) -> float:
+        """The share of the steps asked for over the last second that ran (1.0: none dropped)."""
+        asked = sum(a for _, a, _ in self._asked)
+        return sum(r for _, _, r in self._asked) / asked if asked else 1.0
 
     def steps(self, frame_dt_s: float, speed: float = 1.0) -> int:
         """How many steps to run for a frame of `frame_dt_s` at `speed` times real time."""

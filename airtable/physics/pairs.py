@@ -80,12 +80,21 @@ def overlapping(table: Storage, ctx: StepContext) -> None:
         # was already handled: look again among the same candidates (those
         # that may have come within reach: nothing else changed), collide
         # those pairs too, and at last just push apart what is left.
-        near_sq = nl.reach_squared(OVERLAP_SLOP_M)
-        i, j = _colliding(table, ctx.rest, *broadphase.overlapping_pairs(pos, ci, cj, None, reach_sq=near_sq))
+        # Only pairs with a puck this pass moved can have changed: the others were left as they were.
+        ki, kj, near_sq = _with_rows(ci, cj, nl.reach_squared(OVERLAP_SLOP_M), np.concatenate([i, j]), len(pos))
+        i, j = _colliding(table, ctx.rest, *broadphase.overlapping_pairs(pos, ki, kj, None, reach_sq=near_sq))
     if moved:
         ctx.records += records
         table.collision_count += sum(len(r) for r in records)
         ctx.moved = np.concatenate(moved)
+
+
+def _with_rows(ci, cj, reach_sq, rows: np.ndarray, n: int):
+    """(ci, cj, reach_sq) of only the candidate pairs that have one of `rows` (reach_sq: per pair, or one number)."""
+    touched = np.zeros(n, dtype=bool)
+    touched[rows] = True
+    k = (touched.take(ci) | touched.take(cj)).nonzero()[0]
+    return ci.take(k), cj.take(k), reach_sq if np.ndim(reach_sq) == 0 else reach_sq.take(k)
 
 
 def _colliding(table: Storage, rest: np.ndarray | None, i: np.ndarray, j: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
