@@ -25,13 +25,16 @@ from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
 import numpy as np
-from airtable.demos.demo_0p_gas import COVERAGE, DT_S, RADIUS_M, SPEED_MPS, gas_scene
+from airtable.demos.demo_0p_gas import COVERAGE, RADIUS_M, SPEED_MPS, gas_scene
 
 from airtable.physics import broadphase, vectors
 from airtable.physics.table import AirTable, kinetic_energy_J
 
+# The benchmark's step (the gas demo's own is shorter: its pucks are smaller): at 1 m/s a puck of
+# RADIUS_M moves under a tenth of its radius in one.
+DT_S = 1.0 / 120.0
 # Targets: ours / pymunk time ratio by N, and the deepest overlap allowed.
-TARGET_RATIO = {1000: 1.3, 10000: 0.3}
+TARGET_RATIO = {1000: 2.0, 10000: 1.0}  # issue 24: within 2x at 1000, ahead at 10000
 TARGET_OVERLAP_MM = 10.0
 
 

@@ -18,12 +18,17 @@ def test_the_stats_line_is_read_and_judged_against_60_fps(capsys) -> None:
     line = "stats: frames 360, fps median 60.1 p5 43.0, steps 1440, cpu 1.4 s, peak memory 56 MB"
     frames, median, p5, _, cpu = bench_frames.STATS.search(line).groups()
     assert (frames, median, p5, cpu) == ("360", "60.1", "43.0", "1.4")
-    assert bench_frames._report("app", (360, 60.1, 43.0, 3.9), checked=True) is True
-    assert bench_frames._report("app", (300, 50.0, 30.0, 9.0), checked=True) is False
-    assert bench_frames._report("OpenGL", (100, 16.0, 11.0, 18.0), checked=False) is True
+    assert bench_frames._report("app", (360, 60.1, 43.0, 3.9, 1.0), checked=True) is True
+    assert bench_frames._report("app", (300, 50.0, 30.0, 9.0, 1.0), checked=True) is False
+    assert bench_frames._report("app", (360, 60.0, 55.0, 9.0, 0.7), checked=True) is False  # slow motion
+    assert bench_frames._report("OpenGL", (100, 16.0, 11.0, 18.0, 1.0), checked=False) is True
     out = capsys.readouterr().out
-    assert "PASS" in out and "MISS" in out and "(for comparison)" in out
+    assert "PASS" in out and "MISS" in out and "(for comparison)" in out and "70% of real time" in out
 
 
-def test_the_window_section_asks_for_the_burst_of_its_count_counting_variations_from_1(demos):
-    assert demos["0"].variations[bench_frames._burst_variation() - 1] == f"n = {bench_frames.PUCKS}"
+def test_the_window_section_asks_for_the_burst_and_the_gas_of_its_count_counting_variations_from_1(demos):
+    burst, burst_dt = bench_frames._variation("0")
+    gas, gas_dt = bench_frames._variation("0p")
+    assert demos["0"].variations[burst - 1] == f"n = {bench_frames.PUCKS}"
+    assert demos["0p"].variations[gas - 1] == f"{bench_frames.PUCKS} pucks"
+    assert (burst_dt, gas_dt) == (demos["0"].dt_s, demos["0p"].dt_s)
