@@ -49,21 +49,29 @@ def test_a_stalled_frame_runs_at_most_a_tenth_of_a_second():
 
 def test_a_frames_steps_stop_at_the_budget_and_the_table_runs_in_slow_motion():
     clock = FakeClock()
-    ran: list[float] = []
 
     def heavy_step() -> bool:  # 4 ms of the clock a step: 240 steps a second would need 0.96 s of every 1
-        ran.append(clock.now)
         clock.now += 0.004
         return True
 
-    stepper = FixedStep(1 / 240, budget_s=0.010, clock=clock)
-    counts = []
-    for _ in range(120):  # two seconds of 1/60 s frames, each asking 4 steps
-        counts.append(stepper.run(1 / 60, 1.0, heavy_step))
-        clock.now += 1 / 60
-    assert set(counts) == {3}  # 8 and 12 ms are within 10 ms; the third step passes it
-    assert stepper.real_time_share == pytest.approx(0.75)
-    assert stepper.accumulator_s < 1 / 240  # the dropped steps are not carried over to pile up
+    def frames(stepper: FixedStep, count: int, draw_s: float) -> list[int]:
+        """Real-time frames: each as long as its steps and its drawing (draw_s) took."""
+        ran, last = [], clock.now - 1 / 60
+        for _ in range(count):
+            frame_s, last = clock.now - last, clock.now
+            ran.append(stepper.run(frame_s, 1.0, heavy_step))
+            clock.now += draw_s
+        return ran
+
+    quick_to_draw = FixedStep(1 / 240, budget_s=0.010, clock=clock)
+    assert set(frames(quick_to_draw, 120, draw_s=0.005)) == {3}  # 8 and 12 ms: the third passes 10 ms
+    assert 0.7 < quick_to_draw.real_time_share < 0.8  # 3 of the 4 a 17 ms frame asks for
+    assert quick_to_draw.accumulator_s < 1 / 240  # the dropped steps are not carried over to pile up
+
+    slow_to_draw = FixedStep(1 / 240, budget_s=0.010, clock=clock)  # drawing takes 30 ms (a 4K screen)
+    counts = frames(slow_to_draw, 60, draw_s=0.030)
+    assert counts[0] == 3 and set(counts[1:]) == {8}  # then as long as drawing took: 32 ms
+    assert 0.5 < slow_to_draw.real_time_share < 0.6  # the physics keeps about half the time
 
     free = FixedStep(1 / 240, clock=clock)  # no budget (simulated time): every step runs, whatever the clock
     assert [free.run(1 / 60, 1.0, heavy_step) for _ in range(30)] == [4] * 30

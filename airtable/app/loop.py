@@ -51,12 +51,14 @@ class FixedStep:
     """Fixed physics steps of `dt_s` out of variable frame times.
 
     In real time (`budget_s` set, with the clock that measures it) a frame's
-    steps stop once they have taken budget_s, and the steps left are dropped:
-    a table heavier than the computer can step in real time (a 10000-puck gas)
-    then runs in slow motion at a steady frame rate, instead of a frame that
-    takes ever longer to catch up. Each step is the same fixed step either way,
-    so the results do not change; `real_time_share` says how much of real time
-    the physics kept up with over the last second (1 when it kept up).
+    steps stop once they have taken budget_s, or as long as the rest of the
+    last frame took (drawing it) if that was longer, and the steps left are
+    dropped: a table heavier than the computer can step in real time (a
+    10000-puck gas) then runs in slow motion at a steady frame rate, instead of
+    a frame that takes ever longer to catch up, and where drawing is slow (a 4K
+    screen without a GPU) the physics still gets half the time. Each step is the
+    same fixed step either way, so the results do not change; `real_time_share`
+    says how much of real time the physics kept up with over the last second.
     """
 
     def __init__(
@@ -72,24 +74,29 @@ class FixedStep:
         self.budget_s = budget_s
         self.clock = clock
         self._asked: deque[tuple[float, int, int]] = deque()  # (clock, steps asked, steps run) per frame
+        self._ended: float | None = None  # when the last frame's steps ended (the clock's)
 
     def reset(self, dt_s: float | None = None) -> None:
         if dt_s is not None:
             self.dt_s = dt_s
         self.accumulator_s = 0.0
         self._asked.clear()
+        self._ended = None
 
     def run(self, frame_dt_s: float, speed: float, step: Callable[[], bool]) -> int:
         """Run this frame's steps (`steps`) with `step`, until one returns False or the budget is
         spent; returns how many ran."""
         asked = self.steps(frame_dt_s, speed)
         start = self.clock()
+        budget = self.budget_s
+        if budget is not None and self._ended is not None:  # at least the rest of the last frame
+            budget = min(max(budget, start - self._ended), MAX_SIM_PER_FRAME_S)
         ran = 0
         while ran < asked and step():
             ran += 1
-            if self.budget_s is not None and self.clock() - start > self.budget_s:
+            if budget is not None and self.clock() - start > budget:
                 break
-        now = self.clock()
+        now = self._ended = self.clock()
         self._asked.append((now, asked, ran))
         while self._asked[0][0] < now - 1.0:
             self._asked.popleft()
