@@ -398,7 +398,9 @@ class GameServer:
 
     @property
     def running(self) -> bool:
-        return self._thread is not None and self._thread.is_alive() and not self._stopping.is_set()
+        """Serving: started, not stopped, and the network thread has not failed (see `failure`)."""
+        alive = self._thread is not None and self._thread.is_alive()
+        return alive and not self._stopping.is_set() and self.failure is None
 
     def join_lines(self) -> list[str]:
         """What students type to join, e.g. ["join with: airtable-client 192.168.1.23"].
