@@ -96,9 +96,11 @@ class FixedStep:
             ran += 1
             if budget is not None and self.clock() - start > budget:
                 break
-        now = self._ended = self.clock()
-        self._asked.append((now, asked, ran))
-        while self._asked[0][0] < now - 1.0:
+        first, now = self._ended is None, self.clock()
+        self._ended = now
+        if not first:  # (the first frame after a reset spans building the demo: not the physics' pace)
+            self._asked.append((now, asked, ran))
+        while self._asked and self._asked[0][0] < now - 1.0:
             self._asked.popleft()
         return ran
 
