@@ -5,12 +5,14 @@ from __future__ import annotations
 import numpy as np
 import pygame
 import pytest
+from hypothesis import given
+from hypothesis import strategies as st
 
 from airtable.app import panel_view
 from airtable.app.demo_loader import key_order
 from airtable.app.environment import Environment
 from airtable.app.pucks_view import SPRITE_CACHE_BYTES, core_color
-from airtable.app.window import PAUSED_COLOR, GameWindow, fit_parts
+from airtable.app.window import PAUSED_COLOR, GameWindow, fit_parts, margins_around
 from airtable.model.scene import Scene
 
 TABLE = (10.0, 8.7556)
@@ -210,3 +212,16 @@ def test_f11_twice_brings_back_the_windowed_size(monkeypatch) -> None:
     assert not win.fullscreen
     assert win.surface.get_size() == before == win.env.size_px
     assert win.windowed_size_px == before
+
+
+@given(st.integers(-50, 700), st.integers(-50, 500), st.integers(0, 900), st.integers(0, 700))
+def test_the_margins_and_the_table_cover_the_screen_once(x, y, w, h):
+    """Every pixel of the screen is in the table's rectangle or in exactly one margin, never in two."""
+    screen, table = pygame.Rect(0, 0, 640, 480), pygame.Rect(x, y, w, h)
+    cover = np.zeros((480, 640), dtype=int)
+    inside = table.clip(screen)
+    cover[inside.top : inside.bottom, inside.left : inside.right] += 1
+    for m in margins_around(screen, table):
+        assert screen.contains(m)
+        cover[m.top : m.bottom, m.left : m.right] += 1
+    assert (cover == 1).all()

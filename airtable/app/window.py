@@ -80,6 +80,20 @@ def background_for(scene: Scene) -> tuple[int, int, int]:
     return BACKGROUND
 
 
+def margins_around(screen: pygame.Rect, inner: pygame.Rect) -> list[pygame.Rect]:
+    """The parts of `screen` outside `inner`: up to four rectangles (above, below, left, right)."""
+    inner = inner.clip(screen)
+    if not inner.width or not inner.height:
+        return [screen]
+    parts = [
+        pygame.Rect(screen.left, screen.top, screen.width, inner.top - screen.top),
+        pygame.Rect(screen.left, inner.bottom, screen.width, screen.bottom - inner.bottom),
+        pygame.Rect(screen.left, inner.top, inner.left - screen.left, inner.height),
+        pygame.Rect(inner.right, inner.top, screen.right - inner.right, inner.height),
+    ]
+    return [r for r in parts if r.width > 0 and r.height > 0]
+
+
 class GameWindow:
     """Owns the display surface (or an off-screen one when headless) and draws scenes.
 
@@ -288,8 +302,10 @@ class GameWindow:
         self.follow_display()
         self.label_boxes = []
         surf = self.surface
-        surf.fill(MARGIN_COLOR)
-        surf.fill(background_for(scene), self._table_rect(scene))
+        table = self._table_rect(scene)
+        for margin in margins_around(surf.get_rect(), table):  # not the whole screen: each fill costs its pixels
+            surf.fill(MARGIN_COLOR, margin)
+        surf.fill(background_for(scene), table)
         if trails:
             if self._trail_layer is None:
                 self._trail_layer = pygame.Surface(surf.get_size())
