@@ -170,7 +170,8 @@ class Partners:
         self._starts = np.searchsorted(rows.take(order), np.arange(n + 1)).tolist()
 
     def of(self, k: int) -> list[int]:
-        return self._others[self._starts[k] : self._starts[k + 1]].tolist()
+        """Puck k's partners, in increasing order (however the pairs were found)."""
+        return sorted(self._others[self._starts[k] : self._starts[k + 1]].tolist())
 
 
 class NeighbourList:

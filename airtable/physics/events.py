@@ -61,6 +61,9 @@ REPEAT_MAX = 3
 # In two-step, pair hits are predicted when some puck moves this share of the smallest radius
 # in a step; below it nobody can pass through a puck, and the pair stage sees every hit.
 FAST_FRACTION = 0.5
+# Fast pucks look for their partners each over every puck when that costs at most this many
+# looks (fast pucks times pucks); more, and the grid finds the pairs near every puck.
+FAST_SEARCH_WORK = 2_000_000
 
 
 @dataclass
@@ -135,8 +138,7 @@ def resolve_hits(pos, vel, radius, mass, size_m, dt: float, rules: Rules, neighb
         step.predict_walls(k)
     if step.predicts_pairs():
         step.find_partners(neighbours)
-        for a, b in step.first_pairs():
-            step.predict_pair(a, b)
+        step.predict_pairs(*step.first_pairs())
     step.run()
     step.write_back()
     if past is not None:  # only those past a wall, or on a new path, may still be (resting, landed)
@@ -155,10 +157,13 @@ class _Step:
         self.seq = 0  # breaks ties between events at one time: the earlier predicted first
         self.t_now = 0.0
         self.origin: dict[int, complex] = {}  # the pucks whose path changed, and their new origin
+        self.changed = np.zeros(len(pos), dtype=bool)  # the same rows as a mask, and origins as an array,
+        self.zorigin = np.zeros(len(pos), dtype=complex)  # for paths of many pucks at once (`at_rows`)
         self.version: dict[int, int] = {}  # per puck: how many times its path changed
         self.hit_pairs: dict[tuple[int, int], int] = {}  # how many times each pair hit
         self.hits = Hits()
         self.partners = None  # the pairs that may meet, per puck (see find_partners)
+        self.only_fast: np.ndarray | None = None  # the pucks whose partners were found, if not all
         self.speed_sq = vectors.squared_abs(self.zvel)  # each puck's speed squared on its first path
         speed = math.sqrt(float(self.speed_sq.max())) if len(vel) else 0.0
         self.travel = speed * dt  # the farthest any puck moves this step on its first path (m)
@@ -177,18 +182,32 @@ class _Step:
             return self.zpos.item(k) + self.zvel.item(k) * (t - self.dt)
         return o + self.zvel.item(k) * t
 
+    def at_rows(self, rows: np.ndarray, t: float) -> np.ndarray:
+        """Where the pucks `rows` are at time t of the step on their present paths (`at`, for many)."""
+        out = self.zpos.take(rows) + self.zvel.take(rows) * (t - self.dt)
+        moved = self.changed.take(rows)
+        if moved.any():
+            k = rows[moved]
+            out[moved] = self.zorigin.take(k) + self.zvel.take(k) * t
+        return out
+
     def set_path(self, k: int, x: complex, v: complex) -> None:
         """Puck k is at x at t_now and goes on at v: a new origin, and its old predictions stale."""
         self.zvel[k] = v
-        self.origin[k] = x - v * self.t_now
+        self.origin[k] = self.zorigin[k] = x - v * self.t_now
+        self.changed[k] = True
         self.version[k] = self.version.get(k, 0) + 1
         if self.partners is None:
             return
         # The step's end of its first path (zpos, written back only at the end) and how far
         # the new path strays from it: beyond what the pairs were found for, look at everyone.
+        # With the partners of the fast pucks only (fast_partners), a puck made fast looks too.
         end = self.zpos.item(k)
         stray = max(abs(x - end), abs(x + v * (self.dt - self.t_now) - end))
-        if stray > self.covered:
+        newly_fast = self.only_fast is not None and not self.only_fast[k] and self.fast(k)
+        if stray > self.covered or newly_fast:
+            if newly_fast:
+                self.only_fast[k] = True  # (its partners are then all found: once is enough)
             self.reach_out = max(self.reach_out, stray)
             self.add_everyone_near(k, end, stray)
 
@@ -202,10 +221,11 @@ class _Step:
                 self.extra.setdefault(other, set()).add(k)
 
     def partners_of(self, k: int) -> list[int]:
-        """The pucks k may meet this step."""
+        """The pucks k may meet this step, in increasing order: hits at one time are resolved in the
+        order they were predicted, so that order must not depend on how the pairs were found."""
         out = self.partners.of(k)
         more = self.extra.get(k)
-        return out if not more else list(set(out) | more)
+        return out if not more else sorted(set(out) | more)
 
     def write_back(self) -> None:
         """The pucks whose path changed end the step where their present path has them."""
@@ -243,6 +263,11 @@ class _Step:
         """The pairs that may meet during the step, on any path within 2 travels of the step's ends."""
         pos = vectors.as_rows(self.zpos)
         found = neighbours.pairs_while_moving(pos, self.radius, 2.0 * self.travel)
+        if found is None and self.rules.pairs != "perfect-kiss":  # only fast pucks' hits are predicted
+            fast = self.fast_rows().nonzero()[0]
+            if len(fast) * len(pos) <= FAST_SEARCH_WORK:
+                self.partners = self.fast_partners(fast)
+                return
         if found is None:  # paths longer than the list's skin: the pairs within reach of them now
             margin = 4.0 * self.travel
             i, j = broadphase.find_candidate_pairs(pos, self.radius, margin_m=margin, closer=True)
@@ -252,7 +277,25 @@ class _Step:
         else:
             self.partners = neighbours.partners()
 
-    def first_pairs(self) -> list[tuple[int, int]]:
+    def fast_partners(self, fast: np.ndarray) -> broadphase.Partners:
+        """The partners of the fast pucks only (each looks at every puck within reach of its paths):
+        a puck dragged fast through a crowd moves far in a step, and the pairs within that reach of
+        every puck would number millions. A puck a hit makes fast finds its own (set_path)."""
+        margin = 4.0 * self.travel
+        parts_i, parts_j = [], []
+        is_fast = np.zeros(len(self.zpos), dtype=bool)
+        is_fast[fast] = True
+        for f in fast.tolist():
+            reach = self.radius + (self.radius.item(f) + margin)
+            near = (vectors.squared_abs(self.zpos - self.zpos.item(f)) < reach * reach).nonzero()[0]
+            near = near[(near != f) & (~is_fast.take(near) | (near > f))]  # a fast pair once
+            parts_i.append(np.minimum(near, f))
+            parts_j.append(np.maximum(near, f))
+        self.only_fast = is_fast
+        i, j = np.concatenate(parts_i), np.concatenate(parts_j)
+        return broadphase.Partners(i, j, len(self.zpos))
+
+    def first_pairs(self) -> tuple[np.ndarray, np.ndarray]:
         """The pairs that on their first paths may touch during the step, approaching faster than they rest."""
         i, j = self.partners.i, self.partners.j
         d, w = self.zpos.take(i) - self.zpos.take(j), self.zvel.take(i) - self.zvel.take(j)
@@ -270,33 +313,41 @@ class _Step:
         k = close.nonzero()[0]
         if self.rules.held is not None and len(k):
             k = k.take((~self.rules.held(i.take(k), j.take(k))).nonzero()[0])
-        return list(zip(i.take(k).tolist(), j.take(k).tolist(), strict=True))
+        i, j = i.take(k), j.take(k)
+        by_pair = np.lexsort((j, i))  # in order of (i, j), however the pairs were found (partners_of)
+        return i.take(by_pair), j.take(by_pair)
 
-    def predict_pair(self, a: int, b: int) -> None:
-        """Queue the next hit of a and b on their present paths, if it comes within the step."""
-        t_now, dt = self.t_now, self.dt
-        if self.rules.pairs != "perfect-kiss" and not (self.fast(a) or self.fast(b)):
-            return  # the pair stage sees this pair overlapping, if it hits
-        d, w = self.at(a, t_now) - self.at(b, t_now), self.zvel.item(a) - self.zvel.item(b)
-        reach = self.radius.item(a) + self.radius.item(b)
+    def predict_pairs(self, a: np.ndarray, b: np.ndarray) -> None:
+        """Queue the next hit of each pair (a[k], b[k]) on their present paths, if it comes within the
+        step, in the pairs' order (numpy: a puck's partners, or a step's first pairs, at once)."""
+        t_now, dt, rules = self.t_now, self.dt, self.rules
+        if rules.pairs != "perfect-kiss":  # the pair stage sees the others overlapping, if they hit
+            fast_a = np.abs(self.zvel.take(a)) * dt > FAST_FRACTION * self.radius.take(a)
+            keep = (fast_a | (np.abs(self.zvel.take(b)) * dt > FAST_FRACTION * self.radius.take(b))).nonzero()[0]
+            a, b = a.take(keep), b.take(keep)
+        d, w = self.at_rows(a, t_now) - self.at_rows(b, t_now), self.zvel.take(a) - self.zvel.take(b)
+        reach = self.radius.take(a) + self.radius.take(b)
         t, speed = collision.contact_time(d, w, reach)
-        t = t_now + (t if t > 0.0 else 0.0)  # overlapping and approaching (by round-off): they hit now
-        if t > dt:  # inf where they never meet
-            return
-        if self.rules.pairs != "perfect-kiss":
-            caught = _caught_overlapping(d + w * (dt - t_now), w, reach)
-            if caught is not None and self.rules.pairs == "off":
-                return  # seen overlapping: velocities only, at the step's end (the pair stage's)
-            if caught is not None:  # the course's case: resolved t_p before the step's end
-                t, speed = max(dt - caught[0], t_now), caught[1]
-        rest = self.rules.rest
-        if rest is not None and not speed > max(rest.item(a), rest.item(b)):
-            return  # a resting contact: the contact stage's
-        if self.rules.held is not None and self.rules.held(np.array([min(a, b)]), np.array([max(a, b)]))[0]:
-            return  # pressed on each other in the last step: resting, whatever the speed
-        if self.rules.cr_puck < 1.0 and self.hit_pairs.get((a, b), 0) >= REPEAT_MAX:
-            return
-        self.push(t, a, b)
+        t = t_now + np.where(t > 0.0, t, 0.0)  # overlapping and approaching (by round-off): they hit now
+        soon = (t <= dt).nonzero()[0]  # (inf where they never meet)
+        a, b, d, w, reach, t, speed = (x.take(soon) for x in (a, b, d, w, reach, t, speed))
+        if rules.pairs != "perfect-kiss":
+            caught, t_p, u = _caught_overlapping(d + w * (dt - t_now), w, reach)
+            if rules.pairs == "off":  # seen overlapping: velocities only, at the step's end (the pair stage's)
+                keep = (~caught).nonzero()[0]
+                a, b, t, speed = a.take(keep), b.take(keep), t.take(keep), speed.take(keep)
+            else:  # the course's case: resolved t_p before the step's end
+                t, speed = np.where(caught, np.maximum(dt - t_p, t_now), t), np.where(caught, u, speed)
+        ok = np.ones(len(a), dtype=bool)
+        if rules.rest is not None:  # slower: a resting contact, the contact stage's
+            ok &= speed > np.maximum(rules.rest.take(a), rules.rest.take(b))
+        if rules.held is not None and len(a):  # pressed on each other in the last step: resting
+            ok &= ~rules.held(np.minimum(a, b), np.maximum(a, b))
+        for k in ok.nonzero()[0].tolist():
+            pair = (a.item(k), b.item(k))
+            if rules.cr_puck < 1.0 and self.hit_pairs.get(pair, 0) >= REPEAT_MAX:
+                continue
+            self.push(t.item(k), *pair)
 
     def predict_walls(self, k: int) -> None:
         """Queue puck k's next wall hit on its present path, if it comes within the step."""
@@ -318,8 +369,9 @@ class _Step:
         if self.rules.walls:
             self.predict_walls(k)
         if self.partners is not None:
-            for other in self.partners_of(k):
-                self.predict_pair(k, other)
+            others = np.array(self.partners_of(k), dtype=np.intp)
+            if len(others):
+                self.predict_pairs(np.full(len(others), k), others)
 
     def push(self, t: float, a: int, b: int) -> None:
         """Queue a hit of a with b (b < 0: the wall across axis -1 - b), as their paths are now."""
@@ -396,7 +448,7 @@ class _Step:
         if self.rules.pairs == "two-step":
             left = self.dt - self.t_now
             end, reach = n + (va - vb) * left, self.radius.item(a) + self.radius.item(b)
-            if _caught_overlapping(end, va - vb, reach) is not None:
+            if _caught_overlapping(end, va - vb, reach)[0]:
                 n, overlap, seen = end, reach - abs(end), (xa + va * left, xb + vb * left)
         n /= abs(n)
         new_a, new_b = collision.collide_along(n, va, vb, self.mass.item(a), self.mass.item(b), self.rules.cr_puck)
@@ -407,12 +459,16 @@ class _Step:
         self.hit_pairs[a, b] = self.hit_pairs.get((a, b), 0) + 1
 
 
-def _caught_overlapping(d: complex, w: complex, reach: float) -> tuple[float, float] | None:
-    """(t_p, u) for a pair d = x1 - x2 apart at the step's end, approaching at w = v1 - v2 there: the
-    two-step's penetration time t_p = overlap / u, u the approach speed along the line of centres;
-    None if the step does not end with the pair overlapping and approaching (two-step's case)."""
+def _caught_overlapping(d, w, reach):
+    """(caught, t_p, u) for a pair d = x1 - x2 apart at the step's end, approaching at w = v1 - v2 there:
+    whether the step ends with the pair overlapping and approaching (two-step's case), its penetration
+    time t_p = overlap / u and u, the approach speed along the line of centres. One pair (complex d
+    and w: caught a bool) or many (numpy arrays; t_p and u are 0 where not caught)."""
     dist = abs(d)
-    if not (dist < reach and dist > 0.0):
-        return None
-    u = -vectors.dot(d, w) / dist
-    return ((reach - dist) / u, u) if u > 0.0 else None
+    if isinstance(dist, float):
+        u = -vectors.dot(d, w) / dist if dist > 0.0 else 0.0
+        caught = dist < reach and u > 0.0
+        return caught, ((reach - dist) / u if caught else 0.0), (u if caught else 0.0)
+    u = -vectors.dot(d, w) / np.where(dist > 0.0, dist, 1.0)
+    caught = (dist < reach) & (dist > 0.0) & (u > 0.0)
+    return caught, np.where(caught, (reach - dist) / np.where(caught, u, 1.0), 0.0), np.where(caught, u, 0.0)
