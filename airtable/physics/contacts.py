@@ -55,7 +55,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from airtable.physics import vectors
+from airtable.physics import colouring, vectors
 
 # Iterations over all contacts per step (Box2D and pymunk use about ten);
 # the loop stops early once an iteration changes no velocity by CONVERGED_MPS.
@@ -106,11 +106,6 @@ def rest_for_restitution(rest: np.ndarray, cr: float) -> np.ndarray:
     if cr <= 0.0:
         return np.where(rest > 0.0, np.inf, 0.0)
     return rest / cr
-
-
-def _same_rows(a: np.ndarray | None, b: np.ndarray | None) -> bool:
-    """Whether two optional row arrays are equal (None only equals None)."""
-    return (a is None and b is None) or (a is not None and b is not None and np.array_equal(a, b))
 
 
 @dataclass
@@ -167,31 +162,6 @@ def _wall_contacts(pos, vel, radius, size_m, rest, margin) -> _Contacts:
     return _Contacts(a, b, WALL_NORMALS.take(w), np.concatenate(gap), np.concatenate(vn), keys)
 
 
-def colour_rounds(a: np.ndarray, b: np.ndarray, n_bodies: int, prio: np.ndarray | None = None) -> list[np.ndarray]:
-    """Split contacts (a, b) into rounds in which no body appears twice.
-
-    Vectorised: in each pass, a contact joins the round if it has the
-    highest priority (the lowest number in `prio`) among the remaining
-    contacts of both its bodies. By default the priorities are a fixed
-    scramble of the contact numbers, so that a row of contacts in index
-    order does not go one per round.
-    """
-    m = len(a)
-    if prio is None:
-        prio = (np.arange(m, dtype=np.uint64) * np.uint64(0x9E3779B1)) % np.uint64(1 << 32)
-    remaining = np.arange(m)
-    rounds = []
-    while len(remaining):
-        p, ra, rb = prio.take(remaining), a.take(remaining), b.take(remaining)
-        best = np.full(n_bodies, np.iinfo(np.uint64).max, dtype=np.uint64)
-        np.minimum.at(best, ra, p)
-        np.minimum.at(best, rb, p)
-        pick = (best.take(ra) == p) & (best.take(rb) == p)
-        rounds.append(remaining[pick])
-        remaining = remaining[~pick]
-    return rounds
-
-
 @dataclass
 class _Round:
     """One round's contacts: views into its _Layout's buffers; targets and impulses as (m, 2) [velocity, position]."""
@@ -212,12 +182,12 @@ class ContactSolver:
         self._keys = np.empty(0, dtype=np.int64)  # sorted
         self._impulses = np.empty((0, 2))
         self._rows = -1
-        self._round_keys: np.ndarray | None = None  # the contacts the rounds are for, in their order
-        self._round_sleepers: np.ndarray | None = None  # and the sleepers they were coloured with
-        self._key_order = np.empty(0, dtype=np.intp)  # argsort of _round_keys
-        self._rounds: list[np.ndarray] = []  # bottom-up by bands: the first iteration
-        self._free_rounds: list[np.ndarray] = []  # fewer rounds, in no order: the later iterations
-        self._layouts: tuple[_Layout, _Layout] | None = None  # of _rounds and _free_rounds, while they stay
+        # Each contact's round (colouring.py), by _keys: bottom-up by bands for the first
+        # iteration, and in no order (fewer rounds) for the later ones.
+        self._band_rounds = np.empty(0, dtype=np.intp)
+        self._free_rounds = np.empty(0, dtype=np.intp)
+        self._key_order = np.empty(0, dtype=np.intp)  # this step's contacts in key order
+        self._layouts: tuple | None = None  # (keys, band rounds, free rounds, first _Layout, later _Layout)
         self._wall_rest: tuple | None = None  # (rest, _impulses, answer) of the last wall_rest
         self.count = 0  # contacts in the last step
         self.iterations = 0  # iterations the last step needed
@@ -293,11 +263,11 @@ class ContactSolver:
         if self.count == 0:
             self._keys, self._impulses = np.empty(0, dtype=np.int64), np.empty((0, 2))
             return False
-        self._y, self._r_mean = start[:, 1], float(radius.mean())
+        self._y, self._r_mean = start[:, 1], float(radius.mean())  # for the bands
         inv = np.append(1.0 / mass, 0.0)  # the walls never move, nor do sleepers
         if asleep is not None:
             inv[:-1][asleep] = 0.0
-        first, later = self._gather(c, inv, len(pc.a), dt, asleep)
+        first, later = self._gather(c, inv, dt, asleep)
         w = np.zeros((len(pos) + 1, 2), dtype=complex)  # velocities and pseudo-velocities; the last row: walls
         w[:-1, 0] = vectors.as_complex(np.ascontiguousarray(vel))
         v0 = w[:-1, 0].copy()
@@ -309,11 +279,9 @@ class ContactSolver:
         vel[:, 0], vel[:, 1] = w[:-1, 0].real, w[:-1, 0].imag
         return True
 
-    def _gather(self, c: _Contacts, inv, n_pairs: int, dt: float, asleep=None) -> tuple[_Layout, _Layout]:
+    def _gather(self, c: _Contacts, inv, dt: float, asleep=None) -> tuple[_Layout, _Layout]:
         """This step's targets, inverse masses (inv, with the walls' 0 last) and warm-start impulses,
-        filled into the layouts of the rounds of the first iteration and of the later ones (colouring
-        the contacts anew if they changed)."""
-        rows = len(inv) - 1
+        filled into the layouts of the rounds of the first iteration and of the later ones."""
         # The gaps where the step began: the velocity bound keeps a pair from closing more
         # than its gap, and the pseudo-velocity pushes out a share of its overlap.
         target = np.column_stack(
@@ -322,35 +290,18 @@ class ContactSolver:
                 np.minimum(POSITION_FRACTION * np.maximum(-c.gap - SLOP_M, 0.0) / dt, MAX_PUSH_MPS),
             ]
         )
+        self._key_order = korder = np.argsort(c.keys)
+        last = np.full(len(korder), -1)  # each contact's place in the last step's, by key order
+        if len(self._keys):
+            keys = c.keys.take(korder)
+            found = np.searchsorted(self._keys, keys).clip(0, len(self._keys) - 1)
+            hit = np.flatnonzero(self._keys.take(found) == keys)
+            last[hit] = found.take(hit)
         impulse = np.zeros((len(c.keys), 2))  # pseudo-velocities start from nothing each step
+        kept = np.flatnonzero(last >= 0)
+        impulse[korder.take(kept), 0] = self._impulses[last.take(kept), 0]
         self._warm = impulse[:, 0]
-        sleepers = None if asleep is None else np.flatnonzero(asleep)
-        same = self._round_keys is not None and np.array_equal(self._round_keys, c.keys)
-        same = same and _same_rows(self._round_sleepers, sleepers)
-        if same and len(self._keys) == len(c.keys):
-            # The contacts of the last step, in the same order (not a step with none
-            # between): each finds its impulse where _keep sorted it.
-            impulse[self._key_order, 0] = self._impulses[:, 0]
-        elif len(self._keys):
-            found = np.searchsorted(self._keys, c.keys).clip(0, len(self._keys) - 1)
-            hit = np.flatnonzero(self._keys.take(found) == c.keys)
-            impulse[hit, 0] = self._impulses[found.take(hit), 0]
-        if not same:
-            virtual_a, virtual_b = c.a.copy(), c.b.copy()
-            virtual_b[n_pairs:] = rows + 1 + np.arange(len(c.b) - n_pairs)  # each wall contact its own body
-            bodies = rows + 1 + len(c.b) - n_pairs
-            if asleep is not None:  # and each contact with a sleeper too: it never moves either
-                for v, real in ((virtual_a, c.a), (virtual_b, c.b)):
-                    on = np.flatnonzero(np.append(asleep, False).take(real))
-                    v[on] = bodies + np.arange(len(on))
-                    bodies += len(on)
-            self._rounds = colour_rounds(virtual_a, virtual_b, bodies, self._bands(c))
-            self._free_rounds = colour_rounds(virtual_a, virtual_b, bodies)
-            self._round_keys = c.keys.copy()
-            self._round_sleepers = sleepers
-            self._key_order = np.argsort(c.keys)
-        if self._layouts is None or self._layouts[0].source is not self._rounds:
-            self._layouts = (_Layout(self._rounds, c.a, c.b), _Layout(self._free_rounds, c.a, c.b))
+        first, later = self._colour(c, last, korder, asleep)
         wa, wb = inv.take(c.a), inv.take(c.b)
 
         # Each per-contact number twice, for the velocity and the pseudo-velocity: (m, 2), so
@@ -360,43 +311,56 @@ class ContactSolver:
 
         nab = both(np.concatenate([c.n * wa, -(c.n * wb)]))
         values = (both(c.n.conjugate()), nab, both(1.0 / (wa + wb)), wa + wb, target, impulse)
-        return self._layouts[0].fill(*values), self._layouts[1].fill(*values)
+        return first.fill(*values), later.fill(*values)
 
-    def _bands(self, c: _Contacts) -> np.ndarray | None:
-        """Priorities bottom-up by bands of height (BAND_RADII radii), scrambled within a band."""
+    def _colour(self, c: _Contacts, last: np.ndarray, korder: np.ndarray, asleep=None) -> tuple[_Layout, _Layout]:
+        """The rounds of this step's contacts (in key order; last: each one's place in the last
+        step's, -1 if new): the kept contacts keep theirs, the new ones are fitted in
+        (colouring.py); and their layouts, laid out again only if they changed."""
+        rows = self._rows
+        # Walls and sleepers never move here: to the colouring they are one body, `rows`, never taken.
+        a, b = c.a.take(korder), c.b.take(korder)
+        if asleep is not None:
+            a, b = np.where(asleep.take(a), rows, a), np.where(np.append(asleep, True).take(b), rows, b)
+        rounds = []
+        for kept, band in ((self._band_rounds, self._bands(c, korder)), (self._free_rounds, None)):
+            r = np.where(last >= 0, kept.take(last.clip(0)), -1) if len(kept) else np.full(len(a), -1)
+            r = colouring.keep(r, a, b, rows)
+            rounds.append(colouring.fit(r, a, b, rows, colouring.priorities(len(a), band), band))
+        self._band_rounds, self._free_rounds = rounds
+        cached = self._layouts
+        if cached is None or not all(np.array_equal(x, y) for x, y in zip(cached, (c.keys, *rounds), strict=False)):
+            layouts = [_Layout(korder.take(np.argsort(r, kind="stable")), np.bincount(r), c.a, c.b) for r in rounds]
+            self._layouts = cached = (c.keys, *rounds, *layouts)
+        return cached[3], cached[4]
+
+    def _bands(self, c: _Contacts, korder: np.ndarray) -> np.ndarray | None:
+        """Each contact's band (key order): its height above the lowest, in BAND_RADII radii."""
         if BAND_RADII <= 0:
             return None
-        y = self._y.take(c.a)
-        band = ((y - y.min()) / (BAND_RADII * self._r_mean)).astype(np.uint64)
-        m = len(y)
-        scramble = (np.arange(m, dtype=np.uint64) * np.uint64(0x9E3779B1)) % np.uint64(1 << 32)
-        return band * np.uint64(1 << 32) + scramble
+        y = self._y.take(c.a.take(korder))
+        return np.minimum((y - y.min()) / (BAND_RADII * self._r_mean), 30_000).astype(np.int16)
 
     def _keep(self, c: _Contacts, layout: _Layout) -> None:
         """Keep this step's impulses by contact key, for the next step's warm start."""
         impulses = layout.impulses()
-        order = self._key_order  # c.keys are _round_keys: sorted once per colouring
+        order = self._key_order
         self._keys, self._impulses = c.keys.take(order), impulses.take(order, axis=0)
 
-    # What the solver keeps from step to step: its impulses by contact (the warm start), and the
-    # rounds it solves in, kept while the contacts stay the same (their order depends on where the
-    # pucks were when they were formed, so they change results). The solver replaces these arrays
-    # each step and never changes them in place, so a save keeps references.
-    KEPT = (
-        "_keys", "_impulses", "_rows", "_round_keys", "_round_sleepers", "_key_order", "_rounds", "_free_rounds",
-        "count", "iterations",
-    )  # fmt: skip
-    ROUND_LISTS = ("_rounds", "_free_rounds")  # lists of arrays, saved as tuples
-    # Worked out afresh in each solve, or from kept values while those are the very same objects
-    # (restored ones are other objects): they change no result, so a save need not keep them.
-    NOT_KEPT = frozenset({"_y", "_r_mean", "_warm", "_layouts", "_wall_rest"})
+    # What the solver keeps from step to step: its impulses by contact (the warm start), and each
+    # contact's rounds (they depend on the contacts it had before, so they change results). The
+    # solver replaces these arrays each step and never changes them in place, so a save keeps references.
+    KEPT = ("_keys", "_impulses", "_rows", "_band_rounds", "_free_rounds", "count", "iterations")
+    # Worked out afresh in each solve (the layouts from the kept rounds, the same in the same order):
+    # they change no result, so a save need not keep them.
+    NOT_KEPT = frozenset({"_y", "_r_mean", "_warm", "_key_order", "_layouts", "_wall_rest"})
 
     def save(self, like: tuple | None = None) -> tuple:
         """The KEPT values (references), for state.py; `like`'s parts where they are the same objects."""
         unknown = set(vars(self)) - set(self.KEPT) - self.NOT_KEPT
         if unknown:
             raise TypeError(f"the contact solver keeps {sorted(unknown)}: ContactSolver.save must learn to save it")
-        kept = [tuple(getattr(self, k)) if k in self.ROUND_LISTS else getattr(self, k) for k in self.KEPT]
+        kept = [getattr(self, k) for k in self.KEPT]
         if like is None:
             return tuple(kept)
         same = [_same_part(a, b) for a, b in zip(kept, like, strict=True)]
@@ -405,9 +369,9 @@ class ContactSolver:
         return tuple(old if s else new for new, old, s in zip(kept, like, same, strict=True))
 
     def restore(self, saved: tuple) -> None:
-        """Back to a save: the same impulses and rounds (the rounds as lists again)."""
+        """Back to a save: the same impulses and rounds."""
         for name, value in zip(self.KEPT, saved, strict=True):
-            setattr(self, name, list(value) if name in self.ROUND_LISTS else value)
+            setattr(self, name, value)
 
 
 def _same_part(a, b) -> bool:
@@ -428,13 +392,13 @@ class _Layout:
     round at every step.
     """
 
-    def __init__(self, rounds: list[np.ndarray], a: np.ndarray, b: np.ndarray) -> None:
-        self.source = rounds  # the colouring laid out (compared by identity: a restored state brings new lists)
-        self.order = order = np.concatenate(rounds)
+    def __init__(self, order: np.ndarray, lengths: np.ndarray, a: np.ndarray, b: np.ndarray) -> None:
+        """order: the contacts round by round; lengths: how many in each round (none empty)."""
+        self.order = order
         m = len(order)
-        self.lengths = [len(r) for r in rounds]
-        ends = np.cumsum(self.lengths)
-        self.starts = ends - self.lengths
+        self.lengths = lengths
+        ends = np.cumsum(lengths)
+        self.starts = ends - lengths
         bounds = list(zip(self.starts.tolist(), ends.tolist(), strict=True))
         # Body a's rows of a round, then body b's, side by side: one gather and one write per round.
         # Rows of [everything about body a; everything about body b], contact by contact.
