@@ -262,6 +262,7 @@ class ContactSolver:
         self.count = len(c.a)
         if self.count == 0:
             self._keys, self._impulses = np.empty(0, dtype=np.int64), np.empty((0, 2))
+            self._band_rounds = self._free_rounds = np.empty(0, dtype=np.intp)
             return False
         self._y, self._r_mean = start[:, 1], float(radius.mean())  # for the bands
         inv = np.append(1.0 / mass, 0.0)  # the walls never move, nor do sleepers
@@ -290,18 +291,25 @@ class ContactSolver:
                 np.minimum(POSITION_FRACTION * np.maximum(-c.gap - SLOP_M, 0.0) / dt, MAX_PUSH_MPS),
             ]
         )
-        self._key_order = korder = np.argsort(c.keys)
-        last = np.full(len(korder), -1)  # each contact's place in the last step's, by key order
-        if len(self._keys):
-            keys = c.keys.take(korder)
-            found = np.searchsorted(self._keys, keys).clip(0, len(self._keys) - 1)
-            hit = np.flatnonzero(self._keys.take(found) == keys)
-            last[hit] = found.take(hit)
         impulse = np.zeros((len(c.keys), 2))  # pseudo-velocities start from nothing each step
-        kept = np.flatnonzero(last >= 0)
-        impulse[korder.take(kept), 0] = self._impulses[last.take(kept), 0]
         self._warm = impulse[:, 0]
-        first, later = self._colour(c, last, korder, asleep)
+        cached = self._layouts
+        if cached is not None and cached.same(c.keys, asleep, self):
+            # The very contacts of the last step, in the same order, the same pucks asleep: the same rounds.
+            self._key_order = cached.key_order
+            impulse[cached.key_order, 0] = self._impulses[:, 0]
+        else:
+            self._key_order = korder = np.argsort(c.keys)
+            last = np.full(len(korder), -1)  # each contact's place in the last step's, by key order
+            if len(self._keys):
+                keys = c.keys.take(korder)
+                found = np.searchsorted(self._keys, keys).clip(0, len(self._keys) - 1)
+                hit = np.flatnonzero(self._keys.take(found) == keys)
+                last[hit] = found.take(hit)
+            kept = np.flatnonzero(last >= 0)
+            impulse[korder.take(kept), 0] = self._impulses[last.take(kept), 0]
+            self._layouts = cached = self._colour(c, last, korder, asleep)
+        first, later = cached.first, cached.later
         wa, wb = inv.take(c.a), inv.take(c.b)
 
         # Each per-contact number twice, for the velocity and the pseudo-velocity: (m, 2), so
@@ -313,7 +321,7 @@ class ContactSolver:
         values = (both(c.n.conjugate()), nab, both(1.0 / (wa + wb)), wa + wb, target, impulse)
         return first.fill(*values), later.fill(*values)
 
-    def _colour(self, c: _Contacts, last: np.ndarray, korder: np.ndarray, asleep=None) -> tuple[_Layout, _Layout]:
+    def _colour(self, c: _Contacts, last: np.ndarray, korder: np.ndarray, asleep=None) -> _Colouring:
         """The rounds of this step's contacts (in key order; last: each one's place in the last
         step's, -1 if new): the kept contacts keep theirs, the new ones are fitted in
         (colouring.py); and their layouts, laid out again only if they changed."""
@@ -327,12 +335,14 @@ class ContactSolver:
             r = np.where(last >= 0, kept.take(last.clip(0)), -1) if len(kept) else np.full(len(a), -1)
             r = colouring.keep(r, a, b, rows)
             rounds.append(colouring.fit(r, a, b, rows, colouring.priorities(len(a), band), band))
-        self._band_rounds, self._free_rounds = rounds
         cached = self._layouts
-        if cached is None or not all(np.array_equal(x, y) for x, y in zip(cached, (c.keys, *rounds), strict=False)):
-            layouts = [_Layout(korder.take(np.argsort(r, kind="stable")), np.bincount(r), c.a, c.b) for r in rounds]
-            self._layouts = cached = (c.keys, *rounds, *layouts)
-        return cached[3], cached[4]
+        asleep = None if asleep is None else asleep.copy()
+        if cached is not None and np.array_equal(cached.keys, c.keys) and cached.has(*rounds):
+            self._band_rounds, self._free_rounds = cached.band, cached.free  # the kept arrays, as `same` asks
+            return _Colouring(c.keys, asleep, korder, cached.band, cached.free, cached.first, cached.later)
+        self._band_rounds, self._free_rounds = rounds
+        first, later = (_Layout(korder.take(np.argsort(r, kind="stable")), np.bincount(r), c.a, c.b) for r in rounds)
+        return _Colouring(c.keys, asleep, korder, *rounds, first, later)
 
     def _bands(self, c: _Contacts, korder: np.ndarray) -> np.ndarray | None:
         """Each contact's band (key order): its height above the lowest, in BAND_RADII radii."""
@@ -381,6 +391,33 @@ def _same_part(a, b) -> bool:
     if isinstance(a, tuple):
         return isinstance(b, tuple) and len(a) == len(b) and all(x is y for x, y in zip(a, b, strict=True))
     return a == b
+
+
+@dataclass
+class _Colouring:
+    """A step's contacts (keys in their order, the sleepers), their rounds and their layouts."""
+
+    keys: np.ndarray
+    asleep: np.ndarray | None
+    key_order: np.ndarray
+    band: np.ndarray
+    free: np.ndarray
+    first: _Layout
+    later: _Layout
+
+    def same(self, keys: np.ndarray, asleep: np.ndarray | None, solver: ContactSolver) -> bool:
+        """Whether these contacts are those of the solver's last step, with the same rounds and sleepers."""
+        if self.band is not solver._band_rounds or self.free is not solver._free_rounds:
+            return False  # a restored state: its rounds may be other ones
+        if len(solver._keys) != len(keys) or not np.array_equal(self.keys, keys):
+            return False
+        return (asleep is None and self.asleep is None) or (
+            asleep is not None and self.asleep is not None and np.array_equal(asleep, self.asleep)
+        )
+
+    def has(self, band: np.ndarray, free: np.ndarray) -> bool:
+        """Whether these are the rounds laid out."""
+        return np.array_equal(self.band, band) and np.array_equal(self.free, free)
 
 
 class _Layout:
