@@ -43,16 +43,21 @@ def priorities(count: int, band: np.ndarray | None = None) -> np.ndarray:
 def keep(rounds: np.ndarray, a: np.ndarray, b: np.ndarray, sink: int) -> np.ndarray:
     """The rounds still valid: -1 for a contact sharing a body other than `sink` with an earlier
     contact of its round (a sleeper woke: it is a body again). rounds: -1 for new contacts."""
+    bodies = sink + 1
+    row = (rounds + 1) * bodies  # row 0: the new contacts
+    size = (int(rounds.max(initial=-1)) + 2) * bodies
+    uses = np.bincount(np.concatenate([row + a, row + b]), minlength=size).reshape(-1, bodies)
+    uses[0] = uses[:, sink] = 0
+    if uses.max() <= 1:
+        return rounds  # the common case, and cheap to tell: no body twice in a round
     old = np.flatnonzero(rounds >= 0)
     codes = np.concatenate([a.take(old), b.take(old)])
     real = np.flatnonzero(codes != sink)
     contact = np.concatenate([old, old]).take(real)
-    codes = rounds.take(contact).astype(np.int64) * (sink + 1) + codes.take(real)
+    codes = rounds.take(contact).astype(np.int64) * bodies + codes.take(real)
     order = np.argsort(codes, kind="stable")
     codes = codes.take(order)
     twice = np.flatnonzero(codes[1:] == codes[:-1])
-    if len(twice) == 0:
-        return rounds
     out = rounds.copy()
     out[contact.take(order).take(twice + 1)] = -1
     return out
@@ -87,10 +92,12 @@ def _taken(rounds, a, b, sink: int, band) -> np.ndarray:
     """(bodies, rounds + room) the band + 1 of each body's contact in each round (0: free)."""
     old = np.flatnonzero(rounds >= 0)
     width = int(rounds.max()) + 1 if len(old) else 0
-    taken = np.zeros((sink + 1, width + 8), dtype=np.int16)
+    width += 8
+    taken = np.zeros((sink + 1, width), dtype=np.int16)
     r, mark = rounds.take(old), band.take(old) + 1
-    taken[a.take(old), r] = mark
-    taken[b.take(old), r] = mark
+    flat = taken.reshape(-1)  # a view: one-dimensional indices are cheaper than pairs of them
+    flat[a.take(old) * width + r] = mark
+    flat[b.take(old) * width + r] = mark
     taken[sink] = 0
     return taken
 

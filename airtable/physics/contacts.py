@@ -167,11 +167,10 @@ class _Round:
     """One round's contacts: views into its _Layout's buffers; targets and impulses as (m, 2) [velocity, position]."""
 
     fab: np.ndarray  # flat indices of body a's velocity and pseudo-velocity (2 a, 2 a + 1), then body b's
-    nc: np.ndarray  # (m, 2) complex conjugate normals, to project velocities
+    knc: np.ndarray  # (m, 2) complex conjugate normals times the effective mass k = 1 / (wa + wb)
     nab: np.ndarray  # (2, m, 2) complex: the velocity change of body a per unit impulse, and minus body b's
-    k: np.ndarray  # (m, 2) effective mass 1 / (wa + wb)
-    change: np.ndarray  # (m, 2) the last iteration's change of impulse
-    target: np.ndarray  # (m, 2): least relative normal velocity, and pseudo-velocity
+    kt: np.ndarray  # (m, 2) k times the target: least relative normal velocity, and pseudo-velocity
+    change: np.ndarray  # (m, 2) minus the last iteration's change of impulse
     impulse: np.ndarray  # (m, 2) accumulated, >= 0
 
 
@@ -318,7 +317,8 @@ class ContactSolver:
             return np.repeat(x[:, None], 2, axis=1)
 
         nab = both(np.concatenate([c.n * wa, -(c.n * wb)]))
-        values = (both(c.n.conjugate()), nab, both(1.0 / (wa + wb)), wa + wb, target, impulse)
+        k = 1.0 / (wa + wb)
+        values = (both(c.n.conjugate() * k), nab, target * both(k), wa + wb, impulse)
         return first.fill(*values), later.fill(*values)
 
     def _colour(self, c: _Contacts, last: np.ndarray, korder: np.ndarray, asleep=None) -> _Colouring:
@@ -341,7 +341,11 @@ class ContactSolver:
             self._band_rounds, self._free_rounds = cached.band, cached.free  # the kept arrays, as `same` asks
             return _Colouring(c.keys, asleep, korder, cached.band, cached.free, cached.first, cached.later)
         self._band_rounds, self._free_rounds = rounds
-        first, later = (_Layout(korder.take(np.argsort(r, kind="stable")), np.bincount(r), c.a, c.b) for r in rounds)
+        # In (round, key) order: rounds are few, so a stable sort of them as 16-bit numbers is a quick radix sort.
+        first, later = (
+            _Layout(korder.take(np.argsort(r.astype(np.int16), kind="stable")), np.bincount(r), c.a, c.b)
+            for r in rounds
+        )
         return _Colouring(c.keys, asleep, korder, *rounds, first, later)
 
     def _bands(self, c: _Contacts, korder: np.ndarray) -> np.ndarray | None:
@@ -438,26 +442,31 @@ class _Layout:
         self.starts = ends - lengths
         bounds = list(zip(self.starts.tolist(), ends.tolist(), strict=True))
         # Body a's rows of a round, then body b's, side by side: one gather and one write per round.
-        # Rows of [everything about body a; everything about body b], contact by contact.
-        self.ab_rows = np.concatenate([x for s, e in bounds for x in (order[s:e], m + order[s:e])])
+        # Rows of [everything about body a; everything about body b], contact by contact: the place
+        # p of a round starting at s and ending at e has its a row at p + s and its b row at p + e.
+        place = np.arange(m)
+        at_a, at_b = place + np.repeat(self.starts, lengths), place + np.repeat(ends, lengths)
+        self.ab_rows = np.empty(2 * m, dtype=np.intp)
+        self.ab_rows[at_a], self.ab_rows[at_b] = order, m + order
         both = np.arange(2)
         fab = np.concatenate([2 * a[:, None] + both, 2 * b[:, None] + both]).take(self.ab_rows, axis=0)
-        self.nc, self.nab = np.empty((m, 2), dtype=complex), np.empty((2 * m, 2), dtype=complex)
-        self.k, self.target, self.impulse = np.empty((m, 2)), np.empty((m, 2)), np.empty((m, 2))
+        self.knc, self.nab = np.empty((m, 2), dtype=complex), np.empty((2 * m, 2), dtype=complex)
+        self.kt, self.impulse = np.empty((m, 2)), np.empty((m, 2))
         # Every round's last change of impulse, to find the largest once per iteration, and per
         # contact its round's largest wa + wb, which turns a change of impulse into one of speed.
         # (m, 2), both columns alike: an (m, 1) array broadcast against (m, 2) costs twice as much.
         self.changes, self.w_max = np.zeros((m, 2)), np.empty((m, 2))
         self.rounds = [
-            _Round(fab[2 * s : 2 * e].ravel(), self.nc[s:e], self.nab[2 * s : 2 * e].reshape(2, e - s, 2),
-                   self.k[s:e], self.changes[s:e], self.target[s:e], self.impulse[s:e])
+            _Round(fab[2 * s : 2 * e].ravel(), self.knc[s:e], self.nab[2 * s : 2 * e].reshape(2, e - s, 2),
+                   self.kt[s:e], self.changes[s:e], self.impulse[s:e])
             for s, e in bounds
         ]  # fmt: skip
-        self._impulses = [g.impulse for g in self.rounds]
-        # For a change of every impulse at once (push): the flat rows of both bodies, and which
-        # contact (in this layout's order) each of nab's rows belongs to.
-        self.fab = fab.ravel()
-        self.ab_contact = np.concatenate([x for s, e in bounds for x in (np.arange(s, e), np.arange(s, e))])
+        # For a change of every impulse at once (push): where each real and imaginary part of nab's
+        # rows goes among the velocities' (seen as real numbers), and which contact (in this
+        # layout's order) each of nab's rows belongs to.
+        self.fab_parts = (2 * fab.reshape(-1, 1) + both).ravel()
+        self.ab_contact = np.empty(2 * m, dtype=np.intp)
+        self.ab_contact[at_a], self.ab_contact[at_b] = place, place
 
     def converged(self) -> bool:
         """Whether the last iteration changed no speed by CONVERGED_MPS (a change of impulse times w_max).
@@ -473,38 +482,25 @@ class _Layout:
     def impulses(self) -> np.ndarray:
         """(contacts, 2) the rounds' impulses so far, contact by contact."""
         out = np.empty((len(self.order), 2))
-        out[self.order] = np.concatenate([g.impulse for g in self.rounds])
+        out[self.order] = self.impulse
         return out
-
-    def current(self) -> np.ndarray:
-        """(contacts, 2) the rounds' impulses so far, in this layout's order."""
-        return np.concatenate([g.impulse for g in self.rounds])
 
     def push(self, flat: np.ndarray, impulses: np.ndarray) -> None:
         """Set the impulses (this layout's order) and change the velocities in `flat` to match."""
-        change = (impulses - self.current()).take(self.ab_contact, axis=0) * self.nab
-        size = len(flat)
-        flat += np.bincount(self.fab, change.real.ravel(), size) + 1j * np.bincount(self.fab, change.imag.ravel(), size)
+        change = (impulses - self.impulse).take(self.ab_contact, axis=0) * self.nab
+        parts = flat.view(np.float64)  # (one bincount for both parts instead of two)
+        parts += np.bincount(self.fab_parts, change.view(np.float64).ravel(), len(parts))
         self.impulse[:] = impulses
-        for g, view in zip(self.rounds, self._impulses, strict=True):
-            g.impulse = view
 
-    def take_impulses(self, impulses: np.ndarray) -> None:
-        """Start the rounds from these impulses (contact by contact)."""
-        np.take(impulses, self.order, axis=0, out=self.impulse, mode="clip")
-        for g, view in zip(self.rounds, self._impulses, strict=True):
-            g.impulse = view  # the iterations rebind it to each new value
-
-    def fill(self, nc, nab, k, w_sum, target, impulse) -> _Layout:
+    def fill(self, knc, nab, kt, w_sum, impulse) -> _Layout:
         """This step's values (contact by contact; nab: body a's rows, then body b's) into the rounds."""
         order = self.order
-        np.take(nc, order, axis=0, out=self.nc, mode="clip")  # "clip": no bounds check, no buffering
+        np.take(knc, order, axis=0, out=self.knc, mode="clip")  # "clip": no bounds check, no buffering
         np.take(nab, self.ab_rows, axis=0, out=self.nab, mode="clip")
-        np.take(k, order, axis=0, out=self.k, mode="clip")
-        np.take(target, order, axis=0, out=self.target, mode="clip")
+        np.take(kt, order, axis=0, out=self.kt, mode="clip")
         self.w_max[:] = np.repeat(np.maximum.reduceat(w_sum.take(order), self.starts), self.lengths)[:, None]
         self.w_min = float(self.w_max.min())
-        self.take_impulses(impulse)
+        np.take(impulse, order, axis=0, out=self.impulse, mode="clip")
         return self
 
 
@@ -540,15 +536,15 @@ def _iterate(w: np.ndarray, first: _Layout, later: _Layout) -> tuple[int, _Layou
     _sweep(flat, first)
     if first.converged():
         return 1, first
-    later.take_impulses(first.impulses())
+    np.take(first.impulses(), later.order, axis=0, out=later.impulse, mode="clip")
     direction, last_gg = None, None
     iterations = max(ITERATIONS, min(MAX_ITERATIONS, ITERATION_WORK // len(later.order)))
     for it in range(2, iterations + 1):
-        before = later.current()
+        before = later.impulse.copy()
         _sweep(flat, later)
         if later.converged() or it == iterations:
             return it, later  # (the last word is a sweep's, never an extrapolation)
-        after = later.current()
+        after = later.impulse
         gradient = before - after
         gg = np.einsum("ij,ij->j", gradient, gradient)
         if direction is None:
@@ -567,13 +563,13 @@ def _sweep(flat: np.ndarray, layout: _Layout) -> None:
     Velocities as one row of numbers (1-D fancy indexing is several times
     cheaper than 2-D). No body appears twice in a round, so each writes back
     what it read plus its change; the walls' row takes many writes, all the
-    same (wb = 0).
+    same (wb = 0). A contact's impulse changes by k (target - vn), but stays
+    at least 0: by max(k (target - vn), -impulse), here taken as minus the
+    least of k vn - k target and the impulse (the fewest numpy calls).
     """
     for g in layout.rounds:
         v = flat.take(g.fab).reshape(2, -1, 2)  # body a's rows, then body b's
-        vn = (g.nc * (v[0] - v[1])).real
-        new = np.maximum(g.impulse + g.k * (g.target - vn), 0.0)
-        np.subtract(new, g.impulse, out=g.change)
-        g.impulse = new
-        v += g.change * g.nab
+        np.minimum((g.knc * (v[0] - v[1])).real - g.kt, g.impulse, out=g.change)
+        g.impulse -= g.change
+        v -= g.change * g.nab
         flat[g.fab] = v.reshape(-1)
