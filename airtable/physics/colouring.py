@@ -76,7 +76,7 @@ def fit(rounds: np.ndarray, a: np.ndarray, b: np.ndarray, sink: int, prio: np.nd
         return _dense(rounds)
     band = np.zeros(len(rounds), dtype=np.int16) if band is None else band
     rounds = rounds.copy()
-    taken = _taken(rounds, a, b, sink, band)
+    taken = _taken(rounds, a, b, sink, band, new)
     while len(new):
         pick = _first_by_priority(new, a, b, sink, prio)
         k = new.take(np.flatnonzero(pick))
@@ -88,11 +88,14 @@ def fit(rounds: np.ndarray, a: np.ndarray, b: np.ndarray, sink: int, prio: np.nd
     return _dense(rounds)
 
 
-def _taken(rounds, a, b, sink: int, band) -> np.ndarray:
-    """(bodies, rounds + room) the band + 1 of each body's contact in each round (0: free)."""
-    old = np.flatnonzero(rounds >= 0)
-    width = int(rounds.max()) + 1 if len(old) else 0
-    width += 8
+def _taken(rounds, a, b, sink: int, band, new: np.ndarray) -> np.ndarray:
+    """(bodies, rounds + room) the band + 1 of each body's contact in each round (0: free), for
+    the bodies of the `new` contacts (the others are not asked about)."""
+    asked = np.zeros(sink + 1, dtype=bool)
+    asked[a.take(new)] = asked[b.take(new)] = True
+    asked[sink] = False
+    old = np.flatnonzero((asked.take(a) | asked.take(b)) & (rounds >= 0))
+    width = int(rounds.max()) + 9  # room for 8 more rounds, and more if they fill (_first_free)
     taken = np.zeros((sink + 1, width), dtype=np.int16)
     r, mark = rounds.take(old), band.take(old) + 1
     flat = taken.reshape(-1)  # a view: one-dimensional indices are cheaper than pairs of them
