@@ -166,7 +166,7 @@ def _wall_contacts(pos, vel, radius, size_m, rest, margin) -> _Contacts:
 class _Round:
     """One round's contacts: views into its _Layout's buffers; targets and impulses as (m, 2) [velocity, position]."""
 
-    fab: np.ndarray  # flat indices of body a's velocity and pseudo-velocity (2 a, 2 a + 1), then body b's
+    fab: np.ndarray  # (2, m, 2) flat indices of body a's velocity and pseudo-velocity (2 a, 2 a + 1), then b's
     knc: np.ndarray  # (m, 2) complex conjugate normals times the effective mass k = 1 / (wa + wb)
     nab: np.ndarray  # (2, m, 2) complex: the velocity change of body a per unit impulse, and minus body b's
     kt: np.ndarray  # (m, 2) k times the target: least relative normal velocity, and pseudo-velocity
@@ -284,11 +284,9 @@ class ContactSolver:
         filled into the layouts of the rounds of the first iteration and of the later ones."""
         # The gaps where the step began: the velocity bound keeps a pair from closing more
         # than its gap, and the pseudo-velocity pushes out a share of its overlap.
-        target = np.column_stack(
-            [
-                -np.maximum(c.gap, 0.0) / dt,
-                np.minimum(POSITION_FRACTION * np.maximum(-c.gap - SLOP_M, 0.0) / dt, MAX_PUSH_MPS),
-            ]
+        target = columns(
+            -np.maximum(c.gap, 0.0) / dt,
+            np.minimum(POSITION_FRACTION * np.maximum(-c.gap - SLOP_M, 0.0) / dt, MAX_PUSH_MPS),
         )
         impulse = np.zeros((len(c.keys), 2))  # pseudo-velocities start from nothing each step
         self._warm = impulse[:, 0]
@@ -454,7 +452,7 @@ class _Layout:
         # (m, 2), both columns alike: an (m, 1) array broadcast against (m, 2) costs twice as much.
         self.changes, self.w_max = np.zeros((m, 2)), np.empty((m, 2))
         self.rounds = [
-            _Round(fab[2 * s : 2 * e].ravel(), self.knc[s:e], self.nab[2 * s : 2 * e].reshape(2, e - s, 2),
+            _Round(fab[2 * s : 2 * e].reshape(2, e - s, 2), self.knc[s:e], self.nab[2 * s : 2 * e].reshape(2, e - s, 2),
                    self.kt[s:e], self.changes[s:e], self.impulse[s:e])
             for s, e in bounds
         ]  # fmt: skip
@@ -578,8 +576,8 @@ def _sweep(flat: np.ndarray, layout: _Layout) -> None:
     least of k vn - k target and the impulse (the fewest numpy calls).
     """
     for g in layout.rounds:
-        v = flat.take(g.fab).reshape(2, -1, 2)  # body a's rows, then body b's
+        v = flat.take(g.fab)  # (2, m, 2): body a's rows, then body b's
         np.minimum((g.knc * (v[0] - v[1])).real - g.kt, g.impulse, out=g.change)
         g.impulse -= g.change
         v -= g.change * g.nab
-        flat[g.fab] = v.reshape(-1)
+        flat[g.fab] = v
