@@ -63,10 +63,10 @@ def keep(rounds: np.ndarray, a: np.ndarray, b: np.ndarray, sink: int) -> np.ndar
     return out
 
 
-def fit(rounds: np.ndarray, a: np.ndarray, b: np.ndarray, sink: int, prio: np.ndarray, band=None) -> np.ndarray:
+def fit(rounds: np.ndarray, a: np.ndarray, b: np.ndarray, sink: int, band=None) -> np.ndarray:
     """Rounds for every contact: the kept ones (rounds >= 0) stay, the new ones (-1) are fitted in.
 
-    The new contacts are taken in passes: in each, those first by `prio` (lowest first)
+    The new contacts are taken in passes: in each, those first by `priorities` (lowest first)
     among the remaining new contacts of both their bodies, which share no body, each take the
     first round free at both their bodies and after every round where one of them has a
     contact of a lower `band` (None: all in one band). Empty rounds are dropped.
@@ -74,6 +74,7 @@ def fit(rounds: np.ndarray, a: np.ndarray, b: np.ndarray, sink: int, prio: np.nd
     new = np.flatnonzero(rounds < 0)
     if len(new) == 0:
         return _dense(rounds)
+    prio = priorities(len(rounds), band)
     band = np.zeros(len(rounds), dtype=np.int16) if band is None else band
     rounds = rounds.copy()
     taken = _taken(rounds, a, b, sink, band, new)

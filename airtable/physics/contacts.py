@@ -325,11 +325,12 @@ class ContactSolver:
         a, b = c.a.take(korder), c.b.take(korder)
         if asleep is not None:
             a, b = np.where(asleep.take(a), rows, a), np.where(np.append(asleep, True).take(b), rows, b)
-        rounds = []
-        for kept, band in ((self._band_rounds, self._bands(c, korder)), (self._free_rounds, None)):
-            r = np.where(last >= 0, kept.take(last.clip(0)), -1) if len(kept) else np.full(len(a), -1)
+        rounds, kept, at = [], last >= 0, last.clip(0)
+        for banded, before in ((True, self._band_rounds), (False, self._free_rounds)):
+            r = np.where(kept, before.take(at), -1) if len(before) else np.full(len(a), -1)
             r = colouring.keep(r, a, b, rows)
-            rounds.append(colouring.fit(r, a, b, rows, colouring.priorities(len(a), band), band))
+            band = self._bands(c, korder) if banded and (r < 0).any() else None  # (asked only for new ones)
+            rounds.append(colouring.fit(r, a, b, rows, band))
         cached = self._layouts
         asleep = None if asleep is None else asleep.copy()
         if cached is not None and np.array_equal(cached.keys, c.keys) and cached.has(*rounds):
@@ -545,12 +546,11 @@ def _iterate(w: np.ndarray, first: _Layout, later: _Layout) -> tuple[int, _Layou
     direction, last_gg = None, None
     iterations = max(ITERATIONS, min(MAX_ITERATIONS, ITERATION_WORK // len(later.order)))
     for it in range(2, iterations + 1):
-        before = later.impulse.copy()
         _sweep(flat, later)
         if later.converged() or it == iterations:
             return it, later  # (the last word is a sweep's, never an extrapolation)
         after = later.impulse
-        gradient = before - after
+        gradient = later.changes  # the sweep's impulses before it, less after it (each contact changes once)
         # Per column (velocity, position): numpy broadcasts a pair along rows of two several times slower.
         gg = np.array([gradient[:, 0] @ gradient[:, 0], gradient[:, 1] @ gradient[:, 1]])
         if direction is None:
