@@ -29,7 +29,8 @@ iterations and clamped at zero (contacts push, never pull); a contact's
 impulse from the last step is applied first ("warm starting"), so a pile at
 rest starts from the answer. The contacts are coloured into rounds in which
 no puck appears twice, so each round is one numpy operation and still the
-exact sequential result. The iterations after the first are sped up as
+exact sequential result; a contact keeps its round while it lasts, and new
+ones are fitted in (colouring.py), as Box2D v3 keeps a contact's colour. The iterations after the first are sped up as
 conjugate gradients speed up plain ones (_iterate), and a small group of
 contacts gets as many as ITERATION_WORK pays for: a stack landing settles
 within its step.
@@ -72,12 +73,13 @@ SOLVER = "gs"
 OMEGA = 1.0
 CONVERGED_MPS = 1e-7
 # The first iteration's rounds go bottom-up by horizontal bands this many
-# radii high (random inside a band): support from the floor then travels up a
-# pile within one iteration. The later iterations only refine that answer and
-# take the fewer rounds of a colouring in no order (about 15 against 38 on an
-# 800-puck pile, each round costing numpy's fixed price). Bands of one contact each would be exact Gauss-Seidel from the
-# bottom but need a round per contact of the tallest stack; random order
-# alone is as cheap as these bands, and a 300-puck pile then keeps 3x the jitter.
+# radii high (a contact after its pucks' contacts of lower bands): support from
+# the floor then travels up a pile within one iteration. The later iterations
+# only refine that answer and take the fewer rounds of a colouring in no order
+# (9 against 15 on an 800-puck pile settling, each round costing numpy's fixed
+# price). Bands of one contact each would be exact Gauss-Seidel from the bottom
+# but need a round per contact of the tallest stack; random order alone is as
+# cheap as these bands, and a 300-puck pile then keeps 3x the jitter.
 BAND_RADII = 8.0
 # Contacts are the pairs closer than their reach plus this (m), plus as far
 # as this stage may move a puck in the step: a contact left out here is one
@@ -187,7 +189,7 @@ class ContactSolver:
         self._band_rounds = np.empty(0, dtype=np.intp)
         self._free_rounds = np.empty(0, dtype=np.intp)
         self._key_order = np.empty(0, dtype=np.intp)  # this step's contacts in key order
-        self._layouts: tuple | None = None  # (keys, band rounds, free rounds, first _Layout, later _Layout)
+        self._layouts: _Colouring | None = None  # the last step's contacts, rounds and their layouts
         self._wall_rest: tuple | None = None  # (rest, _impulses, answer) of the last wall_rest
         self.count = 0  # contacts in the last step
         self.iterations = 0  # iterations the last step needed
