@@ -30,10 +30,10 @@ impulse from the last step is applied first ("warm starting"), so a pile at
 rest starts from the answer. The contacts are coloured into rounds in which
 no puck appears twice, so each round is one numpy operation and still the
 exact sequential result; a contact keeps its round while it lasts, and new
-ones are fitted in (colouring.py), as Box2D v3 keeps a contact's colour. The iterations after the first are sped up as
-conjugate gradients speed up plain ones (_iterate), and a small group of
-contacts gets as many as ITERATION_WORK pays for: a stack landing settles
-within its step.
+ones are fitted in (colouring.py), as Box2D v3 keeps a contact's colour. The
+iterations after the first are sped up as conjugate gradients speed up plain
+ones (_iterate), and a small group of contacts gets as many as ITERATION_WORK
+pays for: a stack landing settles within its step.
 
 Order of the step: positions have already moved with the velocities when
 this stage runs, so a velocity change dv also moves the puck by dv dt: the
