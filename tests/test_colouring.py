@@ -79,6 +79,28 @@ def test_kept_contacts_keep_their_rounds_and_new_ones_fit_in(graph, data) -> Non
             assert (again[i] < again[j]) == (rounds[i] < rounds[j])
 
 
+@settings(max_examples=200, deadline=None)
+@given(contact_graphs(), st.data())
+def test_contacts_whose_pucks_changed_band_are_put_back_in_order(graph, data) -> None:
+    a, b, band = graph
+    rounds = colouring.fit(np.full(len(a), -1), a, b, SINK, band)
+    moved = np.array(data.draw(st.lists(st.integers(0, 3), min_size=len(a), max_size=len(a))), dtype=np.int16)
+    checked = colouring.keep_order(rounds, a, b, SINK, moved)
+    late = np.flatnonzero(checked < 0)
+    for k in range(len(a)):  # out of order: some contact of a lower band on one of its bodies is not before it
+        share = ((a == a[k]) | (b == a[k]) | ((a == b[k]) | (b == b[k])) & (b[k] != SINK)) & (moved < moved[k])
+        assert (k in late) == bool(np.any(rounds[share] >= rounds[k]))
+    assert np.all(checked[checked >= 0] == rounds[checked >= 0])
+    checked = colouring.fit(checked, a, b, SINK, moved)
+    for _ in range(len(a) + 1):  # fitted in again until in order (each pass puts at least one in place)
+        again = colouring.keep_order(checked, a, b, SINK, moved)
+        if again is checked:
+            break
+        checked = colouring.fit(again, a, b, SINK, moved)
+    _assert_valid(checked, a, b)
+    assert colouring.keep_order(checked, a, b, SINK, moved) is checked
+
+
 def test_a_woken_body_splits_a_round_it_appeared_twice_in() -> None:
     # Contacts 0 and 1 share body 5, which slept (the sink stood for it): in one round then. Awake,
     # it is a body again: keep() sends the later contact back to be fitted in.

@@ -63,6 +63,33 @@ def keep(rounds: np.ndarray, a: np.ndarray, b: np.ndarray, sink: int) -> np.ndar
     return out
 
 
+def keep_order(rounds: np.ndarray, a: np.ndarray, b: np.ndarray, sink: int, band: np.ndarray) -> np.ndarray:
+    """The rounds still in band order: -1 for a kept contact not after every round where one of its
+    bodies has a contact of a lower band (its pucks moved to other bands since it was fitted in)."""
+    old = np.flatnonzero(rounds >= 0)
+    body = np.concatenate([a.take(old), b.take(old)])
+    real = np.flatnonzero(body != sink)
+    contact = np.concatenate([old, old]).take(real)
+    body, level, r = body.take(real), band.take(contact).astype(np.int64), rounds.take(contact)
+    order = np.argsort(body * (int(band.max()) + 1) + level)  # by body, then band
+    body, level, r, contact = body.take(order), level.take(order), r.take(order), contact.take(order)
+    # The latest round so far among each body's contacts by band (offset by body: none carries over).
+    width = int(rounds.max()) + 2
+    latest = np.maximum.accumulate(body * width + r)
+    place = np.arange(len(body))
+    starts = np.ones(len(body), dtype=bool)
+    starts[1:] = (body[1:] != body[:-1]) | (level[1:] != level[:-1])
+    first = np.maximum.accumulate(np.where(starts, place, 0))  # where each (body, band) group begins
+    before = (first - 1).clip(0)
+    lower = np.where((first > 0) & (body.take(before) == body), latest.take(before) - body * width, -1)
+    late = contact.take(np.flatnonzero(lower >= r))
+    if len(late) == 0:
+        return rounds
+    out = rounds.copy()
+    out[late] = -1
+    return out
+
+
 def fit(rounds: np.ndarray, a: np.ndarray, b: np.ndarray, sink: int, band=None) -> np.ndarray:
     """Rounds for every contact: the kept ones (rounds >= 0) stay, the new ones (-1) are fitted in.
 

@@ -81,6 +81,10 @@ CONVERGED_MPS = 1e-7
 # but need a round per contact of the tallest stack; random order alone is as
 # cheap as these bands, and a 300-puck pile then keeps 3x the jitter.
 BAND_RADII = 8.0
+# Each step its contacts change, the band rounds are checked for order (a contact after its pucks'
+# contacts of lower bands: pucks move between bands) and the ones out of order fitted in again, up
+# to this many times (each refitted contact may put one above it out of order; the rest wait).
+BAND_PASSES = 3
 # Contacts are the pairs closer than their reach plus this (m), plus as far
 # as this stage may move a puck in the step: a contact left out here is one
 # the stage can push a puck into (it is speculative: a gap may close, not more).
@@ -328,12 +332,18 @@ class ContactSolver:
         a, b = c.a.take(korder), c.b.take(korder)
         if asleep is not None:
             a, b = np.where(asleep.take(a), rows, a), np.where(np.append(asleep, True).take(b), rows, b)
-        rounds, kept, at = [], last >= 0, last.clip(0)
-        for banded, before in ((True, self._band_rounds), (False, self._free_rounds)):
+        kept, at = last >= 0, last.clip(0)
+        band = self._bands(c, korder)
+        rounds = []
+        for before, level in ((self._band_rounds, band), (self._free_rounds, None)):
             r = np.where(kept, before.take(at), -1) if len(before) else np.full(len(a), -1)
-            r = colouring.keep(r, a, b, rows)
-            band = self._bands(c, korder) if banded and (r < 0).any() else None  # (asked only for new ones)
-            rounds.append(colouring.fit(r, a, b, rows, band))
+            r = colouring.fit(colouring.keep(r, a, b, rows), a, b, rows, level)
+            for _ in range(BAND_PASSES if level is not None else 0):  # refitted ones may leave others out of order
+                again = colouring.keep_order(r, a, b, rows, level)
+                if again is r:
+                    break
+                r = colouring.fit(again, a, b, rows, level)
+            rounds.append(r)
         cached = self._layouts
         asleep = None if asleep is None else asleep.copy()
         if cached is not None and np.array_equal(cached.keys, c.keys) and cached.has(*rounds):
