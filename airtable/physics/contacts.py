@@ -76,7 +76,7 @@ CONVERGED_MPS = 1e-7
 # radii high (a contact after its pucks' contacts of lower bands): support from
 # the floor then travels up a pile within one iteration. The later iterations
 # only refine that answer and take the fewer rounds of a colouring in no order
-# (9 against 15 on an 800-puck pile settling, each round costing numpy's fixed
+# (9 against about 19 on an 800-puck pile settling, each round costing numpy's fixed
 # price). Bands of one contact each would be exact Gauss-Seidel from the bottom
 # but need a round per contact of the tallest stack; random order alone is as
 # cheap as these bands, and a 300-puck pile then keeps 3x the jitter.
