@@ -83,7 +83,7 @@ def test_the_stage_solves_the_contact_problem(monkeypatch) -> None:
 
     p, v = pos.copy(), vel.copy()
     assert solver.solve(p, v, radius, mass, size, candidates, rest, dt)
-    assert len(solver._free_rounds) < len(c.a)  # contacts were solved several to a round
+    assert solver._free_rounds.max() + 1 < len(c.a)  # contacts were solved several to a round
     assert solver.iterations < 100  # converged (plain sequential impulses are 0.2 mm/s off after 100 sweeps)
     w = _sequential(c, vel, mass, dt)
 

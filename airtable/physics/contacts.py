@@ -29,10 +29,11 @@ iterations and clamped at zero (contacts push, never pull); a contact's
 impulse from the last step is applied first ("warm starting"), so a pile at
 rest starts from the answer. The contacts are coloured into rounds in which
 no puck appears twice, so each round is one numpy operation and still the
-exact sequential result. The iterations after the first are sped up as
-conjugate gradients speed up plain ones (_iterate), and a small group of
-contacts gets as many as ITERATION_WORK pays for: a stack landing settles
-within its step.
+exact sequential result; a contact keeps its round while it lasts, and new
+ones are fitted in (colouring.py), as Box2D v3 keeps a contact's colour. The
+iterations after the first are sped up as conjugate gradients speed up plain
+ones (_iterate), and a small group of contacts gets as many as ITERATION_WORK
+pays for: a stack landing settles within its step.
 
 Order of the step: positions have already moved with the velocities when
 this stage runs, so a velocity change dv also moves the puck by dv dt: the
@@ -52,10 +53,11 @@ at the gap it had if it approached.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import NamedTuple
 
 import numpy as np
 
-from airtable.physics import vectors
+from airtable.physics import colouring, vectors
 
 # Iterations over all contacts per step (Box2D and pymunk use about ten);
 # the loop stops early once an iteration changes no velocity by CONVERGED_MPS.
@@ -71,13 +73,18 @@ SOLVER = "gs"
 OMEGA = 1.0
 CONVERGED_MPS = 1e-7
 # The first iteration's rounds go bottom-up by horizontal bands this many
-# radii high (random inside a band): support from the floor then travels up a
-# pile within one iteration. The later iterations only refine that answer and
-# take the fewer rounds of a colouring in no order (about 15 against 38 on an
-# 800-puck pile, each round costing numpy's fixed price). Bands of one contact each would be exact Gauss-Seidel from the
-# bottom but need a round per contact of the tallest stack; random order
-# alone is as cheap as these bands, and a 300-puck pile then keeps 3x the jitter.
+# radii high (a contact after its pucks' contacts of lower bands): support from
+# the floor then travels up a pile within one iteration. The later iterations
+# only refine that answer and take the fewer rounds of a colouring in no order
+# (9 against about 19 on an 800-puck pile settling, each round costing numpy's fixed
+# price). Bands of one contact each would be exact Gauss-Seidel from the bottom
+# but need a round per contact of the tallest stack; random order alone is as
+# cheap as these bands, and a 300-puck pile then keeps 3x the jitter.
 BAND_RADII = 8.0
+# Each step its contacts change, the band rounds are checked for order (a contact after its pucks'
+# contacts of lower bands: pucks move between bands) and the ones out of order fitted in again, up
+# to this many times (each refitted contact may put one above it out of order; the rest wait).
+BAND_PASSES = 3
 # Contacts are the pairs closer than their reach plus this (m), plus as far
 # as this stage may move a puck in the step: a contact left out here is one
 # the stage can push a puck into (it is speculative: a gap may close, not more).
@@ -106,11 +113,6 @@ def rest_for_restitution(rest: np.ndarray, cr: float) -> np.ndarray:
     if cr <= 0.0:
         return np.where(rest > 0.0, np.inf, 0.0)
     return rest / cr
-
-
-def _same_rows(a: np.ndarray | None, b: np.ndarray | None) -> bool:
-    """Whether two optional row arrays are equal (None only equals None)."""
-    return (a is None and b is None) or (a is not None and b is not None and np.array_equal(a, b))
 
 
 @dataclass
@@ -167,41 +169,15 @@ def _wall_contacts(pos, vel, radius, size_m, rest, margin) -> _Contacts:
     return _Contacts(a, b, WALL_NORMALS.take(w), np.concatenate(gap), np.concatenate(vn), keys)
 
 
-def colour_rounds(a: np.ndarray, b: np.ndarray, n_bodies: int, prio: np.ndarray | None = None) -> list[np.ndarray]:
-    """Split contacts (a, b) into rounds in which no body appears twice.
+class _Round(NamedTuple):
+    """One round's contacts: views into its _Layout's buffers; targets and impulses as (m, 2) [velocity, position].
+    (A tuple: quicker to make and to unpack in each sweep than an object's fields to look up.)"""
 
-    Vectorised: in each pass, a contact joins the round if it has the
-    highest priority (the lowest number in `prio`) among the remaining
-    contacts of both its bodies. By default the priorities are a fixed
-    scramble of the contact numbers, so that a row of contacts in index
-    order does not go one per round.
-    """
-    m = len(a)
-    if prio is None:
-        prio = (np.arange(m, dtype=np.uint64) * np.uint64(0x9E3779B1)) % np.uint64(1 << 32)
-    remaining = np.arange(m)
-    rounds = []
-    while len(remaining):
-        p, ra, rb = prio.take(remaining), a.take(remaining), b.take(remaining)
-        best = np.full(n_bodies, np.iinfo(np.uint64).max, dtype=np.uint64)
-        np.minimum.at(best, ra, p)
-        np.minimum.at(best, rb, p)
-        pick = (best.take(ra) == p) & (best.take(rb) == p)
-        rounds.append(remaining[pick])
-        remaining = remaining[~pick]
-    return rounds
-
-
-@dataclass
-class _Round:
-    """One round's contacts: views into its _Layout's buffers; targets and impulses as (m, 2) [velocity, position]."""
-
-    fab: np.ndarray  # flat indices of body a's velocity and pseudo-velocity (2 a, 2 a + 1), then body b's
-    nc: np.ndarray  # (m, 2) complex conjugate normals, to project velocities
+    fab: np.ndarray  # (2, m, 2) flat indices of body a's velocity and pseudo-velocity (2 a, 2 a + 1), then b's
+    knc: np.ndarray  # (m, 2) complex conjugate normals times the effective mass k = 1 / (wa + wb)
     nab: np.ndarray  # (2, m, 2) complex: the velocity change of body a per unit impulse, and minus body b's
-    k: np.ndarray  # (m, 2) effective mass 1 / (wa + wb)
-    change: np.ndarray  # (m, 2) the last iteration's change of impulse
-    target: np.ndarray  # (m, 2): least relative normal velocity, and pseudo-velocity
+    kt: np.ndarray  # (m, 2) k times the target: least relative normal velocity, and pseudo-velocity
+    change: np.ndarray  # (m, 2) minus the last iteration's change of impulse
     impulse: np.ndarray  # (m, 2) accumulated, >= 0
 
 
@@ -212,12 +188,12 @@ class ContactSolver:
         self._keys = np.empty(0, dtype=np.int64)  # sorted
         self._impulses = np.empty((0, 2))
         self._rows = -1
-        self._round_keys: np.ndarray | None = None  # the contacts the rounds are for, in their order
-        self._round_sleepers: np.ndarray | None = None  # and the sleepers they were coloured with
-        self._key_order = np.empty(0, dtype=np.intp)  # argsort of _round_keys
-        self._rounds: list[np.ndarray] = []  # bottom-up by bands: the first iteration
-        self._free_rounds: list[np.ndarray] = []  # fewer rounds, in no order: the later iterations
-        self._layouts: tuple[_Layout, _Layout] | None = None  # of _rounds and _free_rounds, while they stay
+        # Each contact's round (colouring.py), by _keys: bottom-up by bands for the first
+        # iteration, and in no order (fewer rounds) for the later ones.
+        self._band_rounds = np.empty(0, dtype=np.intp)
+        self._free_rounds = np.empty(0, dtype=np.intp)
+        self._key_order = np.empty(0, dtype=np.intp)  # this step's contacts in key order
+        self._layouts: _Colouring | None = None  # the last step's contacts, rounds and their layouts
         self._wall_rest: tuple | None = None  # (rest, _impulses, answer) of the last wall_rest
         self.count = 0  # contacts in the last step
         self.iterations = 0  # iterations the last step needed
@@ -239,7 +215,7 @@ class ContactSolver:
         on a wall across that axis in the last step (it rests there whatever its speed)."""
         if self._wall_rest is not None and self._wall_rest[0] is rest and self._wall_rest[1] is self._impulses:
             return self._wall_rest[2]  # asked again within the step (walls, then contacts): the same answer
-        out = np.repeat(rest[:, None], 2, axis=1)
+        out = columns(rest, rest)
         self._wall_rest = (rest, self._impulses, out)
         if len(self._keys) == 0 or self._rows != len(rest):
             return out
@@ -292,12 +268,13 @@ class ContactSolver:
         self.count = len(c.a)
         if self.count == 0:
             self._keys, self._impulses = np.empty(0, dtype=np.int64), np.empty((0, 2))
+            self._band_rounds = self._free_rounds = np.empty(0, dtype=np.intp)
             return False
-        self._y, self._r_mean = start[:, 1], float(radius.mean())
+        self._y, self._r_mean = start[:, 1], float(radius.mean())  # for the bands
         inv = np.append(1.0 / mass, 0.0)  # the walls never move, nor do sleepers
         if asleep is not None:
             inv[:-1][asleep] = 0.0
-        first, later = self._gather(c, inv, len(pc.a), dt, asleep)
+        first, later = self._gather(c, inv, dt, asleep)
         w = np.zeros((len(pos) + 1, 2), dtype=complex)  # velocities and pseudo-velocities; the last row: walls
         w[:-1, 0] = vectors.as_complex(np.ascontiguousarray(vel))
         v0 = w[:-1, 0].copy()
@@ -309,94 +286,104 @@ class ContactSolver:
         vel[:, 0], vel[:, 1] = w[:-1, 0].real, w[:-1, 0].imag
         return True
 
-    def _gather(self, c: _Contacts, inv, n_pairs: int, dt: float, asleep=None) -> tuple[_Layout, _Layout]:
+    def _gather(self, c: _Contacts, inv, dt: float, asleep=None) -> tuple[_Layout, _Layout]:
         """This step's targets, inverse masses (inv, with the walls' 0 last) and warm-start impulses,
-        filled into the layouts of the rounds of the first iteration and of the later ones (colouring
-        the contacts anew if they changed)."""
-        rows = len(inv) - 1
+        filled into the layouts of the rounds of the first iteration and of the later ones."""
         # The gaps where the step began: the velocity bound keeps a pair from closing more
         # than its gap, and the pseudo-velocity pushes out a share of its overlap.
-        target = np.column_stack(
-            [
-                -np.maximum(c.gap, 0.0) / dt,
-                np.minimum(POSITION_FRACTION * np.maximum(-c.gap - SLOP_M, 0.0) / dt, MAX_PUSH_MPS),
-            ]
+        target = columns(
+            -np.maximum(c.gap, 0.0) / dt,
+            np.minimum(POSITION_FRACTION * np.maximum(-c.gap - SLOP_M, 0.0) / dt, MAX_PUSH_MPS),
         )
         impulse = np.zeros((len(c.keys), 2))  # pseudo-velocities start from nothing each step
         self._warm = impulse[:, 0]
-        sleepers = None if asleep is None else np.flatnonzero(asleep)
-        same = self._round_keys is not None and np.array_equal(self._round_keys, c.keys)
-        same = same and _same_rows(self._round_sleepers, sleepers)
-        if same and len(self._keys) == len(c.keys):
-            # The contacts of the last step, in the same order (not a step with none
-            # between): each finds its impulse where _keep sorted it.
-            impulse[self._key_order, 0] = self._impulses[:, 0]
-        elif len(self._keys):
-            found = np.searchsorted(self._keys, c.keys).clip(0, len(self._keys) - 1)
-            hit = np.flatnonzero(self._keys.take(found) == c.keys)
-            impulse[hit, 0] = self._impulses[found.take(hit), 0]
-        if not same:
-            virtual_a, virtual_b = c.a.copy(), c.b.copy()
-            virtual_b[n_pairs:] = rows + 1 + np.arange(len(c.b) - n_pairs)  # each wall contact its own body
-            bodies = rows + 1 + len(c.b) - n_pairs
-            if asleep is not None:  # and each contact with a sleeper too: it never moves either
-                for v, real in ((virtual_a, c.a), (virtual_b, c.b)):
-                    on = np.flatnonzero(np.append(asleep, False).take(real))
-                    v[on] = bodies + np.arange(len(on))
-                    bodies += len(on)
-            self._rounds = colour_rounds(virtual_a, virtual_b, bodies, self._bands(c))
-            self._free_rounds = colour_rounds(virtual_a, virtual_b, bodies)
-            self._round_keys = c.keys.copy()
-            self._round_sleepers = sleepers
-            self._key_order = np.argsort(c.keys)
-        if self._layouts is None or self._layouts[0].source is not self._rounds:
-            self._layouts = (_Layout(self._rounds, c.a, c.b), _Layout(self._free_rounds, c.a, c.b))
+        cached = self._layouts
+        if cached is not None and cached.same(c.keys, asleep, self):
+            # The very contacts of the last step, in the same order, the same pucks asleep: the same rounds.
+            self._key_order = cached.key_order
+            impulse[cached.key_order, 0] = self._impulses[:, 0]
+        else:
+            self._key_order = korder = np.argsort(c.keys)
+            last = np.full(len(korder), -1)  # each contact's place in the last step's, by key order
+            if len(self._keys):
+                keys = c.keys.take(korder)
+                found = np.searchsorted(self._keys, keys).clip(0, len(self._keys) - 1)
+                hit = np.flatnonzero(self._keys.take(found) == keys)
+                last[hit] = found.take(hit)
+            kept = np.flatnonzero(last >= 0)
+            impulse[korder.take(kept), 0] = self._impulses[last.take(kept), 0]
+            self._layouts = cached = self._colour(c, last, korder, asleep)
+        first, later = cached.first, cached.later
         wa, wb = inv.take(c.a), inv.take(c.b)
-
         # Each per-contact number twice, for the velocity and the pseudo-velocity: (m, 2), so
         # that nothing is broadcast in the rounds (an (m, 1) column costs twice as much).
-        def both(x: np.ndarray) -> np.ndarray:
-            return np.repeat(x[:, None], 2, axis=1)
+        nab = np.concatenate([c.n * wa, -(c.n * wb)])
+        k = 1.0 / (wa + wb)
+        knc = c.n.conjugate() * k
+        values = (columns(knc, knc), columns(nab, nab), target * columns(k, k), wa + wb, impulse)
+        return first.fill(*values), later.fill(*values)
 
-        nab = both(np.concatenate([c.n * wa, -(c.n * wb)]))
-        values = (both(c.n.conjugate()), nab, both(1.0 / (wa + wb)), wa + wb, target, impulse)
-        return self._layouts[0].fill(*values), self._layouts[1].fill(*values)
+    def _colour(self, c: _Contacts, last: np.ndarray, korder: np.ndarray, asleep=None) -> _Colouring:
+        """The rounds of this step's contacts (in key order; last: each one's place in the last
+        step's, -1 if new): the kept contacts keep theirs, the new ones are fitted in
+        (colouring.py); and their layouts, laid out again only if they changed."""
+        rows = self._rows
+        # Walls and sleepers never move here: to the colouring they are one body, `rows`, never taken.
+        a, b = c.a.take(korder), c.b.take(korder)
+        if asleep is not None:
+            a, b = np.where(asleep.take(a), rows, a), np.where(np.append(asleep, True).take(b), rows, b)
+        kept, at = last >= 0, last.clip(0)
+        band = self._bands(c, korder)
+        rounds = []
+        for before, level in ((self._band_rounds, band), (self._free_rounds, None)):
+            r = np.where(kept, before.take(at), -1) if len(before) else np.full(len(a), -1)
+            r = colouring.fit(colouring.keep(r, a, b, rows), a, b, rows, level)
+            for _ in range(BAND_PASSES if level is not None else 0):  # refitted ones may leave others out of order
+                again = colouring.keep_order(r, a, b, rows, level)
+                if again is r:
+                    break
+                r = colouring.fit(again, a, b, rows, level)
+            rounds.append(r)
+        cached = self._layouts
+        asleep = None if asleep is None else asleep.copy()
+        if cached is not None and np.array_equal(cached.keys, c.keys) and cached.has(*rounds):
+            self._band_rounds, self._free_rounds = cached.band, cached.free  # the kept arrays, as `same` asks
+            return _Colouring(c.keys, asleep, korder, cached.band, cached.free, cached.first, cached.later)
+        self._band_rounds, self._free_rounds = rounds
+        # In (round, key) order: rounds are few, so a stable sort of them as 16-bit numbers is a quick radix sort.
+        first, later = (
+            _Layout(korder.take(np.argsort(r.astype(np.int16), kind="stable")), np.bincount(r), c.a, c.b)
+            for r in rounds
+        )
+        return _Colouring(c.keys, asleep, korder, *rounds, first, later)
 
-    def _bands(self, c: _Contacts) -> np.ndarray | None:
-        """Priorities bottom-up by bands of height (BAND_RADII radii), scrambled within a band."""
+    def _bands(self, c: _Contacts, korder: np.ndarray) -> np.ndarray | None:
+        """Each contact's band (key order): its height above the lowest, in BAND_RADII radii."""
         if BAND_RADII <= 0:
             return None
-        y = self._y.take(c.a)
-        band = ((y - y.min()) / (BAND_RADII * self._r_mean)).astype(np.uint64)
-        m = len(y)
-        scramble = (np.arange(m, dtype=np.uint64) * np.uint64(0x9E3779B1)) % np.uint64(1 << 32)
-        return band * np.uint64(1 << 32) + scramble
+        y = self._y.take(c.a.take(korder))
+        return np.minimum((y - y.min()) / (BAND_RADII * self._r_mean), 30_000).astype(np.int16)
 
     def _keep(self, c: _Contacts, layout: _Layout) -> None:
         """Keep this step's impulses by contact key, for the next step's warm start."""
         impulses = layout.impulses()
-        order = self._key_order  # c.keys are _round_keys: sorted once per colouring
+        order = self._key_order
         self._keys, self._impulses = c.keys.take(order), impulses.take(order, axis=0)
 
-    # What the solver keeps from step to step: its impulses by contact (the warm start), and the
-    # rounds it solves in, kept while the contacts stay the same (their order depends on where the
-    # pucks were when they were formed, so they change results). The solver replaces these arrays
-    # each step and never changes them in place, so a save keeps references.
-    KEPT = (
-        "_keys", "_impulses", "_rows", "_round_keys", "_round_sleepers", "_key_order", "_rounds", "_free_rounds",
-        "count", "iterations",
-    )  # fmt: skip
-    ROUND_LISTS = ("_rounds", "_free_rounds")  # lists of arrays, saved as tuples
-    # Worked out afresh in each solve, or from kept values while those are the very same objects
-    # (restored ones are other objects): they change no result, so a save need not keep them.
-    NOT_KEPT = frozenset({"_y", "_r_mean", "_warm", "_layouts", "_wall_rest"})
+    # What the solver keeps from step to step: its impulses by contact (the warm start), and each
+    # contact's rounds (they depend on the contacts it had before, so they change results). The
+    # solver replaces these arrays each step and never changes them in place, so a save keeps references.
+    KEPT = ("_keys", "_impulses", "_rows", "_band_rounds", "_free_rounds", "count", "iterations")
+    # Worked out afresh in each solve (the layouts from the kept rounds, the same in the same order):
+    # they change no result, so a save need not keep them.
+    NOT_KEPT = frozenset({"_y", "_r_mean", "_warm", "_key_order", "_layouts", "_wall_rest"})
 
     def save(self, like: tuple | None = None) -> tuple:
         """The KEPT values (references), for state.py; `like`'s parts where they are the same objects."""
         unknown = set(vars(self)) - set(self.KEPT) - self.NOT_KEPT
         if unknown:
             raise TypeError(f"the contact solver keeps {sorted(unknown)}: ContactSolver.save must learn to save it")
-        kept = [tuple(getattr(self, k)) if k in self.ROUND_LISTS else getattr(self, k) for k in self.KEPT]
+        kept = [getattr(self, k) for k in self.KEPT]
         if like is None:
             return tuple(kept)
         same = [_same_part(a, b) for a, b in zip(kept, like, strict=True)]
@@ -405,9 +392,9 @@ class ContactSolver:
         return tuple(old if s else new for new, old, s in zip(kept, like, same, strict=True))
 
     def restore(self, saved: tuple) -> None:
-        """Back to a save: the same impulses and rounds (the rounds as lists again)."""
+        """Back to a save: the same impulses and rounds."""
         for name, value in zip(self.KEPT, saved, strict=True):
-            setattr(self, name, list(value) if name in self.ROUND_LISTS else value)
+            setattr(self, name, value)
 
 
 def _same_part(a, b) -> bool:
@@ -419,6 +406,33 @@ def _same_part(a, b) -> bool:
     return a == b
 
 
+@dataclass
+class _Colouring:
+    """A step's contacts (keys in their order, the sleepers), their rounds and their layouts."""
+
+    keys: np.ndarray
+    asleep: np.ndarray | None
+    key_order: np.ndarray
+    band: np.ndarray
+    free: np.ndarray
+    first: _Layout
+    later: _Layout
+
+    def same(self, keys: np.ndarray, asleep: np.ndarray | None, solver: ContactSolver) -> bool:
+        """Whether these contacts are those of the solver's last step, with the same rounds and sleepers."""
+        if self.band is not solver._band_rounds or self.free is not solver._free_rounds:
+            return False  # a restored state: its rounds may be other ones
+        if len(solver._keys) != len(keys) or not np.array_equal(self.keys, keys):
+            return False
+        return (asleep is None and self.asleep is None) or (
+            asleep is not None and self.asleep is not None and np.array_equal(asleep, self.asleep)
+        )
+
+    def has(self, band: np.ndarray, free: np.ndarray) -> bool:
+        """Whether these are the rounds laid out."""
+        return np.array_equal(self.band, band) and np.array_equal(self.free, free)
+
+
 class _Layout:
     """One colouring's rounds laid out once: index arrays, buffers, and each round's views into them.
 
@@ -428,35 +442,41 @@ class _Layout:
     round at every step.
     """
 
-    def __init__(self, rounds: list[np.ndarray], a: np.ndarray, b: np.ndarray) -> None:
-        self.source = rounds  # the colouring laid out (compared by identity: a restored state brings new lists)
-        self.order = order = np.concatenate(rounds)
+    def __init__(self, order: np.ndarray, lengths: np.ndarray, a: np.ndarray, b: np.ndarray) -> None:
+        """order: the contacts round by round; lengths: how many in each round (none empty)."""
+        self.order = order
         m = len(order)
-        self.lengths = [len(r) for r in rounds]
-        ends = np.cumsum(self.lengths)
-        self.starts = ends - self.lengths
+        self.lengths = lengths
+        ends = np.cumsum(lengths)
+        self.starts = ends - lengths
         bounds = list(zip(self.starts.tolist(), ends.tolist(), strict=True))
         # Body a's rows of a round, then body b's, side by side: one gather and one write per round.
-        # Rows of [everything about body a; everything about body b], contact by contact.
-        self.ab_rows = np.concatenate([x for s, e in bounds for x in (order[s:e], m + order[s:e])])
-        both = np.arange(2)
-        fab = np.concatenate([2 * a[:, None] + both, 2 * b[:, None] + both]).take(self.ab_rows, axis=0)
-        self.nc, self.nab = np.empty((m, 2), dtype=complex), np.empty((2 * m, 2), dtype=complex)
-        self.k, self.target, self.impulse = np.empty((m, 2)), np.empty((m, 2)), np.empty((m, 2))
+        # Rows of [everything about body a; everything about body b], contact by contact: the place
+        # p of a round starting at s and ending at e has its a row at p + s and its b row at p + e.
+        place = np.arange(m)
+        at_a, at_b = place + np.repeat(self.starts, lengths), place + np.repeat(ends, lengths)
+        self.ab_rows = np.empty(2 * m, dtype=np.intp)
+        self.ab_rows[at_a], self.ab_rows[at_b] = order, m + order
+        ab = 2 * np.concatenate([a, b]).take(self.ab_rows)
+        fab = columns(ab, ab + 1)  # the flat indices of each body's velocity and pseudo-velocity
+        self.knc, self.nab = np.empty((m, 2), dtype=complex), np.empty((2 * m, 2), dtype=complex)
+        self.kt, self.impulse = np.empty((m, 2)), np.empty((m, 2))
         # Every round's last change of impulse, to find the largest once per iteration, and per
         # contact its round's largest wa + wb, which turns a change of impulse into one of speed.
         # (m, 2), both columns alike: an (m, 1) array broadcast against (m, 2) costs twice as much.
         self.changes, self.w_max = np.zeros((m, 2)), np.empty((m, 2))
         self.rounds = [
-            _Round(fab[2 * s : 2 * e].ravel(), self.nc[s:e], self.nab[2 * s : 2 * e].reshape(2, e - s, 2),
-                   self.k[s:e], self.changes[s:e], self.target[s:e], self.impulse[s:e])
+            _Round(fab[2 * s : 2 * e].reshape(2, e - s, 2), self.knc[s:e], self.nab[2 * s : 2 * e].reshape(2, e - s, 2),
+                   self.kt[s:e], self.changes[s:e], self.impulse[s:e])
             for s, e in bounds
         ]  # fmt: skip
-        self._impulses = [g.impulse for g in self.rounds]
-        # For a change of every impulse at once (push): the flat rows of both bodies, and which
-        # contact (in this layout's order) each of nab's rows belongs to.
-        self.fab = fab.ravel()
-        self.ab_contact = np.concatenate([x for s, e in bounds for x in (np.arange(s, e), np.arange(s, e))])
+        # For a change of every impulse at once (push): where each real and imaginary part of nab's
+        # rows goes among the velocities' (seen as real numbers), and which contact (in this
+        # layout's order) each of nab's rows belongs to.
+        parts = 2 * fab.ravel()
+        self.fab_parts = columns(parts, parts + 1).ravel()
+        self.ab_contact = np.empty(2 * m, dtype=np.intp)
+        self.ab_contact[at_a], self.ab_contact[at_b] = place, place
 
     def converged(self) -> bool:
         """Whether the last iteration changed no speed by CONVERGED_MPS (a change of impulse times w_max).
@@ -472,39 +492,35 @@ class _Layout:
     def impulses(self) -> np.ndarray:
         """(contacts, 2) the rounds' impulses so far, contact by contact."""
         out = np.empty((len(self.order), 2))
-        out[self.order] = np.concatenate([g.impulse for g in self.rounds])
+        out[self.order] = self.impulse
         return out
-
-    def current(self) -> np.ndarray:
-        """(contacts, 2) the rounds' impulses so far, in this layout's order."""
-        return np.concatenate([g.impulse for g in self.rounds])
 
     def push(self, flat: np.ndarray, impulses: np.ndarray) -> None:
         """Set the impulses (this layout's order) and change the velocities in `flat` to match."""
-        change = (impulses - self.current()).take(self.ab_contact, axis=0) * self.nab
-        size = len(flat)
-        flat += np.bincount(self.fab, change.real.ravel(), size) + 1j * np.bincount(self.fab, change.imag.ravel(), size)
+        change = (impulses - self.impulse).take(self.ab_contact, axis=0) * self.nab
+        parts = flat.view(np.float64)  # (one bincount for both parts instead of two)
+        parts += np.bincount(self.fab_parts, change.view(np.float64).ravel(), len(parts))
         self.impulse[:] = impulses
-        for g, view in zip(self.rounds, self._impulses, strict=True):
-            g.impulse = view
 
-    def take_impulses(self, impulses: np.ndarray) -> None:
-        """Start the rounds from these impulses (contact by contact)."""
-        np.take(impulses, self.order, axis=0, out=self.impulse, mode="clip")
-        for g, view in zip(self.rounds, self._impulses, strict=True):
-            g.impulse = view  # the iterations rebind it to each new value
-
-    def fill(self, nc, nab, k, w_sum, target, impulse) -> _Layout:
+    def fill(self, knc, nab, kt, w_sum, impulse) -> _Layout:
         """This step's values (contact by contact; nab: body a's rows, then body b's) into the rounds."""
         order = self.order
-        np.take(nc, order, axis=0, out=self.nc, mode="clip")  # "clip": no bounds check, no buffering
+        np.take(knc, order, axis=0, out=self.knc, mode="clip")  # "clip": no bounds check, no buffering
         np.take(nab, self.ab_rows, axis=0, out=self.nab, mode="clip")
-        np.take(k, order, axis=0, out=self.k, mode="clip")
-        np.take(target, order, axis=0, out=self.target, mode="clip")
-        self.w_max[:] = np.repeat(np.maximum.reduceat(w_sum.take(order), self.starts), self.lengths)[:, None]
+        np.take(kt, order, axis=0, out=self.kt, mode="clip")
+        w_max = np.repeat(np.maximum.reduceat(w_sum.take(order), self.starts), self.lengths)
+        self.w_max[:, 0] = self.w_max[:, 1] = w_max
         self.w_min = float(self.w_max.min())
-        self.take_impulses(impulse)
+        np.take(impulse, order, axis=0, out=self.impulse, mode="clip")
         return self
+
+
+def columns(first: np.ndarray, second: np.ndarray) -> np.ndarray:
+    """(m, 2) the two columns: written column by column, several times quicker in numpy than
+    broadcasting or repeating along an axis of 2."""
+    out = np.empty((len(first), 2), dtype=np.result_type(first, second))
+    out[:, 0], out[:, 1] = first, second
+    return out
 
 
 def _warm_push(c: _Contacts, mass: np.ndarray, impulse: np.ndarray, asleep=None) -> np.ndarray:
@@ -539,23 +555,25 @@ def _iterate(w: np.ndarray, first: _Layout, later: _Layout) -> tuple[int, _Layou
     _sweep(flat, first)
     if first.converged():
         return 1, first
-    later.take_impulses(first.impulses())
+    np.take(first.impulses(), later.order, axis=0, out=later.impulse, mode="clip")
     direction, last_gg = None, None
     iterations = max(ITERATIONS, min(MAX_ITERATIONS, ITERATION_WORK // len(later.order)))
     for it in range(2, iterations + 1):
-        before = later.current()
         _sweep(flat, later)
         if later.converged() or it == iterations:
             return it, later  # (the last word is a sweep's, never an extrapolation)
-        after = later.current()
-        gradient = before - after
-        gg = np.einsum("ij,ij->j", gradient, gradient)
+        after = later.impulse
+        gradient = later.changes  # the sweep's impulses before it, less after it (each contact changes once)
+        # Per column (velocity, position): numpy broadcasts a pair along rows of two several times slower.
+        gg = np.array([gradient[:, 0] @ gradient[:, 0], gradient[:, 1] @ gradient[:, 1]])
         if direction is None:
             direction = -gradient
         else:
             beta = np.where(gg <= last_gg, gg / np.maximum(last_gg, 1e-300), 0.0)  # a rise: start again
-            later.push(flat, np.maximum(after + beta * direction, 0.0))
-            direction = beta * direction - gradient
+            direction[:, 0] *= beta[0]
+            direction[:, 1] *= beta[1]
+            later.push(flat, np.maximum(after + direction, 0.0))
+            direction -= gradient
         last_gg = gg
     return iterations, later  # (only with fewer than two iterations)
 
@@ -566,13 +584,13 @@ def _sweep(flat: np.ndarray, layout: _Layout) -> None:
     Velocities as one row of numbers (1-D fancy indexing is several times
     cheaper than 2-D). No body appears twice in a round, so each writes back
     what it read plus its change; the walls' row takes many writes, all the
-    same (wb = 0).
+    same (wb = 0). A contact's impulse changes by k (target - vn), but stays
+    at least 0: by max(k (target - vn), -impulse), here taken as minus the
+    least of k vn - k target and the impulse (the fewest numpy calls).
     """
-    for g in layout.rounds:
-        v = flat.take(g.fab).reshape(2, -1, 2)  # body a's rows, then body b's
-        vn = (g.nc * (v[0] - v[1])).real
-        new = np.maximum(g.impulse + g.k * (g.target - vn), 0.0)
-        np.subtract(new, g.impulse, out=g.change)
-        g.impulse = new
-        v += g.change * g.nab
-        flat[g.fab] = v.reshape(-1)
+    for fab, knc, nab, kt, change, impulse in layout.rounds:
+        v = flat.take(fab)  # (2, m, 2): body a's rows, then body b's
+        np.minimum((knc * (v[0] - v[1])).real - kt, impulse, out=change)
+        impulse -= change
+        v -= change * nab
+        flat[fab] = v
