@@ -11,6 +11,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from airtable.physics import broadphase, pairs, walls
+from airtable.physics.collision import Collisions
 from airtable.physics.table import AirTable
 
 
@@ -46,9 +47,9 @@ def test_rounds_give_what_one_pair_at_a_time_gives(seed: int, n: int, mode: str,
     np.testing.assert_array_equal(pos, one_pos)
     np.testing.assert_array_equal(vel, one_vel)
     # The same collisions, recorded alike (the rounds group them by round, not in the pairs' order).
-    got, want = (pairs.Collisions.concatenate(r) for r in (rounds, [c for s in singles for c in s]))
+    got, want = (Collisions.of_records(r) for r in (rounds, [c for s in singles for c in s]))
     got, want = (c.take(np.lexsort((c.j, c.i))) for c in (got, want))
-    for field in pairs.Collisions.__dataclass_fields__:
+    for field in Collisions.__dataclass_fields__:
         np.testing.assert_array_equal(getattr(got, field), getattr(want, field))
 
 

@@ -36,7 +36,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from airtable.physics import broadphase, collision, vectors
-from airtable.physics.collision import CORRECTION_MODES, Collisions
+from airtable.physics.collision import CORRECTION_MODES, PairRecords
 
 if TYPE_CHECKING:
     from airtable.physics.context import StepContext
@@ -85,7 +85,7 @@ def overlapping(table: Storage, ctx: StepContext) -> None:
         i, j = _colliding(table, ctx.rest, *broadphase.overlapping_pairs(pos, ki, kj, None, reach_sq=near_sq))
     if moved:
         ctx.records += records
-        table.collision_count += sum(len(r) for r in records)
+        table.collision_count += sum(r.count for r in records)
         ctx.moved = np.concatenate(moved)
 
 
@@ -178,12 +178,12 @@ def resolve_pairs(
     mode: str,
     dt_s: float,
     in_time_order: bool = False,
-) -> list[Collisions]:
+) -> list[PairRecords]:
     """Collide the overlapping pairs (i, j) in order, in place (see the module docstring).
 
     in_time_order: pairs that share a puck go in the order they met during
-    the step, not the given one. Returns one record per round that collided
-    anything; `Collisions.concatenate` joins them, which is left to whoever reads them.
+    the step, not the given one. Returns the records of each round that collided
+    anything; `Collisions.of_records` joins them, which is left to whoever reads them.
     """
     if mode not in CORRECTION_MODES:
         raise ValueError(f"puck_correction must be one of {CORRECTION_MODES}, not {mode!r}")
@@ -383,11 +383,11 @@ _ROUND_BY_MODE: dict[str, Callable[[_Round, float, float], _Outcome]] = {
 }
 
 
-def _resolve_round(zpos, zvel, radius, mass, a, b, cr, mode, dt_s) -> Collisions | None:
+def _resolve_round(zpos, zvel, radius, mass, a, b, cr, mode, dt_s) -> PairRecords | None:
     """Resolve pairs that share no puck, all at once, in place (see `disjoint_rounds`), on the
     table's positions and velocities as complex numbers (vectors.as_complex).
 
-    Returns the record of the pairs that collided, None if none did.
+    Returns the records of the pairs that collided, None if none did.
     """
     g = _gather(zpos, zvel, radius, mass, a, b)
     if g is None:
@@ -399,9 +399,6 @@ def _resolve_round(zpos, zvel, radius, mass, a, b, cr, mode, dt_s) -> Collisions
         zpos[g.a], zpos[g.b] = out.x1, out.x2
     if not out.count:
         return None
-    record = (g.a, g.b, out.n, out.contact_from, g.overlap, g.x1, g.x2, out.x1, out.x2, g.v1, g.v2, out.v1, out.v2)
-    if out.count < len(g.a):  # only those that collided
-        k = out.approach.nonzero()[0]
-        record = tuple(f.take(k) for f in record)
-    i, j, n, touch_j, overlap, *states = record
-    return Collisions.of_pairs(i, j, n, touch_j, overlap, radius, *states)
+    record = (g.a, g.b, out.n, out.contact_from, g.overlap, g.reach, g.r2, g.x1, g.x2, out.x1, out.x2)
+    pick = None if out.count == len(g.a) else out.approach.nonzero()[0]  # only those that collided
+    return PairRecords(out.count, (*record, g.v1, g.v2, out.v1, out.v2), pick)
