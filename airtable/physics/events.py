@@ -41,6 +41,7 @@ import numpy as np
 
 from airtable.physics import broadphase, collision, vectors
 from airtable.physics.collision import PairRecords
+from airtable.physics.walls import room_to_walls
 
 if TYPE_CHECKING:
     from airtable.physics.context import StepContext
@@ -215,8 +216,6 @@ class _Step:
 
     def past_walls(self) -> list[int]:
         """The rows the step ends past a wall: each hit a wall during it (or was there already)."""
-        from airtable.physics.walls import room_to_walls  # walls imports nothing of this module
-
         room = room_to_walls(vectors.as_rows(self.zpos), self.radius, (self.width, self.height))
         return (room < 0.0).nonzero()[0].tolist()
 
@@ -225,7 +224,9 @@ class _Step:
         those of fast pucks (a gas whose pucks all move under FAST_FRACTION of their radius has none)."""
         if self.rules.pairs == "perfect-kiss":
             return True
-        return self.rules.pairs != "none" and bool(self.fast_rows().any())
+        if self.rules.pairs == "none" or self.travel < 0.999 * FAST_FRACTION * float(self.radius.min()):
+            return False  # the fastest puck is not fast for the smallest one (a gas): no need to look at each
+        return bool(self.fast_rows().any())
 
     def fast_rows(self) -> np.ndarray:
         """Which pucks move FAST_FRACTION of their radius in the step on their first paths."""

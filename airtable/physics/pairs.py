@@ -286,7 +286,7 @@ def _maximum(x, y):
     return x if x > y or x != x else y
 
 
-@dataclass
+@dataclass(slots=True)
 class _Round:
     """The overlapping pairs of one round, gathered: puck 1 is row a, puck 2 row b.
 
@@ -316,7 +316,7 @@ class _Round:
         return self.a + self.b
 
 
-@dataclass
+@dataclass(slots=True)
 class _Outcome:
     """What a correction mode did to a round (vectors complex, as in _Round)."""
 
@@ -341,9 +341,10 @@ def _gather(zpos, zvel, radius, mass, a, b) -> _Round | None:
 
     zpos, zvel: the table's positions and velocities as complex numbers.
     """
-    x1, x2 = _take(zpos, a), _take(zpos, b)
-    d, r2 = x1 - x2, _take(radius, b)
-    reach = _take(radius, a) + r2
+    take = np.ndarray.take if isinstance(a, np.ndarray) else np.ndarray.item  # (see _take)
+    x1, x2 = take(zpos, a), take(zpos, b)
+    d, r2 = x1 - x2, take(radius, b)
+    reach = take(radius, a) + r2
     n, dist = vectors.units(d, lambda: a + b)
     overlap = reach - dist
     if _count(overlap > 0.0) < _size(a):
@@ -353,8 +354,8 @@ def _gather(zpos, zvel, radius, mass, a, b) -> _Round | None:
         if len(keep) == 0:
             return None
         a, b, x1, x2, d, r2, reach, n, overlap = (v.take(keep) for v in (a, b, x1, x2, d, r2, reach, n, overlap))
-    v1, v2 = _take(zvel, a), _take(zvel, b)
-    m1, m2 = _take(mass, a), _take(mass, b)
+    v1, v2 = take(zvel, a), take(zvel, b)
+    m1, m2 = take(mass, a), take(mass, b)
     vrel = v1 - v2
     shares = collision.mass_shares(m1, m2)
     return _Round(a, b, x1, x2, v1, v2, m1, m2, *shares, r2, reach, d, n, overlap, vrel, vectors.dot(vrel, n))
