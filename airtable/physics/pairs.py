@@ -29,6 +29,7 @@ of collision.py, on numpy arrays.
 
 from __future__ import annotations
 
+from collections import Counter
 from collections.abc import Callable
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
@@ -117,6 +118,10 @@ def _colliding(table: Storage, rest: np.ndarray | None, i: np.ndarray, j: np.nda
 
 def sharing_pairs(i: np.ndarray, j: np.ndarray) -> np.ndarray:
     """Indices k of the pairs (i, j) that share a puck with another pair."""
+    if len(i) <= FEW_PAIRS:  # a few pairs: in Python numbers, as their rounds go
+        a, b = i.tolist(), j.tolist()
+        uses = Counter(a + b)
+        return np.array([k for k, (p, q) in enumerate(zip(a, b)) if uses[p] > 1 or uses[q] > 1], dtype=np.intp)
     uses = np.bincount(np.concatenate([i, j]))  # as long as the largest row in a pair, no longer
     return ((uses.take(i) > 1) | (uses.take(j) > 1)).nonzero()[0]
 
@@ -142,10 +147,12 @@ def disjoint_rounds(i: np.ndarray, j: np.ndarray, since=None, shared: np.ndarray
     # A pair whose pucks are in no other pair can go in any round: the first.
     # For the others, level[k] = how many earlier pairs form a chain into
     # pair k. One pass in Python over just those, a handful per step.
-    if since is not None:
-        shared = shared.take(np.argsort(-since(shared), kind="stable"))  # the earliest contact first
+    ks = shared.tolist()
+    if since is not None:  # the earliest contact first (a stable sort: ties keep the pairs' order)
+        t = since(shared).tolist()
+        ks = [ks[x] for x in sorted(range(len(ks)), key=lambda x: -t[x])]
     later: dict[int, list[int]] = {}  # the pairs of each round after the first
-    for k, level in zip(shared.tolist(), _chain_levels(i.take(shared).tolist(), j.take(shared).tolist())):
+    for k, level in zip(ks, _chain_levels([i.item(k) for k in ks], [j.item(k) for k in ks])):
         if level:
             later.setdefault(level, []).append(k)
     first = np.ones(m, dtype=bool)
