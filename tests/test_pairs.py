@@ -120,3 +120,25 @@ def test_the_squared_reach_is_one_number_when_every_radius_is_equal() -> None:
     i, j, _ = nl.pairs(pos, np.array([0.1, 0.2, 0.1]))  # a radius changed: the list is built again
     assert (i.tolist(), j.tolist()) == ([0], [1])
     np.testing.assert_allclose(nl.reach_squared(0.05), [0.25**2])  # (0.1 + 0.2 - 0.05)^2, per pair
+
+
+@pytest.mark.parametrize("mode", ["two-step", "perfect-kiss"])
+def test_the_collisions_a_step_keeps_raw_are_those_it_counted(mode: str) -> None:
+    # The records stay raw (PairRecords) until last_collisions is read: reading them or not
+    # changes nothing, and they hold exactly the collisions collision_count counted.
+    from airtable.demos.demo_0p_gas import gas_scene
+
+    read, unread = gas_scene(300, seed=2), gas_scene(300, seed=2)
+    for table in (read, unread):
+        table.puck_correction = mode
+    seen = 0
+    for _ in range(60):
+        read.step(1 / 60)
+        unread.step(1 / 60)
+        c = read.last_collisions
+        seen += len(c)
+        assert len(c.i) == len(c.normal) == len(c.vel_j_after) and c.normal.shape == (len(c), 2)
+        if len(c):
+            np.testing.assert_allclose(np.hypot(*c.normal.T), 1.0, rtol=1e-12)  # unit normals, as rows
+    assert type(read.collision_count) is int and read.collision_count == seen > 100
+    assert same_bits(read.pos_m, unread.pos_m) and same_bits(read.vel_mps, unread.vel_mps)
