@@ -24,7 +24,8 @@ overlaps).
   collide, and go forward again by the same time.
 
 One pair or a thousand, a round takes the same path: the formulas are those
-of collision.py, on numpy arrays.
+of collision.py, on numpy arrays (or, for a round of a few pairs, on Python
+numbers one pair at a time: the same lines, the same bits; see "one round").
 """
 
 from __future__ import annotations
@@ -221,7 +222,7 @@ def resolve_pairs(
             done = _resolve_round(*pucks, i.take(r), j.take(r), cr_puck, mode, dt_s)
             if done is not None:
                 count, columns, approach = done
-                records.append(PairRecords(count, columns, None if count == len(r) else approach.nonzero()[0]))
+                records.append(PairRecords(count, columns, None if count == len(approach) else approach.nonzero()[0]))
             continue
         rows = [_resolve_round(*pucks, i.item(k), j.item(k), cr_puck, mode, dt_s) for k in r.tolist()]
         rows = [row for _, row, _ in filter(None, rows)]
