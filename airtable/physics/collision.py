@@ -139,14 +139,23 @@ class Collisions:
     vel_j_after: np.ndarray
 
     @classmethod
-    def of_pairs(cls, i, j, n, touch_j, overlap, radius: np.ndarray, *states) -> Collisions:
+    def of_pairs(cls, i, j, n, touch_j, overlap, reach, r_j, *states) -> Collisions:
         """The record of the pairs (i, j) that collided along n; touch_j: puck j's centre when they
-        touched; `states`: the positions and velocities before and after, in the fields' order.
-        Vectors complex (one per pair)."""
-        r_j = radius.take(j)
+        touched; reach: r_i + r_j; `states`: the positions and velocities before and after, in the
+        fields' order. Vectors complex (one per pair): the columns of `PairRecords`."""
         contact = touch_j + r_j * n  # on puck j's edge, along the normal
         n, contact, *states = (vectors.as_rows(np.ascontiguousarray(z)) for z in (n, contact, *states))
-        return cls(i, j, n, contact, overlap, radius.take(i) + r_j, *states)
+        return cls(i, j, n, contact, overlap, reach, *states)
+
+    @classmethod
+    def of_records(cls, records: list[PairRecords]) -> Collisions:
+        """One record of what the stages kept as they went (PairRecords), made when someone reads it."""
+        columns = [r.columns() for r in records if r.count]
+        if not columns:
+            return cls.empty()
+        if len(columns) == 1:
+            return cls.of_pairs(*columns[0])
+        return cls.of_pairs(*(np.concatenate(c) for c in zip(*columns, strict=True)))
 
     @property
     def separation_m(self) -> np.ndarray:
@@ -175,3 +184,28 @@ class Collisions:
     def take(self, k: np.ndarray) -> Collisions:
         """Only the collisions k (indices into this record)."""
         return Collisions(*(getattr(self, f).take(k, axis=0) for f in self.__dataclass_fields__))
+
+
+class PairRecords:
+    """Pair collisions as a stage resolved them, kept raw: made into `Collisions` only when read.
+
+    Most steps nobody reads them (AirTable.last_collisions), and turning a stage's complex columns
+    into rows costs a dozen numpy calls a round. Either numpy columns, with `pick` the indices of
+    the pairs that collided (None: all), or `rows`, one tuple per collision (the hits of events.py):
+    the fields of `Collisions.of_pairs` in its order, (i, j, n, xj at contact, overlap, reach, rj,
+    xi, xj before, xi, xj after, vi, vj before, after).
+    """
+
+    __slots__ = ("_columns", "_pick", "_rows", "count")
+
+    def __init__(self, count: int, columns: tuple = (), pick: np.ndarray | None = None, rows: list = ()) -> None:
+        self.count = int(count)  # how many collisions (a numpy count is not a plain int: state.py saves it)
+        self._columns, self._pick, self._rows = columns, pick, rows
+
+    def columns(self) -> tuple:
+        """The fields of `Collisions.of_pairs`, one numpy column each."""
+        if self._rows:
+            return tuple(np.array(column) for column in zip(*self._rows, strict=True))
+        if self._pick is None:
+            return self._columns
+        return tuple(f.take(self._pick) for f in self._columns)

@@ -12,7 +12,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from airtable.physics.collision import Collisions
+from airtable.physics.collision import PairRecords
 from airtable.physics.forces import Pull
 
 
@@ -28,4 +28,4 @@ class StepContext:
     wall_rest: np.ndarray | None = None  # rest_walls where the contacts held a puck on a wall last step
     maybe_past: np.ndarray | None = None  # the rows that may be past a wall after the hits (None: any)
     moved: np.ndarray | None = None  # the rows the pair stage moved (a row may repeat; None: none)
-    records: list[Collisions] = field(default_factory=list)  # what this step's puck-puck collisions did
+    records: list[PairRecords] = field(default_factory=list)  # what this step's puck-puck collisions did (raw)

@@ -40,7 +40,8 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from airtable.physics import broadphase, collision, vectors
-from airtable.physics.collision import Collisions
+from airtable.physics.collision import PairRecords
+from airtable.physics.walls import room_to_walls
 
 if TYPE_CHECKING:
     from airtable.physics.context import StepContext
@@ -84,20 +85,17 @@ class Rules:
 class Hits:
     """What the hits in time order did in one step: the pair hits as rows, the wall bounces."""
 
-    # (i, j, n, xj at contact, overlap, xi, xj before, xi, xj after, vi, vj before, after): the fields of
-    # Collisions.of_pairs, one hit each, vectors complex
+    # (i, j, n, xj at contact, overlap, reach, rj, xi, xj before, xi, xj after, vi, vj before, after):
+    # the fields of Collisions.of_pairs (collision.PairRecords), one hit each, vectors complex
     rows: list = field(default_factory=list)
     walls: int = 0
     capped: bool = False
     maybe_past: np.ndarray | None = None  # the rows that may still be past a wall (None: any)
 
-    def collisions(self, radius: np.ndarray) -> Collisions:
-        """The pair hits as a collision record: an exact hit where the pucks touched (overlap 0), a
+    def records(self) -> PairRecords:
+        """The pair hits' collision records: an exact hit where the pucks touched (overlap 0), a
         two-step one where the step's end caught them overlapping, and where it moved them."""
-        if not self.rows:
-            return Collisions.empty()
-        i, j, n, touch_j, overlap, *states = (np.array(column) for column in zip(*self.rows, strict=True))
-        return Collisions.of_pairs(i, j, n, touch_j, overlap, radius, *states)
+        return PairRecords(len(self.rows), rows=self.rows)
 
 
 def hits_in_order(table: Storage, ctx: StepContext) -> None:
@@ -117,7 +115,7 @@ def hits_in_order(table: Storage, ctx: StepContext) -> None:
     hits = resolve_hits(*pucks, table.size_m, ctx.dt, rules, table.neighbour_list)
     table.wall_collision_count += hits.walls
     if hits.rows:
-        ctx.records.append(hits.collisions(table.radius_m))
+        ctx.records.append(hits.records())
         table.collision_count += len(hits.rows)
     if hits.capped:
         table.notices.say("capped", CAPPED_NOTICE)
@@ -238,8 +236,6 @@ class _Step:
 
     def past_walls(self) -> list[int]:
         """The rows the step ends past a wall: each hit a wall during it (or was there already)."""
-        from airtable.physics.walls import room_to_walls  # walls imports nothing of this module
-
         room = room_to_walls(vectors.as_rows(self.zpos), self.radius, (self.width, self.height))
         return (room < 0.0).nonzero()[0].tolist()
 
@@ -248,7 +244,9 @@ class _Step:
         those of fast pucks (a gas whose pucks all move under FAST_FRACTION of their radius has none)."""
         if self.rules.pairs == "perfect-kiss":
             return True
-        return self.rules.pairs != "none" and bool(self.fast_rows().any())
+        if self.rules.pairs == "none" or self.travel < 0.999 * FAST_FRACTION * float(self.radius.min()):
+            return False  # the fastest puck is not fast for the smallest one (a gas): no need to look at each
+        return bool(self.fast_rows().any())
 
     def fast_rows(self) -> np.ndarray:
         """Which pucks move FAST_FRACTION of their radius in the step on their first paths."""
@@ -444,10 +442,11 @@ class _Step:
         """
         xa, xb = self.at(a, self.t_now), self.at(b, self.t_now)
         va, vb = self.zvel.item(a), self.zvel.item(b)
-        n, overlap, seen = xa - xb, 0.0, (xa, xb)  # the record: where the hit was seen, how deep
+        rb = self.radius.item(b)
+        n, overlap, seen, reach = xa - xb, 0.0, (xa, xb), self.radius.item(a) + rb  # the record: where, how deep
         if self.rules.pairs == "two-step":
             left = self.dt - self.t_now
-            end, reach = n + (va - vb) * left, self.radius.item(a) + self.radius.item(b)
+            end = n + (va - vb) * left
             if _caught_overlapping(end, va - vb, reach)[0]:
                 n, overlap, seen = end, reach - abs(end), (xa + va * left, xb + vb * left)
         n /= abs(n)
@@ -455,7 +454,7 @@ class _Step:
         self.set_path(a, xa, new_a)
         self.set_path(b, xb, new_b)
         after = (self.at(a, self.dt), self.at(b, self.dt)) if overlap else seen
-        self.hits.rows.append((a, b, n, seen[1], overlap, *seen, *after, va, vb, new_a, new_b))
+        self.hits.rows.append((a, b, n, seen[1], overlap, reach, rb, *seen, *after, va, vb, new_a, new_b))
         self.hit_pairs[a, b] = self.hit_pairs.get((a, b), 0) + 1
 
 

@@ -24,11 +24,13 @@ overlaps).
   collide, and go forward again by the same time.
 
 One pair or a thousand, a round takes the same path: the formulas are those
-of collision.py, on numpy arrays.
+of collision.py, on numpy arrays (or, for a round of a few pairs, on Python
+numbers one pair at a time: the same lines, the same bits; see "one round").
 """
 
 from __future__ import annotations
 
+from collections import Counter
 from collections.abc import Callable
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
@@ -36,7 +38,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from airtable.physics import broadphase, collision, vectors
-from airtable.physics.collision import CORRECTION_MODES, Collisions
+from airtable.physics.collision import CORRECTION_MODES, PairRecords
 
 if TYPE_CHECKING:
     from airtable.physics.context import StepContext
@@ -48,6 +50,11 @@ if TYPE_CHECKING:
 EXTRA_PASSES = 2
 # Overlaps smaller than this (m) are left to the next step: round-off only.
 OVERLAP_SLOP_M = 1e-9
+
+# A round of at most this many pairs is resolved one pair at a time in Python numbers, by the
+# same lines (see "one round" below): a round in numpy costs some eighty numpy calls, about as
+# much as this many pairs in Python numbers. A gas step's later rounds mostly hold one or two.
+FEW_PAIRS = 4
 
 # A relative normal speed smaller than this (m/s) counts as "not moving": such
 # an overlap cannot be explained by the last step's motion.
@@ -85,7 +92,7 @@ def overlapping(table: Storage, ctx: StepContext) -> None:
         i, j = _colliding(table, ctx.rest, *broadphase.overlapping_pairs(pos, ki, kj, None, reach_sq=near_sq))
     if moved:
         ctx.records += records
-        table.collision_count += sum(len(r) for r in records)
+        table.collision_count += sum(r.count for r in records)
         ctx.moved = np.concatenate(moved)
 
 
@@ -112,6 +119,10 @@ def _colliding(table: Storage, rest: np.ndarray | None, i: np.ndarray, j: np.nda
 
 def sharing_pairs(i: np.ndarray, j: np.ndarray) -> np.ndarray:
     """Indices k of the pairs (i, j) that share a puck with another pair."""
+    if len(i) <= FEW_PAIRS:  # a few pairs: in Python numbers, as their rounds go
+        a, b = i.tolist(), j.tolist()
+        uses = Counter(a + b)
+        return np.array([k for k, (p, q) in enumerate(zip(a, b)) if uses[p] > 1 or uses[q] > 1], dtype=np.intp)
     uses = np.bincount(np.concatenate([i, j]))  # as long as the largest row in a pair, no longer
     return ((uses.take(i) > 1) | (uses.take(j) > 1)).nonzero()[0]
 
@@ -137,14 +148,18 @@ def disjoint_rounds(i: np.ndarray, j: np.ndarray, since=None, shared: np.ndarray
     # A pair whose pucks are in no other pair can go in any round: the first.
     # For the others, level[k] = how many earlier pairs form a chain into
     # pair k. One pass in Python over just those, a handful per step.
-    if since is not None:
-        shared = shared.take(np.argsort(-since(shared), kind="stable"))  # the earliest contact first
-    levels = _chain_levels(i.take(shared).tolist(), j.take(shared).tolist())
-    level = np.zeros(m, dtype=np.intp)
-    level[shared] = levels
-    order = np.argsort(level, kind="stable")
-    bounds = np.searchsorted(level.take(order), np.arange(max(levels) + 2))
-    return [order[bounds[r] : bounds[r + 1]] for r in range(len(bounds) - 1)]
+    ks = shared.tolist()
+    if since is not None:  # the earliest contact first (a stable sort: ties keep the pairs' order)
+        t = since(shared).tolist()
+        ks = [ks[x] for x in sorted(range(len(ks)), key=lambda x: -t[x])]
+    later: dict[int, list[int]] = {}  # the pairs of each round after the first
+    for k, level in zip(ks, _chain_levels([i.item(k) for k in ks], [j.item(k) for k in ks])):
+        if level:
+            later.setdefault(level, []).append(k)
+    first = np.ones(m, dtype=bool)
+    first[[k for ks in later.values() for k in ks]] = False
+    # Each round in the pairs' order (what sorting by round, keeping the order, gives).
+    return [first.nonzero()[0]] + [np.array(sorted(later[r]), dtype=np.intp) for r in range(1, len(later) + 1)]
 
 
 def _chain_levels(i: list[int], j: list[int]) -> list[int]:
@@ -164,7 +179,7 @@ def time_back_to_contact(d, w, reach, dt_s: float) -> tuple[np.ndarray, np.ndarr
     it (it touched at most dt_s ago). t is 0 where it does not."""
     t, _ = collision.contact_time(d, w, reach)
     explained = (t <= 0.0) & (t >= -dt_s)
-    return np.where(explained, -t, 0.0), explained
+    return _where(explained, -t, 0.0), explained
 
 
 def resolve_pairs(
@@ -178,29 +193,41 @@ def resolve_pairs(
     mode: str,
     dt_s: float,
     in_time_order: bool = False,
-) -> list[Collisions]:
+    few_pairs: int = FEW_PAIRS,
+) -> list[PairRecords]:
     """Collide the overlapping pairs (i, j) in order, in place (see the module docstring).
 
     in_time_order: pairs that share a puck go in the order they met during
-    the step, not the given one. Returns one record per round that collided
-    anything; `Collisions.concatenate` joins them, which is left to whoever reads them.
+    the step, not the given one. A round of `few_pairs` pairs or fewer goes pair by pair in Python
+    numbers (see "one round" below). Returns the records of each round that collided anything;
+    `Collisions.of_records` joins them, which is left to whoever reads them.
     """
     if mode not in CORRECTION_MODES:
         raise ValueError(f"puck_correction must be one of {CORRECTION_MODES}, not {mode!r}")
     zpos, zvel = vectors.as_complex(pos), vectors.as_complex(vel)  # the rounds' vectors (see _Round)
 
-    def since(k):  # how long ago the pairs k met (dt_s where the step does not explain it)
-        a, b = i.take(k), j.take(k)
-        t, explained = time_back_to_contact(
-            zpos.take(a) - zpos.take(b), zvel.take(a) - zvel.take(b), radius.take(a) + radius.take(b), dt_s
-        )
-        return np.where(explained, t, dt_s)
+    def since_met(a, b):  # how long ago pucks a and b met (dt_s where the step does not explain it)
+        d, w = _take(zpos, a) - _take(zpos, b), _take(zvel, a) - _take(zvel, b)
+        t, explained = time_back_to_contact(d, w, _take(radius, a) + _take(radius, b), dt_s)
+        return _where(explained, t, dt_s)
 
-    records = []
+    def since(k):  # ... the pairs k (a few: one by one in Python numbers, see "one round")
+        if len(k) > few_pairs:
+            return since_met(i.take(k), j.take(k))
+        return np.array([since_met(i.item(x), j.item(x)) for x in k.tolist()])
+
+    records, pucks = [], (zpos, zvel, radius, mass)
     for r in disjoint_rounds(i, j, since if in_time_order else None):
-        c = _resolve_round(zpos, zvel, radius, mass, i.take(r), j.take(r), cr_puck, mode, dt_s)
-        if c is not None:
-            records.append(c)
+        if len(r) > few_pairs:
+            done = _resolve_round(*pucks, i.take(r), j.take(r), cr_puck, mode, dt_s)
+            if done is not None:
+                count, columns, approach = done
+                records.append(PairRecords(count, columns, None if count == len(approach) else approach.nonzero()[0]))
+            continue
+        rows = [_resolve_round(*pucks, i.item(k), j.item(k), cr_puck, mode, dt_s) for k in r.tolist()]
+        rows = [row for _, row, _ in filter(None, rows)]
+        if rows:
+            records.append(PairRecords(len(rows), rows=rows))
     return records
 
 
@@ -227,13 +254,51 @@ def push_apart(pos: np.ndarray, radius: np.ndarray, mass: np.ndarray, i: np.ndar
 # for the second (rows b). Gathering, moving and scattering a round are then one 1-D numpy
 # operation per array, and each line reads as the course's formula for one pair: on a few
 # dozen pairs a numpy call costs more than its rows, so fewer calls is what counts.
+#
+# A round of a few pairs goes through the very same lines one pair at a time, in Python numbers
+# (a and b ints, the vectors Python complex numbers): there a numpy call costs a microsecond
+# for one number, the arithmetic of a whole pair a few. The few operations that differ
+# between the two are the helpers below; the bits are the same either way (test_pairs.py).
 
 
-@dataclass
+def _take(a: np.ndarray, rows):
+    """a[rows]: an array for an array of rows, a Python number for one row (an int)."""
+    return a.take(rows) if isinstance(rows, np.ndarray) else a.item(rows)
+
+
+def _count(mask) -> int:
+    """How many are true: of a mask, or of one bool."""
+    return np.count_nonzero(mask) if isinstance(mask, np.ndarray) else int(mask)
+
+
+def _size(rows) -> int:
+    return len(rows) if isinstance(rows, np.ndarray) else 1
+
+
+def _where(c, x, y):
+    """np.where(c, x, y), or for one pair: x if c, else y."""
+    return np.where(c, x, y) if isinstance(c, np.ndarray) else (x if c else y)
+
+
+def _minimum(x, y):
+    """np.minimum(x, y); for one pair as numpy does it (NaN wins; of two equal ones, y: -0.0 or 0.0)."""
+    if isinstance(x, np.ndarray) or isinstance(y, np.ndarray):
+        return np.minimum(x, y)
+    return x if x < y or x != x else y
+
+
+def _maximum(x, y):
+    """np.maximum(x, y); for one pair as numpy does it (see _minimum)."""
+    if isinstance(x, np.ndarray) or isinstance(y, np.ndarray):
+        return np.maximum(x, y)
+    return x if x > y or x != x else y
+
+
+@dataclass(slots=True)
 class _Round:
     """The overlapping pairs of one round, gathered: puck 1 is row a, puck 2 row b.
 
-    Vectors are complex (x + iy), one per pair.
+    Vectors are complex (x + iy), one per pair (arrays, or Python numbers for one pair).
     """
 
     a: np.ndarray
@@ -259,7 +324,7 @@ class _Round:
         return self.a + self.b
 
 
-@dataclass
+@dataclass(slots=True)
 class _Outcome:
     """What a correction mode did to a round (vectors complex, as in _Round)."""
 
@@ -275,8 +340,8 @@ class _Outcome:
 
 def _approaching(approach: np.ndarray) -> tuple[int, np.ndarray | None]:
     """(how many pairs approach, the mask to apply to them): None when all do, as they mostly do."""
-    count = np.count_nonzero(approach)
-    return count, (None if count == len(approach) else approach)
+    count = _count(approach)
+    return count, (None if count == _size(approach) else approach)
 
 
 def _gather(zpos, zvel, radius, mass, a, b) -> _Round | None:
@@ -284,18 +349,21 @@ def _gather(zpos, zvel, radius, mass, a, b) -> _Round | None:
 
     zpos, zvel: the table's positions and velocities as complex numbers.
     """
-    x1, x2 = zpos.take(a), zpos.take(b)
-    d, r2 = x1 - x2, radius.take(b)
-    reach = radius.take(a) + r2
+    take = np.ndarray.take if isinstance(a, np.ndarray) else np.ndarray.item  # (see _take)
+    x1, x2 = take(zpos, a), take(zpos, b)
+    d, r2 = x1 - x2, take(radius, b)
+    reach = take(radius, a) + r2
     n, dist = vectors.units(d, lambda: a + b)
     overlap = reach - dist
-    if np.count_nonzero(overlap > 0.0) < len(a):
+    if _count(overlap > 0.0) < _size(a):
+        if not isinstance(a, np.ndarray):
+            return None
         keep = (overlap > 0.0).nonzero()[0]
         if len(keep) == 0:
             return None
         a, b, x1, x2, d, r2, reach, n, overlap = (v.take(keep) for v in (a, b, x1, x2, d, r2, reach, n, overlap))
-    v1, v2 = zvel.take(a), zvel.take(b)
-    m1, m2 = mass.take(a), mass.take(b)
+    v1, v2 = take(zvel, a), take(zvel, b)
+    m1, m2 = take(mass, a), take(mass, b)
     vrel = v1 - v2
     shares = collision.mass_shares(m1, m2)
     return _Round(a, b, x1, x2, v1, v2, m1, m2, *shares, r2, reach, d, n, overlap, vrel, vectors.dot(vrel, n))
@@ -306,7 +374,7 @@ def _collide(g: _Round, n: np.ndarray, only: np.ndarray | None, cr: float):
     v1, v2 = collision.collide_along(n, g.v1, g.v2, g.m1, g.m2, cr)
     if only is None:
         return v1, v2
-    return np.where(only, v1, g.v1), np.where(only, v2, g.v2)
+    return _where(only, v1, g.v1), _where(only, v2, g.v2)
 
 
 def separate(g: _Round, n: np.ndarray, move: np.ndarray, only: np.ndarray | None):
@@ -317,12 +385,12 @@ def separate(g: _Round, n: np.ndarray, move: np.ndarray, only: np.ndarray | None
     line of centres, by the same shares.
     """
     if only is not None:
-        move = np.where(only, move, 0.0)
+        move = _where(only, move, 0.0)
     x1, x2 = g.x1 + (move * g.share1) * n, g.x2 - (move * g.share2) * n
     d = x1 - x2
-    if np.count_nonzero(vectors.squared_abs(d) < g.reach * g.reach):
+    if _count(vectors.squared_abs(d) < g.reach * g.reach):
         n_now, dist_now = vectors.units(d, g.keys)
-        left = np.maximum(g.reach - dist_now, 0.0)
+        left = _maximum(g.reach - dist_now, 0.0)
         x1, x2 = x1 + (left * g.share1) * n_now, x2 - (left * g.share2) * n_now
     return x1, x2
 
@@ -344,7 +412,7 @@ def _two_step_move(g: _Round, cr: float, dt_s: float) -> np.ndarray:
     overlap deeper than one step of approach can explain is capped there;
     `separate` pushes the rest apart.
     """
-    return (1.0 + cr) * np.minimum(g.overlap, g.vn * -dt_s)
+    return (1.0 + cr) * _minimum(g.overlap, g.vn * -dt_s)
 
 
 def _round_two_step(g: _Round, cr: float, dt_s: float) -> _Outcome:
@@ -358,7 +426,7 @@ def _round_two_step(g: _Round, cr: float, dt_s: float) -> _Outcome:
 def _round_perfect_kiss(g: _Round, cr: float, dt_s: float) -> _Outcome:
     """Collide at first contact; pairs whose overlap this step cannot explain get the two-step correction."""
     t_b, kiss = time_back_to_contact(g.d, g.vrel, g.reach, dt_s)
-    kissing = np.count_nonzero(kiss)
+    kissing = _count(kiss)
     if not kissing:
         return _round_two_step(g, cr, dt_s)
     c1, c2 = g.x1 - t_b * g.v1, g.x2 - t_b * g.v2  # both centres at first contact
@@ -366,7 +434,7 @@ def _round_perfect_kiss(g: _Round, cr: float, dt_s: float) -> _Outcome:
     # They approach now, so they approached at contact (on straight paths d.w only grows). Going
     # forward t_b with the new velocities parts the pair by (1 + cr) |vn| t_b, vn the normal speed there.
     contact_from, approach, move = c2, kiss, -(1.0 + cr) * vectors.dot(g.vrel, n) * t_b
-    if kissing < len(kiss):  # the others: the two-step's normal, approach and move
+    if kissing < _size(kiss):  # the others: the two-step's normal, approach and move
         n, contact_from = np.where(kiss, n, g.n), np.where(kiss, contact_from, g.x2)
         approach = kiss | (g.vn < -REST_SPEED_MPS)
         move = np.where(kiss, move, _two_step_move(g, cr, dt_s))
@@ -383,11 +451,12 @@ _ROUND_BY_MODE: dict[str, Callable[[_Round, float, float], _Outcome]] = {
 }
 
 
-def _resolve_round(zpos, zvel, radius, mass, a, b, cr, mode, dt_s) -> Collisions | None:
+def _resolve_round(zpos, zvel, radius, mass, a, b, cr, mode, dt_s) -> tuple[int, tuple, np.ndarray] | None:
     """Resolve pairs that share no puck, all at once, in place (see `disjoint_rounds`), on the
-    table's positions and velocities as complex numbers (vectors.as_complex).
+    table's positions and velocities as complex numbers (vectors.as_complex); or one pair (a, b ints).
 
-    Returns the record of the pairs that collided, None if none did.
+    Returns (how many collided, the record's columns: the fields of `Collisions.of_pairs`, which
+    of them collided), None if none did; for one pair the columns are its row.
     """
     g = _gather(zpos, zvel, radius, mass, a, b)
     if g is None:
@@ -399,9 +468,5 @@ def _resolve_round(zpos, zvel, radius, mass, a, b, cr, mode, dt_s) -> Collisions
         zpos[g.a], zpos[g.b] = out.x1, out.x2
     if not out.count:
         return None
-    record = (g.a, g.b, out.n, out.contact_from, g.overlap, g.x1, g.x2, out.x1, out.x2, g.v1, g.v2, out.v1, out.v2)
-    if out.count < len(g.a):  # only those that collided
-        k = out.approach.nonzero()[0]
-        record = tuple(f.take(k) for f in record)
-    i, j, n, touch_j, overlap, *states = record
-    return Collisions.of_pairs(i, j, n, touch_j, overlap, radius, *states)
+    record = (g.a, g.b, out.n, out.contact_from, g.overlap, g.reach, g.r2, g.x1, g.x2, out.x1, out.x2)
+    return out.count, (*record, g.v1, g.v2, out.v1, out.v2), out.approach

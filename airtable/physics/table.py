@@ -18,7 +18,7 @@ import numpy as np
 from airtable.physics import forces, integrate, vectors
 from airtable.physics import step as stepping
 from airtable.physics.bodies import Handles, Puck, Spring, as_vector
-from airtable.physics.collision import Collisions
+from airtable.physics.collision import Collisions, PairRecords
 from airtable.physics.colors import rgb
 from airtable.physics.forces import Pull
 from airtable.physics.storage import TABLE_HEIGHT_M, TABLE_WIDTH_M, Storage, non_negative, positive
@@ -148,7 +148,7 @@ class AirTable(Storage):
         self.puck_handles.clear()
         self.spring_handles.clear()
         self.clear_storage()
-        self._last_records: list[Collisions] = []  # what the last step's collisions did (its context's records)
+        self._last_records: list[PairRecords] = []  # what the last step's collisions did (its context's records)
         self._last_collisions: Collisions | None = None  # ... joined, once asked for
 
     def schedule(self, t_s: float, fn: Callable[[AirTable], None]) -> None:
@@ -209,7 +209,7 @@ class AirTable(Storage):
     def last_collisions(self) -> Collisions:
         """What the puck-puck collisions of the last step did (collision.Collisions)."""
         if self._last_collisions is None:  # joined on first read: most steps nobody asks
-            self._last_collisions = Collisions.concatenate(self._last_records)
+            self._last_collisions = Collisions.of_records(self._last_records)
         return self._last_collisions
 
     def restore_settings(self, names: tuple[str, ...], values: tuple) -> None:

@@ -20,6 +20,8 @@ the wrapper that costs twice the work on a few thousand pairs.
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 # Two pucks exactly on top of each other have no line of centres. Each such
@@ -121,7 +123,10 @@ def add_at(a: np.ndarray, idx: np.ndarray, values: np.ndarray) -> None:
 
 
 def squared_abs(z: np.ndarray) -> np.ndarray:
-    """x^2 + y^2 of each complex z = x + iy: the squared length of the vector (x, y)."""
+    """x^2 + y^2 of each complex z = x + iy: the squared length of the vector (x, y); z may be one
+    Python complex number (then a float, by the same arithmetic)."""
+    if isinstance(z, complex):
+        return z.real * z.real + z.imag * z.imag
     xy = z.view(np.float64)
     xy = xy * xy
     return xy[0::2] + xy[1::2]
@@ -140,8 +145,15 @@ def units(z: np.ndarray, keys) -> tuple[np.ndarray, np.ndarray]:
     """unit_vectors for complex z: (z / |z|, |z|), each part divided by the length.
 
     A zero z gets `fallback_directions` of its key; keys may be a function
-    that makes them, called only if some z is zero.
+    that makes them, called only if some z is zero. z may be one Python
+    complex number, and its key one int (then the same arithmetic in Python numbers).
     """
+    if isinstance(z, complex):
+        dist = math.sqrt(squared_abs(z))
+        if dist:  # (a NaN is true: it divides, as below)
+            return complex(z.real / dist, z.imag / dist), dist
+        x, y = fallback_directions(np.array([keys() if callable(keys) else keys]))[0].tolist()
+        return complex(x, y), dist
     dist = np.sqrt(squared_abs(z))
     if np.count_nonzero(dist) == len(dist):
         return (z.view(np.float64) / dist.repeat(2)).view(np.complex128), dist
