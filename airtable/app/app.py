@@ -55,8 +55,10 @@ IDLE_FPS = 12.0
 # A frame's physics steps stop after this share of the frame period (the rest is for
 # drawing): a table too heavy to step in real time runs in slow motion, not at a few frames a second.
 PHYSICS_SHARE = 0.6
-# Below this share of real time over the last second, the status line says the physics is behind.
-SLOW_SHARE = 0.95
+# Below this share of the steps asked for over the last second, the status line says the physics is
+# behind, until it runs above CAUGHT_UP_SHARE again.
+SLOW_SHARE = 0.9
+CAUGHT_UP_SHARE = 0.97
 IDLE_AFTER_S = 1.0  # input this recent keeps the full frame rate
 OUT_OF_VIEW = "the table is out of view: q brings it back"
 STILL_PX_PER_S = 0.5  # slower than this on screen, nothing visibly moves: the table idles
@@ -144,6 +146,7 @@ class App:
         self.message_lasts = False  # the message outlives a demo start (App.say)
         self.clock_s = 0.0  # time the app has run (sum of frame times)
         self.frame_dt_s = 0.0  # the current frame's time (held keys act in proportion)
+        self._said_behind = False  # the status line says the physics is behind (_behind)
         self.last_input_s = 0.0  # clock_s of the last input, local or a student's
         self._students_seen: tuple = ()  # the students' cursors when last looked at
         self.loop: IdlingLoop | None = None  # while run() runs
@@ -468,9 +471,9 @@ class App:
             parts.extend(feature.status_parts(for_students))  # hands off, the floor, the round, rewound
         if self.speed != 1.0:
             parts.append(f"slow motion x1/{round(1 / self.speed)}")
-        share = self.stepper.real_time_share
-        if share < SLOW_SHARE and not self.paused:
-            parts.append(f"physics at {share:.0%} of real time (the computer's most)")
+        if self._behind() and not self.paused:
+            kept = self.stepper.real_time_share * self.speed  # of real time: slow motion's own share taken in
+            parts.append(f"physics at {kept:.0%} of real time (the computer's most)")
         parts.append(f"t = {t.time_s:.2f} s")
         parts.append("F1: help")  # the students' windows have their own F1
         parts.append(gravity_label(t))
@@ -483,6 +486,13 @@ class App:
         else:
             parts.append(f"restitution: pucks {t.cr_puck:g}, walls {t.cr_wall:g}")
         return parts
+
+    def _behind(self) -> bool:
+        """Whether the physics fell behind what was asked of it: said below SLOW_SHARE of the steps, and
+        unsaid again only above CAUGHT_UP_SHARE (a pace near the line would make the status line flicker)."""
+        share = self.stepper.real_time_share
+        self._said_behind = share < (CAUGHT_UP_SHARE if self._said_behind else SLOW_SHARE)
+        return self._said_behind
 
     def status_line(self) -> str:
         return STATUS_SEPARATOR.join(self.status_parts())

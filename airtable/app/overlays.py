@@ -113,7 +113,7 @@ class OverlayValue:
         owner.overlays.set(self.name, bool(value))
 
 
-ESC_PAUSE_S = 0.5  # an Esc this soon after the last one is part of a burst
+ESC_PAUSE_S = 0.3  # an Esc this soon after the last one is part of a burst (a double tap is slower)
 
 
 class EscapeBurst:
