@@ -69,6 +69,8 @@ def repeat_max(cr: float) -> int:
     if cr <= 0.0:
         return REPEAT_MIN
     return max(REPEAT_MIN, math.ceil(math.log(REPEAT_DECAY) / math.log(cr)))
+
+
 # In two-step, pair hits are predicted when some puck moves this share of the smallest radius
 # in a step; below it nobody can pass through a puck, and the pair stage sees every hit.
 FAST_FRACTION = 0.5
@@ -150,7 +152,7 @@ def resolve_hits(pos, vel, radius, mass, size_m, dt: float, rules: Rules, neighb
     step.run()
     step.write_back()
     if past is not None:  # only those past a wall, or on a new path, may still be (resting, landed)
-        step.hits.maybe_past = np.array(sorted(set(past) | step.origin.keys()), dtype=np.intp)
+        step.hits.maybe_past = np.union1d(np.array(past, dtype=np.intp), step.changed.nonzero()[0])
     return step.hits
 
 
@@ -164,9 +166,8 @@ class _Step:
         self.queue: list[tuple] = []
         self.seq = 0  # breaks ties between events at one time: the earlier predicted first
         self.t_now = 0.0
-        self.origin: dict[int, complex] = {}  # the pucks whose path changed, and their new origin
-        self.changed = np.zeros(len(pos), dtype=bool)  # the same rows as a mask, and origins as an array,
-        self.zorigin = np.zeros(len(pos), dtype=complex)  # for paths of many pucks at once (`at_rows`)
+        self.changed = np.zeros(len(pos), dtype=bool)  # the pucks whose path changed ...
+        self.zorigin = np.zeros(len(pos), dtype=complex)  # ... and their new origins
         self.version: dict[int, int] = {}  # per puck: how many times its path changed
         self.hit_pairs: dict[tuple[int, int], int] = {}  # how many times each pair hit
         self.hits = Hits()
@@ -185,10 +186,9 @@ class _Step:
 
     def at(self, k: int, t: float) -> complex:
         """Where puck k is at time t of the step on its present path."""
-        o = self.origin.get(k)
-        if o is None:
+        if not self.changed.item(k):
             return self.zpos.item(k) + self.zvel.item(k) * (t - self.dt)
-        return o + self.zvel.item(k) * t
+        return self.zorigin.item(k) + self.zvel.item(k) * t
 
     def at_rows(self, rows: np.ndarray, t: float) -> np.ndarray:
         """Where the pucks `rows` are at time t of the step on their present paths (`at`, for many)."""
@@ -202,7 +202,7 @@ class _Step:
     def set_path(self, k: int, x: complex, v: complex) -> None:
         """Puck k is at x at t_now and goes on at v: a new origin, and its old predictions stale."""
         self.zvel[k] = v
-        self.origin[k] = self.zorigin[k] = x - v * self.t_now
+        self.zorigin[k] = x - v * self.t_now
         self.changed[k] = True
         self.version[k] = self.version.get(k, 0) + 1
         if self.partners is None:
@@ -221,12 +221,15 @@ class _Step:
 
     def add_everyone_near(self, k: int, end: complex, stray: float) -> None:
         """Puck k's path strays `stray` from its step end: its partners from every puck."""
-        reach = self.radius + (self.radius.item(k) + stray + self.reach_out)
-        near = (vectors.squared_abs(self.zpos - end) < reach * reach).nonzero()[0].tolist()
-        for other in near:
+        for other in self.near(k, end, stray + self.reach_out).tolist():
             if other != k:
                 self.extra.setdefault(k, set()).add(other)
                 self.extra.setdefault(other, set()).add(k)
+
+    def near(self, k: int, centre: complex, margin: float) -> np.ndarray:
+        """The rows (k's own among them) whose step ends are within reach of puck k at `centre` plus margin."""
+        reach = self.radius + (self.radius.item(k) + margin)
+        return (vectors.squared_abs(self.zpos - centre) < reach * reach).nonzero()[0]
 
     def partners_of(self, k: int) -> list[int]:
         """The pucks k may meet this step, in increasing order: hits at one time are resolved in the
@@ -237,8 +240,8 @@ class _Step:
 
     def write_back(self) -> None:
         """The pucks whose path changed end the step where their present path has them."""
-        for k, o in self.origin.items():
-            self.zpos[k] = o + self.zvel.item(k) * self.dt
+        for k in self.changed.nonzero()[0].tolist():
+            self.zpos[k] = self.zorigin.item(k) + self.zvel.item(k) * self.dt
         for k, dv in self.offset.items():
             self.zvel[k] += dv
 
@@ -263,9 +266,10 @@ class _Step:
         lim = FAST_FRACTION * self.radius / self.dt
         return self.speed_sq > lim * lim
 
-    def fast(self, k: int) -> bool:
-        """Whether puck k moves FAST_FRACTION of its radius in a step on its present path."""
-        return abs(self.zvel.item(k)) * self.dt > FAST_FRACTION * self.radius.item(k)
+    def fast(self, k):
+        """Whether puck k (a row, or an array of rows) moves FAST_FRACTION of its radius in a step on
+        its present path."""
+        return np.abs(self.zvel[k]) * self.dt > FAST_FRACTION * self.radius[k]
 
     def find_partners(self, neighbours) -> None:
         """The pairs that may meet during the step, on any path within 2 travels of the step's ends."""
@@ -298,8 +302,7 @@ class _Step:
         is_fast = np.zeros(len(self.zpos), dtype=bool)
         is_fast[fast] = True
         for f in fast.tolist():
-            reach = self.radius + (self.radius.item(f) + margin)
-            near = (vectors.squared_abs(self.zpos - self.zpos.item(f)) < reach * reach).nonzero()[0]
+            near = self.near(f, self.zpos.item(f), margin)
             near = near[(near != f) & (~is_fast.take(near) | (near > f))]  # a fast pair once
             parts_i.append(np.minimum(near, f))
             parts_j.append(np.maximum(near, f))
@@ -334,8 +337,7 @@ class _Step:
         step, in the pairs' order (numpy: a puck's partners, or a step's first pairs, at once)."""
         t_now, dt, rules = self.t_now, self.dt, self.rules
         if rules.pairs != "perfect-kiss":  # the pair stage sees the others overlapping, if they hit
-            fast_a = np.abs(self.zvel.take(a)) * dt > FAST_FRACTION * self.radius.take(a)
-            keep = (fast_a | (np.abs(self.zvel.take(b)) * dt > FAST_FRACTION * self.radius.take(b))).nonzero()[0]
+            keep = (self.fast(a) | self.fast(b)).nonzero()[0]
             a, b = a.take(keep), b.take(keep)
         d, w = self.at_rows(a, t_now) - self.at_rows(b, t_now), self.zvel.take(a) - self.zvel.take(b)
         reach = self.radius.take(a) + self.radius.take(b)
