@@ -90,10 +90,17 @@ class MomentaView:
 
 def momenta_around_collisions(table: AirTable) -> MomentaAround | None:
     """The momenta around the collisions of the table's last step; None if it had none."""
+    seen = _seen(table)
+    return None if seen is None else _momenta_around(*seen)
+
+
+def _seen(table: AirTable) -> tuple | None:
+    """What the momenta around the last step's collisions are made of (copied: the table steps on),
+    as _momenta_around's arguments; None if the step had no collision."""
     c = table.last_collisions
     if len(c) == 0:
         return None
-    return _momenta_around(float(table.time_s), c, table.vel_mps.copy(), table.mass_kg, table.color_rgb.copy())
+    return float(table.time_s), c, table.vel_mps.copy(), table.mass_kg.copy(), table.color_rgb.copy()
 
 
 def _momenta_around(t_s: float, c, vel_after: np.ndarray, mass_kg: np.ndarray, colors: np.ndarray) -> MomentaAround:
@@ -125,11 +132,9 @@ class MomentaLog:
         self._seen = self._latest = None
 
     def observe(self, table: AirTable) -> None:
-        c = table.last_collisions
-        if len(c):
-            mass = table.mass_kg.copy()
-            self._seen = (float(table.time_s), c, table.vel_mps.copy(), mass, table.color_rgb.copy())
-            self._latest = None
+        seen = _seen(table)
+        if seen is not None:
+            self._seen, self._latest = seen, None
 
     @property
     def latest(self) -> MomentaAround | None:
