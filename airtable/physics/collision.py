@@ -172,15 +172,6 @@ class Collisions:
     def __len__(self) -> int:
         return len(self.i)
 
-    @classmethod
-    def concatenate(cls, parts: list[Collisions]) -> Collisions:
-        """One record of all the parts."""
-        if not parts:
-            return cls.empty()
-        if len(parts) == 1:
-            return parts[0]
-        return cls(*(np.concatenate([getattr(p, f) for p in parts]) for f in cls.__dataclass_fields__))
-
     def take(self, k: np.ndarray) -> Collisions:
         """Only the collisions k (indices into this record)."""
         return Collisions(*(getattr(self, f).take(k, axis=0) for f in self.__dataclass_fields__))
