@@ -62,10 +62,12 @@ def find_window(display: str, title: str = "Air Table") -> str | None:
     # `xdotool search --name` misses SDL's windows on some builds; xwininfo lists them all, as
     # `0x200002 "Air Table - Demo 1": ("Air Table" "Air Table")`: the title, then the class,
     # which says "Air Table" before the app has set the title.
+    # A window of an app that just quit, or one SDL has not mapped, may come first: look on past it.
     for line in xwininfo(display, "-root", "-tree").splitlines():
         if line.split('": (')[0].strip().split(" ", 1)[-1].startswith(f'"{title}'):
             wid = str(int(line.split()[0], 16))
-            return wid if "IsViewable" in xwininfo(display, "-id", wid) else None
+            if "IsViewable" in xwininfo(display, "-id", wid):
+                return wid
     return None
 
 
