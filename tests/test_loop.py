@@ -6,7 +6,7 @@ import threading
 
 import pytest
 
-from airtable.app.loop import MAX_SIM_PER_FRAME_S, FixedStep, FpsCounter, FrameLoop
+from airtable.app.loop import IDLE_MAX_PERIOD_S, MAX_SIM_PER_FRAME_S, FixedStep, FpsCounter, FrameLoop, IdlingLoop
 
 
 class FakeClock:
@@ -127,6 +127,25 @@ def test_a_slow_frame_does_not_make_the_next_ones_burst():
     loop.run(frame, max_frames=4)
     assert clock.slept == pytest.approx([0.015, 0.015])  # after the 100 ms frame, no sleep, then the pace again
     assert dts[1] == pytest.approx(0.1)
+
+
+def test_a_still_window_redraws_at_the_idle_rate_or_less_often_if_a_frame_costs_much():
+    """A paused table of 10000 pucks at 4K took 27 ms a frame, 12 times a second: a fifth of a core."""
+    clock = FakeClock()
+    still = iter([False, True, True, True, True])
+    loop = IdlingLoop(60.0, 12.0, lambda: next(still), headless=True, clock=clock, sleep=clock.sleep)
+    work = iter([0.003, 0.003, 0.010, 0.027, 0.002])  # each frame's own work (s)
+
+    def frame(dt_s: float) -> None:
+        clock.now += next(work)
+        loop.after_frame()
+
+    loop.run(frame, max_frames=5)
+    # Moving: 1/60 s; still: 1/12 s for a cheap frame, 20 times a frame's cost above that (a 20th of
+    # the processor), at most 0.5 s (27 ms would be 0.54 s); a cheap frame again: 1/12 s.
+    periods = [work_s + slept for work_s, slept in zip([0.003, 0.003, 0.010, 0.027], clock.slept, strict=True)]
+    assert periods == pytest.approx([1 / 60, 1 / 12, 0.2, IDLE_MAX_PERIOD_S])
+    assert loop.period_s == pytest.approx(1 / 12)
 
 
 def test_frame_returning_false_or_stop_ends_the_loop():

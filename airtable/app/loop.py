@@ -168,6 +168,7 @@ class FrameLoop:
         self.clock = clock
         self.stop = threading.Event()
         self.sleep = sleep if sleep is not None else self.stop.wait
+        self.frame_began = 0.0  # (clock) when the frame running now began
 
     def run(
         self,
@@ -188,6 +189,7 @@ class FrameLoop:
                 dt_s, last = min(now - last, MAX_FRAME_S), now
                 elapsed_s = now - start
             ran += 1
+            self.frame_began = self.clock()
             if frame(dt_s) is False:
                 break
             if max_frames is not None and ran >= max_frames:
@@ -227,23 +229,45 @@ def signals_end_the_run(stop: Callable[[], None]) -> Iterator[None]:
             signal.signal(sig, handler if handler is not None else signal.SIG_DFL)
 
 
+# A still window's frames take at most this share of the processor: a frame that costs much (10000
+# pucks at 3840x2160 take 27 ms) comes less often than idle_fps, but at least every IDLE_MAX_PERIOD_S
+# (a message's end, a student's cursor are shown that late at most).
+IDLE_CPU_SHARE = 0.05
+IDLE_MAX_PERIOD_S = 0.5
+
+
 class IdlingLoop(FrameLoop):
     """The windows' loop (the teacher's and each student's): full rate while anything moves or input
-    came lately, `idle_fps` while the window is still (`still()` says so after each frame), and
-    while idle the wait between frames ends at once on input (a pygame event)."""
+    came lately, `idle_fps` while the window is still (`still()` says so after each frame; less often
+    if a frame costs more than IDLE_CPU_SHARE of that), and while idle the wait between frames ends
+    at once on input (a pygame event)."""
 
-    def __init__(self, fps: float, idle_fps: float, still: Callable[[], bool], headless: bool, **kw) -> None:
+    def __init__(
+        self,
+        fps: float,
+        idle_fps: float,
+        still: Callable[[], bool],
+        headless: bool,
+        sleep: Callable[[float], object] | None = None,
+        **kw,
+    ) -> None:
+        """`sleep`: how to wait where no input can end the wait (headless, or at the full rate)."""
         super().__init__(fps=fps, sleep=self._sleep, **kw)
+        self._plain_sleep = sleep if sleep is not None else self.stop.wait
         self.full_period_s, self.idle_period_s = 1.0 / fps, 1.0 / idle_fps
         self.still, self.headless = still, headless
 
     def after_frame(self) -> None:
         """Call at the end of each frame: the next one comes at the full or the idle rate."""
-        self.period_s = self.idle_period_s if self.still() else self.full_period_s
+        if not self.still():
+            self.period_s = self.full_period_s
+            return
+        took_s = self.clock() - self.frame_began
+        self.period_s = max(self.idle_period_s, min(took_s / IDLE_CPU_SHARE, IDLE_MAX_PERIOD_S))
 
     def _sleep(self, seconds: float) -> None:
         if self.headless or self.period_s == self.full_period_s:
-            self.stop.wait(seconds)
+            self._plain_sleep(seconds)
             return
         import pygame  # only the windows idle this way; the load tool's loops have no pygame
 
