@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import dataclasses
+
 import numpy as np
 import pygame
 import pytest
@@ -225,3 +227,59 @@ def test_the_margins_and_the_table_cover_the_screen_once(x, y, w, h):
         assert screen.contains(m)
         cover[m.top : m.bottom, m.left : m.right] += 1
     assert (cover == 1).all()
+
+
+@pytest.mark.parametrize("size", [(493, 432), (640, 480), (1280, 720), (3840, 2160)])
+def test_every_demos_lecture_notes_fit_the_notes_panel_whole(size) -> None:
+    """The gas's notes in a window on a 640x480 screen lost their last line, with no sign of it."""
+    from airtable.app.demo_loader import BUILTIN_DIR, discover
+
+    demos, _ = discover([BUILTIN_DIR])
+    win = window(size)
+    win.draw(scene(status="t = 5.35 s | F1: help | gravity off"))  # (drawing places the status bar)
+    for demo in demos.values():
+        notes = demo.notes or "(no notes)"
+        assert win.draw_panel(demo.label(0), [notes], large=True) == 1, demo.key  # one page: nothing cut
+    if size[1] >= 720:  # where it fits, in the large type
+        gas = demos["0p"]
+        body = panel_view.body_rect(win.panel_rect().size, win.big_font, win.big_font, win.label_font)
+        assert len(panel_view.layout(win.big_font, [("", (gas.notes,))], body.size)) == 1
+
+
+@given(
+    st.lists(st.text("abcdefghijklmnopqrstuvwxyzäöüжщ", min_size=1, max_size=12), min_size=1, max_size=400),
+    st.integers(120, 900),
+    st.integers(30, 400),
+)
+def test_a_paragraph_taller_than_a_column_goes_on_in_the_next_column_or_page(words, width, height) -> None:
+    """A long paragraph was cut at the column's foot, and the panel said it had one page."""
+    pygame.font.init()
+    font = pygame.font.Font(None, 22)
+    pages = panel_view.layout(font, [("", (" ".join(words),))], (width, height))
+    shown = [piece for page in pages for piece in page]
+    # Every letter in order, nothing lost (a word wider than the column is broken across lines).
+    assert "".join(p.text for p in shown).replace(" ", "") == "".join(words)
+    for page in pages:
+        assert all(p.y + font.get_linesize() <= max(height, font.get_linesize()) for p in page)
+
+
+def test_notes_too_long_for_the_window_turn_pages_with_l_and_say_so() -> None:
+    from airtable.app.app import App
+    from airtable.app.demo_loader import BUILTIN_DIR, discover
+
+    demos, _ = discover([BUILTIN_DIR])
+    long_notes = " ".join(["A teacher's own demo with a very long lecture note."] * 60)
+    demos = {"1": dataclasses.replace(demos["1"], notes=long_notes)}
+    app = App(demos, demo_key="1", headless=True, window_size_px=(640, 480))
+    key = pygame.event.Event(pygame.KEYDOWN, key=pygame.K_l, mod=0, unicode="l")
+    pygame.event.post(key)
+    app.frame(1 / 60)
+    pages = app.panels.notes_pages
+    assert pages > 1 and app.panels.show_notes
+    seen = []
+    for _ in range(pages):  # L turns the pages, then closes the notes
+        seen.append((app.panels.notes_page, app.panels.show_notes))
+        pygame.event.post(key)
+        app.frame(1 / 60)
+    assert seen == [(k, True) for k in range(pages)]
+    assert not app.panels.show_notes and app.panels.notes_page == 0

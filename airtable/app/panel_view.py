@@ -125,8 +125,12 @@ def layout(
             if x < 0:  # a key beside the first line of its description
                 pages[-1].append(Piece(x0, y, text, color))
                 continue
-            if used >= rows_per_col:  # one block taller than a column: cut only then
-                break
+            if used >= rows_per_col:  # a block taller than a column goes on in the next one
+                col, used = col + 1, 0
+                if col == n_cols:
+                    pages.append([])
+                    col = 0
+                x0 = col * (col_w + gap)
             pages[-1].append(Piece(x0 + x, used * line_h, text, color))
             used += 1
     return pages
@@ -148,8 +152,10 @@ def render_panel(
     title_font: pygame.font.Font,
     small_font: pygame.font.Font,
     page: int = 0,
+    page_key: str = "F1",
 ) -> tuple[pygame.Surface, int]:
-    """An opaque panel of `size_px` with `title` and the page `page` of its text, and the page count."""
+    """An opaque panel of `size_px` with `title` and the page `page` of its text, and the page count;
+    `page_key` turns the pages (the note under a text of several says so)."""
     pad = font.get_height()
     panel = pygame.Surface(size_px, pygame.SRCALPHA)
     panel.fill(PANEL_COLOR)
@@ -163,7 +169,7 @@ def render_panel(
     for piece in pages[page]:
         panel.blit(font.render(piece.text, True, piece.color), (body.x + piece.x, body.y + piece.y))
     if len(pages) > 1:
-        then = "press F1 for the next" if page + 1 < len(pages) else "F1 again closes it"
+        then = f"press {page_key} for the next" if page + 1 < len(pages) else f"{page_key} again closes it"
         note = small_font.render(f"page {page + 1} of {len(pages)}: {then}", True, DIM_TEXT)
         panel.blit(note, note.get_rect(bottomright=(size_px[0] - pad, size_px[1] - pad // 4)))
     return panel, len(pages)

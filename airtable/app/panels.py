@@ -47,6 +47,7 @@ class Panels(Feature):
         super().__init__(host)
         self.key_rows = key_rows  # the help's rows: the app's whole key table
         self.help_page, self.help_pages = 0, 1
+        self.notes_page, self.notes_pages = 0, 1  # (notes too long for the window go on pages too)
         self.quit_armed_until = -1.0  # clock_s until which a second Esc quits
         self._escapes = EscapeBurst()
 
@@ -60,8 +61,8 @@ class Panels(Feature):
         """Close what is on top (a panel, else the chart, values or momenta); False if nothing was open."""
         self.panel()  # a lapsed quit question first
         closing = self.overlays.top()
-        if closing == "help":
-            self.help_page = 0
+        if closing in ("help", "notes"):
+            setattr(self, f"{closing}_page", 0)
         return closing is not None and self.overlays.close(closing)
 
     def handle_event(self, event: pygame.event.Event) -> bool:
@@ -129,16 +130,24 @@ class Panels(Feature):
         self.menu = DemoMenu([(key, demo.title) for key, demo in host.demos.items()], current=host.demo_key)
 
     def toggle_notes(self) -> None:
-        self.show_notes = not self.show_notes
+        """L: the demo's lecture notes; again for their next page, if they have more than one; then closed."""
+        self._turn_page("notes")
 
     def toggle_help(self) -> None:
         """F1: help; again for its next page, if it has more than one; then closed."""
-        if not self.show_help:
-            self.show_help, self.help_page = True, 0
-        else:
-            self.help_page += 1
-            self.show_help = self.help_page < self.help_pages
-            self.help_page = self.help_page if self.show_help else 0
+        self._turn_page("help")
+
+    def _turn_page(self, panel: str) -> None:
+        """Open `panel` ("help" or "notes") at its first page, or show its next page, or close it after its last."""
+        page = f"{panel}_page"
+        if not getattr(self, f"show_{panel}"):
+            setattr(self, f"show_{panel}", True)
+            setattr(self, page, 0)
+            return
+        following = getattr(self, page) + 1
+        more = following < getattr(self, f"{panel}_pages")
+        setattr(self, f"show_{panel}", more)
+        setattr(self, page, following if more else 0)
 
     # ------------------------------------------------------------ drawing
 
@@ -158,7 +167,10 @@ class Panels(Feature):
             keys = [(b.label, b.help) for b in self.key_rows]
             self.help_pages = w.draw_panel("Keys", keys, side_title="Demos", side_rows=rows, page=self.help_page)
         elif panel == "notes":
-            w.draw_panel(host.demo.label(host.variation), [host.demo.notes or "(no notes)"], large=True)
+            notes = [host.demo.notes or "(no notes)"]
+            self.notes_pages = w.draw_panel(
+                host.demo.label(host.variation), notes, large=True, page=self.notes_page, page_key="L"
+            )
 
     def _error_text(self) -> tuple[str, list[str]]:
         """The demo error panel's title and lines: what failed, and how to try again."""
@@ -170,7 +182,7 @@ class Panels(Feature):
 
     bindings = (
         Binding("Tab", "demo menu: every demo; arrows and Enter, or type its key", {pygame.K_TAB: open_menu}),
-        Binding("l", "lecture notes for this demo", {pygame.K_l: toggle_notes}),
+        Binding("l", "lecture notes for this demo (again: next page)", {pygame.K_l: toggle_notes}),
         Binding("F1", "this help screen (again: next page); F2-F5: the room", {pygame.K_F1: toggle_help}),
         Binding("Esc", "close what is open (the newest first); else asks: Esc again quits", {pygame.K_ESCAPE: escape}),
     )

@@ -229,10 +229,11 @@ class GameWindow:
             font = self._fonts[px] = pygame.font.Font(None, px)
         return font
 
-    def _panel_font(self, sections, rect: pygame.Rect) -> pygame.font.Font:
-        """The largest type, down to the smallest readable size, that fits the panel on one page."""
+    def _panel_font(self, sections, rect: pygame.Rect, largest: str = "text") -> pygame.font.Font:
+        """The largest type from the size of `largest` (a FONT_SIZES role) down to the smallest readable
+        size that fits the panel on one page."""
         best = None
-        for px in range(self._size_px("text"), FONT_SIZES["label"][1] - 1, -2):
+        for px in range(self._size_px(largest), FONT_SIZES["label"][1] - 1, -2):
             font = self._font_px(px)
             pages = len(
                 panel_view.layout(font, sections, panel_view.body_rect(rect.size, font, self.big_font, font).size)
@@ -512,24 +513,33 @@ class GameWindow:
         side_title: str = "",
         side_rows: Sequence[panel_view.Row] = (),
         page: int = 0,
+        page_key: str = "F1",
     ) -> int:
         """A translucent panel over the table: a title, then rows of text; returns its number of pages.
 
         A row is either a line of text (wrapped to the panel) or a (key,
         description) pair shown in two columns, as on the help screen.
         `side_rows`, if any, follow under their own `side_title`. Rows flow
-        into columns and, if they still do not fit, onto pages: `page` picks one.
+        into columns and, if they still do not fit, onto pages: `page` picks one, `page_key` turns them.
+        `large`: in the large type where the text fits on one page.
         """
         sections = [("", tuple(rows))]
         if side_rows:
             sections.append((side_title, tuple(side_rows)))
         rect = self.panel_rect()
-        key = (title, tuple(sections), large, rect.size, page)
+        key = (title, tuple(sections), large, rect.size, page, page_key)
         cached = self._panels.get(key)
         if cached is None:  # laying out and rendering text is slow: once per content and size
-            font = self.big_font if large else self._panel_font(sections, rect)
+            font = self._panel_font(sections, rect, "big" if large else "text")
             cached = panel_view.render_panel(
-                rect.size, title, sections, font=font, title_font=self.big_font, small_font=self.label_font, page=page
+                rect.size,
+                title,
+                sections,
+                font=font,
+                title_font=self.big_font,
+                small_font=self.label_font,
+                page=page,
+                page_key=page_key,
             )
             if len(self._panels) >= 8:
                 self._panels.clear()
