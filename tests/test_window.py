@@ -283,3 +283,18 @@ def test_notes_too_long_for_the_window_turn_pages_with_l_and_say_so() -> None:
         app.frame(1 / 60)
     assert seen == [(k, True) for k in range(pages)]
     assert not app.panels.show_notes and app.panels.notes_page == 0
+
+
+@pytest.mark.parametrize("size", [(640, 480), (1280, 720), (1920, 1080), (3840, 2160), (1000, 300), (400, 900)])
+def test_panels_leave_the_frame_rate_and_paused_in_view(size) -> None:
+    """Help at 1280x720 full screen covered the frame-rate box (--stats) in the top right corner."""
+    win = window(size)
+    win.show_fps = True
+    win.draw(scene(status="   ".join(["PAUSED", "t = 5.35 s", "F1: help"]), fps=59.7))
+    corner = [box for box in win.label_boxes if box.right > win.surface.get_width() - win.layout.side_px]
+    corner = [box for box in corner if box.top < win.hud_bottom_px and box.left > win.layout.side_px]
+    panel = win.panel_rect()
+    if win.layout.side_px:  # in the margins layout the two boxes sit in the right margin's top
+        assert len(corner) == 2
+    assert panel.collidelist(corner) == -1
+    assert panel.height >= 4 * win.font.get_linesize()

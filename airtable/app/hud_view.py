@@ -99,9 +99,10 @@ def draw_hud(
     lines: Sequence[HudLine],
     fps: float | None,
     paused: bool,
-) -> tuple[list[pygame.Rect], int]:
+) -> tuple[list[pygame.Rect], int, int]:
     """The title, heads-up lines, frame rate (None: not shown) and PAUSED in their places; returns
-    the boxes drawn (for the aids to keep clear of) and how far down the window the text goes."""
+    the boxes drawn (for the aids to keep clear of), how far down the window the text goes, and how
+    far the top right corner's boxes (frame rate, PAUSED) go beside the table (0: none there)."""
     if layout.side_px:
         return _draw_in_margins(surface, layout, style, title, lines, fps, paused)
     return _draw_in_band(surface, layout, style, title, lines, fps, paused)
@@ -133,7 +134,7 @@ def _paused_box(surface, style: HudStyle, font, topright, width_px: int) -> pyga
     return box
 
 
-def _draw_in_band(surface, layout, style, title, lines, fps, paused) -> tuple[list[pygame.Rect], int]:
+def _draw_in_band(surface, layout, style, title, lines, fps, paused) -> tuple[list[pygame.Rect], int, int]:
     w = surface.get_width()
     font = style.font
     pad, line_h = font.get_height() // 2, font.get_linesize()
@@ -150,10 +151,10 @@ def _draw_in_band(surface, layout, style, title, lines, fps, paused) -> tuple[li
     for line in fold_lines(lines, BAND_LINES - 1, font, right - pad):
         y += line_h
         surface.blit(font.render(fit_parts(font, [_text(line)], right - pad), True, _color(line, style.dim)), (pad, y))
-    return [band], layout.top_px
+    return [band], layout.top_px, 0
 
 
-def _draw_in_margins(surface, layout, style, title, lines, fps, paused) -> tuple[list[pygame.Rect], int]:
+def _draw_in_margins(surface, layout, style, title, lines, fps, paused) -> tuple[list[pygame.Rect], int, int]:
     w, _ = surface.get_size()
     font = style.font
     pad, line_h = font.get_height() // 2, font.get_linesize()
@@ -170,4 +171,5 @@ def _draw_in_margins(surface, layout, style, title, lines, fps, paused) -> tuple
     if paused:
         top = (right[-1].bottom if right else pad // 2) + pad
         right.append(_paused_box(surface, style, style.big_font, (w - pad, top), column))
-    return boxes + right, max([y, *(box.bottom for box in right)])
+    corner = max((box.bottom for box in right), default=0)
+    return boxes + right, max(y, corner), corner

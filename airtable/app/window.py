@@ -125,6 +125,7 @@ class GameWindow:
         self._panels: dict[tuple, tuple[pygame.Surface, int]] = {}
         self._status_bar: pygame.Surface | None = None
         self.hud_bottom_px = 0  # below the title and HUD lines: panels start under it
+        self.corner_bottom_px = 0  # below the frame rate and PAUSED in the top right corner (margins layout)
         self.layout = TextLayout(0, 0)  # where the text goes (hud_view.py)
         self.show_fps = False  # the frame rate in a corner (--stats): not for the room
         self.label_boxes: list[pygame.Rect] = []  # text drawn this frame; the aids place labels around it
@@ -445,7 +446,8 @@ class GameWindow:
         parts = [p for p in parts if p != PAUSED]
         style = HudStyle(self.font, self.big_font, TEXT_COLOR, DIM_TEXT, PAUSED_COLOR, self.line_px(3))
         fps = scene.fps if self.show_fps else None
-        boxes, self.hud_bottom_px = draw_hud(self.surface, self.layout, style, scene.title, hud, fps, paused)
+        drawn = draw_hud(self.surface, self.layout, style, scene.title, hud, fps, paused)
+        boxes, self.hud_bottom_px, self.corner_bottom_px = drawn
         self.label_boxes.extend(boxes)
         bar_h = self.status_bar_px
         self.status_top_px = h - bar_h if parts else h
@@ -469,10 +471,11 @@ class GameWindow:
 
     def panel_rect(self) -> pygame.Rect:
         """Where panels go: under the top band, or between the side margins (the join line stays
-        visible either way), above the status bar."""
+        visible either way) and under the frame rate and PAUSED in the top right corner, above the
+        status bar."""
         w, h = self.surface.get_size()
         pad = self.font.get_height() // 2
-        top = max(pad, self.layout.top_px + pad // 2)
+        top = max(pad, self.layout.top_px + pad // 2, self.corner_bottom_px + pad // 2)
         bottom = min(h - pad, self.status_top_px - pad // 2)
         left = max(pad, w // 40, self.layout.side_px)  # the left margin's text stays in view
         right = w - max(pad, w // 40)
