@@ -11,6 +11,7 @@ from conftest import FRAME_S, frames_until, post_key, press
 
 from airtable.app.app import App
 from airtable.app.demo_loader import BUILTIN_DIR, discover
+from airtable.app.panel_view import ACCENT
 from airtable.cli import main
 from airtable.model import aids
 from airtable.physics.table import AirTable
@@ -93,7 +94,7 @@ def test_inspector_shows_the_puck_under_the_cursor(demos):
     app = make_app(demos, "1")
     texts: list[str] = []
     original = app.painter.inspector
-    app.painter.inspector = lambda point, lines: (texts.extend(lines), original(point, lines))
+    app.painter.inspector = lambda point, r, lines: (texts.extend(lines), original(point, r, lines))
     puck = app.table.pucks[0]
     puck.vel_mps = (0.0, 0.0)
     x, y = app.env.to_screen(puck.pos_m)
@@ -107,6 +108,31 @@ def test_inspector_shows_the_puck_under_the_cursor(demos):
     texts.clear()
     app.frame(FRAME_S)
     assert texts == []
+
+
+def test_the_inspector_follows_the_puck_it_was_pressed_on_and_rings_it(demos):
+    """In a gas the puck under a still cursor changed every frame: the inspector named a new one each time."""
+    app = make_app(demos, "1")
+    shown: list[tuple[str, tuple[float, float]]] = []
+    original = app.painter.inspector
+    app.painter.inspector = lambda point, r, lines: (shown.append((lines[0], tuple(point))), original(point, r, lines))
+    puck = app.table.pucks[0]
+    puck.vel_mps = (1.5, 0.0)  # it leaves the still cursor within a few frames
+    x, y = app.env.to_screen(puck.pos_m)
+    pygame.event.post(pygame.event.Event(pygame.MOUSEMOTION, pos=(int(x), int(y)), rel=(0, 0), buttons=(0, 0, 0)))
+    post_key(pygame.K_i)
+    for _ in range(30):  # half a second: it moves 0.75 m, three of its radii
+        app.frame(FRAME_S)
+    assert {name for name, _ in shown} == {"puck 1"}
+    assert len(shown) == 30 and shown[-1][1][0] - shown[0][1][0] > 0.5  # followed where it went
+    ring = pygame.surfarray.array3d(app.window.surface)
+    px = app.env.to_screen(puck.pos_m)
+    r_px = int(0.25 * app.env.px_per_m + 2 * app.window.line_px(2))
+    edge = ring[int(px[0]) + r_px - 1 : int(px[0]) + r_px + 2, int(px[1])]
+    assert any(tuple(c) == ACCENT for c in edge)  # the ring just outside it
+    post_key(pygame.K_i, down=False)
+    app.frame(FRAME_S)
+    assert app.aids.inspected is None  # let go: the next press picks afresh
 
 
 def test_slow_motion_runs_fewer_steps_of_the_same_size(demos):

@@ -15,7 +15,7 @@ from collections.abc import Sequence
 import numpy as np
 import pygame
 
-from airtable.app.panel_view import DIM_TEXT, TEXT_COLOR
+from airtable.app.panel_view import ACCENT, DIM_TEXT, TEXT_COLOR
 from airtable.app.panel_view import wrap as _wrap
 from airtable.model.aids import VectorScale
 from airtable.model.readout import fixed, readable
@@ -394,10 +394,18 @@ class AidsPainter:
 
     # ------------------------------------------------------------ inspector
 
-    def inspector(self, point_m, lines: Sequence[str]) -> None:
+    def inspector(self, point_m, radius_m: float, lines: Sequence[str]) -> None:
+        """The inspected puck ringed, its `lines` beside it."""
         x, y = self._px(point_m)
+        lw = self.w.line_px(2)
+        r = max(round(radius_m * self.w.env.px_per_m) + 2 * lw, 3 * lw)  # just outside the puck, seen on a dot too
+        pygame.draw.circle(self.w.surface, ACCENT, (x, y), r, lw)
         self.label(
-            [(line, TEXT_COLOR) for line in lines], (x, y), gap=self.w.font.get_height(), font=self.w.font, always=True
+            [(line, TEXT_COLOR) for line in lines],
+            (x, y),
+            gap=max(r, self.w.font.get_height()),
+            font=self.w.font,
+            always=True,
         )
 
 

@@ -38,6 +38,8 @@ class Aids(Feature):
         self.show_annotations = False
         self.vectors = 0  # 0 off, 1 velocity, 2 momentum
         self.inspecting = False  # i is held (set again every frame it is)
+        self.inspected = None  # the puck i was pressed on, followed while i is held (in a gas the
+        # puck under a still cursor changes every frame)
         self.collision_log = aids.CollisionLog()
         self.chart = aids.EnergyChart()
 
@@ -76,10 +78,14 @@ class Aids(Feature):
             draw_vectors(paint, t, self.vectors, held, forces)
         if self.show_annotations:
             draw_annotations(paint, self.collision_log.live(host.clock_s), host.clock_s)
-        if self.inspecting:
-            puck = t.puck_at(host.env.to_world(host.mouse_px))
-            if puck is not None:
-                paint.inspector(puck.pos_m, inspector_lines(t, puck, self.chart.scale))
+        if not self.inspecting:
+            self.inspected = None
+        else:
+            if self.inspected is None or not self.inspected.alive:
+                self.inspected = t.puck_at(host.env.to_world(host.mouse_px))
+            if self.inspected is not None:
+                puck = self.inspected
+                paint.inspector(puck.pos_m, puck.radius_m, inspector_lines(t, puck, self.chart.scale))
         self.inspecting = False  # until the held key says so again
 
     # ------------------------------------------------------------ keys
@@ -117,5 +123,7 @@ class Aids(Feature):
         Binding(
             "m / b", "chart: move to the next corner / big or small", {pygame.K_m: move_chart, pygame.K_b: resize_chart}
         ),
-        Binding("i (hold)", "inspect the puck under the cursor", {pygame.K_i: inspect}, held=True),
+        Binding(
+            "i (hold)", "inspect the puck under the cursor (followed while held)", {pygame.K_i: inspect}, held=True
+        ),
     )

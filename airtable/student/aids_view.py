@@ -123,4 +123,4 @@ def _inspect(paint: AidsPainter, scene: Scene, state: StudentAids, mouse_m) -> N
     v = state.velocities(len(pos))
     if v is not None:
         lines.append(f"speed {np.hypot(*v[k]):.3g} m/s (from the snapshots)")
-    paint.inspector(pos[k], lines)
+    paint.inspector(pos[k], float(scene.radius_m[k]), lines)
