@@ -45,6 +45,9 @@ from collections.abc import Callable, Iterator
 MAX_SIM_PER_FRAME_S = 0.1
 # A real frame longer than this (the process was stopped) counts as this long.
 MAX_FRAME_S = 0.25
+# A frame's physics takes at most this much real time, however long drawing the last frame took:
+# a window that draws slowly (4K without a GPU) still answers input a few times a second.
+MAX_PHYSICS_PER_FRAME_S = 0.1
 
 
 class FixedStep:
@@ -90,7 +93,7 @@ class FixedStep:
         start = self.clock()
         budget = self.budget_s
         if budget is not None and self._ended is not None:  # at least the rest of the last frame
-            budget = min(max(budget, start - self._ended), MAX_SIM_PER_FRAME_S)
+            budget = min(max(budget, start - self._ended), MAX_PHYSICS_PER_FRAME_S)
         ran = 0
         while ran < asked and step():
             ran += 1
