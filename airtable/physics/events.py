@@ -39,7 +39,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from airtable.physics import broadphase, collision, vectors
+from airtable.physics import broadphase, collision, either, vectors
 from airtable.physics.collision import PairRecords
 from airtable.physics.walls import room_to_walls
 
@@ -74,6 +74,10 @@ def repeat_max(cr: float) -> int:
 # In two-step, pair hits are predicted when some puck moves this share of the smallest radius
 # in a step; below it nobody can pass through a puck, and the pair stage sees every hit.
 FAST_FRACTION = 0.5
+# A puck whose path changed has its hits with up to this many partners predicted one by one in
+# Python numbers (a few microseconds each), with more at once in numpy (some sixty calls whatever
+# their number): the same lines either way (either.py), the same bits.
+FEW_PARTNERS = 10
 # Fast pucks look for their partners each over every puck when that costs at most this many
 # looks (fast pucks times pucks), or less than the grid would (find_partners).
 FAST_SEARCH_WORK = 2_000_000
@@ -184,8 +188,10 @@ class _Step:
 
     # ------------------------------------------------------------ paths
 
-    def at(self, k: int, t: float) -> complex:
-        """Where puck k is at time t of the step on its present path."""
+    def at(self, k, t: float):
+        """Where puck k is at time t of the step on its present path (a row: complex; rows: at_rows)."""
+        if isinstance(k, np.ndarray):
+            return self.at_rows(k, t)
         if not self.changed.item(k):
             return self.zpos.item(k) + self.zvel.item(k) * (t - self.dt)
         return self.zorigin.item(k) + self.zvel.item(k) * t
@@ -332,36 +338,43 @@ class _Step:
         by_pair = np.lexsort((j, i))  # in order of (i, j), however the pairs were found (partners_of)
         return i.take(by_pair), j.take(by_pair)
 
-    def predict_pairs(self, a: np.ndarray, b: np.ndarray) -> None:
+    def predict_pairs(self, a, b) -> None:
         """Queue the next hit of each pair (a[k], b[k]) on their present paths, if it comes within the
-        step, in the pairs' order (numpy: a puck's partners, or a step's first pairs, at once)."""
-        t_now, dt, rules = self.t_now, self.dt, self.rules
+        step, in the pairs' order: numpy arrays of rows (a step's first pairs, or a puck's many partners,
+        at once), or one pair (a and b ints) in Python numbers, by the same lines (either.py)."""
+        t, speed = self.next_hit(a, b)
+        ok = t <= self.dt  # (inf where they never meet)
+        rules = self.rules
         if rules.pairs != "perfect-kiss":  # the pair stage sees the others overlapping, if they hit
-            keep = (self.fast(a) | self.fast(b)).nonzero()[0]
-            a, b = a.take(keep), b.take(keep)
-        d, w = self.at_rows(a, t_now) - self.at_rows(b, t_now), self.zvel.take(a) - self.zvel.take(b)
-        reach = self.radius.take(a) + self.radius.take(b)
-        t, speed = collision.contact_time(d, w, reach)
-        t = t_now + np.where(t > 0.0, t, 0.0)  # overlapping and approaching (by round-off): they hit now
-        soon = (t <= dt).nonzero()[0]  # (inf where they never meet)
-        a, b, d, w, reach, t, speed = (x.take(soon) for x in (a, b, d, w, reach, t, speed))
-        if rules.pairs != "perfect-kiss":
-            caught, t_p, u = _caught_overlapping(d + w * (dt - t_now), w, reach)
-            if rules.pairs == "off":  # seen overlapping: velocities only, at the step's end (the pair stage's)
-                keep = (~caught).nonzero()[0]
-                a, b, t, speed = a.take(keep), b.take(keep), t.take(keep), speed.take(keep)
-            else:  # the course's case: resolved t_p before the step's end
-                t, speed = np.where(caught, np.maximum(dt - t_p, t_now), t), np.where(caught, u, speed)
-        ok = np.ones(len(a), dtype=bool)
+            ok &= self.fast(a) | self.fast(b)
         if rules.rest is not None:  # slower: a resting contact, the contact stage's
-            ok &= speed > np.maximum(rules.rest.take(a), rules.rest.take(b))
-        if rules.held is not None and len(a):  # pressed on each other in the last step: resting
-            ok &= ~rules.held(np.minimum(a, b), np.maximum(a, b))
-        for k in ok.nonzero()[0].tolist():
-            pair = (a.item(k), b.item(k))
+            ok &= speed > either.maximum(either.take(rules.rest, a), either.take(rules.rest, b))
+        if rules.held is not None and either.count(ok):  # pressed on each other in the last step: resting
+            ok &= ~_held(rules.held, a, b)
+        for k in ok.nonzero()[0].tolist() if isinstance(ok, np.ndarray) else [None] if ok else []:
+            pair = (a, b) if k is None else (a.item(k), b.item(k))
             if rules.cr_puck < 1.0 and self.hit_pairs.get(pair, 0) >= repeat_max(rules.cr_puck):
                 continue
-            self.push(t.item(k), *pair)
+            self.push(t if k is None else t.item(k), *pair)
+
+    def next_hit(self, a, b):
+        """(t, u) for the pairs (a, b) on their present paths: when they next hit (s into the step; inf if
+        never) and how fast they then approach along the normal (m/s); arrays, or one pair (predict_pairs).
+
+        In two-step, a hit the step's end would catch overlapping and approaching comes t_p before the
+        end (the course's case); in "off", never (the pair stage sees it overlapping).
+        """
+        t_now, dt, mode = self.t_now, self.dt, self.rules.pairs
+        d, w = self.at(a, t_now) - self.at(b, t_now), either.take(self.zvel, a) - either.take(self.zvel, b)
+        reach = either.take(self.radius, a) + either.take(self.radius, b)
+        t, speed = collision.contact_time(d, w, reach)
+        t = t_now + either.where(t > 0.0, t, 0.0)  # overlapping and approaching (by round-off): they hit now
+        if mode == "perfect-kiss":
+            return t, speed
+        caught, t_p, u = _caught_overlapping(d + w * (dt - t_now), w, reach)
+        if mode == "off":
+            return either.where(caught, math.inf, t), speed
+        return either.where(caught, either.maximum(dt - t_p, t_now), t), either.where(caught, u, speed)
 
     def predict_walls(self, k: int) -> None:
         """Queue puck k's next wall hit on its present path, if it comes within the step."""
@@ -383,9 +396,12 @@ class _Step:
         if self.rules.walls:
             self.predict_walls(k)
         if self.partners is not None:
-            others = np.array(self.partners_of(k), dtype=np.intp)
-            if len(others):
-                self.predict_pairs(np.full(len(others), k), others)
+            others = self.partners_of(k)
+            if len(others) > FEW_PARTNERS:  # at once in numpy (a fast puck in a crowd)
+                self.predict_pairs(np.full(len(others), k), np.array(others, dtype=np.intp))
+                return
+            for other in others:  # one by one in Python numbers
+                self.predict_pairs(k, other)
 
     def push(self, t: float, a: int, b: int) -> None:
         """Queue a hit of a with b (b < 0: the wall across axis -1 - b), as their paths are now."""
@@ -474,12 +490,20 @@ class _Step:
         self.hit_pairs[a, b] = self.hit_pairs.get((a, b), 0) + 1
 
 
+def _held(held: Callable[[np.ndarray, np.ndarray], np.ndarray], a, b):
+    """Whether the contacts hold each pair (a, b) (Rules.held, which takes pairs i < j): arrays of rows,
+    or one pair (then a bool)."""
+    if isinstance(a, np.ndarray):
+        return held(np.minimum(a, b), np.maximum(a, b))
+    return bool(held(np.array([min(a, b)]), np.array([max(a, b)])).item(0))
+
+
 def _caught_overlapping(d, w, reach):
     """(caught, t_p, u) for a pair d = x1 - x2 apart at the step's end, approaching at w = v1 - v2 there:
     whether the step ends with the pair overlapping and approaching (two-step's case), its penetration
     time t_p = overlap / u and u, the approach speed along the line of centres. One pair (complex d
     and w: caught a bool) or many (numpy arrays; t_p and u are 0 where not caught)."""
-    dist = abs(d)
+    dist = vectors.length(d)
     if isinstance(dist, float):
         u = -vectors.dot(d, w) / dist if dist > 0.0 else 0.0
         caught = dist < reach and u > 0.0

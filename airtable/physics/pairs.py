@@ -37,7 +37,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from airtable.physics import broadphase, collision, vectors
+from airtable.physics import broadphase, collision, either, vectors
 from airtable.physics.collision import CORRECTION_MODES, PairRecords
 
 if TYPE_CHECKING:
@@ -179,7 +179,7 @@ def time_back_to_contact(d, w, reach, dt_s: float) -> tuple[np.ndarray, np.ndarr
     it (it touched at most dt_s ago). t is 0 where it does not."""
     t, _ = collision.contact_time(d, w, reach)
     explained = (t <= 0.0) & (t >= -dt_s)
-    return _where(explained, -t, 0.0), explained
+    return either.where(explained, -t, 0.0), explained
 
 
 def resolve_pairs(
@@ -207,9 +207,9 @@ def resolve_pairs(
     zpos, zvel = vectors.as_complex(pos), vectors.as_complex(vel)  # the rounds' vectors (see _Round)
 
     def since_met(a, b):  # how long ago pucks a and b met (dt_s where the step does not explain it)
-        d, w = _take(zpos, a) - _take(zpos, b), _take(zvel, a) - _take(zvel, b)
-        t, explained = time_back_to_contact(d, w, _take(radius, a) + _take(radius, b), dt_s)
-        return _where(explained, t, dt_s)
+        d, w = either.take(zpos, a) - either.take(zpos, b), either.take(zvel, a) - either.take(zvel, b)
+        t, explained = time_back_to_contact(d, w, either.take(radius, a) + either.take(radius, b), dt_s)
+        return either.where(explained, t, dt_s)
 
     def since(k):  # ... the pairs k (a few: one by one in Python numbers, see "one round")
         if len(k) > few_pairs:
@@ -258,40 +258,7 @@ def push_apart(pos: np.ndarray, radius: np.ndarray, mass: np.ndarray, i: np.ndar
 # A round of a few pairs goes through the very same lines one pair at a time, in Python numbers
 # (a and b ints, the vectors Python complex numbers): there a numpy call costs a microsecond
 # for one number, the arithmetic of a whole pair a few. The few operations that differ
-# between the two are the helpers below; the bits are the same either way (test_pairs.py).
-
-
-def _take(a: np.ndarray, rows):
-    """a[rows]: an array for an array of rows, a Python number for one row (an int)."""
-    return a.take(rows) if isinstance(rows, np.ndarray) else a.item(rows)
-
-
-def _count(mask) -> int:
-    """How many are true: of a mask, or of one bool."""
-    return np.count_nonzero(mask) if isinstance(mask, np.ndarray) else int(mask)
-
-
-def _size(rows) -> int:
-    return len(rows) if isinstance(rows, np.ndarray) else 1
-
-
-def _where(c, x, y):
-    """np.where(c, x, y), or for one pair: x if c, else y."""
-    return np.where(c, x, y) if isinstance(c, np.ndarray) else (x if c else y)
-
-
-def _minimum(x, y):
-    """np.minimum(x, y); for one pair as numpy does it (NaN wins; of two equal ones, y: -0.0 or 0.0)."""
-    if isinstance(x, np.ndarray) or isinstance(y, np.ndarray):
-        return np.minimum(x, y)
-    return x if x < y or x != x else y
-
-
-def _maximum(x, y):
-    """np.maximum(x, y); for one pair as numpy does it (see _minimum)."""
-    if isinstance(x, np.ndarray) or isinstance(y, np.ndarray):
-        return np.maximum(x, y)
-    return x if x > y or x != x else y
+# between the two are those of either.py; the bits are the same either way (test_pairs.py).
 
 
 @dataclass(slots=True)
@@ -340,8 +307,8 @@ class _Outcome:
 
 def _approaching(approach: np.ndarray) -> tuple[int, np.ndarray | None]:
     """(how many pairs approach, the mask to apply to them): None when all do, as they mostly do."""
-    count = _count(approach)
-    return count, (None if count == _size(approach) else approach)
+    count = either.count(approach)
+    return count, (None if count == either.size(approach) else approach)
 
 
 def _gather(zpos, zvel, radius, mass, a, b) -> _Round | None:
@@ -349,13 +316,13 @@ def _gather(zpos, zvel, radius, mass, a, b) -> _Round | None:
 
     zpos, zvel: the table's positions and velocities as complex numbers.
     """
-    take = np.ndarray.take if isinstance(a, np.ndarray) else np.ndarray.item  # (see _take)
+    take = np.ndarray.take if isinstance(a, np.ndarray) else np.ndarray.item  # (see either.take, once)
     x1, x2 = take(zpos, a), take(zpos, b)
     d, r2 = x1 - x2, take(radius, b)
     reach = take(radius, a) + r2
     n, dist = vectors.units(d, lambda: a + b)
     overlap = reach - dist
-    if _count(overlap > 0.0) < _size(a):
+    if either.count(overlap > 0.0) < either.size(a):
         if not isinstance(a, np.ndarray):
             return None
         keep = (overlap > 0.0).nonzero()[0]
@@ -374,7 +341,7 @@ def _collide(g: _Round, n: np.ndarray, only: np.ndarray | None, cr: float):
     v1, v2 = collision.collide_along(n, g.v1, g.v2, g.m1, g.m2, cr)
     if only is None:
         return v1, v2
-    return _where(only, v1, g.v1), _where(only, v2, g.v2)
+    return either.where(only, v1, g.v1), either.where(only, v2, g.v2)
 
 
 def separate(g: _Round, n: np.ndarray, move: np.ndarray, only: np.ndarray | None):
@@ -385,12 +352,12 @@ def separate(g: _Round, n: np.ndarray, move: np.ndarray, only: np.ndarray | None
     line of centres, by the same shares.
     """
     if only is not None:
-        move = _where(only, move, 0.0)
+        move = either.where(only, move, 0.0)
     x1, x2 = g.x1 + (move * g.share1) * n, g.x2 - (move * g.share2) * n
     d = x1 - x2
-    if _count(vectors.squared_abs(d) < g.reach * g.reach):
+    if either.count(vectors.squared_abs(d) < g.reach * g.reach):
         n_now, dist_now = vectors.units(d, g.keys)
-        left = _maximum(g.reach - dist_now, 0.0)
+        left = either.maximum(g.reach - dist_now, 0.0)
         x1, x2 = x1 + (left * g.share1) * n_now, x2 - (left * g.share2) * n_now
     return x1, x2
 
@@ -412,7 +379,7 @@ def _two_step_move(g: _Round, cr: float, dt_s: float) -> np.ndarray:
     overlap deeper than one step of approach can explain is capped there;
     `separate` pushes the rest apart.
     """
-    return (1.0 + cr) * _minimum(g.overlap, g.vn * -dt_s)
+    return (1.0 + cr) * either.minimum(g.overlap, g.vn * -dt_s)
 
 
 def _round_two_step(g: _Round, cr: float, dt_s: float) -> _Outcome:
@@ -426,7 +393,7 @@ def _round_two_step(g: _Round, cr: float, dt_s: float) -> _Outcome:
 def _round_perfect_kiss(g: _Round, cr: float, dt_s: float) -> _Outcome:
     """Collide at first contact; pairs whose overlap this step cannot explain get the two-step correction."""
     t_b, kiss = time_back_to_contact(g.d, g.vrel, g.reach, dt_s)
-    kissing = _count(kiss)
+    kissing = either.count(kiss)
     if not kissing:
         return _round_two_step(g, cr, dt_s)
     c1, c2 = g.x1 - t_b * g.v1, g.x2 - t_b * g.v2  # both centres at first contact
@@ -434,7 +401,7 @@ def _round_perfect_kiss(g: _Round, cr: float, dt_s: float) -> _Outcome:
     # They approach now, so they approached at contact (on straight paths d.w only grows). Going
     # forward t_b with the new velocities parts the pair by (1 + cr) |vn| t_b, vn the normal speed there.
     contact_from, approach, move = c2, kiss, -(1.0 + cr) * vectors.dot(g.vrel, n) * t_b
-    if kissing < _size(kiss):  # the others: the two-step's normal, approach and move
+    if kissing < either.size(kiss):  # the others: the two-step's normal, approach and move
         n, contact_from = np.where(kiss, n, g.n), np.where(kiss, contact_from, g.x2)
         approach = kiss | (g.vn < -REST_SPEED_MPS)
         move = np.where(kiss, move, _two_step_move(g, cr, dt_s))

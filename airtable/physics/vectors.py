@@ -141,6 +141,14 @@ def dot(z, w):
     return xy[0::2] + xy[1::2]
 
 
+def length(z):
+    """|z| = sqrt(x^2 + y^2) of each complex z = x + iy, or of one Python complex number (then a
+    float, the same bits: abs() of a complex takes hypot, which Python and numpy round differently)."""
+    if isinstance(z, complex):
+        return math.sqrt(squared_abs(z))
+    return np.sqrt(squared_abs(z))
+
+
 def units(z: np.ndarray, keys) -> tuple[np.ndarray, np.ndarray]:
     """unit_vectors for complex z: (z / |z|, |z|), each part divided by the length.
 
@@ -148,13 +156,12 @@ def units(z: np.ndarray, keys) -> tuple[np.ndarray, np.ndarray]:
     that makes them, called only if some z is zero. z may be one Python
     complex number, and its key one int (then the same arithmetic in Python numbers).
     """
+    dist = length(z)
     if isinstance(z, complex):
-        dist = math.sqrt(squared_abs(z))
         if dist:  # (a NaN is true: it divides, as below)
             return complex(z.real / dist, z.imag / dist), dist
         x, y = fallback_directions(np.array([keys() if callable(keys) else keys]))[0].tolist()
         return complex(x, y), dist
-    dist = np.sqrt(squared_abs(z))
     if np.count_nonzero(dist) == len(dist):
         return (z.view(np.float64) / dist.repeat(2)).view(np.complex128), dist
     n, _ = unit_vectors(as_rows(z), keys)
