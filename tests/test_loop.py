@@ -148,6 +148,25 @@ def test_a_still_window_redraws_at_the_idle_rate_or_less_often_if_a_frame_costs_
     assert loop.period_s == pytest.approx(1 / 12)
 
 
+def test_a_still_window_whose_physics_runs_keeps_the_idle_rate_and_so_real_time():
+    """Idle frames half a second apart stepped at most MAX_SIM_PER_FRAME_S each: a still table's clock ran at
+    a fifth of real time (a demo's timed events, a prediction waiting for its collision, all late)."""
+    clock = FakeClock()
+    paused = iter([False, False, True, True])
+    loop = IdlingLoop(60.0, 12.0, lambda: True, True, clock=clock, sleep=clock.sleep, stepping=lambda: not next(paused))
+    dts: list[float] = []
+
+    def frame(dt_s: float) -> None:
+        dts.append(dt_s)
+        clock.now += 0.040  # a costly frame: 40 ms
+        loop.after_frame()
+
+    loop.run(frame, max_frames=4)
+    assert dts[1:3] == pytest.approx([1 / 12, 1 / 12])  # stepping: every frame well under MAX_SIM_PER_FRAME_S
+    assert max(dts[1:3]) < MAX_SIM_PER_FRAME_S
+    assert dts[3] > 0.2 and loop.period_s == IDLE_MAX_PERIOD_S  # paused: nothing steps, frames may wait
+
+
 def test_frame_returning_false_or_stop_ends_the_loop():
     loop = FrameLoop(fps=1000, fixed_dt_s=0.01)
     assert loop.run(lambda dt: False) == 1

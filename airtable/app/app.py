@@ -547,7 +547,14 @@ class App:
         display's refresh rate, sleeping in between; a still table runs at
         IDLE_FPS and wakes on input. `started` is called once signals end the run (see loop.py).
         """
-        self.loop = IdlingLoop(display_rate_hz(), IDLE_FPS, self.still, self.window.headless, fixed_dt_s=frame_dt_s)
+        self.loop = IdlingLoop(
+            display_rate_hz(),
+            IDLE_FPS,
+            self.still,
+            self.window.headless,
+            stepping=lambda: not self.paused,  # its physics keeps real time: its idle frames stay short
+            fixed_dt_s=frame_dt_s,
+        )
         # In real time a frame's physics stops after its share of a 60 Hz frame (of a display's slower
         # frame), to leave time to draw it; a faster display draws fewer frames before the physics slows.
         frame_s = 1.0 / min(display_rate_hz(), DEFAULT_FPS)

@@ -232,9 +232,11 @@ def signals_end_the_run(stop: Callable[[], None]) -> Iterator[None]:
             signal.signal(sig, handler if handler is not None else signal.SIG_DFL)
 
 
-# A still window's frames take at most this share of the processor: a frame that costs much (10000
-# pucks at 3840x2160 take 27 ms) comes less often than idle_fps, but at least every IDLE_MAX_PERIOD_S
-# (a message's end, a student's cursor are shown that late at most).
+# A still window that steps no physics (paused, or a student's) takes at most this share of the
+# processor: a frame that costs much (10000 pucks at 3840x2160 take 27 ms) comes less often than
+# idle_fps, but at least every IDLE_MAX_PERIOD_S (a message's end, a student's cursor are shown that
+# late at most). A window whose physics runs keeps idle_fps: a frame steps at most
+# MAX_SIM_PER_FRAME_S of simulated time, so longer frames would slow its clock.
 IDLE_CPU_SHARE = 0.05
 IDLE_MAX_PERIOD_S = 0.5
 
@@ -242,8 +244,8 @@ IDLE_MAX_PERIOD_S = 0.5
 class IdlingLoop(FrameLoop):
     """The windows' loop (the teacher's and each student's): full rate while anything moves or input
     came lately, `idle_fps` while the window is still (`still()` says so after each frame; less often
-    if a frame costs more than IDLE_CPU_SHARE of that), and while idle the wait between frames ends
-    at once on input (a pygame event)."""
+    if a frame costs more than IDLE_CPU_SHARE of that while `stepping()` says no physics runs), and
+    while idle the wait between frames ends at once on input (a pygame event)."""
 
     def __init__(
         self,
@@ -252,11 +254,14 @@ class IdlingLoop(FrameLoop):
         still: Callable[[], bool],
         headless: bool,
         sleep: Callable[[float], object] | None = None,
+        stepping: Callable[[], bool] = lambda: False,
         **kw,
     ) -> None:
-        """`sleep`: how to wait where no input can end the wait (headless, or at the full rate)."""
+        """`sleep`: how to wait where no input can end the wait (headless, or at the full rate);
+        `stepping`: whether the frames step physics in real time now (the teacher's, unless paused)."""
         super().__init__(fps=fps, sleep=self._sleep, **kw)
         self._plain_sleep = sleep if sleep is not None else self.stop.wait
+        self.stepping = stepping
         self.full_period_s, self.idle_period_s = 1.0 / fps, 1.0 / idle_fps
         self.still, self.headless = still, headless
 
@@ -264,6 +269,9 @@ class IdlingLoop(FrameLoop):
         """Call at the end of each frame: the next one comes at the full or the idle rate."""
         if not self.still():
             self.period_s = self.full_period_s
+            return
+        if self.stepping():
+            self.period_s = self.idle_period_s
             return
         took_s = self.clock() - self.frame_began
         self.period_s = max(self.idle_period_s, min(took_s / IDLE_CPU_SHARE, IDLE_MAX_PERIOD_S))
