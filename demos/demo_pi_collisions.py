@@ -40,6 +40,12 @@ def build(table, variation=0):
         v_light, v_heavy = light.vel_mps[0], heavy.vel_mps[0]
         if 0.0 <= v_light <= v_heavy and heavy.pos_m[0] > table.width_m - 3.0 * HEAVY_RADIUS_M:
             light.vel_mps = heavy.vel_mps = (0.0, 0.0)
+            pairs, walls = table.collision_count, table.wall_collision_count
+            table.notices.say(
+                "pi",
+                f"{pairs + walls} hits in all: {pairs} between the pucks, {walls} on the wall. No more can come,"
+                " so both pucks stop here, before the far wall sends the heavy one back.",
+            )
             return
         table.schedule(table.time_s + CHECK_EVERY_S, stop_when_done)
 

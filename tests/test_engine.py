@@ -159,6 +159,12 @@ def test_the_pi_demo_counts_the_digits_of_pi_and_stops_the_pucks(demos) -> None:
             table.step(demo.dt_s)
         assert table.collision_count + table.wall_collision_count == due
         np.testing.assert_allclose(table.vel_mps, 0.0)  # stopped before the far wall
+        # ... and says why, with the count the lesson is about (the window shows it, as each notice)
+        pairs, walls = table.collision_count, table.wall_collision_count
+        assert list(table.notices) == [
+            f"{due} hits in all: {pairs} between the pucks, {walls} on the wall. No more can come,"
+            " so both pucks stop here, before the far wall sends the heavy one back."
+        ]
 
 
 # The 120-puck pile in a 2.5 m box: tests/test_sleep.py (it comes to rest exactly, asleep).

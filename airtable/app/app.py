@@ -471,21 +471,27 @@ class App:
             parts.extend(feature.status_parts(for_students))  # hands off, the floor, the round, rewound
         if self.speed != 1.0:
             parts.append(f"slow motion x1/{round(1 / self.speed)}")
-        if self._behind() and not self.paused:
-            kept = self.stepper.real_time_share * self.speed  # of real time: slow motion's own share taken in
-            parts.append(f"physics at {kept:.0%} of real time (the computer's most)")
+        if for_students and self._physics_behind():  # (the teacher's window has it in the heads-up lines)
+            parts.append(f"{self._physics_behind()} (the teacher's computer's most)")
         parts.append(f"t = {t.time_s:.2f} s")
         parts.append("F1: help")  # the students' windows have their own F1
         parts.append(gravity_label(t))
         parts.append(f"correction: {t.puck_correction}")
-        n, hits = len(t.pos_m), t.collision_count
+        n, hits, walls = len(t.pos_m), t.collision_count, t.wall_collision_count
         parts.append(f"{n} puck{'' if n == 1 else 's'}")
-        parts.append(f"{hits} collision{'' if hits == 1 else 's'}")
+        parts.append(f"{hits} collision{'' if hits == 1 else 's'}, {walls} on walls")
         if t.cr_puck == t.cr_wall:
             parts.append(f"restitution {t.cr_puck:g}")
         else:
             parts.append(f"restitution: pucks {t.cr_puck:g}, walls {t.cr_wall:g}")
         return parts
+
+    def _physics_behind(self) -> str:
+        """ "physics at N% of real time" while the physics falls behind (slow motion's own share taken in),
+        else ""."""
+        if self.paused or not self._behind():
+            return ""
+        return f"physics at {self.stepper.real_time_share * self.speed:.0%} of real time"
 
     def _behind(self) -> bool:
         """Whether the physics fell behind what was asked of it: said below SLOW_SHARE of the steps, and
@@ -499,8 +505,10 @@ class App:
 
     def hud_lines(self) -> list:
         """The heads-up lines under the title: the features' (why students cannot join, in red, the join
-        line, the student count), then the newest message."""
+        line, the student count), whether the physics keeps real time, then the newest message."""
         lines: list = [line for feature in self.features for line in feature.hud_lines()]
+        if self._physics_behind():  # here, not in the status line: coming and going, it pushed parts off it
+            lines.append(f"{self._physics_behind()} (the computer's most)")
         if self.message and self.clock_s < self.message_until:
             lines.append(self.message)
         elif not self.window.wall_rects():
