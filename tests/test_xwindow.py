@@ -71,6 +71,13 @@ def find_window(display: str, title: str = "Air Table") -> str | None:
     return None
 
 
+def window_place(display: str, wid: str) -> tuple[int, int] | None:
+    """Where the window's top-left corner is on the screen now (None once it is gone)."""
+    lines = xwininfo(display, "-id", wid).splitlines()
+    at = dict(line.strip().split(": ", 1) for line in lines if line.strip().startswith("Absolute upper-left"))
+    return (int(at["Absolute upper-left X"]), int(at["Absolute upper-left Y"])) if len(at) == 2 else None
+
+
 def window_size(display: str, wid: str) -> tuple[int, int] | None:
     """The window's size as X has it now (None once it is gone)."""
     lines = xwininfo(display, "-id", wid).splitlines()
@@ -280,7 +287,8 @@ def test_f11_in_the_app_fills_the_screen(display, tmp_path):
 
 @pytest.mark.skipif(not shutil.which("openbox"), reason="needs a window manager (apt-get install openbox)")
 def test_f11_twice_under_a_window_manager_brings_back_the_window(display, tmp_path):
-    # User test: under a window manager the window came back at the desktop's size, partly off screen.
+    # User tests: under a window manager the window came back at the desktop's size, partly off screen,
+    # and a title bar lower each time.
     wm = subprocess.Popen(
         ["openbox"], env={**os.environ, "DISPLAY": display}, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL
     )
@@ -288,6 +296,7 @@ def test_f11_twice_under_a_window_manager_brings_back_the_window(display, tmp_pa
         with running(display, demo_2(tmp_path / "shot.png"), cwd=tmp_path) as (app, wid):
             before = wait_for(lambda: window_size(display, wid), what="the window's size")
             assert before != (1024, 900)
+            place = window_place(display, wid)
             key_taken(display, wid, "F11")
             wid = wait_for(lambda: sized_window(display, (1024, 900)), what="the fullscreen window")
             # SDL takes keys again once it has settled into fullscreen: a screenshot (F12) tells.
@@ -297,6 +306,8 @@ def test_f11_twice_under_a_window_manager_brings_back_the_window(display, tmp_pa
             wid = wait_for(lambda: sized_window(display, before), what="the window at its size again")
             for _ in range(10):  # and it stays so once the window manager is done
                 assert window_size(display, wid) == before
+            # Where it was, too: it came back a title bar lower each time, then partly off the screen.
+            assert window_place(display, wid) == place
             quit_with_escape(display, wid, app)
     finally:
         wm.terminate()

@@ -130,6 +130,7 @@ class GameWindow:
         self.show_fps = False  # the frame rate in a corner (--stats): not for the room
         self.label_boxes: list[pygame.Rect] = []  # text drawn this frame; the aids place labels around it
         self.status_top_px = 0
+        self._windowed_at: tuple[int, int] | None = None  # where the window was before fullscreen (F11)
         if headless:
             self.windowed_size_px = tuple(int(v) for v in (size_px or env.size_px))
             self.surface = pygame.Surface(self.windowed_size_px)
@@ -172,7 +173,11 @@ class GameWindow:
             return
         if not self.fullscreen:
             self.windowed_size_px = self.surface.get_size()
+            self._windowed_at = pygame.display.get_window_position()
         self._open(not self.fullscreen)
+        if not self.fullscreen and self._windowed_at is not None:
+            # Where it was: left to itself, the window came back a title bar lower each time.
+            pygame.display.set_window_position(self._windowed_at)
         self._sized()
 
     def resize(self, size_px: Sequence[int]) -> None:
