@@ -21,6 +21,17 @@ from airtable.physics.table import AirTable
 WIDTH_M, HEIGHT_M = 10.0, 8.7556
 
 
+# Below restitution 1 discs can hit infinitely often in a finite time (inelastic collapse: a light
+# disc squeezed between two others is hit by each ever more often at ever smaller speeds), and the
+# motion converges, to one in which neither pair approaches. The oracle follows the hits to that
+# limit within ROUND_OFF: a pair approaching slower than ROUND_OFF times the scene's top speed does
+# not hit (a hit would change less than that; at round-off itself it would change nothing and come
+# again at the same time, for ever), and discs less than ROUND_OFF times the box's size apart touch
+# (a pair that has just hit touches, but its distance holds the positions' round-off: with a gap of
+# round-off and a sliding motion the quadratic sees a graze where touching discs that approach hit).
+ROUND_OFF = 1e-12
+
+
 class Oracle:
     """Discs in the box [0, width] x [0, height], moved from event to event (Rapaport's method)."""
 
@@ -29,6 +40,8 @@ class Oracle:
         self.width, self.height, self.cr_puck, self.cr_wall = width, height, cr_puck, cr_wall
         self.t = 0.0
         self.events = 0
+        self.slowest = ROUND_OFF * max((math.hypot(p[2], p[3]) for p in pucks), default=0.0)  # m/s
+        self.touch = ROUND_OFF * max(width, height)  # m
 
     def _pair_time(self, a: list[float], b: list[float]) -> float:
         dx, dy, wx, wy = a[0] - b[0], a[1] - b[1], a[2] - b[2], a[3] - b[3]
@@ -36,12 +49,15 @@ class Oracle:
         b_ = dx * wx + dy * wy
         if b_ >= 0.0:
             return math.inf
+        dist = math.hypot(dx, dy)
+        if dist - reach <= self.touch:  # touching or overlapping, and approaching: they hit now
+            return 0.0 if -b_ / dist > self.slowest else math.inf
         aa = wx * wx + wy * wy
         c = dx * dx + dy * dy - reach * reach
         disc = b_ * b_ - aa * c
-        if disc <= 0.0:
+        if disc <= 0.0 or math.sqrt(disc) / reach <= self.slowest:  # (the approach speed at contact)
             return math.inf
-        return max((-b_ - math.sqrt(disc)) / aa, 0.0)
+        return (-b_ - math.sqrt(disc)) / aa
 
     def _wall_time(self, p: list[float]) -> tuple[float, int]:
         best, axis = math.inf, -1
@@ -93,7 +109,7 @@ class Oracle:
         b[2], b[3] = b[2] + (w2 - u2) * nx, b[3] + (w2 - u2) * ny
 
     def run_until(self, t_end: float, max_events: int = 10**6) -> None:
-        """Advance to time t_end, resolving every hit on the way (at most max_events more)."""
+        """Advance to time t_end, resolving every hit on the way (at most max_events more: else it raises)."""
         for _ in range(max_events):
             t, i, j = self._next()
             if self.t + t > t_end:
@@ -101,6 +117,8 @@ class Oracle:
             self._advance(t)
             self._resolve(i, j)
             self.events += 1
+        else:
+            raise RuntimeError(f"the oracle met more than {max_events} hits before {t_end} s")
         self._advance(t_end - self.t)
 
     def time_of_event(self, n: int, t_max: float) -> float:
