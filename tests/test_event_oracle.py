@@ -23,13 +23,15 @@ WIDTH_M, HEIGHT_M = 10.0, 8.7556
 
 # Below restitution 1 discs can hit infinitely often in a finite time (inelastic collapse: a light
 # disc squeezed between two others is hit by each ever more often at ever smaller speeds), and the
-# motion converges, to one in which neither pair approaches. The oracle follows the hits to that
-# limit within ROUND_OFF: a pair approaching slower than ROUND_OFF times the scene's top speed does
-# not hit (a hit would change less than that; at round-off itself it would change nothing and come
-# again at the same time, for ever), and discs less than ROUND_OFF times the box's size apart touch
-# (a pair that has just hit touches, but its distance holds the positions' round-off: with a gap of
-# round-off and a sliding motion the quadratic sees a graze where touching discs that approach hit).
+# motion converges, to one in which none of them approach each other. The oracle follows the hits
+# to that limit: a pair approaching slower than ROUND_OFF times the scene's top speed does not hit
+# (a hit would change less than that; at round-off itself it would change nothing and come again
+# at the same time, for ever). And discs less than POSITION_ROUND_OFF times the box's size apart
+# touch: a pair that has just hit touches, but its distance holds the positions' round-off, and
+# with a gap of round-off and a sliding motion the quadratic sees a graze where touching discs
+# that approach hit.
 ROUND_OFF = 1e-12
+POSITION_ROUND_OFF = 1e-15
 
 
 class Oracle:
@@ -41,7 +43,7 @@ class Oracle:
         self.t = 0.0
         self.events = 0
         self.slowest = ROUND_OFF * max((math.hypot(p[2], p[3]) for p in pucks), default=0.0)  # m/s
-        self.touch = ROUND_OFF * max(width, height)  # m
+        self.touch = POSITION_ROUND_OFF * max(width, height)  # m
 
     def _pair_time(self, a: list[float], b: list[float]) -> float:
         dx, dy, wx, wy = a[0] - b[0], a[1] - b[1], a[2] - b[2], a[3] - b[3]

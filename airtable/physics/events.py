@@ -62,6 +62,13 @@ CAPPED_NOTICE = (
 # nothing representable and come again at the same time, for ever.) A count of hits would not
 # do: squeezed, a pair's approach falls much more slowly than by its restitution at each hit.
 ROUND_OFF = 1e-12
+# Discs that have just hit each other touch, but a distance computed from positions carries their
+# round-off (some ulps of the table's size): a squeezed pair a round-off gap apart, sliding, would
+# be a graze (collision.contact_time), and the collapse would stop short at 1e-8 of the speeds. So
+# discs closer than this share of the table's size to touching touch. Not more: hits that close
+# come in an order set by round-off (a puck touching three at once), and at 1e-14 that order
+# already moves pucks by 1e-7 m.
+POSITION_ROUND_OFF = 1e-15
 
 
 # In two-step, pair hits are predicted when some puck moves this share of the smallest radius
@@ -168,10 +175,10 @@ class _Step:
         self.speed_sq = vectors.squared_abs(self.zvel)  # each puck's speed squared on its first path
         speed = math.sqrt(float(self.speed_sq.max())) if len(vel) else 0.0
         self.travel = speed * dt  # the farthest any puck moves this step on its first path (m)
-        # Pairs approaching slower than this (m/s) touch, and pairs closer than this (m) to touching
-        # touch: positions are numbers up to the table's size, a path's read a travel from its origin.
+        # Pairs approaching slower than this (m/s) touch (ROUND_OFF), and pairs closer than this (m) to
+        # touching touch: positions are numbers up to the table's size, read a travel from an origin.
         self.touching = ROUND_OFF * speed
-        self.touch_m = ROUND_OFF * (max(self.width, self.height) + self.travel)
+        self.touch_m = POSITION_ROUND_OFF * (max(self.width, self.height) + self.travel)
         # The pairs found hold every pair that can meet while each path stays within `covered`
         # of its puck's step end; `reach_out` is the farthest any present path strays.
         self.covered = self.reach_out = 2.0 * self.travel
