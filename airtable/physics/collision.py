@@ -73,7 +73,7 @@ def collide_along(n, v1, v2, m1, m2, cr):
     return v1 + (w1 - u1) * n, v2 + (w2 - u2) * n
 
 
-def contact_time(d, w, reach, touch=0.0):
+def contact_time(d, w, reach):
     """(t, u): when two discs on straight paths first touch (s from now), and how fast they then
     approach along the line of centres (m/s).
 
@@ -86,21 +86,12 @@ def contact_time(d, w, reach, touch=0.0):
     The one rule for whether they touch at all: they approach now (d.w < 0) and
     their paths come within reach (disc > 0: more than a graze). Where they do
     not, t = inf and u = 0. One pair (complex d and w) or many (numpy arrays).
-
-    touch (m): a pair less than this apart touches now (c taken as 0: t = 0, u = -d.w / reach). Two
-    discs that have just hit each other touch, but their distance, a difference of positions, carries
-    those positions' round-off: a gap of round-off and a sliding motion make disc < 0, a graze, where
-    touching discs that approach hit (a puck squeezed between two others: inelastic collapse).
     """
     dw = vectors.dot(d, w)
     one = isinstance(dw, float)  # one pair, in Python numbers
     if one and not dw < 0.0:
         return math.inf, 0.0  # parting or still (the rule below, checked first: half the calls stop here)
     c = vectors.dot(d, d) - reach * reach
-    if touch and one:  # less than touch apart: (reach + touch)^2 - reach^2 = (2 reach + touch) touch
-        c = min(c, 0.0) if c < (2.0 * reach + touch) * touch else c
-    elif touch:
-        c = np.where(c < (2.0 * reach + touch) * touch, np.minimum(c, 0.0), c)
     disc = dw * dw - vectors.dot(w, w) * c
     meets = (dw < 0.0) & (disc > 0.0)
     if one:  # skip the division where they do not meet
