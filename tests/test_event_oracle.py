@@ -34,7 +34,7 @@ WIDTH_M, HEIGHT_M = 10.0, 8.7556
 # with a gap of round-off and a sliding motion the quadratic sees a graze where touching discs that
 # approach hit). A touching pair left approaching that slowly, or more than COLLAPSE_HITS hits in a
 # run, is a collapse (`collapsed`): no finite run of hits comes near either (a pi setup at the
-# scenes' widest mass ratio, 10^6, has 3142 hits; 400 random elastic runs at most 216).
+# scenes' widest mass ratio, 10^6, has 3141 hits; 400 random elastic runs at most 216).
 ROUND_OFF = 1e-12
 POSITION_ROUND_OFF = 1e-15
 COLLAPSE_HITS = 20_000
