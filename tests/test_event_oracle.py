@@ -4,7 +4,9 @@ The oracle imports nothing of airtable.physics: plain Python floats, the next
 event the earliest of every pair's contact time and every puck's wall times,
 everyone advanced to it, the hit resolved as a 1D collision along the line of
 centres. In perfect kiss the engine must follow it to round-off over each
-scene's first hits (before chaos amplifies round-off), for any dt up to 1/30 s.
+scene's first hits (before chaos amplifies round-off), for any dt up to 1/30 s,
+wherever those hits are finitely many: an inelastic collapse (see ROUND_OFF)
+is found by the oracle and left out.
 """
 
 from __future__ import annotations
@@ -13,12 +15,29 @@ import math
 
 import numpy as np
 import pytest
-from hypothesis import example, given, settings
+from hypothesis import assume, example, given, settings
 from hypothesis import strategies as st
 
 from airtable.physics.table import AirTable
 
 WIDTH_M, HEIGHT_M = 10.0, 8.7556
+
+
+# Below restitution 1 discs can hit infinitely often in a finite time: inelastic collapse. A light
+# disc squeezed between two others (or a wall and another) is hit by each ever more often at ever
+# smaller speeds, and the motion converges to one in which none of them approach each other; but
+# hits taken one by one reach that limit only in the limit. The oracle follows them to within
+# round-off of it: a pair approaching slower than ROUND_OFF times the scene's top speed does not
+# hit (a hit would change less than that; at round-off itself it would change nothing and come
+# again at the same time, for ever), and discs less than POSITION_ROUND_OFF times the box's size
+# apart touch (a pair that has just hit touches, but its distance holds the positions' round-off:
+# with a gap of round-off and a sliding motion the quadratic sees a graze where touching discs that
+# approach hit). A touching pair left approaching that slowly, or more than COLLAPSE_HITS hits in a
+# run, is a collapse (`collapsed`): no finite run of hits comes near either (a pi setup at the
+# scenes' widest mass ratio, 10^6, has 3141 hits; 400 random elastic runs at most 216).
+ROUND_OFF = 1e-12
+POSITION_ROUND_OFF = 1e-15
+COLLAPSE_HITS = 20_000
 
 
 class Oracle:
@@ -29,6 +48,9 @@ class Oracle:
         self.width, self.height, self.cr_puck, self.cr_wall = width, height, cr_puck, cr_wall
         self.t = 0.0
         self.events = 0
+        self.slowest = ROUND_OFF * max((math.hypot(p[2], p[3]) for p in pucks), default=0.0)  # m/s
+        self.touch = POSITION_ROUND_OFF * max(width, height)  # m
+        self.collapsed = False  # an inelastic collapse met (see ROUND_OFF)
 
     def _pair_time(self, a: list[float], b: list[float]) -> float:
         dx, dy, wx, wy = a[0] - b[0], a[1] - b[1], a[2] - b[2], a[3] - b[3]
@@ -36,12 +58,18 @@ class Oracle:
         b_ = dx * wx + dy * wy
         if b_ >= 0.0:
             return math.inf
+        dist = math.hypot(dx, dy)
+        if dist - reach <= self.touch:  # touching or overlapping, and approaching: they hit now
+            if -b_ / dist > self.slowest:
+                return 0.0
+            self.collapsed = True  # hits converged within round-off of their limit
+            return math.inf
         aa = wx * wx + wy * wy
         c = dx * dx + dy * dy - reach * reach
         disc = b_ * b_ - aa * c
-        if disc <= 0.0:
+        if disc <= 0.0 or math.sqrt(disc) / reach <= self.slowest:  # (the approach speed at contact)
             return math.inf
-        return max((-b_ - math.sqrt(disc)) / aa, 0.0)
+        return (-b_ - math.sqrt(disc)) / aa
 
     def _wall_time(self, p: list[float]) -> tuple[float, int]:
         best, axis = math.inf, -1
@@ -92,15 +120,20 @@ class Oracle:
         a[2], a[3] = a[2] + (w1 - u1) * nx, a[3] + (w1 - u1) * ny
         b[2], b[3] = b[2] + (w2 - u2) * nx, b[3] + (w2 - u2) * ny
 
-    def run_until(self, t_end: float, max_events: int = 10**6) -> None:
-        """Advance to time t_end, resolving every hit on the way (at most max_events more)."""
-        for _ in range(max_events):
+    def run_until(self, t_end: float) -> None:
+        """Advance to time t_end, resolving every hit on the way; stop where it meets a collapse."""
+        for _ in range(COLLAPSE_HITS):
             t, i, j = self._next()
+            if self.collapsed:
+                return
             if self.t + t > t_end:
                 break
             self._advance(t)
             self._resolve(i, j)
             self.events += 1
+        else:
+            self.collapsed = True
+            return
         self._advance(t_end - self.t)
 
     def time_of_event(self, n: int, t_max: float) -> float:
@@ -153,6 +186,7 @@ restitutions = st.sampled_from([1.0, 1.0, 0.9, 0.5])
 @given(st.integers(0, 2**32 - 1), st.integers(1, 30), dts, restitutions, restitutions)
 @example(seed=15, n=12, dt=1 / 32, cr_puck=1.0, cr_wall=1.0)  # 29 hits in a step: chaos (the tolerance)
 @example(seed=46, n=20, dt=1 / 32, cr_puck=0.9, cr_wall=1.0)  # a pair hits 4+ times in a step (repeat_max)
+@example(seed=1980032180, n=19, dt=1 / 30, cr_puck=0.5, cr_wall=0.5)  # issue 24: a collapse, left out (ROUND_OFF)
 def test_perfect_kiss_follows_the_exact_hard_disc_motion(seed: int, n: int, dt: float, cr_puck, cr_wall) -> None:
     pucks = random_scene(seed, n)
     oracle = Oracle(pucks, WIDTH_M, HEIGHT_M, cr_puck, cr_wall)
@@ -161,17 +195,21 @@ def test_perfect_kiss_follows_the_exact_hard_disc_motion(seed: int, n: int, dt: 
     # off a tonne turns round-off into metres within a few dozen hits, in any solver.)
     horizon = oracle.time_of_event(12, 0.5)
     steps = max(1, int(horizon / dt))
-    table = table_of(pucks, cr_puck, cr_wall)
-    for _ in range(steps):
-        table.step(dt)
     oracle.run_until(steps * dt)
+    # The claim is for runs of finitely many hits: the engine follows a pair for events.repeat_max hits
+    # in a step (a collapse can take millions: a step has a frame's time), then the overlap stage.
+    assume(not oracle.collapsed)
     want = np.array([p[:4] for p in oracle.p])
     # A step can hold more hits than the horizon (29 at 200 m/s and masses 5 decades apart in one step
     # of 1/32 s): the oracle itself then moves further than 1e-9 m when its start moves by round-off.
     # The engine must agree with it 1e-9 m, or 100 times as well as two such oracles agree.
     nudged = Oracle([[x * (1.0 + 1e-15), *rest] for x, *rest in pucks], WIDTH_M, HEIGHT_M, cr_puck, cr_wall)
     nudged.run_until(steps * dt)
+    assume(not nudged.collapsed)
     chaos = np.abs(np.array([p[:4] for p in nudged.p]) - want).max(axis=0)
+    table = table_of(pucks, cr_puck, cr_wall)
+    for _ in range(steps):
+        table.step(dt)
     atol = max(1e-9, 100.0 * float(chaos[:2].max()))
     np.testing.assert_allclose(table.pos_m, want[:, :2], rtol=0.0, atol=atol)
     np.testing.assert_allclose(
@@ -191,6 +229,31 @@ def test_the_oracle_by_hand() -> None:
     oracle = Oracle([[8.5, 4.0, 2.0, 0.0, 0.5, 1.0]], 10.0, 8.0, 1.0, 0.5)
     oracle.run_until(1.5)
     assert oracle.p[0][:3] == pytest.approx([8.5, 4.0, -1.0], abs=1e-15)
+
+
+def test_the_oracle_follows_an_inelastic_collapse_to_its_limit_and_says_so() -> None:
+    # By hand, in 1D: a 1 kg disc between two 100 kg ones, the left coming at 1 m/s, restitution 0.5.
+    # The light one is hit by each in turn, ever more often at ever smaller speeds; in the limit no
+    # pair approaches: the three move together at 100 / 201 m/s (momentum), within a finite time.
+    oracle = Oracle(
+        [[3.0, 4.0, 1.0, 0.0, 0.5, 100.0], [4.1, 4.0, 0.0, 0.0, 0.5, 1.0], [5.3, 4.0, 0.0, 0.0, 0.5, 100.0]],
+        20.0,
+        8.0,
+        0.5,
+        1.0,
+    )
+    oracle.run_until(1.0)
+    assert oracle.collapsed and oracle.t < 1.0
+    assert [p[2] for p in oracle.p] == pytest.approx([100.0 / 201.0] * 3, abs=1e-9)
+    # Issue 24's scene: a 21 g disc between a 315 kg and a 0.5 kg one at 0.5, 1 ms before the end
+    # of the first step of 1/30 s, after 400 hits.
+    oracle = Oracle(random_scene(1980032180, 19), WIDTH_M, HEIGHT_M, 0.5, 0.5)
+    oracle.run_until(1 / 30)
+    assert oracle.collapsed and 300 < oracle.events < 1000
+    # The same discs at restitution 1: finitely many hits, none of them a collapse.
+    oracle = Oracle(random_scene(1980032180, 19), WIDTH_M, HEIGHT_M, 1.0, 1.0)
+    oracle.run_until(1 / 30)
+    assert not oracle.collapsed and oracle.events < 30 and oracle.t == 1 / 30
 
 
 # ---------------------------------------------------------------- the pi setup
