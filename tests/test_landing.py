@@ -62,7 +62,7 @@ def test_a_stack_thrown_down_at_restitution_0_lands_dead(rows: int, cols: int, d
     assert table.asleep.all()
 
 
-@settings(max_examples=12, deadline=None)
+@settings(max_examples=12, deadline=None, derandomize=True)  # physics within tolerances: the same scenes every run
 @given(
     rows=st.integers(2, 8),
     dt=st.sampled_from(DTS),

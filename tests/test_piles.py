@@ -21,6 +21,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
+import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
@@ -88,7 +89,7 @@ def drop(n: int, seed: int, dt: float, throw_mps: float = 0.0):
     return rise / start, up, overlap
 
 
-@settings(max_examples=12, deadline=None)
+@settings(max_examples=12, deadline=None, derandomize=True)  # the same scenes every run: a failure is found, not met
 @given(
     n=st.integers(5, 30),
     seed=st.integers(0, 2**32 - 1),
@@ -102,3 +103,13 @@ def test_a_random_pile_thrown_down_at_restitution_0_loses_energy_and_lands_dead(
     assert rise < ENERGY_ROUND_OFF
     assert up < UP_MPS
     assert overlap < OVERLAP_M
+
+
+@pytest.mark.xfail(strict=True, reason="known, not fixed yet: one puck of this pile rises out of rest at 3.4 mm/s")
+def test_a_pile_hypothesis_found_where_a_puck_rises_out_of_rest_at_dt_1_60() -> None:
+    """Found by the random test above when it was not derandomized (a CI run could meet it): at dt 1/60 a puck
+    of this 30-puck heap leaves rest upward at 3.4 mm/s (the limit is 1 mm/s); energy and overlaps are fine.
+    Strict: once fixed, this fails, to be made an ordinary test."""
+    rise, up, overlap = drop(30, 1532515, 1 / 60, 0.0)
+    assert rise < ENERGY_ROUND_OFF and overlap < OVERLAP_M
+    assert up < UP_MPS

@@ -145,7 +145,7 @@ def test_the_substep_count_by_hand() -> None:
     assert substeps.count(mass, a, b, np.array([1e6]), DT_S) == 1
 
 
-@settings(max_examples=25, deadline=None)
+@settings(max_examples=25, deadline=None, derandomize=True)  # physics within tolerances: the same scenes every run
 @given(
     k=st.floats(1.0, 1e9),
     dt=st.sampled_from([1 / 1000, 1 / 240, 1 / 60, 1 / 30]),
