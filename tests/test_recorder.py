@@ -278,6 +278,19 @@ def test_a_crowd_too_big_for_the_export_key_is_not_recorded_and_x_says_why(demos
     assert len(energy) == 10 * 4 + 1  # up to the crowd, every step
 
 
+def test_x_on_a_demo_too_big_to_record_writes_nothing_and_says_why_first(demos, tmp_path, monkeypatch):
+    """The 10000-puck gas: x wrote two files of headers only, and the window cut the reason off."""
+    monkeypatch.chdir(tmp_path)
+    app = App(demos, demo_key="0p", headless=True, window_size_px=(640, 480))  # 2000 pucks
+    pygame.event.clear()
+    for _ in range(5):
+        app.frame(FRAME_S)
+    press(app, pygame.K_x)
+    assert not (tmp_path / "recordings").exists() or not list((tmp_path / "recordings").iterdir())
+    assert app.message.startswith("nothing recorded yet (over 200 pucks: --record FILE.csv records every puck)")
+    assert app.window.font.size(app.message)[0] <= 640  # whole, in the smallest window
+
+
 def test_the_recording_for_x_stops_at_its_size_on_disk_and_x_says_so(demos, tmp_path, monkeypatch):
     from airtable.app import lessons
 

@@ -99,7 +99,7 @@ class Lessons(Feature):
             too = f"{SPOOL_MAX_BYTES / 2**30:.3g} GB written" if rec.nbytes > SPOOL_MAX_BYTES else too
             if too is not None:
                 rec.flush()
-                rec.stop(f"{too}; --record records all")
+                rec.stop(f"{too}: --record FILE.csv records every puck")
         rec.sample(table)
 
     def finish(self) -> list[Recorder]:
@@ -142,6 +142,11 @@ class Lessons(Feature):
     def export_recording(self) -> None:
         """Copy the demo's recording so far to recordings/demo<key>-<time>.csv (and _energy.csv); say where."""
         rec, say = self.recorder, self.host.say
+        if rec.samples == 0:  # no file of headers only: say why there is nothing, and how to get it
+            why = f" ({rec.error})" if rec.error else ""
+            say(f"nothing recorded yet{why}", lasting=True)
+            print(f"airtable: nothing to export: no step was recorded{why}", file=sys.stderr)
+            return
         stem = f"demo{self.host.demo_key}-{time.strftime('%Y%m%d-%H%M%S')}"
         try:
             RECORDINGS_DIR.mkdir(parents=True, exist_ok=True)
@@ -156,8 +161,8 @@ class Lessons(Feature):
         self.exported_to_s = self.host.table.time_s
         stopped = f"; it stopped: {rec.error}" if rec.error else ""
         print(f"recorded {rec.summary()} to {pucks.resolve()} and {energy.name}{stopped}", flush=True)
-        if rec.error:
-            say(f"recorded {rec.span_s:.2f} s to {short_path(pucks)} (stopped: {rec.error})", lasting=True)
+        if rec.error:  # why first: a long message is cut at the window's edge
+            say(f"the recording stopped ({rec.error}): {rec.span_s:.2f} s to {short_path(pucks)}", lasting=True)
         else:
             say(f"recorded {rec.span_s:.2f} s to {short_path(pucks)} (and _energy.csv)", lasting=True)
 
