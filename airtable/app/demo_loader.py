@@ -95,6 +95,12 @@ def key_label(key: str) -> str:
     return key
 
 
+def has_own_key(key: str) -> bool:
+    """Whether a key press starts the demo `key` ("7", "1p": a digit, with Shift); the others ("t",
+    "t1", "s2") are picked in Tab's menu, where typing the key finds them."""
+    return len(key) in (1, 2) and key[0].isdigit() and key[1:] in ("", "p")
+
+
 def key_from_label(text: str) -> str:
     """What a person typed for a demo ("Shift+1", "shift + 1", "1p", "3") as its key ("1p", "3")."""
     plain = text.replace(" ", "")

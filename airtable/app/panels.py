@@ -15,7 +15,7 @@ from typing import TYPE_CHECKING
 
 import pygame
 
-from airtable.app.demo_loader import key_label
+from airtable.app.demo_loader import has_own_key, key_label
 from airtable.app.feature import Binding, Feature
 from airtable.app.menu import DemoMenu
 from airtable.app.overlays import EscapeBurst, OverlayFlag, OverlayValue
@@ -163,7 +163,7 @@ class Panels(Feature):
         elif panel == "notice":
             w.draw_panel("Some demo files could not be loaded", [*self.notice, "Press any key to go on."])
         elif panel == "help":
-            rows = [(key_label(k), d.title) for k, d in host.demos.items()]
+            rows = [(key_label(k) if has_own_key(k) else f"Tab {k}", d.title) for k, d in host.demos.items()]
             keys = [(b.label, b.help) for b in self.key_rows]
             self.help_pages = w.draw_panel("Keys", keys, side_title="Demos", side_rows=rows, page=self.help_page)
         elif panel == "notes":
@@ -176,8 +176,7 @@ class Panels(Feature):
         """The demo error panel's title and lines: what failed, and how to try again."""
         key = self.host.demo_key
         title = ERROR_TITLES[self.host.build_error.stage].format(key=key_label(key))
-        label = key_label(key)  # "7", "Shift+1"; keys like "t1" have no key of their own
-        again = f"press {label} again" if len(key) == 1 or label != key else "pick it in Tab's menu"
+        again = f"press {key_label(key)} again" if has_own_key(key) else "pick it in Tab's menu"
         return title, [str(self.host.build_error), f"Fix the file, then {again}. Esc hides this."]
 
     bindings = (
