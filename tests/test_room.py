@@ -266,7 +266,8 @@ def test_the_anonymous_projector_hides_names_but_not_colours(served, monkeypatch
     press(app, pygame.K_F5)
     assert app.room.anonymous and "floor: C1" in app.scene().status_parts
     projected = app.room.projected(app.scene())
-    assert [(c.name, c.color) for c in projected.cursors if c.name != "local"] == [("C1", client_color(1))]
+    assert [(c.name, c.color) for c in projected.cursors if c.name != "teacher"] == [("C1", client_color(1))]
+    assert "teacher" in [c.name for c in projected.cursors]  # the teacher's own cursor ("local" meant nothing)
     assert any(c.name == "C1 Ann" for c in app.scene().cursors)  # the students' own snapshots keep names
     press(app, pygame.K_F2)
     rows: list[list[str]] = []

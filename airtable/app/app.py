@@ -110,7 +110,7 @@ class App:
             raise ValueError("no demos found")
         self.table = AirTable(TABLE_WIDTH_M, TABLE_HEIGHT_M)
         self.env = Environment(width_m=TABLE_WIDTH_M, height_m=TABLE_HEIGHT_M)
-        self.local = Client(name="local", color=LOCAL_COLOR)
+        self.local = Client(name="teacher", color=LOCAL_COLOR)  # its cursor is labelled so, for the class
         # The loop owns the clients (index 0 is the local user); the server adds the students.
         self.clients: list[Client] = [self.local]
         self.window = GameWindow(self.env, headless=headless, size_px=window_size_px, fullscreen=fullscreen)

@@ -41,7 +41,7 @@ TIMEOUT_S = 8.0  # table time after which the reveal freezes anyway
 WITHIN_DEG = 5.0  # "within 5 deg"
 WITHIN_SPEED = 0.2  # "speeds within 20 %"
 RESTING_MPS = 0.05  # a true speed below this: the puck stops, and direction means nothing
-LOCAL_LABEL = "local"
+LOCAL_LABEL = "teacher"
 LOCAL_COLOR = (120, 255, 120)
 
 
