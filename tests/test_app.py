@@ -197,6 +197,19 @@ def test_mouse_drags_and_flings_a_puck(app):
     assert np.linalg.norm(puck.pos_m - p0) > 0.01
 
 
+@pytest.mark.parametrize("beside_px, grabbed", [(3, True), (7, True), (20, False)])
+def test_a_click_just_beside_a_small_puck_grabs_it(app, beside_px, grabbed):
+    """In the 10000-puck gas a puck is a few pixels across: a click between pucks grabbed nothing."""
+    press(app, pygame.K_1)
+    app.paused = True  # nothing moves while we aim
+    puck = app.table.pucks[0]  # the small orange one at (2.5, 7.5), its left side clear
+    edge_px = app.env.to_screen(puck.pos_m)[0] - puck.radius_m * app.env.px_per_m
+    at = (round(edge_px - beside_px * app.window.unit), round(app.env.to_screen(puck.pos_m)[1]))
+    pygame.event.post(pygame.event.Event(pygame.MOUSEBUTTONDOWN, pos=at, button=1))
+    app.frame(FRAME_S)
+    assert (app.local.held is puck) == grabbed
+
+
 def test_a_press_and_a_quick_move_in_one_frame_grab_the_puck_under_the_press(app):
     # On a slow frame (or a quick flick) the press and the move arrive together: the grab is where the button went down.
     press(app, pygame.K_1)

@@ -45,6 +45,8 @@ from airtable.model.scene import STATUS_SEPARATOR, Scene
 from airtable.physics.table import TABLE_HEIGHT_M, TABLE_WIDTH_M, AirTable
 
 MESSAGE_S = 4.0
+# A click this far (px at 720 px tall) beside a puck's edge grabs it.
+GRAB_WITHIN_PX = 8.0
 # Closing the window asks first when leaving would lose at least this much recording.
 UNEXPORTED_ASK_S = 2.0
 DEFAULT_FPS = 60.0  # when the display does not say its refresh rate
@@ -389,8 +391,10 @@ class App:
                 self.panning = True
             else:
                 self.mouse_button = event.button
-                # Grab where the button went down: a press and a quick move can share one frame.
-                self.local.set_input(self.table, self.env.to_world(event.pos), event.button)
+                # Grab where the button went down: a press and a quick move can share one frame. A click
+                # just beside a puck takes it too: in a gas of 10000 a puck is a few pixels across.
+                within_m = GRAB_WITHIN_PX * self.window.unit / self.env.px_per_m
+                self.local.set_input(self.table, self.env.to_world(event.pos), event.button, within_m)
 
     # ------------------------------------------------------------ the frame
 

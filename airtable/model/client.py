@@ -38,8 +38,9 @@ class Client:
     held: object = None  # airtable.physics.bodies.Puck or None
     active: bool = True
 
-    def set_input(self, table, cursor_m, button: int) -> None:
-        """Take new input; grab the puck under the cursor when a button goes down."""
+    def set_input(self, table, cursor_m, button: int, grab_within_m: float = 0.0) -> None:
+        """Take new input; grab the puck under the cursor when a button goes down (or the nearest one,
+        if its edge is within `grab_within_m`: table.puck_at)."""
         self.cursor_m = np.asarray(cursor_m, dtype=float).reshape(2).copy()
         if button not in (0, *CURSOR_STRINGS):
             raise ValueError(f"mouse button must be 0-3, not {button!r}")
@@ -48,7 +49,7 @@ class Client:
         if button == 0:
             self.held = None
         elif pressed:
-            self.held = table.puck_at(self.cursor_m)
+            self.held = table.puck_at(self.cursor_m, grab_within_m)
         if self.held is not None and not self.held.alive:
             self.held = None
 

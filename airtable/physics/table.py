@@ -160,14 +160,19 @@ class AirTable(Storage):
 
     # ------------------------------------------------------------ queries
 
-    def puck_at(self, point_m: Sequence[float]) -> Puck | None:
-        """The puck under `point_m` (the last created, i.e. drawn on top), or None."""
+    def puck_at(self, point_m: Sequence[float], within_m: float = 0.0) -> Puck | None:
+        """The puck under `point_m` (the last created, i.e. drawn on top); else the one whose edge is
+        nearest it if that is within `within_m` (a click beside a small puck); else None."""
         p = as_vector(point_m, "point_m")
         if self.n_pucks == 0:
             return None
         d = self.pos_m - p
         inside = np.flatnonzero(vectors.squared_lengths(d) <= self.radius_m**2)
-        return self.puck_handles[int(inside[-1])] if len(inside) else None
+        if len(inside):
+            return self.puck_handles[int(inside[-1])]
+        gap = vectors.lengths(d) - self.radius_m
+        nearest = int(np.argmin(gap))
+        return self.puck_handles[nearest] if gap[nearest] <= within_m else None
 
     def springs_on(self, puck: Puck) -> tuple[Spring, ...]:
         """The springs attached to `puck`, in creation order."""
