@@ -135,6 +135,29 @@ def test_the_inspector_follows_the_puck_it_was_pressed_on_and_rings_it(demos):
     assert app.aids.inspected is None  # let go: the next press picks afresh
 
 
+def test_the_inspectors_words_leave_its_puck_and_the_status_line_in_view_even_in_a_corner_of_a_crowd(demos):
+    """Near the bottom right corner of the gas the words covered the puck they describe and the status line."""
+    app = make_app(demos, "0p")
+    app.paused = True
+    rects: list = []
+    original = app.painter.label
+    app.painter.label = lambda *a, **k: rects.append(original(*a, **k)) or rects[-1]
+    px = app.env.to_screen(app.table.pos_m)
+    w, h = app.window.surface.get_size()
+    for k in np.argsort(np.hypot(px[:, 0] - w, px[:, 1] - h))[:5].tolist():  # the pucks nearest the corner
+        at = (int(px[k, 0]), int(px[k, 1]))
+        pygame.event.post(pygame.event.Event(pygame.MOUSEMOTION, pos=at, rel=(0, 0), buttons=(0, 0, 0)))
+        post_key(pygame.K_i)
+        rects.clear()
+        app.frame(FRAME_S)
+        post_key(pygame.K_i, down=False)
+        app.frame(FRAME_S)
+        box = rects[-1]
+        assert box is not None and app.window.surface.get_rect().contains(box)
+        assert not box.collidepoint(at)  # its puck in view
+        assert box.bottom <= app.window.status_top_px  # the status line too
+
+
 def test_slow_motion_runs_fewer_steps_of_the_same_size(demos):
     app = make_app(demos, "1")
     for factor in (0.5, 0.25, 0.125, 0.0625, 1.0):

@@ -168,7 +168,10 @@ class AidsPainter:
         if rect is None:
             if not always:
                 return None
-            rect = box_at(anchor_px, size, AROUND[0], gap + pad).clamp(screen)
+            # Over other pucks, then, but beside its own and off the other labels and text if it can be;
+            # clamped into the window only as a last resort (it would cover its puck in a corner).
+            rect = place_box(size, anchor_px, gap + pad, self._taken, screen, line_h) if clear_of_pucks else None
+            rect = rect or box_at(anchor_px, size, AROUND[0], gap + pad).clamp(screen)
         self._taken.append(rect)
         pygame.draw.rect(self.w.surface, (0, 0, 0), rect)
         for k, (text, color) in enumerate(lines):
