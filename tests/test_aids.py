@@ -176,7 +176,7 @@ def test_slow_motion_runs_fewer_steps_of_the_same_size(demos):
 def test_collision_counter_on_the_status_line(demos):
     app = make_app(demos, "2p")
     frames_until(app, lambda: app.table.collision_count, what="the first collision", max_frames=600)
-    assert app.table.collision_count == 1 and "1 collision" in app.status_parts()  # singular
+    assert app.table.collision_count == 1 and "1 collision, 0 on walls" in app.status_parts()  # singular
 
 
 def test_reverse_time_brings_every_puck_back(demos):
