@@ -470,13 +470,9 @@ class _Layout:
                    self.kt[s:e], self.changes[s:e], self.impulse[s:e])
             for s, e in bounds
         ]  # fmt: skip
-        # For a change of every impulse at once (push): where each real and imaginary part of nab's
-        # rows goes among the velocities' (seen as real numbers), and which contact (in this
-        # layout's order) each of nab's rows belongs to.
-        parts = 2 * fab.ravel()
-        self.fab_parts = columns(parts, parts + 1).ravel()
-        self.ab_contact = np.empty(2 * m, dtype=np.intp)
-        self.ab_contact[at_a], self.ab_contact[at_b] = place, place
+        # For the few impulses an extrapolation cuts at zero (push): each contact's two rows of fab and nab.
+        self.fab = fab.reshape(-1)
+        self.at_ab = np.concatenate([at_a, at_b])
 
     def converged(self) -> bool:
         """Whether the last iteration changed no speed by CONVERGED_MPS (a change of impulse times w_max).
@@ -495,12 +491,22 @@ class _Layout:
         out[self.order] = self.impulse
         return out
 
-    def push(self, flat: np.ndarray, impulses: np.ndarray) -> None:
-        """Set the impulses (this layout's order) and change the velocities in `flat` to match."""
-        change = (impulses - self.impulse).take(self.ab_contact, axis=0) * self.nab
-        parts = flat.view(np.float64)  # (one bincount for both parts instead of two)
-        parts += np.bincount(self.fab_parts, change.view(np.float64).ravel(), len(parts))
-        self.impulse[:] = impulses
+    def push(self, w: np.ndarray, direction: np.ndarray, image: np.ndarray) -> None:
+        """Move the impulses (this layout's order) by `direction`, but to no less than 0, and the
+        velocities `w` to match; image: the velocity change that `direction` alone makes.
+
+        Only the few impulses cut at zero need a look of their own: the image is
+        kept up by the caller from the sweeps' own changes, whole arrays at once.
+        """
+        target = self.impulse + direction
+        w += image
+        cut = np.flatnonzero(target.reshape(-1) < 0.0)
+        if len(cut):  # these moved by less than direction: take back the part below zero
+            contact, column = np.divmod(cut, 2)
+            rows = 2 * self.at_ab.take(np.concatenate([contact, contact + len(self.order)])) + np.tile(column, 2)
+            below = target.reshape(-1).take(cut)
+            np.subtract.at(w.reshape(-1), self.fab.take(rows), self.nab.reshape(-1).take(rows) * np.tile(below, 2))
+        np.maximum(target, 0.0, out=self.impulse)
 
     def fill(self, knc, nab, kt, w_sum, impulse) -> _Layout:
         """This step's values (contact by contact; nab: body a's rows, then body b's) into the rounds."""
@@ -556,24 +562,28 @@ def _iterate(w: np.ndarray, first: _Layout, later: _Layout) -> tuple[int, _Layou
     if first.converged():
         return 1, first
     np.take(first.impulses(), later.order, axis=0, out=later.impulse, mode="clip")
-    direction, last_gg = None, None
+    direction = image = None  # the direction, and the velocity change it makes (kept up as it changes)
+    last_gg = (0.0, 0.0)
     iterations = max(ITERATIONS, min(MAX_ITERATIONS, ITERATION_WORK // len(later.order)))
     for it in range(2, iterations + 1):
+        before = w.copy()
         _sweep(flat, later)
         if later.converged() or it == iterations:
             return it, later  # (the last word is a sweep's, never an extrapolation)
-        after = later.impulse
         gradient = later.changes  # the sweep's impulses before it, less after it (each contact changes once)
+        swept = w - before  # what the sweep did to the velocities: the image of -gradient
         # Per column (velocity, position): numpy broadcasts a pair along rows of two several times slower.
-        gg = np.array([gradient[:, 0] @ gradient[:, 0], gradient[:, 1] @ gradient[:, 1]])
+        gg = (float(gradient[:, 0] @ gradient[:, 0]), float(gradient[:, 1] @ gradient[:, 1]))
         if direction is None:
-            direction = -gradient
+            direction, image = -gradient, swept
         else:
-            beta = np.where(gg <= last_gg, gg / np.maximum(last_gg, 1e-300), 0.0)  # a rise: start again
-            direction[:, 0] *= beta[0]
-            direction[:, 1] *= beta[1]
-            later.push(flat, np.maximum(after + direction, 0.0))
+            for col in (0, 1):
+                beta = gg[col] / max(last_gg[col], 1e-300) if gg[col] <= last_gg[col] else 0.0  # a rise: start again
+                direction[:, col] *= beta
+                image[:, col] *= beta
+            later.push(w, direction, image)
             direction -= gradient
+            image += swept
         last_gg = gg
     return iterations, later  # (only with fewer than two iterations)
 
