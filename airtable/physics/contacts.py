@@ -334,28 +334,50 @@ class ContactSolver:
             a, b = np.where(asleep.take(a), rows, a), np.where(np.append(asleep, True).take(b), rows, b)
         kept, at = last >= 0, last.clip(0)
         band = self._bands(c, korder)
-        rounds = []
+        dirty = self._dirty(a, b, kept, at, band, asleep)
+        rounds, ordered = [], False
         for before, level in ((self._band_rounds, band), (self._free_rounds, None)):
-            r = np.where(kept, before.take(at), -1) if len(before) else np.full(len(a), -1)
-            r = colouring.fit(colouring.keep(r, a, b, rows), a, b, rows, level)
+            r = colouring.keep(np.where(kept, before.take(at), -1) if len(before) else np.full(len(a), -1), a, b, rows)
+            if level is not None:
+                _mark(dirty, a, b, r < 0, rows)  # new and refitted contacts: the order may break at their bodies
+            r = colouring.fit(r, a, b, rows, level)
             for _ in range(BAND_PASSES if level is not None else 0):  # refitted ones may leave others out of order
-                again = colouring.keep_order(r, a, b, rows, level)
+                again = colouring.keep_order(r, a, b, rows, level, dirty)
                 if again is r:
+                    ordered = True
                     break
+                _mark(dirty, a, b, again < 0, rows)
                 r = colouring.fit(again, a, b, rows, level)
             rounds.append(r)
         cached = self._layouts
         asleep = None if asleep is None else asleep.copy()
         if cached is not None and np.array_equal(cached.keys, c.keys) and cached.has(*rounds):
             self._band_rounds, self._free_rounds = cached.band, cached.free  # the kept arrays, as `same` asks
-            return _Colouring(c.keys, asleep, korder, cached.band, cached.free, cached.first, cached.later)
+            kept_layouts = (cached.band, cached.free, cached.first, cached.later)
+            return _Colouring(c.keys, asleep, korder, *kept_layouts, band, ordered)
         self._band_rounds, self._free_rounds = rounds
         # In (round, key) order: rounds are few, so a stable sort of them as 16-bit numbers is a quick radix sort.
         first, later = (
             _Layout(korder.take(np.argsort(r.astype(np.int16), kind="stable")), np.bincount(r), c.a, c.b)
             for r in rounds
         )
-        return _Colouring(c.keys, asleep, korder, *rounds, first, later)
+        return _Colouring(c.keys, asleep, korder, *rounds, first, later, band, ordered)
+
+    def _dirty(self, a, b, kept, at, band, asleep) -> np.ndarray | None:
+        """The bodies where the band order of the kept rounds may be broken (a mask, the walls' row
+        False), or None: anywhere. The last colouring left its rounds in order (else None), so
+        only where a kept contact changed band or a sleeper woke; the new contacts are added later.
+
+        The same answer as looking everywhere, so a restored state (no last colouring) gives the same rounds.
+        """
+        cached = self._layouts
+        if cached is None or not cached.ordered or cached.band is not self._band_rounds or band is None:
+            return None
+        dirty = np.zeros(self._rows + 1, dtype=bool)
+        _mark(dirty, a, b, kept & (band != cached.levels.take(at)), self._rows)
+        if cached.asleep is not None:  # the woken: their contacts were the walls' row's, never looked at
+            dirty[:-1] |= cached.asleep if asleep is None else cached.asleep & ~asleep
+        return dirty
 
     def _bands(self, c: _Contacts, korder: np.ndarray) -> np.ndarray | None:
         """Each contact's band (key order): its height above the lowest, in BAND_RADII radii."""
@@ -406,6 +428,14 @@ def _same_part(a, b) -> bool:
     return a == b
 
 
+def _mark(dirty: np.ndarray | None, a: np.ndarray, b: np.ndarray, which: np.ndarray, sink: int) -> None:
+    """Mark the bodies of the contacts `which` (a mask) in `dirty` (if any), never the sink."""
+    if dirty is not None:
+        k = np.flatnonzero(which)
+        dirty[a.take(k)] = dirty[b.take(k)] = True
+        dirty[sink] = False
+
+
 @dataclass
 class _Colouring:
     """A step's contacts (keys in their order, the sleepers), their rounds and their layouts."""
@@ -417,6 +447,8 @@ class _Colouring:
     free: np.ndarray
     first: _Layout
     later: _Layout
+    levels: np.ndarray | None  # each contact's band (key order) when coloured
+    ordered: bool  # whether `band` was then in band order everywhere
 
     def same(self, keys: np.ndarray, asleep: np.ndarray | None, solver: ContactSolver) -> bool:
         """Whether these contacts are those of the solver's last step, with the same rounds and sleepers."""
@@ -470,9 +502,11 @@ class _Layout:
                    self.kt[s:e], self.changes[s:e], self.impulse[s:e])
             for s, e in bounds
         ]  # fmt: skip
-        # For the few impulses an extrapolation cuts at zero (push): each contact's two rows of fab and nab.
+        # For the few impulses an extrapolation cuts at zero (push): for each impulse (contact by
+        # contact, velocity then position), its places in fab and nab for body a and for body b.
         self.fab = fab.reshape(-1)
-        self.at_ab = np.concatenate([at_a, at_b])
+        parts = np.tile(np.arange(2), m)
+        self.entries = columns(np.repeat(2 * at_a, 2) + parts, np.repeat(2 * at_b, 2) + parts)
 
     def converged(self) -> bool:
         """Whether the last iteration changed no speed by CONVERGED_MPS (a change of impulse times w_max).
@@ -498,15 +532,14 @@ class _Layout:
         Only the few impulses cut at zero need a look of their own: the image is
         kept up by the caller from the sweeps' own changes, whole arrays at once.
         """
-        target = self.impulse + direction
+        self.impulse += direction
         w += image
-        cut = np.flatnonzero(target.reshape(-1) < 0.0)
+        impulse = self.impulse.reshape(-1)
+        cut = np.flatnonzero(impulse < 0.0)
         if len(cut):  # these moved by less than direction: take back the part below zero
-            contact, column = np.divmod(cut, 2)
-            rows = 2 * self.at_ab.take(np.concatenate([contact, contact + len(self.order)])) + np.tile(column, 2)
-            below = target.reshape(-1).take(cut)
-            np.subtract.at(w.reshape(-1), self.fab.take(rows), self.nab.reshape(-1).take(rows) * np.tile(below, 2))
-        np.maximum(target, 0.0, out=self.impulse)
+            at = self.entries.take(cut, axis=0)  # (cut, 2): body a's and body b's
+            np.subtract.at(w.reshape(-1), self.fab.take(at), self.nab.reshape(-1).take(at) * impulse.take(cut)[:, None])
+            impulse[cut] = 0.0
 
     def fill(self, knc, nab, kt, w_sum, impulse) -> _Layout:
         """This step's values (contact by contact; nab: body a's rows, then body b's) into the rounds."""
@@ -596,11 +629,13 @@ def _sweep(flat: np.ndarray, layout: _Layout) -> None:
     what it read plus its change; the walls' row takes many writes, all the
     same (wb = 0). A contact's impulse changes by k (target - vn), but stays
     at least 0: by max(k (target - vn), -impulse), here taken as minus the
-    least of k vn - k target and the impulse (the fewest numpy calls).
+    least of k vn - k target and the impulse (the fewest numpy calls). A
+    contact is in one round, so its impulse is read once a sweep: all of them
+    change at the end, in one call instead of one a round.
     """
     for fab, knc, nab, kt, change, impulse in layout.rounds:
         v = flat.take(fab)  # (2, m, 2): body a's rows, then body b's
         np.minimum((knc * (v[0] - v[1])).real - kt, impulse, out=change)
-        impulse -= change
         v -= change * nab
         flat[fab] = v
+    layout.impulse -= layout.changes
