@@ -8,8 +8,9 @@ time never lets support travel up a stack, so they get a stage of their own,
 after the collisions, in which walls and puck pairs take part together.
 
 Which contacts: pairs and puck-wall contacts that touch or nearly touch
-(gap under a margin: MARGIN_M plus as far as the stage may move a puck)
-and approach slower than the rest speed over the restitution (faster ones
+(gap under a margin: MARGIN_M plus as far as the stage may move a puck,
+and HOLD_M more for last step's contacts) and approach slower than the
+rest speed over the restitution (faster ones
 are collisions: they keep the course's model; at restitution 0 no contact
 is: see rest_for_restitution), and pairs that pressed on each other in the last
 step, whatever their speed. Each contact k has a normal
@@ -89,6 +90,12 @@ BAND_PASSES = 3
 # as this stage may move a puck in the step: a contact left out here is one
 # the stage can push a puck into (it is speculative: a gap may close, not more).
 MARGIN_M = 1e-3
+# A pair that was a contact in the last step stays one until it is this much (m) further apart than
+# the margin. The margin follows the fastest puck on the table and swings between 5 and 19 mm from
+# step to step in an 800-puck pile settling: without this the pairs at its edge came and went, a
+# third of the steps' new rounds and layouts for nothing (such a contact has a gap: all it can do
+# is keep the pair from closing more than that gap within the step).
+HOLD_M = 0.02
 # Overlap left alone (m), so contacts stay touching from step to step.
 SLOP_M = 2e-5
 # Share of the overlap beyond the slop pushed out per step.
@@ -130,11 +137,18 @@ class _Contacts:
 _FIELDS = tuple(_Contacts.__dataclass_fields__)
 
 
-def _pair_contacts(pos, vel, ci, cj, reach, rest, held, margin) -> _Contacts:
-    """The candidate pairs that touch (within margin) and approach slower than their rest speed."""
+def _pair_contacts(pos, vel, ci, cj, reach, rest, held, margin, kept=None) -> _Contacts:
+    """The candidate pairs that touch (within margin) and approach slower than their rest speed;
+    and those of `kept` (last step's contacts) within HOLD_M more."""
     d = vectors.take(pos, ci) - vectors.take(pos, cj)
     lim = reach + margin
-    near = np.flatnonzero(vectors.squared_lengths(d) < lim * lim)
+    squared = vectors.squared_lengths(d)
+    near = squared < lim * lim
+    if kept is not None:
+        hold = lim + HOLD_M
+        maybe = np.flatnonzero((squared < hold * hold) & ~near)
+        near[maybe] = kept(ci.take(maybe), cj.take(maybe))
+    near = np.flatnonzero(near)
     i, j = ci.take(near), cj.take(near)
     n, dist = vectors.unit_vectors(vectors.take(d, near), i + j)
     vn = vectors.dot_rows(vectors.take(vel, i) - vectors.take(vel, j), n)
@@ -195,6 +209,7 @@ class ContactSolver:
         self._key_order = np.empty(0, dtype=np.intp)  # this step's contacts in key order
         self._layouts: _Colouring | None = None  # the last step's contacts, rounds and their layouts
         self._wall_rest: tuple | None = None  # (rest, _impulses, answer) of the last wall_rest
+        self._held_walls: tuple | None = None  # (_impulses, rows, axes) of the pucks pressed on a wall
         self.count = 0  # contacts in the last step
         self.iterations = 0  # iterations the last step needed
 
@@ -210,6 +225,14 @@ class ContactSolver:
         found = np.searchsorted(self._keys, keys).clip(0, len(self._keys) - 1)
         return (self._keys.take(found) == keys) & (self._impulses[found, 0] > 0.0)
 
+    def kept(self, i: np.ndarray, j: np.ndarray) -> np.ndarray:
+        """Which pairs (i, j) were contacts in the last step."""
+        if len(self._keys) == 0 or len(i) == 0:
+            return np.zeros(len(i), dtype=bool)
+        keys = i.astype(np.int64) * (self._rows + 4) + j
+        found = np.searchsorted(self._keys, keys).clip(0, len(self._keys) - 1)
+        return self._keys.take(found) == keys
+
     def wall_rest(self, rest: np.ndarray) -> np.ndarray:
         """(N, 2) rest speeds towards the walls along x and y: infinite where the puck pressed
         on a wall across that axis in the last step (it rests there whatever its speed)."""
@@ -218,6 +241,9 @@ class ContactSolver:
         out = columns(rest, rest)
         self._wall_rest = (rest, self._impulses, out)
         if len(self._keys) == 0 or self._rows != len(rest):
+            return out
+        if self._held_walls is not None and self._held_walls[0] is self._impulses:
+            out[self._held_walls[1], self._held_walls[2]] = np.inf  # (found by _keep, without a division)
             return out
         row, other = np.divmod(self._keys, self._rows + 4)
         held = np.flatnonzero((other >= self._rows) & (self._impulses[:, 0] > 0.0))
@@ -253,10 +279,11 @@ class ContactSolver:
         # (see "Where the contacts are" above); `moved` is what the others' positions hold already.
         moved = vel.copy()
         if began is not None:
-            plain = np.abs(pos - vel * dt - began).max(axis=1) <= 1e-9 * (1.0 + np.abs(began).max(axis=1))
+            off, size = np.abs(pos - vel * dt - began), np.abs(began)  # (columns: a max along rows of 2 is slow)
+            plain = np.maximum(off[:, 0], off[:, 1]) <= 1e-9 * (1.0 + np.maximum(size[:, 0], size[:, 1]))
             moved[plain] = 0.0
         start = pos - (vel - moved) * dt
-        pc = _pair_contacts(start, vel, ci, cj, reach, rest, self.held, margin)
+        pc = _pair_contacts(start, vel, ci, cj, reach, rest, self.held, margin, self.kept)
         rest_walls = rest if rest_walls is None else rest_walls
         wc = _wall_contacts(start, vel, radius, size_m, self.wall_rest(rest_walls), margin)
         if asleep is not None:
@@ -391,6 +418,10 @@ class ContactSolver:
         impulses = layout.impulses()
         order = self._key_order
         self._keys, self._impulses = c.keys.take(order), impulses.take(order, axis=0)
+        # The pucks pressed on a wall, and the wall's axis (normal 1 or -1: x; 1j or -1j: y), for wall_rest.
+        walls = np.flatnonzero(c.b == self._rows)
+        held = walls.take(np.flatnonzero(impulses[walls, 0] > 0.0))
+        self._held_walls = (self._impulses, c.a.take(held), (c.n.take(held).imag != 0.0).astype(np.intp))
 
     # What the solver keeps from step to step: its impulses by contact (the warm start), and each
     # contact's rounds (they depend on the contacts it had before, so they change results). The
@@ -398,7 +429,7 @@ class ContactSolver:
     KEPT = ("_keys", "_impulses", "_rows", "_band_rounds", "_free_rounds", "count", "iterations")
     # Worked out afresh in each solve (the layouts from the kept rounds, the same in the same order):
     # they change no result, so a save need not keep them.
-    NOT_KEPT = frozenset({"_y", "_r_mean", "_warm", "_key_order", "_layouts", "_wall_rest"})
+    NOT_KEPT = frozenset({"_y", "_r_mean", "_warm", "_key_order", "_layouts", "_wall_rest", "_held_walls"})
 
     def save(self, like: tuple | None = None) -> tuple:
         """The KEPT values (references), for state.py; `like`'s parts where they are the same objects."""
