@@ -53,6 +53,7 @@ at the gap it had if it approached.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from typing import NamedTuple
 
@@ -535,16 +536,20 @@ class _Layout:
         ]  # fmt: skip
         # For the few impulses an extrapolation cuts at zero (push): for each impulse (contact by
         # contact, velocity then position), its places in fab and nab for body a and for body b.
+        # (Built by the first push: the first iteration's layout never pushes.)
         self.fab = fab.reshape(-1)
-        parts = np.tile(np.arange(2), m)
-        self.entries = columns(np.repeat(2 * at_a, 2) + parts, np.repeat(2 * at_b, 2) + parts)
+        self._at, self._entries = (at_a, at_b), None
 
-    def converged(self) -> bool:
+    def converged(self, gg: tuple[float, float] | None = None) -> bool:
         """Whether the last iteration changed no speed by CONVERGED_MPS (a change of impulse times w_max).
 
         The largest change of impulse times the least w_max bounds that from
         below, and in a pile it is far above: one cheap reduction then answers.
+        Given gg, each column's sum of squared changes, their root mean square
+        bounds the largest from below too, with no reduction at all.
         """
+        if gg is not None and math.sqrt(max(gg) / len(self.changes)) * self.w_min >= 2.0 * CONVERGED_MPS:
+            return False  # (twice: room for the roundings of the sums and the root)
         largest = float(np.abs(self.changes).max())
         if largest * self.w_min >= CONVERGED_MPS:
             return False
@@ -568,9 +573,18 @@ class _Layout:
         impulse = self.impulse.reshape(-1)
         cut = np.flatnonzero(impulse < 0.0)
         if len(cut):  # these moved by less than direction: take back the part below zero
-            at = self.entries.take(cut, axis=0)  # (cut, 2): body a's and body b's
+            at = self._impulse_entries().take(cut, axis=0)  # (cut, 2): body a's and body b's
             np.subtract.at(w.reshape(-1), self.fab.take(at), self.nab.reshape(-1).take(at) * impulse.take(cut)[:, None])
             impulse[cut] = 0.0
+
+    def _impulse_entries(self) -> np.ndarray:
+        """(2 m, 2) for each impulse (contact by contact, velocity then position), its places in
+        fab and nab (seen as flat) for body a and for body b."""
+        if self._entries is None:
+            at_a, at_b = self._at
+            parts = np.tile(np.arange(2), len(at_a))
+            self._entries = columns(np.repeat(2 * at_a, 2) + parts, np.repeat(2 * at_b, 2) + parts)
+        return self._entries
 
     def fill(self, knc, nab, kt, w_sum, impulse) -> _Layout:
         """This step's values (contact by contact; nab: body a's rows, then body b's) into the rounds."""
@@ -578,9 +592,9 @@ class _Layout:
         np.take(knc, order, axis=0, out=self.knc, mode="clip")  # "clip": no bounds check, no buffering
         np.take(nab, self.ab_rows, axis=0, out=self.nab, mode="clip")
         np.take(kt, order, axis=0, out=self.kt, mode="clip")
-        w_max = np.repeat(np.maximum.reduceat(w_sum.take(order), self.starts), self.lengths)
-        self.w_max[:, 0] = self.w_max[:, 1] = w_max
-        self.w_min = float(self.w_max.min())
+        w_round = np.maximum.reduceat(w_sum.take(order), self.starts)
+        self.w_max[:, 0] = self.w_max[:, 1] = np.repeat(w_round, self.lengths)
+        self.w_min = float(w_round.min())
         np.take(impulse, order, axis=0, out=self.impulse, mode="clip")
         return self
 
@@ -632,12 +646,12 @@ def _iterate(w: np.ndarray, first: _Layout, later: _Layout) -> tuple[int, _Layou
     for it in range(2, iterations + 1):
         before = w.copy()
         _sweep(flat, later)
-        if later.converged() or it == iterations:
-            return it, later  # (the last word is a sweep's, never an extrapolation)
         gradient = later.changes  # the sweep's impulses before it, less after it (each contact changes once)
-        swept = w - before  # what the sweep did to the velocities: the image of -gradient
         # Per column (velocity, position): numpy broadcasts a pair along rows of two several times slower.
         gg = (float(gradient[:, 0] @ gradient[:, 0]), float(gradient[:, 1] @ gradient[:, 1]))
+        if it == iterations or later.converged(gg):
+            return it, later  # (the last word is a sweep's, never an extrapolation)
+        swept = w - before  # what the sweep did to the velocities: the image of -gradient
         if direction is None:
             direction, image = -gradient, swept
         else:
