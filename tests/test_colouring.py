@@ -101,6 +101,38 @@ def test_contacts_whose_pucks_changed_band_are_put_back_in_order(graph, data) ->
     assert colouring.keep_order(checked, a, b, SINK, moved) is checked
 
 
+@settings(max_examples=200, deadline=None)
+@given(contact_graphs(), st.data())
+def test_the_order_looked_at_where_it_can_break_is_the_order_looked_at_everywhere(graph, data) -> None:
+    # The contact stage looks at the band order only at the bodies of the contacts that are new
+    # or changed band since the rounds were last all in order (contacts.py): a body whose
+    # contacts all kept their rounds and bands keeps them in order. Both looks must agree.
+    a, b, band = graph
+    rounds = colouring.fit(np.full(len(a), -1), a, b, SINK, band)
+    for _ in range(len(a) + 1):
+        again = colouring.keep_order(rounds, a, b, SINK, band)
+        if again is rounds:
+            break
+        rounds = colouring.fit(again, a, b, SINK, band)
+    assert colouring.keep_order(rounds, a, b, SINK, band) is rounds  # in order, as the stage needs to look less
+
+    def draw(values) -> np.ndarray:
+        return np.array(data.draw(st.lists(values, min_size=len(a), max_size=len(a))))
+
+    few = st.integers(0, 9).map(lambda k: k == 0)  # a tenth of them: most bodies keep their contacts
+    moved, new, level = draw(few), draw(few), draw(st.integers(0, 3))
+    now_band = np.where(moved, level, band).astype(np.int16)
+    now = colouring.fit(np.where(new, -1, rounds), a, b, SINK, now_band)
+    changed = np.flatnonzero(moved | new)
+    dirty = np.zeros(SINK + 1, dtype=bool)
+    dirty[a[changed]] = dirty[b[changed]] = True
+    dirty[SINK] = False
+    everywhere = colouring.keep_order(now, a, b, SINK, now_band)
+    np.testing.assert_array_equal(colouring.keep_order(now, a, b, SINK, now_band, dirty), everywhere)
+    if not changed.size:
+        assert everywhere is now  # nothing changed: still in order
+
+
 def test_a_woken_body_splits_a_round_it_appeared_twice_in() -> None:
     # Contacts 0 and 1 share body 5, which slept (the sink stood for it): in one round then. Awake,
     # it is a body again: keep() sends the later contact back to be fitted in.

@@ -134,3 +134,28 @@ def test_a_fall_under_the_pressed_rest_speed_rests_and_a_faster_one_bounces(drop
         assert tops[-1] == pytest.approx(2.04, abs=0.3) and tops[-2] > 2.04
     assert puck.pos_m[1] == pytest.approx(0.1, abs=1e-9)  # at rest on the floor
     assert puck.vel_mps[1] == pytest.approx(0.0, abs=1e-9)
+
+
+def test_a_contact_of_the_last_step_stays_one_a_little_further_apart() -> None:
+    # Two still pucks side by side (no wall near): a pair is a contact within the margin
+    # (MARGIN_M, plus 0.5 m/s of push times dt for still pucks); last step's contact stays
+    # one up to HOLD_M further apart, so the pairs at the margin's edge do not come and go
+    # as the margin follows the fastest puck; a new pair that far apart is no contact.
+    dt = 1 / 240
+    margin = contacts.MARGIN_M + contacts.MAX_PUSH_MPS * dt
+    radius, mass = np.full(2, 0.1), np.full(2, 0.01)
+    i, j = np.array([0]), np.array([1])
+    candidates = (i, j, np.array([0.2]))
+    rest = np.full(2, 0.1)
+
+    def count(solver: contacts.ContactSolver, gap_m: float) -> int:
+        pos, vel = np.array([[4.0, 4.0], [4.2 + gap_m, 4.0]]), np.zeros((2, 2))
+        solver.solve(pos, vel, radius, mass, np.array([10.0, 10.0]), candidates, rest, dt)
+        return solver.count
+
+    solver = contacts.ContactSolver()
+    assert count(solver, 0.5 * margin) == 1
+    assert count(solver, margin + 0.5 * contacts.HOLD_M) == 1  # kept
+    assert count(solver, margin + 1.5 * contacts.HOLD_M) == 0  # too far: let go
+    assert count(solver, margin + 0.5 * contacts.HOLD_M) == 0  # not a contact last step
+    assert count(contacts.ContactSolver(), margin + 0.5 * contacts.HOLD_M) == 0

@@ -31,13 +31,14 @@ import numpy as np
 # Knuth's multiplicative hash: odd, so it maps 0 .. 2^32 - 1 onto themselves one to one.
 _GOLDEN = np.uint64(0x9E3779B1)
 _LOW_32 = np.uint64((1 << 32) - 1)
+_NONE = np.iinfo(np.uint64).max
 
 
-def priorities(count: int, band: np.ndarray | None = None) -> np.ndarray:
-    """A distinct priority per contact (uint64, lowest first): by band, then scrambled, so that
-    a row of contacts in key order does not take one round each."""
-    prio = (np.arange(count, dtype=np.uint64) * _GOLDEN) & _LOW_32
-    return prio if band is None else prio | (band.astype(np.uint64) << np.uint64(32))
+def priorities(contacts: np.ndarray, band: np.ndarray | None = None) -> np.ndarray:
+    """A distinct priority for each of these contacts (indices; uint64, lowest first): by band, then
+    scrambled, so that a row of contacts in key order does not take one round each."""
+    prio = (contacts.astype(np.uint64) * _GOLDEN) & _LOW_32
+    return prio if band is None else prio | (band.take(contacts).astype(np.uint64) << np.uint64(32))
 
 
 def keep(rounds: np.ndarray, a: np.ndarray, b: np.ndarray, sink: int) -> np.ndarray:
@@ -63,12 +64,16 @@ def keep(rounds: np.ndarray, a: np.ndarray, b: np.ndarray, sink: int) -> np.ndar
     return out
 
 
-def keep_order(rounds: np.ndarray, a: np.ndarray, b: np.ndarray, sink: int, band: np.ndarray) -> np.ndarray:
+def keep_order(rounds: np.ndarray, a: np.ndarray, b: np.ndarray, sink: int, band: np.ndarray, only=None) -> np.ndarray:
     """The rounds still in band order: -1 for a kept contact not after every round where one of its
-    bodies has a contact of a lower band (its pucks moved to other bands since it was fitted in)."""
+    bodies has a contact of a lower band (its pucks moved to other bands since it was fitted in).
+
+    only: a mask of the bodies to look at (sink's False), or None: all. The caller
+    knows the order can be broken only at these (where contacts came or changed band).
+    """
     old = np.flatnonzero(rounds >= 0)
     body = np.concatenate([a.take(old), b.take(old)])
-    real = np.flatnonzero(body != sink)
+    real = np.flatnonzero(body != sink) if only is None else np.flatnonzero(only.take(body))
     contact = np.concatenate([old, old]).take(real)
     body, level, r = body.take(real), band.take(contact).astype(np.int64), rounds.take(contact)
     order = np.argsort(body * (int(band.max()) + 1) + level)  # by body, then band
@@ -101,12 +106,11 @@ def fit(rounds: np.ndarray, a: np.ndarray, b: np.ndarray, sink: int, band=None) 
     new = np.flatnonzero(rounds < 0)
     if len(new) == 0:
         return _dense(rounds)
-    prio = priorities(len(rounds), band)
     band = np.zeros(len(rounds), dtype=np.int16) if band is None else band
     rounds = rounds.copy()
     taken = _taken(rounds, a, b, sink, band, new)
     while len(new):
-        pick = _first_by_priority(new, a, b, sink, prio)
+        pick = _first_by_priority(new, a, b, sink, priorities(new, band))
         k = new.take(np.flatnonzero(pick))
         taken, r = _first_free(taken, a.take(k), b.take(k), band.take(k))
         rounds[k] = r
@@ -133,10 +137,10 @@ def _taken(rounds, a, b, sink: int, band, new: np.ndarray) -> np.ndarray:
     return taken
 
 
-def _first_by_priority(new, a, b, sink: int, prio) -> np.ndarray:
-    """Which of the `new` contacts come first by prio among the new contacts of both their bodies."""
-    p, ra, rb = prio.take(new), a.take(new), b.take(new)
-    best = np.full(sink + 1, np.iinfo(np.uint64).max, dtype=np.uint64)
+def _first_by_priority(new, a, b, sink: int, p) -> np.ndarray:
+    """Which of the `new` contacts come first by their priorities p among the new contacts of both their bodies."""
+    ra, rb = a.take(new), b.take(new)
+    best = np.full(sink + 1, _NONE, dtype=np.uint64)
     np.minimum.at(best, ra, p)
     np.minimum.at(best, rb, p)
     best[sink] = 0  # the sink is never taken: a contact on it is first there

@@ -8,8 +8,9 @@ time never lets support travel up a stack, so they get a stage of their own,
 after the collisions, in which walls and puck pairs take part together.
 
 Which contacts: pairs and puck-wall contacts that touch or nearly touch
-(gap under a margin: MARGIN_M plus as far as the stage may move a puck)
-and approach slower than the rest speed over the restitution (faster ones
+(gap under a margin: MARGIN_M plus as far as the stage may move a puck,
+and HOLD_M more for last step's contacts) and approach slower than the
+rest speed over the restitution (faster ones
 are collisions: they keep the course's model; at restitution 0 no contact
 is: see rest_for_restitution), and pairs that pressed on each other in the last
 step, whatever their speed. Each contact k has a normal
@@ -52,6 +53,7 @@ at the gap it had if it approached.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from typing import NamedTuple
 
@@ -89,6 +91,12 @@ BAND_PASSES = 3
 # as this stage may move a puck in the step: a contact left out here is one
 # the stage can push a puck into (it is speculative: a gap may close, not more).
 MARGIN_M = 1e-3
+# A pair that was a contact in the last step stays one until it is this much (m) further apart than
+# the margin. The margin follows the fastest puck on the table and swings between 5 and 19 mm from
+# step to step in an 800-puck pile settling: without this the pairs at its edge came and went, a
+# third of the steps' new rounds and layouts for nothing (such a contact has a gap: all it can do
+# is keep the pair from closing more than that gap within the step).
+HOLD_M = 0.02
 # Overlap left alone (m), so contacts stay touching from step to step.
 SLOP_M = 2e-5
 # Share of the overlap beyond the slop pushed out per step.
@@ -130,11 +138,18 @@ class _Contacts:
 _FIELDS = tuple(_Contacts.__dataclass_fields__)
 
 
-def _pair_contacts(pos, vel, ci, cj, reach, rest, held, margin) -> _Contacts:
-    """The candidate pairs that touch (within margin) and approach slower than their rest speed."""
+def _pair_contacts(pos, vel, ci, cj, reach, rest, held, margin, kept=None) -> _Contacts:
+    """The candidate pairs that touch (within margin) and approach slower than their rest speed;
+    and those of `kept` (last step's contacts) within HOLD_M more."""
     d = vectors.take(pos, ci) - vectors.take(pos, cj)
     lim = reach + margin
-    near = np.flatnonzero(vectors.squared_lengths(d) < lim * lim)
+    squared = vectors.squared_lengths(d)
+    near = squared < lim * lim
+    if kept is not None:
+        hold = lim + HOLD_M
+        maybe = np.flatnonzero((squared < hold * hold) & ~near)
+        near[maybe] = kept(ci.take(maybe), cj.take(maybe))
+    near = np.flatnonzero(near)
     i, j = ci.take(near), cj.take(near)
     n, dist = vectors.unit_vectors(vectors.take(d, near), i + j)
     vn = vectors.dot_rows(vectors.take(vel, i) - vectors.take(vel, j), n)
@@ -195,6 +210,7 @@ class ContactSolver:
         self._key_order = np.empty(0, dtype=np.intp)  # this step's contacts in key order
         self._layouts: _Colouring | None = None  # the last step's contacts, rounds and their layouts
         self._wall_rest: tuple | None = None  # (rest, _impulses, answer) of the last wall_rest
+        self._held_walls: tuple | None = None  # (_impulses, rows, axes) of the pucks pressed on a wall
         self.count = 0  # contacts in the last step
         self.iterations = 0  # iterations the last step needed
 
@@ -210,6 +226,14 @@ class ContactSolver:
         found = np.searchsorted(self._keys, keys).clip(0, len(self._keys) - 1)
         return (self._keys.take(found) == keys) & (self._impulses[found, 0] > 0.0)
 
+    def kept(self, i: np.ndarray, j: np.ndarray) -> np.ndarray:
+        """Which pairs (i, j) were contacts in the last step."""
+        if len(self._keys) == 0 or len(i) == 0:
+            return np.zeros(len(i), dtype=bool)
+        keys = i.astype(np.int64) * (self._rows + 4) + j
+        found = np.searchsorted(self._keys, keys).clip(0, len(self._keys) - 1)
+        return self._keys.take(found) == keys
+
     def wall_rest(self, rest: np.ndarray) -> np.ndarray:
         """(N, 2) rest speeds towards the walls along x and y: infinite where the puck pressed
         on a wall across that axis in the last step (it rests there whatever its speed)."""
@@ -218,6 +242,9 @@ class ContactSolver:
         out = columns(rest, rest)
         self._wall_rest = (rest, self._impulses, out)
         if len(self._keys) == 0 or self._rows != len(rest):
+            return out
+        if self._held_walls is not None and self._held_walls[0] is self._impulses:
+            out[self._held_walls[1], self._held_walls[2]] = np.inf  # (found by _keep, without a division)
             return out
         row, other = np.divmod(self._keys, self._rows + 4)
         held = np.flatnonzero((other >= self._rows) & (self._impulses[:, 0] > 0.0))
@@ -253,10 +280,11 @@ class ContactSolver:
         # (see "Where the contacts are" above); `moved` is what the others' positions hold already.
         moved = vel.copy()
         if began is not None:
-            plain = np.abs(pos - vel * dt - began).max(axis=1) <= 1e-9 * (1.0 + np.abs(began).max(axis=1))
+            off, size = np.abs(pos - vel * dt - began), np.abs(began)  # (columns: a max along rows of 2 is slow)
+            plain = np.maximum(off[:, 0], off[:, 1]) <= 1e-9 * (1.0 + np.maximum(size[:, 0], size[:, 1]))
             moved[plain] = 0.0
         start = pos - (vel - moved) * dt
-        pc = _pair_contacts(start, vel, ci, cj, reach, rest, self.held, margin)
+        pc = _pair_contacts(start, vel, ci, cj, reach, rest, self.held, margin, self.kept)
         rest_walls = rest if rest_walls is None else rest_walls
         wc = _wall_contacts(start, vel, radius, size_m, self.wall_rest(rest_walls), margin)
         if asleep is not None:
@@ -334,28 +362,50 @@ class ContactSolver:
             a, b = np.where(asleep.take(a), rows, a), np.where(np.append(asleep, True).take(b), rows, b)
         kept, at = last >= 0, last.clip(0)
         band = self._bands(c, korder)
-        rounds = []
+        dirty = self._dirty(a, b, kept, at, band, asleep)
+        rounds, ordered = [], False
         for before, level in ((self._band_rounds, band), (self._free_rounds, None)):
-            r = np.where(kept, before.take(at), -1) if len(before) else np.full(len(a), -1)
-            r = colouring.fit(colouring.keep(r, a, b, rows), a, b, rows, level)
+            r = colouring.keep(np.where(kept, before.take(at), -1) if len(before) else np.full(len(a), -1), a, b, rows)
+            if level is not None:
+                _mark(dirty, a, b, r < 0, rows)  # new and refitted contacts: the order may break at their bodies
+            r = colouring.fit(r, a, b, rows, level)
             for _ in range(BAND_PASSES if level is not None else 0):  # refitted ones may leave others out of order
-                again = colouring.keep_order(r, a, b, rows, level)
+                again = colouring.keep_order(r, a, b, rows, level, dirty)
                 if again is r:
+                    ordered = True
                     break
+                _mark(dirty, a, b, again < 0, rows)
                 r = colouring.fit(again, a, b, rows, level)
             rounds.append(r)
         cached = self._layouts
         asleep = None if asleep is None else asleep.copy()
         if cached is not None and np.array_equal(cached.keys, c.keys) and cached.has(*rounds):
             self._band_rounds, self._free_rounds = cached.band, cached.free  # the kept arrays, as `same` asks
-            return _Colouring(c.keys, asleep, korder, cached.band, cached.free, cached.first, cached.later)
+            kept_layouts = (cached.band, cached.free, cached.first, cached.later)
+            return _Colouring(c.keys, asleep, korder, *kept_layouts, band, ordered)
         self._band_rounds, self._free_rounds = rounds
         # In (round, key) order: rounds are few, so a stable sort of them as 16-bit numbers is a quick radix sort.
         first, later = (
             _Layout(korder.take(np.argsort(r.astype(np.int16), kind="stable")), np.bincount(r), c.a, c.b)
             for r in rounds
         )
-        return _Colouring(c.keys, asleep, korder, *rounds, first, later)
+        return _Colouring(c.keys, asleep, korder, *rounds, first, later, band, ordered)
+
+    def _dirty(self, a, b, kept, at, band, asleep) -> np.ndarray | None:
+        """The bodies where the band order of the kept rounds may be broken (a mask, the walls' row
+        False), or None: anywhere. The last colouring left its rounds in order (else None), so
+        only where a kept contact changed band or a sleeper woke; the new contacts are added later.
+
+        The same answer as looking everywhere, so a restored state (no last colouring) gives the same rounds.
+        """
+        cached = self._layouts
+        if cached is None or not cached.ordered or cached.band is not self._band_rounds or band is None:
+            return None
+        dirty = np.zeros(self._rows + 1, dtype=bool)
+        _mark(dirty, a, b, kept & (band != cached.levels.take(at)), self._rows)
+        if cached.asleep is not None:  # the woken: their contacts were the walls' row's, never looked at
+            dirty[:-1] |= cached.asleep if asleep is None else cached.asleep & ~asleep
+        return dirty
 
     def _bands(self, c: _Contacts, korder: np.ndarray) -> np.ndarray | None:
         """Each contact's band (key order): its height above the lowest, in BAND_RADII radii."""
@@ -369,6 +419,10 @@ class ContactSolver:
         impulses = layout.impulses()
         order = self._key_order
         self._keys, self._impulses = c.keys.take(order), impulses.take(order, axis=0)
+        # The pucks pressed on a wall, and the wall's axis (normal 1 or -1: x; 1j or -1j: y), for wall_rest.
+        walls = np.flatnonzero(c.b == self._rows)
+        held = walls.take(np.flatnonzero(impulses[walls, 0] > 0.0))
+        self._held_walls = (self._impulses, c.a.take(held), (c.n.take(held).imag != 0.0).astype(np.intp))
 
     # What the solver keeps from step to step: its impulses by contact (the warm start), and each
     # contact's rounds (they depend on the contacts it had before, so they change results). The
@@ -376,7 +430,7 @@ class ContactSolver:
     KEPT = ("_keys", "_impulses", "_rows", "_band_rounds", "_free_rounds", "count", "iterations")
     # Worked out afresh in each solve (the layouts from the kept rounds, the same in the same order):
     # they change no result, so a save need not keep them.
-    NOT_KEPT = frozenset({"_y", "_r_mean", "_warm", "_key_order", "_layouts", "_wall_rest"})
+    NOT_KEPT = frozenset({"_y", "_r_mean", "_warm", "_key_order", "_layouts", "_wall_rest", "_held_walls"})
 
     def save(self, like: tuple | None = None) -> tuple:
         """The KEPT values (references), for state.py; `like`'s parts where they are the same objects."""
@@ -406,6 +460,14 @@ def _same_part(a, b) -> bool:
     return a == b
 
 
+def _mark(dirty: np.ndarray | None, a: np.ndarray, b: np.ndarray, which: np.ndarray, sink: int) -> None:
+    """Mark the bodies of the contacts `which` (a mask) in `dirty` (if any), never the sink."""
+    if dirty is not None:
+        k = np.flatnonzero(which)
+        dirty[a.take(k)] = dirty[b.take(k)] = True
+        dirty[sink] = False
+
+
 @dataclass
 class _Colouring:
     """A step's contacts (keys in their order, the sleepers), their rounds and their layouts."""
@@ -417,6 +479,8 @@ class _Colouring:
     free: np.ndarray
     first: _Layout
     later: _Layout
+    levels: np.ndarray | None  # each contact's band (key order) when coloured
+    ordered: bool  # whether `band` was then in band order everywhere
 
     def same(self, keys: np.ndarray, asleep: np.ndarray | None, solver: ContactSolver) -> bool:
         """Whether these contacts are those of the solver's last step, with the same rounds and sleepers."""
@@ -470,20 +534,22 @@ class _Layout:
                    self.kt[s:e], self.changes[s:e], self.impulse[s:e])
             for s, e in bounds
         ]  # fmt: skip
-        # For a change of every impulse at once (push): where each real and imaginary part of nab's
-        # rows goes among the velocities' (seen as real numbers), and which contact (in this
-        # layout's order) each of nab's rows belongs to.
-        parts = 2 * fab.ravel()
-        self.fab_parts = columns(parts, parts + 1).ravel()
-        self.ab_contact = np.empty(2 * m, dtype=np.intp)
-        self.ab_contact[at_a], self.ab_contact[at_b] = place, place
+        # For the few impulses an extrapolation cuts at zero (push): for each impulse (contact by
+        # contact, velocity then position), its places in fab and nab for body a and for body b.
+        # (Built by the first push: the first iteration's layout never pushes.)
+        self.fab = fab.reshape(-1)
+        self._at, self._entries = (at_a, at_b), None
 
-    def converged(self) -> bool:
+    def converged(self, gg: tuple[float, float] | None = None) -> bool:
         """Whether the last iteration changed no speed by CONVERGED_MPS (a change of impulse times w_max).
 
         The largest change of impulse times the least w_max bounds that from
         below, and in a pile it is far above: one cheap reduction then answers.
+        Given gg, each column's sum of squared changes, their root mean square
+        bounds the largest from below too, with no reduction at all.
         """
+        if gg is not None and math.sqrt(max(gg) / len(self.changes)) * self.w_min >= 2.0 * CONVERGED_MPS:
+            return False  # (twice: room for the roundings of the sums and the root)
         largest = float(np.abs(self.changes).max())
         if largest * self.w_min >= CONVERGED_MPS:
             return False
@@ -495,12 +561,30 @@ class _Layout:
         out[self.order] = self.impulse
         return out
 
-    def push(self, flat: np.ndarray, impulses: np.ndarray) -> None:
-        """Set the impulses (this layout's order) and change the velocities in `flat` to match."""
-        change = (impulses - self.impulse).take(self.ab_contact, axis=0) * self.nab
-        parts = flat.view(np.float64)  # (one bincount for both parts instead of two)
-        parts += np.bincount(self.fab_parts, change.view(np.float64).ravel(), len(parts))
-        self.impulse[:] = impulses
+    def push(self, w: np.ndarray, direction: np.ndarray, image: np.ndarray) -> None:
+        """Move the impulses (this layout's order) by `direction`, but to no less than 0, and the
+        velocities `w` to match; image: the velocity change that `direction` alone makes.
+
+        Only the few impulses cut at zero need a look of their own: the image is
+        kept up by the caller from the sweeps' own changes, whole arrays at once.
+        """
+        self.impulse += direction
+        w += image
+        impulse = self.impulse.reshape(-1)
+        cut = np.flatnonzero(impulse < 0.0)
+        if len(cut):  # these moved by less than direction: take back the part below zero
+            at = self._impulse_entries().take(cut, axis=0)  # (cut, 2): body a's and body b's
+            np.subtract.at(w.reshape(-1), self.fab.take(at), self.nab.reshape(-1).take(at) * impulse.take(cut)[:, None])
+            impulse[cut] = 0.0
+
+    def _impulse_entries(self) -> np.ndarray:
+        """(2 m, 2) for each impulse (contact by contact, velocity then position), its places in
+        fab and nab (seen as flat) for body a and for body b."""
+        if self._entries is None:
+            at_a, at_b = self._at
+            parts = np.tile(np.arange(2), len(at_a))
+            self._entries = columns(np.repeat(2 * at_a, 2) + parts, np.repeat(2 * at_b, 2) + parts)
+        return self._entries
 
     def fill(self, knc, nab, kt, w_sum, impulse) -> _Layout:
         """This step's values (contact by contact; nab: body a's rows, then body b's) into the rounds."""
@@ -508,9 +592,9 @@ class _Layout:
         np.take(knc, order, axis=0, out=self.knc, mode="clip")  # "clip": no bounds check, no buffering
         np.take(nab, self.ab_rows, axis=0, out=self.nab, mode="clip")
         np.take(kt, order, axis=0, out=self.kt, mode="clip")
-        w_max = np.repeat(np.maximum.reduceat(w_sum.take(order), self.starts), self.lengths)
-        self.w_max[:, 0] = self.w_max[:, 1] = w_max
-        self.w_min = float(self.w_max.min())
+        w_round = np.maximum.reduceat(w_sum.take(order), self.starts)
+        self.w_max[:, 0] = self.w_max[:, 1] = np.repeat(w_round, self.lengths)
+        self.w_min = float(w_round.min())
         np.take(impulse, order, axis=0, out=self.impulse, mode="clip")
         return self
 
@@ -556,24 +640,28 @@ def _iterate(w: np.ndarray, first: _Layout, later: _Layout) -> tuple[int, _Layou
     if first.converged():
         return 1, first
     np.take(first.impulses(), later.order, axis=0, out=later.impulse, mode="clip")
-    direction, last_gg = None, None
+    direction = image = None  # the direction, and the velocity change it makes (kept up as it changes)
+    last_gg = (0.0, 0.0)
     iterations = max(ITERATIONS, min(MAX_ITERATIONS, ITERATION_WORK // len(later.order)))
     for it in range(2, iterations + 1):
+        before = w.copy()
         _sweep(flat, later)
-        if later.converged() or it == iterations:
-            return it, later  # (the last word is a sweep's, never an extrapolation)
-        after = later.impulse
         gradient = later.changes  # the sweep's impulses before it, less after it (each contact changes once)
         # Per column (velocity, position): numpy broadcasts a pair along rows of two several times slower.
-        gg = np.array([gradient[:, 0] @ gradient[:, 0], gradient[:, 1] @ gradient[:, 1]])
+        gg = (float(gradient[:, 0] @ gradient[:, 0]), float(gradient[:, 1] @ gradient[:, 1]))
+        if it == iterations or later.converged(gg):
+            return it, later  # (the last word is a sweep's, never an extrapolation)
+        swept = w - before  # what the sweep did to the velocities: the image of -gradient
         if direction is None:
-            direction = -gradient
+            direction, image = -gradient, swept
         else:
-            beta = np.where(gg <= last_gg, gg / np.maximum(last_gg, 1e-300), 0.0)  # a rise: start again
-            direction[:, 0] *= beta[0]
-            direction[:, 1] *= beta[1]
-            later.push(flat, np.maximum(after + direction, 0.0))
+            for col in (0, 1):
+                beta = gg[col] / max(last_gg[col], 1e-300) if gg[col] <= last_gg[col] else 0.0  # a rise: start again
+                direction[:, col] *= beta
+                image[:, col] *= beta
+            later.push(w, direction, image)
             direction -= gradient
+            image += swept
         last_gg = gg
     return iterations, later  # (only with fewer than two iterations)
 
@@ -586,11 +674,13 @@ def _sweep(flat: np.ndarray, layout: _Layout) -> None:
     what it read plus its change; the walls' row takes many writes, all the
     same (wb = 0). A contact's impulse changes by k (target - vn), but stays
     at least 0: by max(k (target - vn), -impulse), here taken as minus the
-    least of k vn - k target and the impulse (the fewest numpy calls).
+    least of k vn - k target and the impulse (the fewest numpy calls). A
+    contact is in one round, so its impulse is read once a sweep: all of them
+    change at the end, in one call instead of one a round.
     """
     for fab, knc, nab, kt, change, impulse in layout.rounds:
         v = flat.take(fab)  # (2, m, 2): body a's rows, then body b's
         np.minimum((knc * (v[0] - v[1])).real - kt, impulse, out=change)
-        impulse -= change
         v -= change * nab
         flat[fab] = v
+    layout.impulse -= layout.changes
