@@ -39,9 +39,9 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument(
         "--variation",
         type=_positive_int,
-        default=1,
+        default=None,
         metavar="N",
-        help="which variation of that demo, counting from 1 as --list-demos lists them (default 1)",
+        help="which variation of that demo, counting from 1 as --list-demos lists them (default: the demo's own)",
     )
     p.add_argument("--list-demos", action="store_true", help="list the demos and exit")
     _server_options(p)
@@ -247,7 +247,7 @@ def load_demos(parser: argparse.ArgumentParser, args: argparse.Namespace) -> Dem
             print(error.one_line(), file=sys.stderr)
         parser.error(f"there is no demo {args.demo!r}; choose one of: {', '.join(shelf.demos)}")
     variations = shelf.demos[args.demo].variations
-    if args.variation > max(1, len(variations)):
+    if args.variation is not None and args.variation > max(1, len(variations)):
         having = f"variations 1 to {len(variations)}" if variations else "no variations"
         parser.error(f"demo {args.demo} has {having}; --variation {args.variation} is not one of them")
     return shelf
@@ -331,7 +331,7 @@ def run_app(args: argparse.Namespace, shelf: DemoShelf, shot: Path | None) -> in
         app = App(
             shelf,
             demo_key=args.demo,
-            variation=args.variation - 1,  # the app counts from 0, a teacher from 1
+            variation=None if args.variation is None else args.variation - 1,  # the app counts from 0, a teacher from 1
             headless=args.headless,
             server=server,
             server_problem=server_problem,

@@ -12,9 +12,10 @@ step can follow, so the step solves their springs implicitly: the block keeps it
 sags just as k says, but its fastest wobble is damped away. Left and Right change the stiffness.
 """
 
-VARIATIONS = ("k 300 N/m", "soft: k 60 N/m", "stiff: k 1500 N/m")
-STIFFNESS_NPM = (300.0, 60.0, 1500.0)
-DAMPER_NSPM = (0.5, 0.1, 1.0)
+VARIATIONS = ("soft: k 60 N/m", "k 300 N/m", "stiff: k 1500 N/m")
+DEFAULT_VARIATION = 1
+STIFFNESS_NPM = (60.0, 300.0, 1500.0)
+DAMPER_NSPM = (0.1, 0.5, 1.0)
 SIDE = 5  # pucks along each side of the block
 PITCH_M = 0.5  # their spacing
 RADIUS_M = 0.15

@@ -56,13 +56,29 @@ def test_variations_and_page_keys(app, demos):
     assert len(app.table.pucks) > n0
     assert demos["0"].variations[1] in app.window.caption
     press(app, pygame.K_LEFT)
-    press(app, pygame.K_LEFT)  # wraps round to the last variation
-    assert app.variation == len(demos["0"].variations) - 1
+    n_first, t_first = len(app.table.pucks), app.table.time_s
+    press(app, pygame.K_LEFT)  # at the first it stays (round the end was the heaviest, 10000 pucks)
+    assert app.variation == 0 and len(app.table.pucks) == n_first and app.table.time_s > t_first
+    assert app.message == "this is its first variation (Right goes back)"
     press(app, pygame.K_PAGEDOWN)
     keys = list(demos)
     assert app.demo_key == keys[(keys.index("0") + 1) % len(keys)]
     press(app, pygame.K_PAGEUP)
     assert app.demo_key == "0"
+
+
+def test_a_demo_key_starts_its_default_variation_and_left_right_go_down_and_up_from_it(app, demos):
+    """The gas's variations went 2000, 500, 5000, 10000 pucks: Left from the start gave 10000."""
+    press(app, pygame.K_0, mod=pygame.KMOD_SHIFT)
+    assert app.demo_key == "0p" and len(app.table.pucks) == 2000
+    seen = []
+    for key in [pygame.K_LEFT] * 2 + [pygame.K_RIGHT] * 4:
+        press(app, key)
+        seen.append(len(app.table.pucks))
+    assert seen == [500, 500, 2000, 5000, 10000, 10000]
+    assert app.message == "this is its last variation (Left goes back)"
+    press(app, pygame.K_0, mod=pygame.KMOD_SHIFT)  # its key again: its default
+    assert len(app.table.pucks) == 2000
 
 
 def test_pause_and_single_step(app):

@@ -291,3 +291,20 @@ def test_correction_demos_hit_in_view_and_the_trails_differ():
         assert_sane(table)
     assert np.linalg.norm(paths["1p"] - paths["2p"]) > 0.2
     assert np.linalg.norm(paths["2p"] - paths["3p"]) > 0.2
+
+
+@pytest.mark.parametrize("default, ok", [("1", True), ("2", False), ("-1", False), ("'1'", False)])
+def test_a_default_variation_must_count_one_of_the_variations(tmp_path, default, ok) -> None:
+    from airtable.app.demo_loader import discover
+
+    (tmp_path / "demo_t9.py").write_text(
+        f"KEY = 't9'\nTITLE = 'x'\nVARIATIONS = ('a', 'b')\nDEFAULT_VARIATION = {default}\n\n"
+        "def build(table, variation=0):\n    table.add_puck((1, 1), 0.1 + variation)\n"
+    )
+    found, errors = discover([tmp_path])
+    if ok:
+        assert not errors and found["t9"].default_variation == 1
+    else:
+        assert [str(e) for e in errors] == [
+            f"demo_t9.py: DEFAULT_VARIATION must count one of VARIATIONS from 0, not {default}"
+        ]

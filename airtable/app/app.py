@@ -98,7 +98,7 @@ class App:
         demos: dict[str, Demo] | DemoShelf,
         *,
         demo_key: str = "1",
-        variation: int = 0,
+        variation: int | None = None,
         headless: bool = False,
         server=None,
         server_problem: str | None = None,
@@ -196,8 +196,9 @@ class App:
         self.errors.append(error)
         print(error.one_line(), file=sys.stderr, flush=True)
 
-    def start_demo(self, key: str, variation: int = 0) -> None:
-        """Clear the table and build demo `key`, re-reading demo files that changed on disk.
+    def start_demo(self, key: str, variation: int | None = None) -> None:
+        """Clear the table and build demo `key` (its `variation`; None: the demo's default), re-reading
+        demo files that changed on disk.
 
         A demo whose file does not load, or whose build fails, shows its error instead.
         """
@@ -213,6 +214,8 @@ class App:
         if self.build_error is not None:
             self.paused = False  # the pause came with the error; a new start runs
         self.demo_key, self.demo_path = key, (demo.path if demo else broken.path)
+        if variation is None:
+            variation = demo.default_variation if demo else 0
         self.variation = variation % len(demo.variations) if demo and demo.variations else 0
         self._clear_table()
         self.build_error = broken
@@ -246,10 +249,16 @@ class App:
         return self.demo.label(self.variation)
 
     def next_variation(self, step: int) -> None:
-        if not self.demo.variations:
+        """Left/Right: the demo's previous or next variation; at either end it stays (a step round the end
+        jumped from the lightest to the heaviest: from a 500-puck gas to 10000)."""
+        count = len(self.demo.variations)
+        if not count:
             self.say("this demo has no variations")
-            return
-        self.start_demo(self.demo_key, self.variation + step)
+        elif not 0 <= self.variation + step < count:
+            end, back = ("first", "Right") if step < 0 else ("last", "Left")
+            self.say(f"this is its {end} variation ({back} goes back)")
+        else:
+            self.start_demo(self.demo_key, self.variation + step)
 
     def next_demo(self, step: int) -> None:
         self.shelf.refresh()

@@ -6,6 +6,7 @@ A demo is one Python file that defines:
     TITLE = "Spring triangle"
     NOTES = "Two to four sentences a teacher can read out."
     VARIATIONS = ("n = 4", "n = 8")   # optional; Left/Right step through them
+    DEFAULT_VARIATION = 0     # optional: the one its key starts (counting from 0)
     DT_S = 1 / 240            # optional fixed physics step
     TRAILS = False            # optional: start with trails (no erasing) on
     def build(table, variation=0): ...   # adds pucks, springs, settings, events
@@ -40,6 +41,7 @@ class Demo:
     build: Callable = field(repr=False)
     variations: tuple[str, ...] = ()
     dt_s: float = DEFAULT_DT_S
+    default_variation: int = 0  # the variation its key starts
     trails: bool = False
     path: Path | None = None
 
@@ -160,13 +162,20 @@ def load_demo_file(path: Path) -> Demo:
     path = Path(path)
     module = _import(path)
     dt_s = _check(path, module)
+    variations = tuple(str(v) for v in getattr(module, "VARIATIONS", ()))
+    default = getattr(module, "DEFAULT_VARIATION", 0)
+    if not isinstance(default, int) or not 0 <= default < max(1, len(variations)):
+        raise DemoLoadError(
+            DemoError(path, None, f"DEFAULT_VARIATION must count one of VARIATIONS from 0, not {default!r}")
+        )
     return Demo(
         key=str(module.KEY),
         title=str(module.TITLE),
         notes=" ".join(str(getattr(module, "NOTES", "")).split()),
         build=module.build,
-        variations=tuple(str(v) for v in getattr(module, "VARIATIONS", ())),
+        variations=variations,
         dt_s=dt_s,
+        default_variation=default,
         trails=bool(getattr(module, "TRAILS", False)),
         path=path,
     )
