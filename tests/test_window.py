@@ -298,3 +298,22 @@ def test_panels_leave_the_frame_rate_and_paused_in_view(size) -> None:
         assert len(corner) == 2
     assert panel.collidelist(corner) == -1
     assert panel.height >= 4 * win.font.get_linesize()
+
+
+def test_the_notes_panel_is_no_taller_than_its_text_so_the_table_shows_below() -> None:
+    """The notes covered the whole table, the orange puck they speak of too, with the panel's lower half empty."""
+    from airtable.app.demo_loader import BUILTIN_DIR, discover
+
+    gas = discover([BUILTIN_DIR])[0]["0p"]
+    win = window((1920, 1080))
+    win.draw(scene(status="t = 5.35 s"))
+    rect = win.panel_rect()
+    font = win._panel_font([("", (gas.notes,))], rect, "big")
+    args = dict(font=font, title_font=win.big_font, small_font=win.label_font)
+    full, _ = panel_view.render_panel(rect.size, gas.label(1), [("", (gas.notes,))], **args)
+    fitted, pages = panel_view.render_panel(rect.size, gas.label(1), [("", (gas.notes,))], fit=True, **args)
+    assert pages == 1 and full.get_size() == rect.size
+    assert fitted.get_width() == rect.width and fitted.get_height() < 0.7 * rect.height
+    body = panel_view.body_rect(rect.size, font, win.big_font, win.label_font)
+    lines = panel_view.layout(font, [("", (gas.notes,))], body.size)[0]
+    assert body.y + max(p.y for p in lines) + font.get_linesize() <= fitted.get_height()  # every line inside it

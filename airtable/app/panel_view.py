@@ -153,18 +153,23 @@ def render_panel(
     small_font: pygame.font.Font,
     page: int = 0,
     page_key: str = "F1",
+    fit: bool = False,
 ) -> tuple[pygame.Surface, int]:
     """An opaque panel of `size_px` with `title` and the page `page` of its text, and the page count;
-    `page_key` turns the pages (the note under a text of several says so)."""
+    `page_key` turns the pages (the note under a text of several says so). With `fit`, a text that
+    fits on one page gets a panel only as tall as it needs (the lecture notes: the table shows below)."""
     pad = font.get_height()
+    if title_font.size(title)[0] > size_px[0] - 2 * pad:  # a long title in the body's type
+        title_font = font
+    body = body_rect(size_px, font, title_font, small_font)
+    pages = layout(font, sections, body.size)
+    if fit and len(pages) == 1 and pages[0]:
+        used = max(piece.y for piece in pages[0]) + font.get_linesize()
+        size_px = (size_px[0], min(size_px[1], body.y + used + pad // 2))
     panel = pygame.Surface(size_px, pygame.SRCALPHA)
     panel.fill(PANEL_COLOR)
     pygame.draw.rect(panel, ACCENT, panel.get_rect(), max(1, pad // 10))
-    if title_font.size(title)[0] > size_px[0] - 2 * pad:  # a long title in the body's type
-        title_font = font
     panel.blit(title_font.render(shorten(title_font, title, size_px[0] - 2 * pad), True, ACCENT), (pad, pad // 2))
-    body = body_rect(size_px, font, title_font, small_font)
-    pages = layout(font, sections, body.size)
     page %= len(pages)
     for piece in pages[page]:
         panel.blit(font.render(piece.text, True, piece.color), (body.x + piece.x, body.y + piece.y))

@@ -529,7 +529,7 @@ class GameWindow:
         description) pair shown in two columns, as on the help screen.
         `side_rows`, if any, follow under their own `side_title`. Rows flow
         into columns and, if they still do not fit, onto pages: `page` picks one, `page_key` turns them.
-        `large`: in the large type where the text fits on one page.
+        `large`: in the large type where the text fits on one page, the panel no taller than the text.
         """
         sections = [("", tuple(rows))]
         if side_rows:
@@ -548,6 +548,7 @@ class GameWindow:
                 small_font=self.label_font,
                 page=page,
                 page_key=page_key,
+                fit=large,
             )
             if len(self._panels) >= 8:
                 self._panels.clear()
