@@ -484,8 +484,9 @@ class App:
             parts.extend(feature.status_parts(for_students))  # hands off, the floor, the round, rewound
         if self.speed != 1.0:
             parts.append(f"slow motion x1/{round(1 / self.speed)}")
-        if for_students and self._physics_behind():  # (the teacher's window has it in the heads-up lines)
-            parts.append(f"{self._physics_behind()} (the teacher's computer's most)")
+        behind = self._physics_behind() if for_students else ""  # (the teacher's: in the heads-up lines)
+        if behind:
+            parts.append(f"{behind} (the teacher's computer's most)")
         parts.append(f"t = {t.time_s:.2f} s")
         parts.append("F1: help")  # the students' windows have their own F1
         parts.append(gravity_label(t))
@@ -520,8 +521,9 @@ class App:
         """The heads-up lines under the title: the features' (why students cannot join, in red, the join
         line, the student count), whether the physics keeps real time, then the newest message."""
         lines: list = [line for feature in self.features for line in feature.hud_lines()]
-        if self._physics_behind():  # here, not in the status line: coming and going, it pushed parts off it
-            lines.append(f"{self._physics_behind()} (the computer's most)")
+        behind = self._physics_behind()  # here, not in the status line: coming and going, it pushed parts off it
+        if behind:
+            lines.append(f"{behind} (the computer's most)")
         if self.message and self.clock_s < self.message_until:
             lines.append(self.message)
         elif not self.window.wall_rects():

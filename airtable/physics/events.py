@@ -351,11 +351,19 @@ class _Step:
             ok &= speed > either.maximum(either.take(rules.rest, a), either.take(rules.rest, b))
         if rules.held is not None and either.count(ok):  # pressed on each other in the last step: resting
             ok &= ~_held(rules.held, a, b)
-        for k in ok.nonzero()[0].tolist() if isinstance(ok, np.ndarray) else [None] if ok else []:
-            pair = (a, b) if k is None else (a.item(k), b.item(k))
-            if rules.cr_puck < 1.0 and self.hit_pairs.get(pair, 0) >= repeat_max(rules.cr_puck):
-                continue
-            self.push(t if k is None else t.item(k), *pair)
+        if not isinstance(ok, np.ndarray):  # one pair
+            if ok:
+                self.push_pair(t, a, b)
+            return
+        for k in ok.nonzero()[0].tolist():
+            self.push_pair(t.item(k), a.item(k), b.item(k))
+
+    def push_pair(self, t: float, a: int, b: int) -> None:
+        """Queue a hit of the pair (a, b) at t, unless below restitution 1 it has hit repeat_max times already."""
+        cr = self.rules.cr_puck
+        if cr < 1.0 and self.hit_pairs.get((a, b), 0) >= repeat_max(cr):
+            return
+        self.push(t, a, b)
 
     def next_hit(self, a, b):
         """(t, u) for the pairs (a, b) on their present paths: when they next hit (s into the step; inf if
