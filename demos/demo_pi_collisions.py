@@ -35,18 +35,19 @@ def build(table, variation=0):
     )
 
     def stop_when_done(table):
-        # Done once both go right and the heavy one is faster: no more hits can
-        # come. Stop both before the far wall sends the heavy one back.
+        # Done once both go right and the heavy one is faster: no more hits can come, and the count
+        # is said at once. Both stop before the far wall sends the heavy one back.
         v_light, v_heavy = light.vel_mps[0], heavy.vel_mps[0]
-        if 0.0 <= v_light <= v_heavy and heavy.pos_m[0] > table.width_m - 3.0 * HEAVY_RADIUS_M:
-            light.vel_mps = heavy.vel_mps = (0.0, 0.0)
+        if 0.0 <= v_light <= v_heavy:
             pairs, walls = table.collision_count, table.wall_collision_count
             table.notices.say(
                 "pi",
-                f"{pairs + walls} hits in all: {pairs} between the pucks, {walls} on the wall. No more can come,"
-                " so both pucks stop here, before the far wall sends the heavy one back.",
+                f"{pairs + walls} hits in all: {pairs} between the pucks, {walls} on the wall. No more can come:"
+                " both pucks stop before the far wall.",
             )
-            return
+            if heavy.pos_m[0] > table.width_m - 3.0 * HEAVY_RADIUS_M:
+                light.vel_mps = heavy.vel_mps = (0.0, 0.0)
+                return
         table.schedule(table.time_s + CHECK_EVERY_S, stop_when_done)
 
     table.schedule(CHECK_EVERY_S, stop_when_done)

@@ -77,7 +77,10 @@ def test_a_demo_key_starts_its_default_variation_and_left_right_go_down_and_up_f
         seen.append(len(app.table.pucks))
     assert seen == [500, 500, 2000, 5000, 10000, 10000]
     assert app.message == "this is its last variation (Left goes back)"
-    press(app, pygame.K_0, mod=pygame.KMOD_SHIFT)  # its key again: its default
+    press(app, pygame.K_0, mod=pygame.KMOD_SHIFT)  # its key again restarts it as it was
+    assert len(app.table.pucks) == 10000 and app.table.time_s < 0.1
+    press(app, pygame.K_1)
+    press(app, pygame.K_0, mod=pygame.KMOD_SHIFT)  # from another demo: its default
     assert len(app.table.pucks) == 2000
 
 

@@ -45,6 +45,8 @@ from airtable.model.scene import STATUS_SEPARATOR, Scene
 from airtable.physics.table import TABLE_HEIGHT_M, TABLE_WIDTH_M, AirTable
 
 MESSAGE_S = 4.0
+# What the table or a demo says (a softened spring, the pi demo's count) stays this long.
+NOTICE_S = 12.0
 # A click this far (px at 720 px tall) beside a puck's edge grabs it.
 GRAB_WITHIN_PX = 8.0
 # Closing the window asks first when leaving would lose at least this much recording.
@@ -330,11 +332,11 @@ class App:
 
     # ------------------------------------------------------------ what the features may ask
 
-    def say(self, text: str, *, lasting: bool = False) -> None:
-        """Show a one-line message on screen for a few seconds. It is about the demo on the table and goes
+    def say(self, text: str, *, lasting: bool = False, for_s: float = MESSAGE_S) -> None:
+        """Show a one-line message on screen for `for_s` seconds. It is about the demo on the table and goes
         when another demo starts, unless `lasting` (it says where a file was written)."""
         self.message = text
-        self.message_until = self.clock_s + MESSAGE_S
+        self.message_until = self.clock_s + for_s
         self.message_lasts = lasting
 
     def student_count(self) -> int:
@@ -374,8 +376,8 @@ class App:
             return
         if event.type == pygame.KEYDOWN and not self.keys.press(event):
             key = demo_key_for(event)
-            if key is not None:
-                self.start_demo(key)
+            if key is not None:  # its key again restarts it as it is (the variation it was at)
+                self.start_demo(key, self.variation if key == self.demo_key else None)
         elif event.type in MOUSE_EVENTS:
             self._handle_mouse(event)
         elif event.type in (pygame.VIDEORESIZE, pygame.WINDOWSIZECHANGED):
@@ -460,7 +462,7 @@ class App:
         if len(notices) < self._notices_seen:  # a new scene started the list again
             self._notices_seen = 0
         for sentence in notices[self._notices_seen :]:
-            self.say(sentence)
+            self.say(sentence, for_s=NOTICE_S)
             print(f"airtable: {sentence}", file=sys.stderr)
         self._notices_seen = len(notices)
 

@@ -136,7 +136,7 @@ class Rewind(Feature):
     bindings = (
         Binding(
             ", / .",
-            "rewind / on a frame (Shift: 1 s)",
+            "rewind / on a step (Shift: 1 s)",
             {
                 pygame.K_COMMA: step_back,
                 pygame.K_PERIOD: step_forward,
