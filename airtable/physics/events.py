@@ -275,7 +275,7 @@ class _Step:
     def fast(self, k):
         """Whether puck k (a row, or an array of rows) moves FAST_FRACTION of its radius in a step on
         its present path."""
-        return np.abs(self.zvel[k]) * self.dt > FAST_FRACTION * self.radius[k]
+        return vectors.length(either.take(self.zvel, k)) * self.dt > FAST_FRACTION * either.take(self.radius, k)
 
     def find_partners(self, neighbours) -> None:
         """The pairs that may meet during the step, on any path within 2 travels of the step's ends."""
@@ -342,11 +342,15 @@ class _Step:
         """Queue the next hit of each pair (a[k], b[k]) on their present paths, if it comes within the
         step, in the pairs' order: numpy arrays of rows (a step's first pairs, or a puck's many partners,
         at once), or one pair (a and b ints) in Python numbers, by the same lines (either.py)."""
-        t, speed = self.next_hit(a, b)
-        ok = t <= self.dt  # (inf where they never meet)
         rules = self.rules
         if rules.pairs != "perfect-kiss":  # the pair stage sees the others overlapping, if they hit
-            ok &= self.fast(a) | self.fast(b)
+            fast = self.fast(a) | self.fast(b)
+            if not either.count(fast):
+                return  # no hit of theirs is this stage's: none is worked out
+        t, speed = self.next_hit(a, b)
+        ok = t <= self.dt  # (inf where they never meet)
+        if rules.pairs != "perfect-kiss":
+            ok &= fast
         if rules.rest is not None:  # slower: a resting contact, the contact stage's
             ok &= speed > either.maximum(either.take(rules.rest, a), either.take(rules.rest, b))
         if rules.held is not None and either.count(ok):  # pressed on each other in the last step: resting
