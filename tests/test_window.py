@@ -317,3 +317,16 @@ def test_the_notes_panel_is_no_taller_than_its_text_so_the_table_shows_below() -
     body = panel_view.body_rect(rect.size, font, win.big_font, win.label_font)
     lines = panel_view.layout(font, [("", (gas.notes,))], body.size)[0]
     assert body.y + max(p.y for p in lines) + font.get_linesize() <= fitted.get_height()  # every line inside it
+
+
+@pytest.mark.parametrize("size", [(640, 480), (1280, 720), (3840, 2160)])
+def test_a_cursors_name_stays_whole_on_screen_on_dark_ground(size) -> None:
+    """The teacher's "teacher" was cut to "teac" at the right edge, and hard to read over the gas."""
+    win = window(size)
+    win.draw(scene())
+    w, h = win.surface.get_size()
+    for at_px in ((w - 2, h // 2), (w // 2, h - 2), (w - 2, h - 2), (5, 5)):
+        box = win.draw_cursor("teacher", (120, 255, 120), win.env.to_world(at_px))
+        assert win.surface.get_rect().contains(box) and box.width >= win.label_font.size("teacher")[0]
+        corner = tuple(win.surface.get_at(box.topleft))[:3]
+        assert corner == (0, 0, 0)  # the name's own dark ground

@@ -426,8 +426,8 @@ class GameWindow:
                 pygame.draw.line(self.surface, cur.color, start, end, self.line_px(2))
             self.draw_cursor(cur.name, cur.color, cur.cursor_m)
 
-    def draw_cursor(self, name: str, color: Sequence[int], cursor_m: Sequence[float]) -> None:
-        """A coloured arrow with the client's name, its tip at the cursor."""
+    def draw_cursor(self, name: str, color: Sequence[int], cursor_m: Sequence[float]) -> pygame.Rect:
+        """A coloured arrow with the client's name on dark ground, its tip at the cursor; returns the name's box."""
         x, y = self.env.to_screen(np.asarray(cursor_m, dtype=float))
         u = max(1.0, self.unit)
         arrow = [(x, y), (x + 4 * u, y + 15 * u), (x + 7 * u, y + 10 * u), (x + 13 * u, y + 12 * u)]
@@ -438,8 +438,11 @@ class GameWindow:
         if label is None:  # rendering text is the slow part of thirty cursors
             if len(self._labels) > 256:
                 self._labels.clear()
-            label = self._labels[key] = self.label_font.render(name, True, color)
-        self.surface.blit(label, (x + 12 * u, y + 14 * u))
+            label = self._labels[key] = self.label_font.render(name, True, color, (0, 0, 0))  # on dark ground
+        box = label.get_rect(topleft=(x + 12 * u, y + 14 * u))
+        if box.right > self.surface.get_width():  # at the right edge, left of the arrow instead
+            box.right = int(x - 2 * u)
+        return self.surface.blit(label, box.clamp(self.surface.get_rect()))
 
     def _draw_hud(self, scene: Scene, hud: Sequence[HudLine]) -> None:
         """The title, heads-up lines, frame rate and PAUSED in their places (hud_view.py), then the
