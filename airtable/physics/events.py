@@ -18,15 +18,17 @@ path longer than that is checked against every puck.
 
 What is left to later stages: hits slower than a puck's rest speed, and pairs
 that pressed on each other in the last step (the contact stage holds those).
-In two-step, a pair hit that the step's end would catch overlapping and
-approaching is resolved the course's way, at dt - t_p (t_p = overlap / normal
-speed there) along the line of centres there: the pair ends where the
-two-step correction puts it, and a hit it would catch too late (past the
-closest approach, or through) is resolved at first contact. In "off", such a
-pair is left overlapping to the pair stage (velocities only: what it shows).
 Outside perfect kiss only fast pucks' pair hits are predicted (those moving
 FAST_FRACTION of their radius in a step: they could pass through); the pair
-stage sees the others overlapping.
+stage sees the others overlapping. Of those, a hit the step's end would catch
+overlapping and approaching is left to the pair stage too, which resolves it
+the course's way (two-step: backed up t_p = overlap / normal speed along the
+line of centres there; "off": velocities only), unless a puck of the pair
+moves CHAIN_FRACTION of its radius in a step: in two-step that hit is resolved
+here, at dt - t_p along the line of centres at the step's end (the pair ends
+where the two-step correction puts it), so the hits a shot starts down a row of
+touching pucks come in order. A hit the end would catch too late (past the
+closest approach) or not at all (through) is resolved here, at first contact.
 """
 
 from __future__ import annotations
@@ -74,6 +76,10 @@ def repeat_max(cr: float) -> int:
 # In two-step, pair hits are predicted when some puck moves this share of the smallest radius
 # in a step; below it nobody can pass through a puck, and the pair stage sees every hit.
 FAST_FRACTION = 0.5
+# In two-step, a hit the step's end would catch overlapping and approaching is the pair stage's
+# (it resolves it the same way), unless a puck of the pair moves this share of its radius in a step:
+# then the hits it starts down a row of touching pucks come here, in order, or the row's end swaps.
+CHAIN_FRACTION = 1.0
 # A puck whose path changed has its hits with up to this many partners predicted one by one in
 # Python numbers (a few microseconds each), with more at once in numpy (some sixty calls whatever
 # their number): the same lines either way (either.py), the same bits.
@@ -272,10 +278,10 @@ class _Step:
         lim = FAST_FRACTION * self.radius / self.dt
         return self.speed_sq > lim * lim
 
-    def fast(self, k):
-        """Whether puck k (a row, or an array of rows) moves FAST_FRACTION of its radius in a step on
-        its present path."""
-        return vectors.length(either.take(self.zvel, k)) * self.dt > FAST_FRACTION * either.take(self.radius, k)
+    def fast(self, k, fraction: float = FAST_FRACTION):
+        """Whether puck k (a row, or an array of rows) moves `fraction` of its radius in a step on its
+        present path."""
+        return vectors.length(either.take(self.zvel, k)) * self.dt > fraction * either.take(self.radius, k)
 
     def find_partners(self, neighbours) -> None:
         """The pairs that may meet during the step, on any path within 2 travels of the step's ends."""
@@ -384,9 +390,12 @@ class _Step:
         if mode == "perfect-kiss":
             return t, speed
         caught, t_p, u = _caught_overlapping(d + w * (dt - t_now), w, reach)
-        if mode == "off":
-            return either.where(caught, math.inf, t), speed
-        return either.where(caught, either.maximum(dt - t_p, t_now), t), either.where(caught, u, speed)
+        if mode == "two-step":  # a puck over its radius a step may start a chain: its hits in order here
+            chain = self.fast(a, CHAIN_FRACTION) | self.fast(b, CHAIN_FRACTION)
+            here = caught & chain
+            t, speed = either.where(here, either.maximum(dt - t_p, t_now), t), either.where(here, u, speed)
+            caught = either.where(chain, False, caught)
+        return either.where(caught, math.inf, t), speed
 
     def predict_walls(self, k: int) -> None:
         """Queue puck k's next wall hit on its present path, if it comes within the step."""
