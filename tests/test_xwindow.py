@@ -114,7 +114,14 @@ def running(display: str, args: list[str], cwd=None):
     env = {**os.environ, "DISPLAY": display, "SDL_VIDEODRIVER": "x11"}
     proc = subprocess.Popen(args, env=env, cwd=cwd, stdout=subprocess.PIPE, stderr=subprocess.PIPE)
     try:
-        yield proc, wait_for(lambda: find_window(display), what="the window")
+
+        def seen() -> str | None:  # the window; or, if the process ended first, that (not a 60 s wait)
+            return find_window(display) or ("exited" if proc.poll() is not None else None)
+
+        wid = wait_for(seen, what=f"the window of {args[-1]!r} on {display}")
+        if wid == "exited":
+            pytest.fail(f"the process ended with {proc.returncode} before its window showed: {proc.stderr.read()!r}")
+        yield proc, wid
     finally:
         if proc.poll() is None:
             proc.kill()
