@@ -246,7 +246,8 @@ FULLSCREEN_DRIVER = """
 import sys, numpy as np, pygame
 from airtable.app.environment import Environment
 from airtable.model.scene import Scene
-from airtable.app.window import GameWindow
+from airtable.app.window import GameWindow, prefer_plain_framebuffer
+prefer_plain_framebuffer()  # as the app's entry points do (no OpenGL framebuffer on X11)
 env = Environment(width_m=10.0, height_m=8.7556)
 win = GameWindow(env, caption="Air Table - fullscreen test", size_px=(640, 480))
 scene = Scene(10.0, 8.7556, np.array([[5.0, 4.4]]), np.array([0.5]), np.array([[255, 165, 0]], np.uint8))
