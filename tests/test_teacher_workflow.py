@@ -287,19 +287,19 @@ def test_a_settled_spring_demo_idles_though_round_off_never_stops(demos):
 
 def test_every_demo_starts_the_way_the_help_says(demos):
     """Help listed the pi demo as "t", but t shows the values table: a demo without a key of its own is
-    "Tab t" there (the menu, then its key), and doing what each row says starts that demo."""
+    "Tab, t" there (the menu, then its key), and doing what each row says starts that demo."""
     app = App(demos, demo_key="1", headless=True)
     shown: list = []
     app.window.draw_panel = lambda title, rows, **kw: (shown.append(kw.get("side_rows", ())), 1)[1]
     press(app, pygame.K_F1)
     press(app, pygame.K_F1)
     labels = dict((title, label) for label, title in shown[0])
-    assert labels["Pi from collisions"] == "Tab t" and labels["Gas: Maxwell speeds"] == "Shift+0"
+    assert labels["Pi from collisions"] == "Tab, t" and labels["Gas: Maxwell speeds"] == "Shift+0"
     for key, demo in demos.items():
         label = labels[demo.title]
-        if label.startswith("Tab "):
+        if label.startswith("Tab, "):
             press(app, pygame.K_TAB)
-            for ch in label[4:]:
+            for ch in label[5:]:
                 press(app, pygame.key.key_code(ch), unicode=ch)
             press(app, pygame.K_RETURN)
         else:

@@ -163,7 +163,7 @@ class Panels(Feature):
         elif panel == "notice":
             w.draw_panel("Some demo files could not be loaded", [*self.notice, "Press any key to go on."])
         elif panel == "help":
-            rows = [(key_label(k) if has_own_key(k) else f"Tab {k}", d.title) for k, d in host.demos.items()]
+            rows = [(key_label(k) if has_own_key(k) else f"Tab, {k}", d.title) for k, d in host.demos.items()]
             keys = [(b.label, b.help) for b in self.key_rows]
             self.help_pages = w.draw_panel("Keys", keys, side_title="Demos", side_rows=rows, page=self.help_page)
         elif panel == "notes":
