@@ -220,19 +220,20 @@ class ContactSolver:
         Such a pair is a resting contact whatever its approach speed: a pile
         whose contacts have not quite converged must not start to bounce.
         """
-        if len(self._keys) == 0 or len(i) == 0:
-            return np.zeros(len(i), dtype=bool)
-        keys = i.astype(np.int64) * (self._rows + 4) + j
-        found = np.searchsorted(self._keys, keys).clip(0, len(self._keys) - 1)
-        return (self._keys.take(found) == keys) & (self._impulses[found, 0] > 0.0)
+        found, kept = self._last_step(i, j)
+        return kept & (self._impulses[found, 0] > 0.0) if len(self._keys) else kept
 
     def kept(self, i: np.ndarray, j: np.ndarray) -> np.ndarray:
         """Which pairs (i, j) were contacts in the last step."""
+        return self._last_step(i, j)[1]
+
+    def _last_step(self, i: np.ndarray, j: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """(where each pair (i, j) is or would be among the last step's contacts, whether it is one)."""
         if len(self._keys) == 0 or len(i) == 0:
-            return np.zeros(len(i), dtype=bool)
+            return np.zeros(len(i), dtype=np.intp), np.zeros(len(i), dtype=bool)
         keys = i.astype(np.int64) * (self._rows + 4) + j
         found = np.searchsorted(self._keys, keys).clip(0, len(self._keys) - 1)
-        return self._keys.take(found) == keys
+        return found, self._keys.take(found) == keys
 
     def wall_rest(self, rest: np.ndarray) -> np.ndarray:
         """(N, 2) rest speeds towards the walls along x and y: infinite where the puck pressed
