@@ -275,13 +275,12 @@ class _Step:
 
     def fast_rows(self) -> np.ndarray:
         """Which pucks move FAST_FRACTION of their radius in the step on their first paths."""
-        lim = FAST_FRACTION * self.radius / self.dt
-        return self.speed_sq > lim * lim
+        return _moves(self.speed_sq, self.radius, self.dt, FAST_FRACTION)
 
     def fast(self, k, fraction: float = FAST_FRACTION):
         """Whether puck k (a row, or an array of rows) moves `fraction` of its radius in a step on its
         present path."""
-        return vectors.length(either.take(self.zvel, k)) * self.dt > fraction * either.take(self.radius, k)
+        return _moves(vectors.squared_abs(either.take(self.zvel, k)), either.take(self.radius, k), self.dt, fraction)
 
     def find_partners(self, neighbours) -> None:
         """The pairs that may meet during the step, on any path within 2 travels of the step's ends."""
@@ -379,8 +378,9 @@ class _Step:
         """(t, u) for the pairs (a, b) on their present paths: when they next hit (s into the step; inf if
         never) and how fast they then approach along the normal (m/s); arrays, or one pair (predict_pairs).
 
-        In two-step, a hit the step's end would catch overlapping and approaching comes t_p before the
-        end (the course's case); in "off", never (the pair stage sees it overlapping).
+        A hit the step's end would catch overlapping and approaching is the pair stage's (never, here),
+        except in two-step where a puck of the pair moves CHAIN_FRACTION of its radius in a step: then
+        it comes t_p before the end (the course's case; see the module docstring).
         """
         t_now, dt, mode = self.t_now, self.dt, self.rules.pairs
         d, w = self.at(a, t_now) - self.at(b, t_now), either.take(self.zvel, a) - either.take(self.zvel, b)
@@ -509,6 +509,13 @@ class _Step:
         after = (self.at(a, self.dt), self.at(b, self.dt)) if overlap else seen
         self.hits.rows.append((a, b, n, seen[1], overlap, reach, rb, *seen, *after, va, vb, new_a, new_b))
         self.hit_pairs[a, b] = self.hit_pairs.get((a, b), 0) + 1
+
+
+def _moves(speed_sq, radius, dt: float, fraction: float):
+    """Whether a puck of speed sqrt(speed_sq) and that radius moves `fraction` of its radius in a step
+    (numpy arrays, or one puck in Python numbers: the same bits)."""
+    lim = fraction * radius / dt
+    return speed_sq > lim * lim
 
 
 def _held(held: Callable[[np.ndarray, np.ndarray], np.ndarray], a, b):
