@@ -165,7 +165,7 @@ class Partners:
     def __init__(self, i: np.ndarray, j: np.ndarray, n: int) -> None:
         self.i, self.j = i, j
         rows = np.concatenate([i, j])
-        order = np.argsort(rows, kind="stable")
+        order = _argsort_cells(rows, n)  # rows are cell numbers of a kind: the same radix sort
         self._others = np.concatenate([j, i]).take(order)
         self._starts = np.searchsorted(rows.take(order), np.arange(n + 1)).tolist()
 
