@@ -250,12 +250,13 @@ def test_gas_conserves_energy_and_keeps_pucks_apart(mode: str, tight: bool) -> N
 
 
 @st.composite
-def puck_sets(draw) -> tuple[np.ndarray, np.ndarray]:
-    """Positions and radii: mixed radii, maybe one giant, sparse to piled up, on a lattice or on the walls."""
+def puck_sets(draw, most: int = 400) -> tuple[np.ndarray, np.ndarray]:
+    """Positions and radii: mixed radii, maybe one giant, sparse to piled up, on a lattice or on the walls;
+    up to `most` pucks."""
     n = draw(
         st.one_of(
             st.integers(0, broadphase.BRUTE_FORCE_MAX_PUCKS),
-            st.integers(broadphase.BRUTE_FORCE_MAX_PUCKS + 1, 400),
+            st.integers(broadphase.BRUTE_FORCE_MAX_PUCKS + 1, most),
         )
     )
     rng = np.random.default_rng(draw(st.integers(0, 2**32 - 1)))
@@ -389,6 +390,22 @@ def test_closer_candidates_are_the_candidates_closer_than_the_largest_reach(puck
     near = broadphase._closer_than(pos, i, j, 2.0 * float(radius.max(initial=0.0)) + margin)
     ci, cj = broadphase.find_candidate_pairs(pos, radius, margin_m=margin, closer=True)
     assert np.array_equal(ci, i.take(near)) and np.array_equal(cj, j.take(near))
+
+
+@settings(max_examples=150, deadline=None, derandomize=True)
+@given(puck_sets(most=1200), st.floats(0.0, 1.0), st.floats(0.0, 1.0), st.integers(0, 2**32 - 1))
+def test_pairs_near_some_rows_are_exactly_those_of_looking_at_every_pair(pucks, margin: float, share: float, seed):
+    # The fast pucks' partners (events.py): a few rows look at every puck; more (over
+    # NEAR_BRUTE_FORCE_LOOKS rows times pucks: a tenth of 1000 pucks) search the grid around them.
+    pos, radius = pucks
+    n = len(pos)
+    rows = np.random.default_rng(seed).choice(n, size=int(share * n), replace=False)
+    i, j = broadphase.pairs_near(pos, radius, rows, margin)
+    a, b = np.triu_indices(n, k=1)
+    d = pos[a] - pos[b]
+    reach = radius[a] + radius[b] + margin
+    keep = (np.isin(a, rows) | np.isin(b, rows)) & (d[:, 0] * d[:, 0] + d[:, 1] * d[:, 1] < reach * reach)
+    assert np.array_equal(i, a[keep]) and np.array_equal(j, b[keep])  # each once, in (i, j) order
 
 
 def test_neighbour_list_finds_every_overlap_as_pucks_drift_jump_and_grow() -> None:

@@ -12,13 +12,14 @@ the step. The pucks that did not collide have the same arrow in both.
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from functools import cached_property
 
 import numpy as np
 
 from airtable.model.readout import SceneScale
+from airtable.physics.collision import Collisions
 from airtable.physics.table import AirTable, kinetic_energy_J
 
 # Pucks are numbered from 1 wherever the app names one (values, momenta, predict, inspect, the CSV files,
@@ -97,14 +98,17 @@ def momenta_around_collisions(table: AirTable) -> MomentaAround | None:
 def _seen(table: AirTable) -> tuple | None:
     """What the momenta around the last step's collisions are made of (copied: the table steps on),
     as _momenta_around's arguments; None if the step had no collision."""
-    c = table.last_collisions
-    if len(c) == 0:
+    collisions = table.last_collisions_later()  # joined only if the diagram is drawn
+    if collisions is None:
         return None
-    return float(table.time_s), c, table.vel_mps.copy(), table.mass_kg.copy(), table.color_rgb.copy()
+    return float(table.time_s), collisions, table.vel_mps.copy(), table.mass_kg.copy(), table.color_rgb.copy()
 
 
-def _momenta_around(t_s: float, c, vel_after: np.ndarray, mass_kg: np.ndarray, colors: np.ndarray) -> MomentaAround:
-    """The momenta around the collisions `c` of a step that ended at t_s with velocities `vel_after`."""
+def _momenta_around(
+    t_s: float, collisions: Callable[[], Collisions], vel_after: np.ndarray, mass_kg: np.ndarray, colors: np.ndarray
+) -> MomentaAround:
+    """The momenta around the collisions() of a step that ended at t_s with velocities `vel_after`."""
+    c = collisions()
     vel_before = vel_after.copy()
     # Each puck's velocity when its first collision of the step found it.
     rows = np.stack([c.i, c.j], axis=1).ravel()

@@ -94,10 +94,86 @@ def find_candidate_pairs(
     return np.minimum(i, j), np.maximum(i, j)
 
 
+def pairs_near(pos: np.ndarray, radius: np.ndarray, rows: np.ndarray, margin_m: float) -> tuple[np.ndarray, np.ndarray]:
+    """Pairs (i < j) with a puck of `rows` in them whose centres are closer than r_i + r_j + margin_m,
+    each once, sorted by (i, j).
+
+    The grid of find_candidate_pairs, searched around each of `rows` only: a few pucks dragged fast
+    through a crowd look at the pucks near them, not every pair of the crowd at that reach. Pucks
+    too big for the grid (twice the mean radius) are paired with every one of `rows`, and each big
+    one of `rows` with every puck. A handful of rows look at every puck (NEAR_BRUTE_FORCE_LOOKS).
+    """
+    n = len(pos)
+    rows = np.unique(np.asarray(rows, dtype=np.intp))  # (rows, not pair keys: a small range, fast)
+    if n < 2 or len(rows) == 0:
+        empty = np.empty(0, dtype=np.intp)
+        return empty, empty
+    if len(rows) * n <= NEAR_BRUTE_FORCE_LOOKS:  # a few rows: each against every puck, no grid to build
+        return _each_pair_once(n, *_near_each(pos, radius, rows, margin_m))
+    big = radius > 2.0 * radius.mean() if float(radius.max()) > 2.0 * float(radius.min()) else np.zeros(n, dtype=bool)
+    small = (~big).nonzero()[0]
+    a, b = [], []
+    if len(small) > 1 and (~big.take(rows)).any():
+        cell = 2.0 * float(radius.take(small).max()) + margin_m
+        ga, gb = _grid_around(vectors.take(pos, small), cell, np.searchsorted(small, rows[~big.take(rows)]))
+        a.append(small.take(ga))
+        b.append(small.take(gb))
+    for r in rows[big.take(rows)].tolist():  # a big one of rows: with every puck
+        a.append(np.full(n, r))
+        b.append(np.arange(n))
+    for r in big.nonzero()[0].tolist():  # a big puck: with every one of rows
+        a.append(rows)
+        b.append(np.full(len(rows), r))
+    a, b = np.concatenate(a), np.concatenate(b)
+    near = _closer_than(pos, a, b, pair_reach(radius, a, b) + margin_m)
+    return _each_pair_once(n, a.take(near), b.take(near))
+
+
+def _near_each(pos: np.ndarray, radius: np.ndarray, rows: np.ndarray, margin_m: float):
+    """(a, b): each of `rows` (a) with every puck b closer than r_a + r_b + margin_m, itself too
+    (the arithmetic of _closer_than, without gathering a copy of each puck for each row)."""
+    z = vectors.as_complex(np.ascontiguousarray(pos, dtype=np.float64))
+    a, b = [], []
+    for r in rows.tolist():
+        reach = (radius.item(r) + radius) + margin_m
+        near = (vectors.squared_abs(z - z.item(r)) < reach * reach).nonzero()[0]
+        a.append(np.full(len(near), r))
+        b.append(near)
+    return np.concatenate(a), np.concatenate(b)
+
+
+def _each_pair_once(n: int, a: np.ndarray, b: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The pairs (a, b) of n pucks as (i < j), each once, sorted by (i, j); a puck paired with itself dropped."""
+    i, j = np.minimum(a, b), np.maximum(a, b)
+    key = np.sort((i * n + j)[i != j])  # one key per pair sorts as (i, j) does
+    first = np.ones(len(key), dtype=bool)
+    first[1:] = key[1:] != key[:-1]
+    key = key[first]  # each pair once (np.unique hashes such keys, 20 times slower)
+    return key // n, key % n
+
+
+def _grid_around(pos: np.ndarray, cell: float, rows: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(a, b): each of `rows` (a) with every puck b in the grid's cells within `cell` of its own, itself too."""
+    order, skey, ends, ny = _sort_into_cells(pos, cell)
+    ends = np.concatenate([np.zeros(ny + 1, dtype=ends.dtype), ends])  # a spare column on the left
+    where = np.empty(len(pos), dtype=np.intp)
+    where[order] = np.arange(len(pos))  # each puck's place in the sorted order
+    c = skey.take(where.take(rows)) + ny + 1  # the cell of each of rows, in the padded ends
+    rise = ROWS_PER_CELL  # a cell is a reach / ROWS_PER_CELL tall
+    first = np.stack([ends.take(c + k * ny - rise - 1) for k in (-1, 0, 1)])  # the columns before, own, after
+    stop = np.stack([ends.take(c + k * ny + rise) for k in (-1, 0, 1)])
+    at, b = _expand_ranges(first, stop)
+    return rows.take(at), order.take(b)
+
+
 def pair_reach(radius: np.ndarray, i: np.ndarray, j: np.ndarray) -> np.ndarray:
     """Sum of the radii of each pair: closer centres than this overlap."""
     return radius.take(i) + radius.take(j)
 
+
+# pairs_near looks from each of its rows at every puck, with no grid, up to this many looks (rows
+# times pucks): sorting 10000 pucks into the grid costs as much as some 150000 looks.
+NEAR_BRUTE_FORCE_LOOKS = 100_000
 
 # Once one candidate pair in this many overlaps (a pile, not a gas), picking the overlapping
 # pairs in a kept sorted order beats sorting them.
@@ -167,7 +243,7 @@ class Partners:
         rows = np.concatenate([i, j])
         order = _argsort_cells(rows, n)  # rows are cell numbers of a kind: the same radix sort
         self._others = np.concatenate([j, i]).take(order)
-        self._starts = np.searchsorted(rows.take(order), np.arange(n + 1)).tolist()
+        self._starts = [0, *np.cumsum(np.bincount(rows, minlength=n)).tolist()]  # where each row's partners begin
 
     def of(self, k: int) -> list[int]:
         """Puck k's partners, in increasing order (however the pairs were found)."""

@@ -84,9 +84,6 @@ CHAIN_FRACTION = 1.0
 # Python numbers (a few microseconds each), with more at once in numpy (some sixty calls whatever
 # their number): the same lines either way (either.py), the same bits.
 FEW_PARTNERS = 10
-# Fast pucks look for their partners each over every puck when that costs at most this many
-# looks (fast pucks times pucks), or less than the grid would (find_partners).
-FAST_SEARCH_WORK = 2_000_000
 
 
 @dataclass
@@ -221,7 +218,7 @@ class _Step:
             return
         # The step's end of its first path (zpos, written back only at the end) and how far
         # the new path strays from it: beyond what the pairs were found for, look at everyone.
-        # With the partners of the fast pucks only (fast_partners), a puck made fast looks too.
+        # With the partners of the fast pucks only (find_partners), a puck made fast looks too.
         end = self.zpos.item(k)
         stray = max(abs(x - end), abs(x + v * (self.dt - self.t_now) - end))
         newly_fast = self.only_fast is not None and not self.only_fast[k] and self.fast(k)
@@ -286,40 +283,18 @@ class _Step:
         """The pairs that may meet during the step, on any path within 2 travels of the step's ends."""
         pos = vectors.as_rows(self.zpos)
         found = neighbours.pairs_while_moving(pos, self.radius, 2.0 * self.travel)
-        if found is None and self.rules.pairs != "perfect-kiss":  # only fast pucks' hits are predicted
-            fast = self.fast_rows().nonzero()[0]
-            # The grid below finds the pairs within a reach of every puck: as many as a disc that wide
-            # holds for each. Looking from each fast puck at every puck costs about 1/20 as much a look.
-            reach = 2.0 * float(self.radius.max()) + 4.0 * self.travel
-            grid_pairs = len(pos) ** 2 * math.pi * reach * reach / (2.0 * self.width * self.height)
-            if len(fast) * len(pos) <= max(FAST_SEARCH_WORK, 20.0 * grid_pairs):
-                self.partners = self.fast_partners(fast)
-                return
-        if found is None:  # paths longer than the list's skin: the pairs within reach of them now
+        if found is not None:
+            self.partners = neighbours.partners()
+        elif self.rules.pairs != "perfect-kiss":  # only fast pucks' hits are predicted: their partners
+            self.only_fast = self.fast_rows()
+            i, j = broadphase.pairs_near(pos, self.radius, self.only_fast.nonzero()[0], 4.0 * self.travel)
+            self.partners = broadphase.Partners(i, j, len(pos))
+        else:  # paths longer than the list's skin: the pairs within reach of them now
             margin = 4.0 * self.travel
             i, j = broadphase.find_candidate_pairs(pos, self.radius, margin_m=margin, closer=True)
             near = broadphase.squared_distances(pos, i, j) < (self.radius.take(i) + self.radius.take(j) + margin) ** 2
             i, j = i.take(near.nonzero()[0]), j.take(near.nonzero()[0])
             self.partners = broadphase.Partners(i, j, len(pos))
-        else:
-            self.partners = neighbours.partners()
-
-    def fast_partners(self, fast: np.ndarray) -> broadphase.Partners:
-        """The partners of the fast pucks only (each looks at every puck within reach of its paths):
-        a puck dragged fast through a crowd moves far in a step, and the pairs within that reach of
-        every puck would number millions. A puck a hit makes fast finds its own (set_path)."""
-        margin = 4.0 * self.travel
-        parts_i, parts_j = [], []
-        is_fast = np.zeros(len(self.zpos), dtype=bool)
-        is_fast[fast] = True
-        for f in fast.tolist():
-            near = self.near(f, self.zpos.item(f), margin)
-            near = near[(near != f) & (~is_fast.take(near) | (near > f))]  # a fast pair once
-            parts_i.append(np.minimum(near, f))
-            parts_j.append(np.maximum(near, f))
-        self.only_fast = is_fast
-        i, j = np.concatenate(parts_i), np.concatenate(parts_j)
-        return broadphase.Partners(i, j, len(self.zpos))
 
     def first_pairs(self) -> tuple[np.ndarray, np.ndarray]:
         """The pairs that on their first paths may touch during the step, approaching faster than they rest."""

@@ -217,6 +217,24 @@ class AirTable(Storage):
             self._last_collisions = Collisions.of_records(self._last_records)
         return self._last_collisions
 
+    def last_collisions_later(self) -> Callable[[], Collisions] | None:
+        """The last step's collisions as a function that joins them when first called; None if it had none.
+
+        For whoever keeps each step's collisions in case they are wanted (the momenta diagram): a
+        10000-puck gas collides some 600 times a step, and joining them all is a tenth of a millisecond.
+        """
+        if self._last_collisions is not None or not any(r.count for r in self._last_records):
+            c = self._last_collisions
+            return None if c is None or len(c) == 0 else lambda: c
+        records, joined = self._last_records, []
+
+        def collisions() -> Collisions:
+            if not joined:
+                joined.append(Collisions.of_records(records))
+            return joined[0]
+
+        return collisions
+
     def restore_settings(self, names: tuple[str, ...], values: tuple) -> None:
         """Storage.restore_settings; a restored table reports no collisions until it steps."""
         super().restore_settings(names, values)
