@@ -320,3 +320,24 @@ def test_freed_memory_is_kept_for_reuse_on_linux() -> None:
 
     assert keep_freed_memory() is sys.platform.startswith("linux")
     assert keep_freed_memory() is sys.platform.startswith("linux")  # idempotent
+
+
+def test_a_steps_collisions_kept_for_later_are_that_steps_after_the_table_steps_on() -> None:
+    # The momenta diagram keeps each step's collisions unjoined until it is drawn (table.last_collisions_later).
+    table = AirTable()
+    table.gravity_on = False
+    table.add_puck(pos_m=(1.0, 1.0), radius_m=0.1, vel_mps=(2.0, 0.0))
+    table.add_puck(pos_m=(1.25, 1.0), radius_m=0.1, vel_mps=(-2.0, 0.0))
+    for _ in range(10):  # bounded: they meet within 0.0125 s
+        table.step(1 / 240)
+        if table.collision_count:  # (not last_collisions: that would join them now)
+            break
+    later = table.last_collisions_later()
+    now = table.last_collisions
+    assert later is not None and len(now) == 1
+    table.step(1 / 240)  # apart now: no collision this step
+    assert table.last_collisions_later() is None and len(table.last_collisions) == 0
+    kept = later()
+    assert kept is later()  # joined once
+    assert kept.i.tolist() == [0] and kept.j.tolist() == [1]
+    assert np.array_equal(kept.vel_i_after, now.vel_i_after) and kept.vel_i_after[0, 0] == pytest.approx(-2.0)
