@@ -8,8 +8,9 @@ NOTES = """
 Twenty-five pucks joined by springs along every edge and diagonal act like a block of
 jelly: it falls, lands, wobbles and settles, and you can grab a puck and throw it at a wall.
 The diagonals stop the squares from folding flat. The stiffer jellies vibrate faster than a
-step can follow, so the step solves their springs implicitly: the block keeps its shape and
-sags just as k says, but its fastest wobble is damped away. Left and Right change the stiffness.
+step can follow, so the step solves their springs implicitly: the block keeps its shape, and
+its sag under its own weight is the one k gives (2 cm when soft, a millimetre when stiff: too
+little to see), but its fastest wobble is damped away. Left and Right change the stiffness.
 """
 
 VARIATIONS = ("soft: k 60 N/m", "k 300 N/m", "stiff: k 1500 N/m")
