@@ -135,11 +135,17 @@ def _near_each(pos: np.ndarray, radius: np.ndarray, rows: np.ndarray, margin_m: 
     z = vectors.as_complex(np.ascontiguousarray(pos, dtype=np.float64))
     a, b = [], []
     for r in rows.tolist():
-        reach = (radius.item(r) + radius) + margin_m
-        near = (vectors.squared_abs(z - z.item(r)) < reach * reach).nonzero()[0]
+        near = rows_near(z, radius, z.item(r), radius.item(r), margin_m)
         a.append(np.full(len(near), r))
         b.append(near)
     return np.concatenate(a), np.concatenate(b)
+
+
+def rows_near(z: np.ndarray, radius: np.ndarray, centre: complex, radius_m: float, margin_m: float) -> np.ndarray:
+    """The rows of the pucks at z (complex x + iy) closer to a puck of `radius_m` at `centre` than their
+    reach plus margin_m: |z - centre| < (radius_m + r) + margin_m, in increasing order."""
+    reach = (radius_m + radius) + margin_m
+    return (vectors.squared_abs(z - centre) < reach * reach).nonzero()[0]
 
 
 def _each_pair_once(n: int, a: np.ndarray, b: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

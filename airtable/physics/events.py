@@ -230,15 +230,11 @@ class _Step:
 
     def add_everyone_near(self, k: int, end: complex, stray: float) -> None:
         """Puck k's path strays `stray` from its step end: its partners from every puck."""
-        for other in self.near(k, end, stray + self.reach_out).tolist():
+        near = broadphase.rows_near(self.zpos, self.radius, end, self.radius.item(k), stray + self.reach_out)
+        for other in near.tolist():
             if other != k:
                 self.extra.setdefault(k, set()).add(other)
                 self.extra.setdefault(other, set()).add(k)
-
-    def near(self, k: int, centre: complex, margin: float) -> np.ndarray:
-        """The rows (k's own among them) whose step ends are within reach of puck k at `centre` plus margin."""
-        reach = self.radius + (self.radius.item(k) + margin)
-        return (vectors.squared_abs(self.zpos - centre) < reach * reach).nonzero()[0]
 
     def partners_of(self, k: int) -> list[int]:
         """The pucks k may meet this step, in increasing order: hits at one time are resolved in the
