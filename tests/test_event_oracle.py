@@ -148,6 +148,36 @@ class Oracle:
         return copy.t
 
 
+# Round-off. The engine holds every coordinate to an ulp or so: it rounds each position once a step
+# (x + v dt) and the result of each hit, as the oracle rounds each position once an event. Where the
+# motion is chaotic (small discs, fast: an error in the line of centres of a pair that touches turns
+# their velocities by that error over their reach) those ulps grow, in any solver. The oracle measures
+# by how much itself: ROUND_OFF_RUNS runs from starts with every coordinate (x, y, vx, vy) moved by one
+# ulp, up or down at random (from the scene's seed), each stopped at every step's end as the engine
+# is; the farthest any of them ends from the unmoved run. (Not the start scaled by 1 + 1e-15: that
+# moves two discs 1e-15 times their distance apart, 1e-16 m for a touching pair, a tenth of one
+# rounding of their coordinates; three scenes, each within round-off of the exact motion at its first
+# hits, failed on it.) Over 1200 random scenes the engine ends at most 3 times that far from the oracle.
+ROUND_OFF_RUNS = 5
+
+
+def round_off_spread(pucks, steps: int, dt: float, cr_puck, cr_wall, seed: int, want) -> np.ndarray | None:
+    """How far the oracle's end after `steps` steps of dt moves under round-off (see ROUND_OFF_RUNS),
+    per column (x, y: m; vx, vy: m/s) of `want`, its unmoved end; None if a run meets a collapse."""
+    rng = np.random.default_rng((seed, 1))
+    spread = np.zeros(4)
+    for _ in range(ROUND_OFF_RUNS):
+        signs = rng.choice((-1.0, 1.0), size=(len(pucks), 4))
+        start = [[c + sign * math.ulp(c) for c, sign in zip(p[:4], row)] + p[4:] for p, row in zip(pucks, signs)]
+        oracle = Oracle(start, WIDTH_M, HEIGHT_M, cr_puck, cr_wall)
+        for k in range(1, steps + 1):
+            oracle.run_until(k * dt)
+            if oracle.collapsed:
+                return None
+        spread = np.maximum(spread, np.abs(np.array([p[:4] for p in oracle.p]) - want).max(axis=0))
+    return spread
+
+
 def random_scene(seed: int, n: int) -> list[list[float]]:
     """n discs in the box, none overlapping: radii over two decades (1 cm to 1 m), masses over six
     (1 g to 1 t), speeds up to 200 m/s in any direction."""
@@ -187,6 +217,9 @@ restitutions = st.sampled_from([1.0, 1.0, 0.9, 0.5])
 @example(seed=15, n=12, dt=1 / 32, cr_puck=1.0, cr_wall=1.0)  # 29 hits in a step: chaos (the tolerance)
 @example(seed=46, n=20, dt=1 / 32, cr_puck=0.9, cr_wall=1.0)  # a pair hits 4+ times in a step (repeat_max)
 @example(seed=1980032180, n=19, dt=1 / 30, cr_puck=0.5, cr_wall=0.5)  # issue 24: a collapse, left out (ROUND_OFF)
+@example(seed=4089532836, n=13, dt=1 / 240, cr_puck=1.0, cr_wall=1.0)  # an ulp at the first pair hit, x10^7 ...
+@example(seed=4044363540, n=17, dt=1 / 240, cr_puck=1.0, cr_wall=0.9)  # ... by its end (round_off_spread)
+@example(seed=3250422163, n=11, dt=0.013400020908274319, cr_puck=1.0, cr_wall=0.5)
 def test_perfect_kiss_follows_the_exact_hard_disc_motion(seed: int, n: int, dt: float, cr_puck, cr_wall) -> None:
     pucks = random_scene(seed, n)
     oracle = Oracle(pucks, WIDTH_M, HEIGHT_M, cr_puck, cr_wall)
@@ -201,12 +234,11 @@ def test_perfect_kiss_follows_the_exact_hard_disc_motion(seed: int, n: int, dt: 
     assume(not oracle.collapsed)
     want = np.array([p[:4] for p in oracle.p])
     # A step can hold more hits than the horizon (29 at 200 m/s and masses 5 decades apart in one step
-    # of 1/32 s): the oracle itself then moves further than 1e-9 m when its start moves by round-off.
-    # The engine must agree with it 1e-9 m, or 100 times as well as two such oracles agree.
-    nudged = Oracle([[x * (1.0 + 1e-15), *rest] for x, *rest in pucks], WIDTH_M, HEIGHT_M, cr_puck, cr_wall)
-    nudged.run_until(steps * dt)
-    assume(not nudged.collapsed)
-    chaos = np.abs(np.array([p[:4] for p in nudged.p]) - want).max(axis=0)
+    # of 1/32 s), and small fast discs turn an ulp into 1e-7 m within a dozen hits: the oracle itself
+    # then moves further than 1e-9 m when its start moves by round-off. The engine must agree with it
+    # 1e-9 m, or 100 times as well as the oracle agrees with itself under round-off (round_off_spread).
+    chaos = round_off_spread(pucks, steps, dt, cr_puck, cr_wall, seed, want)
+    assume(chaos is not None)
     table = table_of(pucks, cr_puck, cr_wall)
     for _ in range(steps):
         table.step(dt)
