@@ -153,7 +153,7 @@ class Oracle:
 # it takes back from the step's end; the oracle rounds once an event. Where the motion is chaotic those
 # ulps grow, in any solver: an error e across the line of centres of a touching pair turns the normal
 # by e / reach, and the pair's velocities with it (in one scene 4.5e-15 m at the second hit, with 0.15 m
-# of reach at 100 m/s, is 1.2e-7 m ten hits later). The oracle measures that growth on itself:
+# of reach at 100 m/s, is 1.2e-7 m nine hits later). The oracle measures that growth on itself:
 # ROUND_OFF_RUNS runs from starts with every coordinate (x, y, vx, vy) moved by one ulp, up or down at
 # random (from the scene's seed), each stopped at every step's end as the engine is; the spread is the
 # farthest any of them ends from the unmoved run. (Not the start scaled by 1 + 1e-15: that moves two
