@@ -151,7 +151,7 @@ def resolve_hits(pos, vel, radius, mass, size_m, dt: float, rules: Rules, neighb
     if len(pos) == 0 or dt <= 0.0:
         return step.hits
     past = step.past_walls() if rules.walls else None
-    for k in past or ():
+    for k in step.moving_faster_than_wall_rest(past) if past else ():
         step.predict_walls(k)
     if step.predicts_pairs():
         step.find_partners(neighbours)
@@ -377,6 +377,18 @@ class _Step:
             if t is None or self.t_now + t > self.dt or not abs(va) > self._wall_rest(k, axis):
                 continue
             self.push(self.t_now + t, k, -1 - axis)
+
+    def moving_faster_than_wall_rest(self, rows: list[int]) -> list[int]:
+        """Those of `rows` that move faster than their wall rest speed along an axis: no other can have
+        a wall hit queued (predict_walls), as a pile's pucks resting on the floor cannot, some forty a step."""
+        rest = self.rules.wall_rest
+        if rest is None:
+            return rows
+        v = self.zvel.take(rows)
+        rest = rest.take(rows, axis=0)
+        x_rest, y_rest = (rest, rest) if rest.ndim == 1 else (rest[:, 0], rest[:, 1])
+        fast = (np.abs(v.real) > x_rest) | (np.abs(v.imag) > y_rest)
+        return np.array(rows).take(fast.nonzero()[0]).tolist()
 
     def _wall_rest(self, k: int, axis: int) -> float:
         rest = self.rules.wall_rest
