@@ -12,7 +12,7 @@ from __future__ import annotations
 from collections.abc import Sequence
 from typing import TYPE_CHECKING
 
-from airtable.physics import events, integrate, pairs, resting, sleep, walls
+from airtable.physics import events, integrate, pairs, resting, sleep, substeps, vectors, walls
 from airtable.physics.context import StepContext
 from airtable.physics.forces import Pull
 
@@ -24,9 +24,24 @@ def step(table: Storage, dt: float, pulls: Sequence[Pull] = ()) -> StepContext:
     """Advance `table` by dt seconds with the cursor strings `pulls`; return the step's context.
 
     Sleeping pucks are not moved: the step first wakes those something
-    disturbed; when every puck sleeps, it only advances time.
+    disturbed; when every puck sleeps, it only advances time. Where many pucks
+    are fast (a gas stirred hot) the step is taken in pieces (substeps.pieces);
+    the context returned is the last piece's, with every piece's collisions.
     """
     table.run_due_events()  # 0. a demo's timed events whose time has come (storage.py)
+    n = substeps.pieces(vectors.squared_lengths(table.vel_mps), table.radius_m, dt, table.puck_correction)
+    records = []
+    for _ in range(n):
+        ctx = _piece(table, dt / n, pulls)
+        records += ctx.records
+    ctx.records = records
+    table.time_s += dt
+    table.steps += 1
+    return ctx
+
+
+def _piece(table: Storage, dt: float, pulls: Sequence[Pull]) -> StepContext:
+    """The stages of a step of dt, in order."""
     ctx = StepContext(dt, pulls)
     if table.n_pucks and sleep.wake(table, ctx):  # 0b. wake the sleepers something disturbed
         ctx.began = table.pos_m.copy()  # where the step began (the contacts start there)
@@ -43,6 +58,4 @@ def step(table: Storage, dt: float, pulls: Sequence[Pull] = ()) -> StepContext:
         held = resting.hold(table, ctx)  # 5. resting contacts: piles, squeezed pairs
         walls.again(table, ctx, held)  # 6. walls again: parting pairs can push a puck into one
         sleep.fall_asleep(table, ctx)  # 7. pucks still for long enough fall asleep
-    table.time_s += dt
-    table.steps += 1
     return ctx
