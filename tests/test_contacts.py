@@ -159,3 +159,40 @@ def test_a_contact_of_the_last_step_stays_one_a_little_further_apart() -> None:
     assert count(solver, margin + 1.5 * contacts.HOLD_M) == 0  # too far: let go
     assert count(solver, margin + 0.5 * contacts.HOLD_M) == 0  # not a contact last step
     assert count(contacts.ContactSolver(), margin + 0.5 * contacts.HOLD_M) == 0
+
+
+@pytest.mark.parametrize(
+    ("small_m", "push_mps", "dt"),
+    [(0.05, 3.0, 1 / 60), (0.05, 3.0, 1 / 240), (0.09, 10.0, 1 / 240), (0.05, 1.0, 1 / 60)],
+)
+def test_a_puck_pushed_into_one_held_in_a_corner_lifts_it_as_hard_discs_do(
+    small_m: float, push_mps: float, dt: float
+) -> None:
+    # Puck A (R = 0.1 m) sits in the bottom right corner; puck B (radius r) on the floor touches
+    # it from the left and is pushed at it at u (restitution 0). Their normal n, from B to A, is
+    # (2 sqrt(R r), R - r) / (R + r): it rises. By hand, if A leaves the floor: the wall takes A's
+    # x part, the floor B's y part, and the contact's impulse L keeps them from closing along n:
+    #     A: (0, -g dt + L n_y / m_A),   B: (u - L n_x / m_B, 0),   (v_A - v_B).n = 0
+    #     so L = (u n_x + g dt n_y) / (n_y^2 / m_A + n_x^2 / m_B),
+    # and A rises at n_x / n_y times B's speed (a wedge: 19 times for r = 0.09 m). If that A would
+    # fall (u = 1 m/s), it stays on the floor and B stops. A puck lifted out of rest by a slow
+    # neighbour is hard-disc physics (tests/test_piles.py counts such a puck pushed, not risen).
+    big = 0.1
+    table = AirTable()
+    table.gravity_on, table.sleeping = True, False
+    table.cr_puck = table.cr_wall = 0.0
+    width = float(table.size_m[0])
+    across = 2.0 * math.sqrt(big * small_m)
+    table.add_puck(pos_m=(width - big, big), radius_m=big)
+    table.add_puck(pos_m=(width - big - across, small_m), radius_m=small_m, vel_mps=(push_mps, 0.0))
+    table.step(dt)
+    m_a, m_b = table.mass_kg
+    nx, ny = across / (big + small_m), (big - small_m) / (big + small_m)
+    fall = GRAVITY_MPS2 * dt
+    impulse = (push_mps * nx + fall * ny) / (ny**2 / m_a + nx**2 / m_b)
+    lift, slide = -fall + impulse * ny / m_a, push_mps - impulse * nx / m_b
+    if lift <= 0.0:
+        lift = slide = 0.0
+    else:
+        assert lift == pytest.approx(slide * nx / ny, rel=1e-9)
+    np.testing.assert_allclose(table.vel_mps, [[0.0, lift], [slide, 0.0]], rtol=0, atol=1e-6)
