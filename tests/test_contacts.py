@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 
 from airtable.physics import broadphase, contacts, resting
+from airtable.physics.context import StepContext
 from airtable.physics.forces import GRAVITY_MPS2
 from airtable.physics.table import AirTable
 
@@ -196,3 +197,44 @@ def test_a_puck_pushed_into_one_held_in_a_corner_lifts_it_as_hard_discs_do(
     else:
         assert lift == pytest.approx(slide * nx / ny, rel=1e-9)
     np.testing.assert_allclose(table.vel_mps, [[0.0, lift], [slide, 0.0]], rtol=0, atol=1e-6)
+
+
+def test_a_puck_squeezed_out_from_under_a_falling_one_meets_the_puck_in_its_path() -> None:
+    # A small puck S (r 0.05 m) on the floor; a big one B (r 0.5 m, 100 times heavier) touching it
+    # from above, its centre 5 cm to the left, falling at 3 m/s; a puck C (r 0.1 m) on the floor
+    # 0.3 m to the right of S. Their normal is 5 degrees from vertical, so S leaves the wedge at
+    # about 11 times B's speed, over 16 m/s: in a step of 1/30 s it would cross C's 0.3 m gap and C
+    # itself. The contacts were found within a margin for the speeds the pucks came with (0.24 m);
+    # S leaves faster, so the stage starts again with the margin of its answer: C is a contact, S
+    # stops at C and pushes it on. (Before: S passed through C in two steps.)
+    dt = 1 / 30
+    table = AirTable()
+    table.gravity_on, table.sleeping = True, False
+    table.cr_puck = table.cr_wall = 0.0
+    table.add_puck(pos_m=(5.0, 0.05), radius_m=0.05)
+    table.add_puck(pos_m=(4.95, 0.05 + math.sqrt(0.55**2 - 0.05**2)), radius_m=0.5, vel_mps=(0.0, -3.0))
+    table.add_puck(pos_m=(5.45, 0.1), radius_m=0.1)
+    assert 0.3 > contacts.margin_m(table.vel_mps - (0.0, GRAVITY_MPS2 * dt), dt)  # C is beyond the first margin
+    for _ in range(3):
+        table.step(dt)
+        pos, radius = table.pos_m, table.radius_m
+        gaps = [math.dist(pos[a], pos[b]) - radius[a] - radius[b] for a, b in ((0, 1), (0, 2), (1, 2))]
+        assert min(gaps) > -1e-3
+        assert pos[0, 0] < pos[2, 0]  # S stays on its side of C
+    assert table.vel_mps[2, 0] > 1.0  # S set C moving
+
+
+def test_the_contact_stage_is_offered_every_pair_within_its_margin_where_the_step_began() -> None:
+    # Two pucks 0.3 m apart, closing at 10 m/s, at dt 1/30 (0.33 m in the step): the contact margin
+    # (0.7 m) takes them. 0.3 m is twice the neighbour list's skin (1.5 radii), so the list's pairs
+    # that may overlap now leave them out; the contact stage is offered them all the same.
+    dt = 1 / 30
+    table = AirTable()
+    table.add_puck(pos_m=(4.0, 4.0), radius_m=0.1, vel_mps=(5.0, 0.0))
+    table.add_puck(pos_m=(4.5, 4.0), radius_m=0.1, vel_mps=(-5.0, 0.0))
+    ctx = StepContext(dt, (), began=table.pos_m.copy())
+    margin = contacts.margin_m(table.vel_mps, dt)
+    assert margin > 0.3 > broadphase.SKIN_RADII * 0.1
+    assert len(table.neighbour_list.pairs(table.pos_m, table.radius_m)[0]) == 0
+    i, j, reach = resting._candidates(table, ctx, margin)
+    assert (i.tolist(), j.tolist(), reach.tolist()) == ([0], [1], [0.2])
