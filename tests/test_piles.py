@@ -134,11 +134,12 @@ def test_a_random_pile_thrown_down_at_restitution_0_loses_energy_and_lands_dead(
 
 def test_a_pile_where_a_shallow_wedge_lifts_a_puck_in_a_corner_at_dt_1_60() -> None:
     """Found by the random test above when it was not derandomized: at dt 1/60 (step 87) the heaviest puck
-    of this 30-puck heap slides into the bottom right corner at 3.2 m/s and rides a puck (r 0.246 m) up over
-    a small one (r 0.0625 m) on the floor, which it pushes right at 9.6 um/s into a puck (r 0.0629 m) held
-    in the corner; their normal rises 0.16 degrees, so the corner puck leaves the floor at 3.4 mm/s: the
-    exact answer for hard discs (the contact stage's velocities meet its contacts' bounds to 1e-7 m/s).
-    Its neighbour pushes it (`pushes`), though slower than STILL_MPS: the check counts it stirred."""
+    of this 30-puck heap slides along the floor at 3.2 m/s into a puck (r 0.246 m) near the right wall,
+    which rides up over a small one (r 0.0625 m) on the floor and presses it right, at 9.6 um/s, into a
+    puck (r 0.0629 m) held in the bottom right corner. Their normal rises 0.16 degrees, so the corner puck
+    leaves the floor at 3.4 mm/s: the exact answer for hard discs (the contact stage's velocities meet its
+    contacts' bounds to 5e-8 m/s; tests/test_contacts.py works a wedge by hand). The check of old took
+    the small puck for still (slower than STILL_MPS); it pushes the corner puck (`pushes`)."""
     rise, up, overlap = drop(30, 1532515, 1 / 60, 0.0)
     assert rise < ENERGY_ROUND_OFF and overlap < OVERLAP_M
     assert up < UP_MPS
