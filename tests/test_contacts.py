@@ -8,7 +8,6 @@ import numpy as np
 import pytest
 
 from airtable.physics import broadphase, contacts, resting
-from airtable.physics.context import StepContext
 from airtable.physics.forces import GRAVITY_MPS2
 from airtable.physics.table import AirTable
 
@@ -222,19 +221,3 @@ def test_a_puck_squeezed_out_from_under_a_falling_one_meets_the_puck_in_its_path
         assert min(gaps) > -1e-3
         assert pos[0, 0] < pos[2, 0]  # S stays on its side of C
     assert table.vel_mps[2, 0] > 1.0  # S set C moving
-
-
-def test_the_contact_stage_is_offered_every_pair_within_its_margin_where_the_step_began() -> None:
-    # Two pucks 0.3 m apart, closing at 10 m/s, at dt 1/30 (0.33 m in the step): the contact margin
-    # (0.7 m) takes them. 0.3 m is twice the neighbour list's skin (1.5 radii), so the list's pairs
-    # that may overlap now leave them out; the contact stage is offered them all the same.
-    dt = 1 / 30
-    table = AirTable()
-    table.add_puck(pos_m=(4.0, 4.0), radius_m=0.1, vel_mps=(5.0, 0.0))
-    table.add_puck(pos_m=(4.5, 4.0), radius_m=0.1, vel_mps=(-5.0, 0.0))
-    ctx = StepContext(dt, (), began=table.pos_m.copy())
-    margin = contacts.margin_m(table.vel_mps, dt)
-    assert margin > 0.3 > broadphase.SKIN_RADII * 0.1
-    assert len(table.neighbour_list.pairs(table.pos_m, table.radius_m)[0]) == 0
-    i, j, reach = resting._candidates(table, ctx, margin)
-    assert (i.tolist(), j.tolist(), reach.tolist()) == ([0], [1], [0.2])

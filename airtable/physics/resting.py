@@ -9,12 +9,11 @@ contact is a collision, as in the course's model, and the stage is skipped.
 
 from __future__ import annotations
 
-import math
 from typing import TYPE_CHECKING
 
 import numpy as np
 
-from airtable.physics import broadphase, contacts, vectors
+from airtable.physics import contacts
 from airtable.physics.storage import non_negative
 
 if TYPE_CHECKING:
@@ -65,10 +64,14 @@ def hold(table: Storage, ctx: StepContext) -> bool:
     pucks = (table.pos_m, table.vel_mps, table.radius_m, table.mass_kg)
     solver = table.contact_solver
     rest = (ctx.rest, ctx.dt, asleep)
+    if table.puck_collisions:
+        candidates = table.neighbour_list.pairs(table.pos_m, table.radius_m)
+    else:
+        none = np.empty(0, dtype=np.intp)
+        candidates = (none, none, np.empty(0))
     margin = contacts.margin_m(table.vel_mps, ctx.dt)
     for tries in range(1, MARGIN_TRIES + 1):
         before = table.pos_m.copy(), table.vel_mps.copy(), solver.save()
-        candidates = _candidates(table, ctx, margin)
         held = solver.solve(*pucks, table.size_m, candidates, *rest, ctx.rest_walls, ctx.began, margin)
         needed = contacts.margin_m(table.vel_mps, ctx.dt)
         if needed - contacts.MARGIN_M <= margin or tries == MARGIN_TRIES:  # a pair left out cannot close its gap
@@ -77,21 +80,3 @@ def hold(table: Storage, ctx: StepContext) -> bool:
         solver.restore(before[2])
         margin = needed
     return held
-
-
-def _candidates(table: Storage, ctx: StepContext, margin: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """(i, j, reach) for every pair the contact stage may take: closer than reach plus `margin` where
-    the step began, so closer than reach plus the margin and both pucks' travel since, now. (The
-    pairs that may overlap now are not enough: a pair the margin takes is one the stage keeps from
-    closing more than its gap; a pair it misses, a puck the stage pushes out of a wedge can pass into.)"""
-    if not table.puck_collisions:
-        none = np.empty(0, dtype=np.intp)
-        return none, none, np.empty(0)
-    pos, radius = table.pos_m, table.radius_m
-    travel = 0.0 if ctx.began is None else math.sqrt(float(vectors.squared_lengths(pos - ctx.began).max()))
-    stray = 0.5 * margin + travel  # each puck's share of the reach to add
-    found = table.neighbour_list.pairs_while_moving(pos, radius, stray)
-    if found is None:  # further than the list's skin holds: a search of its own
-        i, j = broadphase.find_candidate_pairs(pos, radius, margin_m=2.0 * stray)
-        found = (i, j, broadphase.pair_reach(radius, i, j))
-    return found
