@@ -57,6 +57,8 @@ def hold(table: Storage, ctx: StepContext) -> bool:
     small one under a big one falling) can leave faster than any puck came: if the answer moves a
     puck faster than the margin allowed, the stage starts again with the margin of the answer's
     speeds, so the puck's path meets its new neighbours as contacts (MARGIN_TRIES times at most).
+    The pairs it may take are the neighbour list's: a pair within the margin but beyond the list's
+    skin is not offered (a step of 1/30 s with a puck at several m/s can leave one out).
     """
     if ctx.rest is None:
         return False
