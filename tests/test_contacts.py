@@ -159,3 +159,65 @@ def test_a_contact_of_the_last_step_stays_one_a_little_further_apart() -> None:
     assert count(solver, margin + 1.5 * contacts.HOLD_M) == 0  # too far: let go
     assert count(solver, margin + 0.5 * contacts.HOLD_M) == 0  # not a contact last step
     assert count(contacts.ContactSolver(), margin + 0.5 * contacts.HOLD_M) == 0
+
+
+@pytest.mark.parametrize(
+    ("small_m", "push_mps", "dt"),
+    [(0.05, 3.0, 1 / 60), (0.05, 3.0, 1 / 240), (0.09, 10.0, 1 / 240), (0.05, 1.0, 1 / 60)],
+)
+def test_a_puck_pushed_into_one_held_in_a_corner_lifts_it_as_hard_discs_do(
+    small_m: float, push_mps: float, dt: float
+) -> None:
+    # Puck A (R = 0.1 m) sits in the bottom right corner; puck B (radius r) on the floor touches
+    # it from the left and is pushed at it at u (restitution 0). Their normal n, from B to A, is
+    # (2 sqrt(R r), R - r) / (R + r): it rises. By hand, if A leaves the floor: the wall takes A's
+    # x part, the floor B's y part, and the contact's impulse L keeps them from closing along n:
+    #     A: (0, -g dt + L n_y / m_A),   B: (u - L n_x / m_B, 0),   (v_A - v_B).n = 0
+    #     so L = (u n_x + g dt n_y) / (n_y^2 / m_A + n_x^2 / m_B),
+    # and A rises at n_x / n_y times B's speed (a wedge: 19 times for r = 0.09 m). If that A would
+    # fall (u = 1 m/s), it stays on the floor and B stops. A puck lifted out of rest by a slow
+    # neighbour is hard-disc physics (tests/test_piles.py counts such a puck pushed, not risen).
+    big = 0.1
+    table = AirTable()
+    table.gravity_on, table.sleeping = True, False
+    table.cr_puck = table.cr_wall = 0.0
+    width = float(table.size_m[0])
+    across = 2.0 * math.sqrt(big * small_m)
+    table.add_puck(pos_m=(width - big, big), radius_m=big)
+    table.add_puck(pos_m=(width - big - across, small_m), radius_m=small_m, vel_mps=(push_mps, 0.0))
+    table.step(dt)
+    m_a, m_b = table.mass_kg
+    nx, ny = across / (big + small_m), (big - small_m) / (big + small_m)
+    fall = GRAVITY_MPS2 * dt
+    impulse = (push_mps * nx + fall * ny) / (ny**2 / m_a + nx**2 / m_b)
+    lift, slide = -fall + impulse * ny / m_a, push_mps - impulse * nx / m_b
+    if lift <= 0.0:
+        lift = slide = 0.0
+    else:
+        assert lift == pytest.approx(slide * nx / ny, rel=1e-9)
+    np.testing.assert_allclose(table.vel_mps, [[0.0, lift], [slide, 0.0]], rtol=0, atol=1e-6)
+
+
+def test_a_puck_squeezed_out_from_under_a_falling_one_meets_the_puck_in_its_path() -> None:
+    # A small puck S (r 0.05 m) on the floor; a big one B (r 0.5 m, 100 times heavier) touching it
+    # from above, its centre 5 cm to the left, falling at 3 m/s; a puck C (r 0.1 m) on the floor
+    # 0.3 m to the right of S. Their normal is 5 degrees from vertical, so S leaves the wedge at
+    # about 11 times B's speed, over 16 m/s: in a step of 1/30 s it would cross C's 0.3 m gap and C
+    # itself. The contacts were found within a margin for the speeds the pucks came with (0.24 m);
+    # S leaves faster, so the stage starts again with the margin of its answer: C is a contact, S
+    # stops at C and pushes it on. (Before: S passed through C in two steps.)
+    dt = 1 / 30
+    table = AirTable()
+    table.gravity_on, table.sleeping = True, False
+    table.cr_puck = table.cr_wall = 0.0
+    table.add_puck(pos_m=(5.0, 0.05), radius_m=0.05)
+    table.add_puck(pos_m=(4.95, 0.05 + math.sqrt(0.55**2 - 0.05**2)), radius_m=0.5, vel_mps=(0.0, -3.0))
+    table.add_puck(pos_m=(5.45, 0.1), radius_m=0.1)
+    assert 0.3 > contacts.margin_m(table.vel_mps - (0.0, GRAVITY_MPS2 * dt), dt)  # C is beyond the first margin
+    for _ in range(3):
+        table.step(dt)
+        pos, radius = table.pos_m, table.radius_m
+        gaps = [math.dist(pos[a], pos[b]) - radius[a] - radius[b] for a, b in ((0, 1), (0, 2), (1, 2))]
+        assert min(gaps) > -1e-3
+        assert pos[0, 0] < pos[2, 0]  # S stays on its side of C
+    assert table.vel_mps[2, 0] > 1.0  # S set C moving

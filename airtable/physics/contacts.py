@@ -123,6 +123,12 @@ def rest_for_restitution(rest: np.ndarray, cr: float) -> np.ndarray:
     return rest / cr
 
 
+def margin_m(vel: np.ndarray, dt: float) -> float:
+    """How far apart (m) a pair or a puck and a wall may be where the step began and still be a contact:
+    MARGIN_M, plus as far as this stage may move two pucks towards each other in the step."""
+    return MARGIN_M + (2.0 * float(np.abs(vel).max()) + MAX_PUSH_MPS) * dt
+
+
 @dataclass
 class _Contacts:
     """The contacts of one step: body a, body b (the row count for a wall), normal n from b to a."""
@@ -257,8 +263,9 @@ class ContactSolver:
         self.__init__()
 
     def solve(
-        self, pos, vel, radius, mass, size_m, candidates, rest, dt, asleep=None, rest_walls=None, began=None
-    ) -> bool:
+        self, pos, vel, radius, mass, size_m, candidates, rest, dt, asleep=None, rest_walls=None, began=None,
+        margin=None,
+    ) -> bool:  # fmt: skip
         """Solve the resting contacts in place; return whether there were any.
 
         candidates: (i, j, reach) pairs that may touch; rest: each puck's rest
@@ -267,13 +274,13 @@ class ContactSolver:
         which pucks sleep (sleep.py), or None: to the awake pucks a sleeper is
         immovable, and its contacts with the walls and with other sleepers are
         left out. began: the positions when the step began (None: unknown, every contact
-        is taken where the step ends).
+        is taken where the step ends). margin: how far apart a contact may be (m; None: margin_m).
         """
         if len(pos) != self._rows:
             self.forget()
             self._rows = len(pos)
         ci, cj, reach = candidates
-        margin = MARGIN_M + (2.0 * float(np.abs(vel).max()) + MAX_PUSH_MPS) * dt
+        margin = margin_m(vel, dt) if margin is None else margin
         if asleep is not None:
             awake = np.flatnonzero(~(asleep.take(ci) & asleep.take(cj)))
             ci, cj, reach = ci.take(awake), cj.take(awake), reach.take(awake)
