@@ -6,8 +6,9 @@ NOTES = """
 A heavy puck slides at 1 m/s towards a light one near the left wall, and every hit is
 elastic. Count every hit, puck on puck and puck on wall: with the heavy puck 100^n times
 heavier the count is 3, 31, 314, 3141, 31415, the first digits of pi (G. Galperin, 2003).
-Left/Right change n; at n = 4 the light puck bounces many times in one step, and the
-engine finds each hit in time order.
+Left/Right change n; at n = 4 the light puck bounces many times in one step, each hit
+found in time order; once no more can come (both pucks move away from the wall, the heavy
+one faster), the demo says the count and stops both before the far wall sends one back.
 """
 
 N_MAX = 4
@@ -42,8 +43,7 @@ def build(table, variation=0):
             pairs, walls = table.collision_count, table.wall_collision_count
             table.notices.say(
                 "pi",
-                f"{pairs + walls} hits in all: {pairs} between the pucks, {walls} on the wall. No more can come:"
-                " both pucks stop before the far wall.",
+                f"{pairs + walls} hits in all: {pairs} between the pucks, {walls} on the wall. No more can come.",
             )
             if heavy.pos_m[0] > table.width_m - 3.0 * HEAVY_RADIUS_M:
                 light.vel_mps = heavy.vel_mps = (0.0, 0.0)

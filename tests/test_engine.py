@@ -171,8 +171,7 @@ def test_the_pi_demo_counts_the_digits_of_pi_and_stops_the_pucks(demos) -> None:
         # ... and says why, with the count the lesson is about (the window shows it, as each notice)
         pairs, walls = table.collision_count, table.wall_collision_count
         assert list(table.notices) == [
-            f"{due} hits in all: {pairs} between the pucks, {walls} on the wall. No more can come:"
-            " both pucks stop before the far wall."
+            f"{due} hits in all: {pairs} between the pucks, {walls} on the wall. No more can come."
         ]
 
 

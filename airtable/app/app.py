@@ -490,12 +490,12 @@ class App:
         if behind:
             parts.append(f"{behind} (the teacher's computer's most)")
         parts.append(f"t = {t.time_s:.2f} s")
+        n, hits, walls = len(t.pos_m), t.collision_count, t.wall_collision_count
+        parts.append(f"{hits} collision{'' if hits == 1 else 's'}, {walls} on walls")  # what a class counts along
         parts.append("F1: help")  # the students' windows have their own F1
         parts.append(gravity_label(t))
         parts.append(f"correction: {t.puck_correction}")
-        n, hits, walls = len(t.pos_m), t.collision_count, t.wall_collision_count
         parts.append(f"{n} puck{'' if n == 1 else 's'}")
-        parts.append(f"{hits} collision{'' if hits == 1 else 's'}, {walls} on walls")
         if t.cr_puck == t.cr_wall:
             parts.append(f"restitution {t.cr_puck:g}")
         else:
