@@ -225,9 +225,12 @@ class EnergyChart:
         return {**values, **scales}
 
     def euler_wiggle_note(self, table: AirTable) -> str | None:
-        """One line explaining the swing of the total, when springs make it visible."""
+        """One line explaining the swing of the total, when springs make it visible and nothing on the
+        table loses energy (no damper, every bounce elastic): else the total's changes are real losses."""
         wiggle = self.total_wiggle(WIGGLE_WINDOW_S)
         if table.spring_pairs.size == 0 or not (2e-3 < wiggle < 0.2) or self.total_drifts(WIGGLE_WINDOW_S):
+            return None
+        if np.any(table.spring_damper_Nspm) or table.cr_puck < 1.0 or table.cr_wall < 1.0:
             return None
         return (
             f"The total swings by {100 * wiggle:.2g} % but does not drift: semi-implicit Euler "
