@@ -185,8 +185,13 @@ class AidsPainter:
         draw_arrow_px(self.w.surface, color, a, b, width or self.w.line_px(2), head_widths=5.0)
 
     def arrows(self, starts_m: np.ndarray, vectors_m: np.ndarray, color) -> None:
-        for s, v in zip(starts_m, vectors_m):
-            self.arrow(s, v, color)
+        """arrow() for many, their ends turned into pixels at once (a gas has thousands)."""
+        if len(starts_m) == 0:
+            return
+        ends = self.w.env.to_screen(np.concatenate([starts_m, starts_m + vectors_m]).astype(float)).tolist()
+        width = self.w.line_px(2)
+        for a, b in zip(ends[: len(starts_m)], ends[len(starts_m) :]):
+            draw_arrow_px(self.w.surface, color, a, b, width, head_widths=5.0)
 
     def marker(self, point_m, color, label: str) -> None:
         x, y = self._px(point_m)
