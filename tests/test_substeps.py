@@ -167,3 +167,52 @@ def test_any_stiffness_steps_to_finite_numbers_and_says_what_it_does(k: float, d
         assert len(implicit) == 1  # beyond what substeps take: said, once
     else:
         assert implicit == []  # substeps (or none needed): the spring rings at its own period
+
+
+# ---------------------------------------------------------------- pieces: a step where many pucks are fast
+
+
+@pytest.mark.parametrize(
+    "moves, fast_ones, mode, want",
+    [
+        # A puck at speed v moves v dt / (FAST_FRACTION r) "fast lengths" in a step: in n pieces it is fast
+        # where that is at least n. 100 pucks may have FEW_FAST = 10 fast in a piece.
+        (2.5, 100, "two-step", 3),  # all move 2.5: fast in 1 and 2 pieces, in 3 none
+        (2.5, 100, "off", 3),
+        (2.5, 100, "perfect-kiss", 1),  # every hit found in order anyway
+        (2.5, 10, "two-step", 1),  # ten fast ones: the hit stage takes them
+        (2.5, 11, "two-step", 3),
+        (0.99, 100, "two-step", 1),  # none fast
+        (1.01, 100, "two-step", 2),  # just over one fast length: fast in one piece, not in two
+        (1000.0, 100, "two-step", substeps.MAX_PIECES),
+    ],
+)
+def test_a_step_is_cut_into_the_fewest_pieces_in_which_few_pucks_are_fast(moves, fast_ones, mode, want) -> None:
+    r, dt = 0.1, 1 / 240
+    speed = moves * substeps.FAST_FRACTION * r / dt
+    vel = np.zeros((100, 2))
+    vel[:fast_ones] = (0.6 * speed, 0.8 * speed)  # (a 3-4-5 triangle: the speed exactly)
+    vel[fast_ones:] = (0.01, 0.0)
+    assert substeps.pieces(vel, np.full(100, r), dt, mode) == want
+
+
+def test_a_gas_stirred_hot_keeps_its_energy_and_order_when_its_steps_are_cut_into_pieces() -> None:
+    # 200 pucks at 10 times the gas demo's speed: steps in pieces, every hit elastic.
+    from airtable.demos.demo_0p_gas import gas_scene
+
+    table = gas_scene(200, speed_mps=10.0, seed=3)
+    assert substeps.pieces(table.vel_mps, table.radius_m, 1 / 30, table.puck_correction) > 1
+    energy = table.kinetic_energy_J()
+    seen = 0
+    for _ in range(60):
+        table.step(1 / 30)
+        seen += len(table.last_collisions)
+    assert table.kinetic_energy_J() == pytest.approx(energy, rel=1e-12)
+    assert seen == table.collision_count > 0  # each piece's collisions are the step's
+    i, j = np.triu_indices(table.n_pucks, k=1)
+    d = np.hypot(*(table.pos_m[i] - table.pos_m[j]).T)
+    # Two-step leaves an overlap where pucks move near half their radius a step, each piece's share
+    # here (the demo gas at 3 m/s and dt 1/60 keeps 35 mm whole), far from a centre inside another puck.
+    assert (d - table.radius_m[i] - table.radius_m[j]).min() > -0.1 * 0.75
+    assert (table.pos_m >= table.radius_m[:, None] - 1e-9).all()
+    assert (table.pos_m <= table.size_m - table.radius_m[:, None] + 1e-9).all()

@@ -12,7 +12,7 @@ from __future__ import annotations
 from collections.abc import Sequence
 from typing import TYPE_CHECKING
 
-from airtable.physics import events, integrate, pairs, resting, sleep, substeps, vectors, walls
+from airtable.physics import events, integrate, pairs, resting, sleep, substeps, walls
 from airtable.physics.context import StepContext
 from airtable.physics.forces import Pull
 
@@ -29,7 +29,7 @@ def step(table: Storage, dt: float, pulls: Sequence[Pull] = ()) -> StepContext:
     the context returned is the last piece's, with every piece's collisions.
     """
     table.run_due_events()  # 0. a demo's timed events whose time has come (storage.py)
-    n = substeps.pieces(vectors.squared_lengths(table.vel_mps), table.radius_m, dt, table.puck_correction)
+    n = substeps.pieces(table.vel_mps, table.radius_m, dt, table.puck_correction)
     records = []
     for _ in range(n):
         ctx = _piece(table, dt / n, pulls)

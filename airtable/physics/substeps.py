@@ -32,6 +32,7 @@ import math
 
 import numpy as np
 
+from airtable.physics import vectors
 from airtable.physics.events import FAST_FRACTION
 
 # Per puck, the sum of k h^2 / m each substep may take explicitly: a pair of equal
@@ -60,16 +61,22 @@ FEW_FAST = 10
 MAX_PIECES = 8
 
 
-def pieces(speed_sq: np.ndarray, radius: np.ndarray, dt_s: float, mode: str) -> int:
-    """Into how many pieces of dt_s / n a step of pucks at speeds sqrt(speed_sq) (m/s) and radii `radius` (m)
-    is cut (see the module docstring): the fewest in which at most FAST_SHARE of them, or FEW_FAST, move
-    FAST_FRACTION of their radius; 1 in perfect kiss, and up to MAX_PIECES."""
+def pieces(vel: np.ndarray, radius: np.ndarray, dt_s: float, mode: str) -> int:
+    """Into how many pieces of dt_s / n a step of pucks at velocities `vel` (N, 2; m/s) and radii `radius`
+    (m) is cut (see the module docstring): the fewest in which at most FAST_SHARE of them, or FEW_FAST,
+    move FAST_FRACTION of their radius; 1 in perfect kiss, and up to MAX_PIECES."""
     allowed = max(FEW_FAST, int(FAST_SHARE * len(radius)))
     if mode not in ("two-step", "off") or len(radius) <= allowed:
         return 1
+    # No puck is faster than sqrt(2) times its fastest component: if that is not fast for the smallest
+    # puck, none is (the usual case, in one pass over the velocities).
+    if not math.sqrt(2.0) * float(np.abs(vel).max()) * dt_s > FAST_FRACTION * float(radius.min()):
+        return 1
+    speed_sq = vectors.squared_lengths(vel)
     # In n pieces a puck is fast where it moves FAST_FRACTION of its radius n times in the whole step.
-    times = np.sqrt(speed_sq) * (dt_s / FAST_FRACTION) / radius
-    most = float(np.partition(times, len(times) - 1 - allowed)[len(times) - 1 - allowed])  # (allowed + 1)th
+    times_sq = speed_sq / (radius * radius) * (dt_s / FAST_FRACTION) ** 2
+    at = len(times_sq) - 1 - allowed
+    most = math.sqrt(float(np.partition(times_sq, at)[at]))  # the (allowed + 1)th most
     if not most >= 1.0:  # (also NaN)
         return 1
     return min(MAX_PIECES, math.floor(most) + 1)
