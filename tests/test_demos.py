@@ -168,6 +168,8 @@ def test_demo_6_triangle_keeps_its_shape():
     table = fresh("6")
     assert table.cr_puck == 0.7
     assert len(table.springs) == 3
+    np.testing.assert_allclose(spring_lengths(table), 2.5, rtol=1e-12)  # at rest: nothing stored to jolt it
+    assert table.spring_energy_J() < 1e-20
     energy = mechanical_energy(table)
     run(table, "6", 500)
     assert np.all(np.abs(spring_lengths(table) - 2.5) < 0.2 * 2.5)
