@@ -68,13 +68,14 @@ def pieces(vel: np.ndarray, radius: np.ndarray, dt_s: float, mode: str) -> int:
     allowed = max(FEW_FAST, int(FAST_SHARE * len(radius)))
     if mode not in ("two-step", "off") or len(radius) <= allowed:
         return 1
-    # No puck is faster than sqrt(2) times its fastest component: if that is not fast for the smallest
-    # puck, none is (the usual case, in one pass over the velocities).
-    if not math.sqrt(2.0) * float(np.abs(vel).max()) * dt_s > FAST_FRACTION * float(radius.min()):
-        return 1
     speed_sq = vectors.squared_lengths(vel)
+    limit = FAST_FRACTION * float(radius.min()) / dt_s
+    if not float(speed_sq.max()) > limit * limit:  # the fastest is not fast for the smallest: the usual case
+        return 1
     # In n pieces a puck is fast where it moves FAST_FRACTION of its radius n times in the whole step.
     times_sq = speed_sq / (radius * radius) * (dt_s / FAST_FRACTION) ** 2
+    if np.count_nonzero(times_sq >= 1.0) <= allowed:  # a few fast ones: the hit stage's
+        return 1
     at = len(times_sq) - 1 - allowed
     most = math.sqrt(float(np.partition(times_sq, at)[at]))  # the (allowed + 1)th most
     if not most >= 1.0:  # (also NaN)
