@@ -275,6 +275,7 @@ def test_a_settled_spring_demo_idles_though_round_off_never_stops(demos):
     """Demo 6 rings down to velocities of about 1e-16 m/s that never reach 0 exactly: nothing on screen
     moves by half a pixel a second, so the table idles (issue 22: it drew 55 fps at 1080p)."""
     app = App(demos, demo_key="6", headless=True, window_size_px=(1920, 1080))
+    app.table.pos_m[3, 0] += 0.8  # the demo starts at rest length: a corner pulled out sets it ringing
     app.run(seconds=1.0, frame_dt_s=FRAME_S)
     assert app.motion_px_per_s() > 10 and not app.still()  # it rings at first
     for _ in range(round(25.0 / app.dt_s)):  # 25 s: rung down, what is left is round-off
