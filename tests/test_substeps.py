@@ -180,6 +180,7 @@ def test_any_stiffness_steps_to_finite_numbers_and_says_what_it_does(k: float, d
         (2.5, 100, "two-step", 3),  # all move 2.5: fast in 1 and 2 pieces, in 3 none
         (2.5, 100, "off", 3),
         (2.5, 100, "perfect-kiss", 1),  # every hit found in order anyway
+        (2.5, 100, "none", 1),  # collisions off (step.py): no hits to find
         (2.5, 10, "two-step", 1),  # ten fast ones: the hit stage takes them
         (2.5, 11, "two-step", 3),
         (0.99, 100, "two-step", 1),  # none fast

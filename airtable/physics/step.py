@@ -29,7 +29,8 @@ def step(table: Storage, dt: float, pulls: Sequence[Pull] = ()) -> StepContext:
     the context returned is the last piece's, with every piece's collisions.
     """
     table.run_due_events()  # 0. a demo's timed events whose time has come (storage.py)
-    n = substeps.pieces(table.vel_mps, table.radius_m, dt, table.puck_correction)
+    mode = table.puck_correction if table.puck_collisions else "none"  # (no pair hits: nothing to cut for)
+    n = substeps.pieces(table.vel_mps, table.radius_m, dt, mode)
     records = []
     for _ in range(n):
         ctx = _piece(table, dt / n, pulls)
