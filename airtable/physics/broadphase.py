@@ -73,8 +73,7 @@ def find_candidate_pairs(
             i, j = i.take(near), j.take(near)
         return i, j
     r_max = float(radius.max())
-    # No puck can be twice the mean while the largest is within twice the smallest.
-    big = radius > 2.0 * radius.mean() if r_max > 2.0 * float(radius.min()) else None
+    big = too_big_for_the_grid(radius)
     if big is not None and big.any():
         small_idx = np.flatnonzero(~big)
         cell = 2.0 * float(radius.take(small_idx).max()) + margin_m
@@ -94,6 +93,12 @@ def find_candidate_pairs(
     return np.minimum(i, j), np.maximum(i, j)
 
 
+def too_big_for_the_grid(radius: np.ndarray) -> np.ndarray | None:
+    """Which pucks are more than twice the mean radius (the grid pairs those with everyone); None when none
+    can be: no puck is twice the mean while the largest is within twice the smallest."""
+    return radius > 2.0 * radius.mean() if float(radius.max()) > 2.0 * float(radius.min()) else None
+
+
 def pairs_near(pos: np.ndarray, radius: np.ndarray, rows: np.ndarray, margin_m: float) -> tuple[np.ndarray, np.ndarray]:
     """Pairs (i < j) with a puck of `rows` in them whose centres are closer than r_i + r_j + margin_m,
     each once, sorted by (i, j).
@@ -110,7 +115,8 @@ def pairs_near(pos: np.ndarray, radius: np.ndarray, rows: np.ndarray, margin_m: 
         return empty, empty
     if len(rows) * n <= NEAR_BRUTE_FORCE_LOOKS:  # a few rows: each against every puck, no grid to build
         return _each_pair_once(n, *_near_each(pos, radius, rows, margin_m))
-    big = radius > 2.0 * radius.mean() if float(radius.max()) > 2.0 * float(radius.min()) else np.zeros(n, dtype=bool)
+    big = too_big_for_the_grid(radius)
+    big = np.zeros(n, dtype=bool) if big is None else big
     small = (~big).nonzero()[0]
     a, b = [], []
     if len(small) > 1 and (~big.take(rows)).any():

@@ -10,6 +10,7 @@ step.py, one stage a line.
 
 from __future__ import annotations
 
+import functools
 import math
 from collections.abc import Callable, Sequence
 
@@ -226,14 +227,8 @@ class AirTable(Storage):
         if self._last_collisions is not None or not any(r.count for r in self._last_records):
             c = self._last_collisions
             return None if c is None or len(c) == 0 else lambda: c
-        records, joined = self._last_records, []
-
-        def collisions() -> Collisions:
-            if not joined:
-                joined.append(Collisions.of_records(records))
-            return joined[0]
-
-        return collisions
+        records = self._last_records
+        return functools.cache(lambda: Collisions.of_records(records))
 
     def restore_settings(self, names: tuple[str, ...], values: tuple) -> None:
         """Storage.restore_settings; a restored table reports no collisions until it steps."""
