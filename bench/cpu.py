@@ -40,7 +40,8 @@ def start_xvfb(size: str = "1280x720") -> tuple[subprocess.Popen, str]:
     """A private Xvfb of `size` (WxH) on a display number it picks itself; returns it and ':N'."""
     read_fd, write_fd = os.pipe()
     xvfb = subprocess.Popen(
-        ["Xvfb", "-displayfd", str(write_fd), "-screen", "0", f"{size}x24", "-nolisten", "tcp"],
+        # -noreset: a reset when the last client leaves would drop a client that is still connecting
+        ["Xvfb", "-displayfd", str(write_fd), "-screen", "0", f"{size}x24", "-nolisten", "tcp", "-noreset"],
         pass_fds=(write_fd,),
         stdout=subprocess.DEVNULL,
         stderr=subprocess.DEVNULL,
