@@ -241,6 +241,10 @@ class ContactSolver:
         found = np.searchsorted(self._keys, keys).clip(0, len(self._keys) - 1)
         return found, self._keys.take(found) == keys
 
+    def held_pairs(self) -> bool:
+        """Whether the last step held two pucks against each other (not only pucks on walls)."""
+        return bool(len(self._keys)) and bool((self._keys % (self._rows + 4) < self._rows).any())
+
     def wall_rest(self, rest: np.ndarray) -> np.ndarray:
         """(N, 2) rest speeds towards the walls along x and y: infinite where the puck pressed
         on a wall across that axis in the last step (it rests there whatever its speed)."""

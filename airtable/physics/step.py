@@ -24,15 +24,19 @@ def step(table: Storage, dt: float, pulls: Sequence[Pull] = ()) -> StepContext:
     """Advance `table` by dt seconds with the cursor strings `pulls`; return the step's context.
 
     Sleeping pucks are not moved: the step first wakes those something
-    disturbed; when every puck sleeps, it only advances time. Where many pucks
-    are fast (a gas stirred hot) the step is taken in pieces (substeps.pieces);
-    the context returned is the last piece's, with every piece's collisions.
+    disturbed; when every puck sleeps, it only advances time. Where springs are
+    too stiff for dt or many pucks are fast (a gas stirred hot), the step is
+    taken in pieces, each the whole loop (substeps.py); the context returned
+    is the last piece's, with every piece's collisions.
     """
     table.run_due_events()  # 0. a demo's timed events whose time has come (storage.py)
     mode = table.puck_correction if table.puck_collisions else "none"  # (no pair hits: nothing to cut for)
-    n = substeps.pieces(table.vel_mps, table.radius_m, dt, mode)
+    n = max(substeps.pieces(table.vel_mps, table.radius_m, dt, mode), substeps.for_contacts(table, dt))
+    outside = table.force_N.copy() if n > 1 and table.force_N.any() else None  # forces set from outside
     records = []
-    for _ in range(n):
+    for piece in range(n):
+        if piece and outside is not None:
+            table.force_N[:] = outside  # act in every piece, as they would through the whole step
         ctx = _piece(table, dt / n, pulls)
         records += ctx.records
     ctx.records = records
@@ -47,7 +51,7 @@ def _piece(table: Storage, dt: float, pulls: Sequence[Pull]) -> StepContext:
     if table.n_pucks and sleep.wake(table, ctx):  # 0b. wake the sleepers something disturbed
         ctx.began = table.pos_m.copy()  # where the step began (the contacts start there)
         if dt > 0.0:
-            integrate.forces_and_integrate(table, ctx)  # 1-2. forces; v += F/m dt, x += v dt (substeps)
+            integrate.forces_and_integrate(table, ctx)  # 1-2. forces; v += F/m dt, x += v dt
         table.force_N[:] = 0.0  # the accumulators hold one step's forces
         resting.rest_speeds(table, ctx)  # below these, contacts rest instead of bouncing
         if dt > 0.0:
