@@ -5,12 +5,14 @@ import math
 KEY = "6p"
 TITLE = "Jelly"
 NOTES = """
-Twenty-five pucks joined by springs along every edge and diagonal act like a block of
-jelly: it falls, lands, wobbles and settles, and you can grab a puck and throw it at a wall.
-The diagonals stop the squares from folding flat. The stiffer jellies vibrate faster than a
-step can follow, so the step solves their springs implicitly: the block keeps its shape, and
-its sag under its own weight is the one k gives (2 cm when soft, a millimetre when stiff: too
-little to see), but its fastest wobble is damped away. Left and Right change the stiffness.
+Twenty-five pucks joined by springs along every edge and diagonal (the diagonals stop the
+squares folding flat) act like a block of jelly: it falls, lands, wobbles and settles, and
+you can grab a puck and throw it at a wall. The jellies vibrate faster than one step can
+follow, so their springs are stepped in substeps (2, 4 and 9 a step): each wobble rings and
+dies as k and the dampers say, and the sag under its own weight is the one k gives (2 cm
+when soft, a millimetre when stiff: too little to see). Pull a puck right through its
+neighbours and the block stays tangled, as pucks on springs still collide; press the key
+again to start over. Left and Right change the stiffness.
 """
 
 VARIATIONS = ("soft: k 60 N/m", "k 300 N/m", "stiff: k 1500 N/m")

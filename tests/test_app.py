@@ -124,10 +124,12 @@ def test_freeze_gravity_and_corrections(app):
     assert np.all(app.table.vel_mps == 0.0)
     press(app, pygame.K_g)
     assert app.table.gravity_on and app.table.cr_puck == 0.9 and app.table.cr_wall == 0.9
+    assert app.message == "gravity on (9.8 m/s²); restitution of pucks and walls 0.9 (Shift+g: gravity only)"
     app.frame(FRAME_S)
     assert app.window.surface.get_at((450, 300))[:3] == (20, 20, 70)
     press(app, pygame.K_g)
     assert not app.table.gravity_on and app.table.cr_puck == 1.0
+    assert app.message.startswith("gravity off; restitution of pucks and walls 1 ")
     press(app, pygame.K_p)
     assert app.table.puck_correction == "off"
     assert app.window.surface.get_at((450, 300))[:3] == (40, 40, 40)

@@ -89,6 +89,9 @@ class LiveEdits(Feature):
         t = self.host.table
         t.gravity_on = not t.gravity_on
         t.cr_puck = t.cr_wall = 0.9 if t.gravity_on else 1.0
+        # Said, as every key that changes the table says: the restitution a demo set is replaced.
+        state = f"on ({t.gravity_mps2:g} m/s²)" if t.gravity_on else "off"
+        self.host.say(f"gravity {state}; restitution of pucks and walls {t.cr_puck:g} (Shift+g: gravity only)")
 
     def toggle_correction(self) -> None:
         """The next correction mode: off, two-step, perfect kiss, off, ..."""
