@@ -278,3 +278,21 @@ def test_forces_set_from_outside_act_through_every_piece_of_a_step() -> None:
     table.step(DT_S)
     assert table.vel_mps[row] == pytest.approx(np.array([0.3, -0.2]) * DT_S / table.mass_kg[row], rel=1e-12)
     assert free is not None
+
+
+@pytest.mark.parametrize("variation", [0, 1, 2])
+def test_a_dropped_jelly_never_reads_more_energy_than_it_started_with(demos, variation) -> None:
+    """The jelly demo (springs in 2, 4, 9 substeps) thrown up and landing: gravity, dampers and bounces at
+    restitution 0.7 only take. The stiff one's landing read 15 % more than its start for a few steps when
+    its wall hits were resolved once after the springs' substeps; it lands now in pieces of the step."""
+    table = AirTable()
+    demos["6p"].build(table, variation)
+
+    def energy() -> float:
+        return table.kinetic_energy_J() + table.spring_energy_J() + table.gravity_energy_J()
+
+    start, most = energy(), 0.0
+    for _ in range(480):  # 2 s: up, the landing, the first bounces
+        table.step(DT_S)
+        most = max(most, energy())
+    assert most <= start * (1.0 + 1e-3)
