@@ -180,16 +180,15 @@ class AidsPainter:
 
     def arrow(self, start_m, vector_m, color, width: int | None = None) -> None:
         """An arrow from start_m along vector_m (both in metres)."""
-        start = np.asarray(start_m, dtype=float)
-        a, b = self._px(start), self._px(start + np.asarray(vector_m, dtype=float))
-        draw_arrow_px(self.w.surface, color, a, b, width or self.w.line_px(2), head_widths=5.0)
+        self.arrows(np.asarray([start_m], dtype=float), np.asarray([vector_m], dtype=float), color, width)
 
-    def arrows(self, starts_m: np.ndarray, vectors_m: np.ndarray, color) -> None:
-        """arrow() for many, their ends turned into pixels at once (a gas has thousands)."""
+    def arrows(self, starts_m: np.ndarray, vectors_m: np.ndarray, color, width: int | None = None) -> None:
+        """Arrows from each of starts_m along vectors_m (metres), their ends turned into pixels at once
+        (a gas has thousands)."""
         if len(starts_m) == 0:
             return
         ends = self.w.env.to_screen(np.concatenate([starts_m, starts_m + vectors_m]).astype(float)).tolist()
-        width = self.w.line_px(2)
+        width = width or self.w.line_px(2)
         for a, b in zip(ends[: len(starts_m)], ends[len(starts_m) :]):
             draw_arrow_px(self.w.surface, color, a, b, width, head_widths=5.0)
 

@@ -101,6 +101,14 @@ def contact_time(d, w, reach):
     return np.where(meets, c / np.where(meets, root - dw, 1.0), np.inf), root / reach
 
 
+def each_wall(pos: np.ndarray, vel: np.ndarray, radius: np.ndarray, size_m) -> tuple:
+    """For the left, bottom, right and top walls, in that order (contacts.WALL_NORMALS'): each puck's
+    room between its edge and the wall (m; negative: past it) and its speed away from it (m/s)."""
+    x, y, vx, vy = pos[:, 0], pos[:, 1], vel[:, 0], vel[:, 1]
+    width, height = size_m
+    return ((x - radius, vx), (y - radius, vy), (width - x - radius, -vx), (height - y - radius, -vy))
+
+
 def wall_time(x: float, v: float, lo: float, hi: float) -> float | None:
     """How long until a centre at x moving at v (along one axis) reaches lo (moving down) or hi
     (moving up): where a puck of radius r touches the walls at 0 and size (lo = r, hi = size - r).

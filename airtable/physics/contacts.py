@@ -59,7 +59,7 @@ from typing import NamedTuple
 
 import numpy as np
 
-from airtable.physics import colouring, vectors
+from airtable.physics import collision, colouring, vectors
 
 # Iterations over all contacts per step (Box2D and pymunk use about ten);
 # the loop stops early once an iteration changes no velocity by CONVERGED_MPS.
@@ -172,18 +172,14 @@ def _pair_contacts(pos, vel, ci, cj, reach, rest, held, margin, kept=None) -> _C
 
 def _wall_contacts(pos, vel, radius, size_m, rest, margin) -> _Contacts:
     """The pucks within margin of a wall, moving into it slower than their rest speed (rest: (N, 2), per axis)."""
-    x, y, vx, vy = pos[:, 0], pos[:, 1], vel[:, 0], vel[:, 1]
-    width, height = size_m
-    gaps = (x - radius, y - radius, width - x - radius, height - y - radius)
-    speeds = (vx, vy, -vx, -vy)
-    rows, walls, gap, vn = [], [], [], []
-    for w in range(4):
-        k = np.flatnonzero((gaps[w] < margin) & (speeds[w] >= -rest[:, w % 2]))
+    rows, which, gap, vn = [], [], [], []
+    for w, (room, away) in enumerate(collision.each_wall(pos, vel, radius, size_m)):
+        k = np.flatnonzero((room < margin) & (away >= -rest[:, w % 2]))
         rows.append(k)
-        walls.append(np.full(len(k), w))
-        gap.append(gaps[w].take(k))
-        vn.append(speeds[w].take(k))
-    a, w = np.concatenate(rows), np.concatenate(walls)
+        which.append(np.full(len(k), w))
+        gap.append(room.take(k))
+        vn.append(away.take(k))
+    a, w = np.concatenate(rows), np.concatenate(which)
     count = len(pos)
     keys = a.astype(np.int64) * (count + 4) + count + w
     b = np.full(len(a), count)

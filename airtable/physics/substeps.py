@@ -47,7 +47,7 @@ import math
 
 import numpy as np
 
-from airtable.physics import vectors
+from airtable.physics import collision, vectors
 from airtable.physics.events import FAST_FRACTION
 
 # Per puck, the sum of k h^2 / m each substep may take explicitly: a pair of equal
@@ -77,17 +77,16 @@ LANDING_MPS = 0.5
 def for_contacts(table, dt_s: float) -> int:
     """Into how many pieces a step of dt_s is cut for its springs' substeps (see the module docstring):
     `count`'s substeps if the contact stage held a pair last step or a puck is landing on a wall, else 1."""
-    if table.n_springs == 0 or not (table.contact_solver.held_pairs() or _hits_a_wall(table, dt_s)):
+    if table.n_springs == 0:
         return 1
-    return count(table.mass_kg, *table.spring_ends, table.spring_k_Npm, dt_s)
+    n = count(table.mass_kg, *table.spring_ends, table.spring_k_Npm, dt_s)
+    return n if n > 1 and (table.contact_solver.held_pairs() or _hits_a_wall(table, dt_s)) else 1
 
 
 def _hits_a_wall(table, dt_s: float) -> bool:
     """Whether a puck coming at a wall faster than LANDING_MPS may reach it within the step."""
-    x, y, vx, vy, r = table.pos_m[:, 0], table.pos_m[:, 1], table.vel_mps[:, 0], table.vel_mps[:, 1], table.radius_m
-    width, height = table.size_m
-    for room, towards in ((x - r, -vx), (y - r, -vy), (width - x - r, vx), (height - y - r, vy)):
-        if ((towards > LANDING_MPS) & (room < towards * dt_s)).any():
+    for room, away in collision.each_wall(table.pos_m, table.vel_mps, table.radius_m, table.size_m):
+        if ((-away > LANDING_MPS) & (room < -away * dt_s)).any():
             return True
     return False
 
