@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+import warnings
 
 import numpy as np
 import pytest
@@ -17,6 +18,19 @@ DT_S = 1 / 240
 
 def _light_puck(table: AirTable, pos_m, mass_kg: float, r: float = 0.05):
     return table.add_puck(pos_m=pos_m, radius_m=r, density_kgpm2=mass_kg / (math.pi * r * r))
+
+
+def test_explicit_fractions_by_hand_and_a_puck_with_no_spring_warns_nothing() -> None:
+    """Pucks 0-1 on a spring of k 1e6, c 0; puck 2 on none (its budget over nothing overflowed:
+    a RuntimeWarning on the teacher's console). m 1 kg, dt 1 ms: a puck's budget is
+    EXPLICIT_STIFFNESS m / dt^2 = 5e5 N/m, so the spring is taken half explicitly."""
+    mass = np.array([1.0, 1.0, 1e6])
+    a, b = np.array([0]), np.array([1])
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        frac_k, frac_c = forces.explicit_fractions(mass, a, b, np.array([1e6]), np.array([0.0]), 1e-3)
+    assert frac_k.tolist() == [0.5]
+    assert frac_c.tolist() == [1.0]
 
 
 # ---------------------------------------------------------------- static sag

@@ -16,7 +16,7 @@ import numpy as np
 import pygame
 
 from airtable.app.aids_paint import CHART_COLORS, CHART_CORNERS, draw_arrow_px, place_in_corner
-from airtable.app.panel_view import ACCENT, DIM_TEXT, TEXT_COLOR, shorten, wrap
+from airtable.app.panel_view import ACCENT, DIM_TEXT, TEXT_COLOR, panel_surface, shorten, wrap
 from airtable.model.momenta import FEW_PUCKS, VALUE_HEADINGS, MomentaView, PuckValues, fit_chains, tip_to_tail
 from airtable.model.readout import readable
 
@@ -101,7 +101,7 @@ class LessonsPainter:
         return rect
 
     def _panel(self, rect: pygame.Rect) -> None:
-        back = pygame.Surface(rect.size, pygame.SRCALPHA)
+        back = panel_surface(rect.size)
         back.fill(PANEL_FILL)
         self.w.surface.blit(back, rect)
         pygame.draw.rect(self.w.surface, DIM_TEXT, rect, 1)

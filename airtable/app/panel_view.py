@@ -21,6 +21,12 @@ COLUMN_EMS = 20  # a column is at least this many font sizes wide (about 50 char
 Row = tuple[str, str] | str
 
 
+def panel_surface(size_px: tuple[int, int]) -> pygame.Surface:
+    """A transparent surface of `size_px` for a panel; 0 wide or tall where a window too small for the
+    panel leaves it less (a window shrunk to a strip must not end the lesson)."""
+    return pygame.Surface((max(0, int(size_px[0])), max(0, int(size_px[1]))), pygame.SRCALPHA)
+
+
 def shorten(font: pygame.font.Font, text: str, width: int) -> str:
     """`text`, cut and ended with "..." if it is wider than `width` pixels."""
     if font.size(text)[0] <= width:
@@ -166,7 +172,7 @@ def render_panel(
     if fit and len(pages) == 1 and pages[0]:
         used = max(piece.y for piece in pages[0]) + font.get_linesize()
         size_px = (size_px[0], min(size_px[1], body.y + used + pad // 2))
-    panel = pygame.Surface(size_px, pygame.SRCALPHA)
+    panel = panel_surface(size_px)
     panel.fill(PANEL_COLOR)
     pygame.draw.rect(panel, ACCENT, panel.get_rect(), max(1, pad // 10))
     panel.blit(title_font.render(shorten(title_font, title, size_px[0] - 2 * pad), True, ACCENT), (pad, pad // 2))

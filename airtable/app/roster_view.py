@@ -54,7 +54,7 @@ def draw_roster(
     `most` seats in all; returns each row's (number, box) and the panel's box, for clicks."""
     rect = w.panel_rect()
     font, pad = w.font, w.font.get_height() // 2
-    surf = pygame.Surface(rect.size, pygame.SRCALPHA)
+    surf = panel_view.panel_surface(rect.size)
     surf.fill(panel_view.PANEL_COLOR)
     pygame.draw.rect(surf, panel_view.ACCENT, surf.get_rect(), max(1, pad // 5))
     n = len(seats)

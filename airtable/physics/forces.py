@@ -136,7 +136,8 @@ def explicit_fractions(
     for coeff, budget, power in ((k, EXPLICIT_STIFFNESS, 2), (c, EXPLICIT_DAMPING, 1)):
         per_puck = np.bincount(a, coeff, len(mass)) + np.bincount(b, coeff, len(mass))
         limit = budget * mass / dt_s**power
-        room = np.minimum(1.0, limit / np.maximum(per_puck, 1e-300))
+        room = np.ones(len(mass))  # (divided only where over budget: a puck with none would overflow)
+        np.divide(limit, per_puck, out=room, where=per_puck > limit)
         out.append(np.minimum(room.take(a), room.take(b)))
     return out[0], out[1]
 

@@ -1,0 +1,55 @@
+"""A window shrunk to a strip or a dot keeps the lesson: every panel and aid opens and draws at any size.
+
+A window manager lets a teacher drag the window down to a few pixels (to see the desktop
+behind it, or by accident); the panels then had less room than their margins, and creating a
+surface of negative size raised: the app ended, and the lesson with it.
+"""
+
+from __future__ import annotations
+
+import pygame
+import pytest
+from conftest import FRAME_S, press
+
+from airtable.app.app import App
+
+# Keys that open, close or change what is drawn over the table (the key table's rows: F1 help,
+# F2-F5 roster pages, Tab menu, l notes, F6 prediction, d/t/k lessons, e/a/v/c/m/b aids, s stats).
+OVERLAY_KEYS = (
+    pygame.K_F1, pygame.K_F2, pygame.K_F3, pygame.K_F4, pygame.K_F5, pygame.K_TAB, pygame.K_l,
+    pygame.K_F6, pygame.K_d, pygame.K_t, pygame.K_k, pygame.K_e, pygame.K_a, pygame.K_v, pygame.K_c,
+    pygame.K_m, pygame.K_b, pygame.K_s,
+)  # fmt: skip
+SIZES = ((1, 1), (1920, 1), (1, 1080), (120, 40), (40, 300), (320, 60))
+
+
+def resize(app: App, size: tuple[int, int]) -> None:
+    """The window manager's resize, as a real window gets it."""
+    pygame.event.post(pygame.event.Event(pygame.VIDEORESIZE, size=size, w=size[0], h=size[1]))
+    app.frame(FRAME_S)
+
+
+@pytest.mark.parametrize("size", SIZES)
+def test_every_panel_opens_and_draws_in_a_window_shrunk_to_a_strip(demos, size):
+    app = App(demos, demo_key="4", headless=True)  # pucks, springs and collisions: every aid has something
+    pygame.event.clear()
+    resize(app, size)
+    assert app.window.surface.get_size() == size
+    for key in OVERLAY_KEYS:
+        press(app, key, frames=2)  # open (or turn on) ...
+    for key in (pygame.K_i, pygame.K_h):  # ... the held keys too (inspect, zoom in)
+        pygame.event.post(pygame.event.Event(pygame.KEYDOWN, key=key, mod=0, unicode="", scancode=0))
+        app.frame(FRAME_S)
+        pygame.event.post(pygame.event.Event(pygame.KEYUP, key=key, mod=0, unicode="", scancode=0))
+    for button in (1, 3):  # a click and a right click anywhere in what is left of the window
+        pygame.event.post(pygame.event.Event(pygame.MOUSEBUTTONDOWN, pos=(0, 0), button=button))
+        app.frame(FRAME_S)
+        pygame.event.post(pygame.event.Event(pygame.MOUSEBUTTONUP, pos=(0, 0), button=button))
+        app.frame(FRAME_S)
+    for key in reversed(OVERLAY_KEYS):
+        press(app, key, frames=2)  # ... and closed again, all drawn in the strip
+    assert app.running
+    resize(app, (1280, 720))  # dragged back out: the lesson is still there, and it draws
+    press(app, pygame.K_F1)
+    assert app.running and app.window.surface.get_size() == (1280, 720)
+    assert app.table.n_pucks > 0 and app.table.time_s > 0.0
