@@ -96,6 +96,7 @@ class AidsPainter:
         self.chart_corner: int | None = None  # index into CHART_CORNERS; None: pick one clear of pucks
         self.chart_small = False
         self.chart_text: list[pygame.Rect] = []  # the chart's lines of text as last drawn
+        self.chart_plot = pygame.Rect(0, 0, 0, 0)  # and its plot's box
         self._vector_scales: dict[str, VectorScale] = {}
         self._noted: tuple[np.ndarray, np.ndarray] | None = None  # this frame's pucks (note_pucks)
         self._puck_boxes: list[pygame.Rect] | None = None  # and their boxes, once asked for
@@ -375,6 +376,7 @@ class AidsPainter:
         plot_w = box.width - 2 * pad if stacked else box.width - key_w - 3 * pad
         plot = pygame.Rect(box.x + pad, box.y + pad, plot_w, room - len(notes) * line_h)
         pygame.draw.rect(surf, (60, 60, 60), plot, 1)
+        self.chart_plot = plot
         if len(series["time_s"]) >= 2 and plot.width > 10 and plot.height > 10:
             self._chart_plot(series, plot, latest)
         x, y = (box.x + pad, plot.bottom) if stacked else (plot.right + pad, box.y + pad)

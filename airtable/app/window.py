@@ -133,7 +133,8 @@ class GameWindow:
         self.label_boxes: list[pygame.Rect] = []  # text drawn this frame; the aids place labels around it
         self.hud_boxes: list[pygame.Rect] = []  # the window's own text this frame: cursors' names keep off it
         self.status_top_px = 0
-        self.status_boxes: list[pygame.Rect] = []  # each part of the status line drawn this frame
+        self.status_boxes: list[tuple[str, pygame.Rect]] = []  # each part of the status line drawn, and where
+        self.cursor_boxes: list[pygame.Rect] = []  # the cursors' names drawn this frame
         self._windowed_at: tuple[int, int] | None = None  # where the window was before fullscreen (F11)
         if headless:
             self.windowed_size_px = tuple(int(v) for v in (size_px or env.size_px))
@@ -423,12 +424,13 @@ class GameWindow:
                 pygame.draw.polygon(self.surface, color, [qa[s], qb[s], rb[s], ra[s]])
 
     def _draw_cursors(self, scene: Scene) -> None:
+        self.cursor_boxes = []
         for cur in scene.cursors:
             if 0 <= cur.held < len(scene.pos_m):
                 start = self.env.to_screen(np.asarray(cur.cursor_m))
                 end = self.env.to_screen(scene.pos_m[cur.held])
                 pygame.draw.line(self.surface, cur.color, start, end, self.line_px(2))
-            self.draw_cursor(cur.name, cur.color, cur.cursor_m)
+            self.cursor_boxes.append(self.draw_cursor(cur.name, cur.color, cur.cursor_m))
 
     def draw_cursor(self, name: str, color: Sequence[int], cursor_m: Sequence[float]) -> pygame.Rect:
         """A coloured arrow with the client's name on dark ground, its tip at the cursor; returns the name's box."""
@@ -489,8 +491,9 @@ class GameWindow:
         x, top = pad, h - bar_h + self.timeline_strip_px + pad // 2
         gap = self.font.size(STATUS_SEPARATOR)[0]
         for part in fitting_parts(self.font, parts, w - 2 * pad):
-            self.status_boxes.append(self.surface.blit(self.font.render(part, True, TEXT_COLOR), (x, top)))
-            x = self.status_boxes[-1].right + gap
+            box = self.surface.blit(self.font.render(part, True, TEXT_COLOR), (x, top))
+            self.status_boxes.append((part, box))
+            x = box.right + gap
 
     def draw_banner(self, text: str) -> None:
         """A big message across the middle of the window."""
