@@ -453,7 +453,7 @@ class App:
             shared.aids = self.shared_aids()  # the students see the teacher's aids too
             self.server.publish(shared)
         self.draw(scene)
-        self.stats.frame()
+        self.stats.frame(idle=self.window.idle)
 
     def shared_aids(self):
         """What the students' windows show of the teacher's aids, notes and lesson panels (aids_share.py)."""
