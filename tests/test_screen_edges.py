@@ -91,8 +91,9 @@ def test_the_momentum_axis_is_labelled_in_n_s_in_its_lines_colour(size):
     energy = drawn_text_at(app, "0.15 J", TEXT_COLOR, font)
     plot = app.painter.chart_plot
     assert momentum is not None and energy is not None
-    assert momentum.right == plot.right - 2 and momentum.top - plot.top < 2 * font.get_linesize()  # top right
-    assert energy.topleft == (plot.left + 2, plot.top + 2) and not energy.colliderect(momentum)  # top left
+    # Above the plot, over none of its lines: J at the left, N s at the right.
+    assert momentum.right == plot.right and momentum.bottom <= plot.top
+    assert energy.left == plot.left and energy.bottom <= plot.top and not energy.colliderect(momentum)
     # The |p| line is drawn against its own scale: 0.5 of 0.6 of the plot's height.
     column = pixels(app)[plot.centerx, plot.top + 1 : plot.bottom - 1]
     ys = np.flatnonzero(np.all(column == MOMENTUM_COLOR, axis=1)) + plot.top + 1
@@ -122,6 +123,19 @@ def test_the_charts_text_stays_readable_and_inside_its_box(demos, size, small):
         box.contains(app.painter.chart_plot)
         and app.painter.chart_plot.height >= 3 * app.window.label_font.get_linesize()
     )
+
+
+@pytest.mark.parametrize("size", SIZES, ids=lambda s: f"{s[0]}x{s[1]}")
+def test_the_charts_note_keeps_off_its_key(demos, size):
+    """Demo 5 without its damper: the chart explains the total's swing under the plot and its key."""
+    app = App(demos, demo_key="5", variation=1, headless=True, window_size_px=size)
+    pygame.event.clear()
+    press(app, pygame.K_c, frames=150)
+    assert app.aids.chart.euler_wiggle_note(app.table) is not None
+    box, texts = app.painter.chart_rect(), app.painter.chart_text
+    assert len(texts) > 5 + 3  # the key, the axes and at least a line of the note
+    assert all(box.contains(rect) for rect in texts), (box, texts)
+    assert all(a.collidelist([b for b in texts if b is not a]) < 0 for a in texts), texts
 
 
 def test_at_640x480_the_chart_covers_a_small_share_of_the_table(demos):

@@ -15,6 +15,7 @@ from collections.abc import Sequence
 import numpy as np
 import pygame
 
+from airtable.app import panel_view
 from airtable.app.panel_view import ACCENT, DIM_TEXT, TEXT_COLOR
 from airtable.app.panel_view import wrap as _wrap
 from airtable.model.aids import VectorScale
@@ -371,16 +372,17 @@ class AidsPainter:
         line_h, pad = font.get_linesize(), self.w.line_px(4)
         key, key_w, stacked = self._chart_key(box, latest)
         room = box.height - 2 * pad - (len(key) * line_h if stacked else 0)
-        notes = _wrap(font, note, box.width - 20)[:2] if note and not self.chart_small else []
-        notes = notes if room - len(notes) * line_h >= 4 * line_h else []
+        # The note goes under the plot (its axes' line and four lines tall at least) and under a key beside it.
+        most = room // line_h - max(5, 0 if stacked else len(key))
+        notes = chart_notes(font, note if not self.chart_small else None, box.width - 2 * pad, most)
         plot_w = box.width - 2 * pad if stacked else box.width - key_w - 3 * pad
-        plot = pygame.Rect(box.x + pad, box.y + pad, plot_w, room - len(notes) * line_h)
+        plot = pygame.Rect(box.x + pad, box.y + pad + line_h, plot_w, room - (1 + len(notes)) * line_h)
         pygame.draw.rect(surf, (60, 60, 60), plot, 1)
         self.chart_plot = plot
         if len(series["time_s"]) >= 2 and plot.width > 10 and plot.height > 10:
             self._chart_plot(series, plot, latest)
         x, y = (box.x + pad, plot.bottom) if stacked else (plot.right + pad, box.y + pad)
-        spare = box.bottom - pad - (0 if stacked else len(notes) * line_h) - y - len(key) * line_h
+        spare = box.bottom - pad - len(notes) * line_h - y - len(key) * line_h
         gap = max(0, min(pad // 2, spare // max(1, len(key) - 1)))
         for text, color in key:
             mid = y + line_h // 2
@@ -413,20 +415,20 @@ class AidsPainter:
         return rect
 
     def _chart_plot(self, series: dict[str, np.ndarray], plot: pygame.Rect, latest: dict[str, float]) -> None:
-        """The lines and the plot's labels: the energy axis's top (J) at the top left, the momentum axis's (N s,
-        in the |momentum| line's colour) at the top right (a line lower if they would meet), the span below."""
+        """The lines and the plot's labels: above it, the energy axis's top (J) at the left, the momentum axis's
+        (N s, in the |momentum| line's colour) at the right (inside the plot if they would meet); the span in it."""
         font, line_h = self.w.label_font, self.w.label_font.get_linesize()
         t = series["time_s"]
         # Round-off (the chart's top is 0) lies on the axis: any positive top draws it there.
         top_e = chart_top(series["total_J"], latest.get("energy_scale_J", 0.0))
         top_p = chart_top(series["momentum_Ns"], latest.get("momentum_scale_Ns", 0.0))
         self._chart_lines(series, plot, top_e or 1.0, top_p or 1.0)
-        left = self._chart_text(f"{top_e:.3g} J", (plot.x + 2, plot.y + 2), TEXT_COLOR)
+        left = self._chart_text(f"{top_e:.3g} J", (plot.x, plot.y - line_h), TEXT_COLOR)
         text = f"{top_p:.3g} N s"
         right = pygame.Rect((0, 0), font.size(text))
-        right.topright = (plot.right - 2, plot.y + 2)
+        right.topright = (plot.right, plot.y - line_h)
         if right.inflate(8, 0).colliderect(left):
-            right.y += line_h
+            right.topright = (plot.right - 2, plot.y + 2)
         self._chart_text(text, right.topleft, CHART_COLORS["momentum_Ns"])
         if plot.height >= 3 * line_h:
             self._chart_text(f"last {max(t[-1] - t[0], 0.0):.1f} s", (plot.x + 2, plot.bottom - line_h), DIM_TEXT)
@@ -505,6 +507,15 @@ def round_up(value: float) -> float:
         if top >= value * (1 - 1e-12):
             return top
     return 10.0 ** (exp + 1)
+
+
+def chart_notes(font: pygame.font.Font, note: str | None, width_px: int, most: int) -> list[str]:
+    """`note` wrapped to `width_px`, at most `most` lines (the plot keeps four lines' height): where it is
+    longer, its last line ends in "..."."""
+    lines = _wrap(font, note, width_px) if note and most > 0 else []
+    if len(lines) <= most:
+        return lines
+    return [*lines[: most - 1], panel_view.shorten(font, lines[most - 1] + " ...", width_px)]
 
 
 def key_text(key: str, value: float) -> str:
