@@ -49,7 +49,7 @@ LABELLED_ANNOTATIONS = 2  # only the newest collisions get their numbers in a bo
 CHART_SIZE_PX = (520, 240)  # at 720 px tall; the small chart is SMALL_CHART of it
 SMALL_CHART = 0.65
 # Over the table (a window without side margins) the chart takes at most these shares of the window's
-# width and height, large and small (b): at 640x480 it then covers a fifth, or a tenth, of the table.
+# width and height, large and small (key b): at 640x480 it then covers 13 %, or 6 %, of the table.
 CHART_SHARE = {False: (0.4, 0.3), True: (0.3, 0.22)}
 # The axes' tops: round numbers x 10^k, a little above the largest value shown (lines at 71-95 % of the height).
 CHART_STEPS = (1.0, 1.2, 1.5, 2.0, 2.5, 3.0, 4.0, 5.0, 6.0, 8.0)
