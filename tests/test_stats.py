@@ -32,6 +32,17 @@ def test_the_line_reports_median_and_slowest_frames_from_the_clock() -> None:
     assert cpu_text == "2.5"  # since the stats began
 
 
+def test_the_idle_loops_waits_are_not_timed() -> None:
+    """A lesson spent mostly on a still table drew 12 frames a second on purpose: not a slow machine."""
+    now = [0.0]
+    stats = RunStats(clock=lambda: now[0])
+    for k in range(200):  # 50 frames at 60 fps, then 150 idle ones at 12 fps
+        now[0] += 1 / 60 if k < 50 else 1 / 12
+        stats.frame(idle=k >= 50)
+    median, p5 = stats.fps()
+    assert stats.frames == 200 and median == pytest.approx(60.0) and p5 == pytest.approx(60.0)
+
+
 def test_before_two_frames_the_rate_is_not_made_up() -> None:
     stats = RunStats()
     stats.frame()

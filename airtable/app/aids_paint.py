@@ -15,6 +15,7 @@ from collections.abc import Sequence
 import numpy as np
 import pygame
 
+from airtable.app import panel_view
 from airtable.app.panel_view import ACCENT, DIM_TEXT, TEXT_COLOR
 from airtable.app.panel_view import wrap as _wrap
 from airtable.model.aids import VectorScale
@@ -41,10 +42,18 @@ CHART_LABELS = {
     "total_J": "total",
     "momentum_Ns": "|momentum|",
 }
+SHORT_LABELS = {**CHART_LABELS, "momentum_Ns": "|p|"}  # a small chart's key: names only
 CHART_CORNERS = ("top right", "bottom right", "bottom left", "top left")
 MAX_AVOIDED_PUCKS = 2000
 LABELLED_ANNOTATIONS = 2  # only the newest collisions get their numbers in a box: more pile up unreadably
-CHART_SIZE_PX = (520, 240)  # at 720 px tall; the small chart is 0.65 of it
+CHART_SIZE_PX = (520, 240)  # at 720 px tall; the small chart is SMALL_CHART of it
+SMALL_CHART = 0.65
+# Over the table (a window without side margins) the chart takes at most these shares of the window's
+# width and height, large and small (key b): at 640x480 it then covers 13 %, or 6 %, of the table.
+CHART_SHARE = {False: (0.4, 0.3), True: (0.3, 0.22)}
+# The axes' tops: round numbers x 10^k, a little above the largest value shown (lines at 71-95 % of the height).
+CHART_STEPS = (1.0, 1.2, 1.5, 2.0, 2.5, 3.0, 4.0, 5.0, 6.0, 8.0)
+CHART_HEADROOM = 1.05
 # Where a label may go around its anchor, in order of preference: (x side, y side).
 AROUND = ((1, 1), (1, -1), (-1, 1), (-1, -1), (0, 1), (0, -1))
 RINGS = 8  # how far out (in lines) a label may move from its anchor
@@ -87,6 +96,8 @@ class AidsPainter:
         self.w = window
         self.chart_corner: int | None = None  # index into CHART_CORNERS; None: pick one clear of pucks
         self.chart_small = False
+        self.chart_text: list[pygame.Rect] = []  # the chart's lines of text as last drawn
+        self.chart_plot = pygame.Rect(0, 0, 0, 0)  # and its plot's box
         self._vector_scales: dict[str, VectorScale] = {}
         self._noted: tuple[np.ndarray, np.ndarray] | None = None  # this frame's pucks (note_pucks)
         self._puck_boxes: list[pygame.Rect] | None = None  # and their boxes, once asked for
@@ -334,62 +345,99 @@ class AidsPainter:
         self.chart_small = not self.chart_small
 
     def chart_rect(self, corner: int | None = None) -> pygame.Rect:
-        """The chart's box: in its corner, under the HUD or above the status bar, at most half the width."""
+        """The chart's box: in its corner, under the HUD or above the status bar. Over the table (no side
+        margins) at most CHART_SHARE of the window's width and height, but tall enough for its key."""
         w, h = self.w.surface.get_size()
-        scale = self.w.unit * (0.65 if self.chart_small else 1.0)
+        scale = max(self.w.unit * (SMALL_CHART if self.chart_small else 1.0), 0.6)
+        share_w, share_h = (1.0, 0.5) if self.w.layout.side_px else CHART_SHARE[self.chart_small]
+        key_h = len(CHART_COLORS) * self.w.label_font.get_linesize() + 2 * self.w.line_px(4) + 2
         size = (
-            min(w // 2, int(CHART_SIZE_PX[0] * max(scale, 0.6))),
-            min(h // 2, int(CHART_SIZE_PX[1] * max(scale, 0.6))),
+            min(int(w * share_w), int(CHART_SIZE_PX[0] * scale)),
+            min(h // 2, max(key_h, min(int(h * share_h), int(CHART_SIZE_PX[1] * scale)))),
         )
         return place_in_corner(
             self.w, pygame.Rect((0, 0), size), (self.chart_corner or 0) if corner is None else corner
         )
 
     def energy_chart(self, series: dict[str, np.ndarray], latest: dict[str, float], note: str | None) -> None:
-        """Strip chart of energies (left scale) and |momentum| (right scale) in an opaque corner panel;
-        the key beside the plot, or under it where the panel is narrow (a side margin)."""
+        """Strip chart of energies (left scale, in J) and |momentum| (right scale, in N s, in its colour) in an
+        opaque corner panel; the key beside the plot, or under it where the panel is narrow (a side margin),
+        or beside it without the values where the panel is small (the values panel has them)."""
         box = self.chart_rect()
         surf, font = self.w.surface, self.w.label_font
         pygame.draw.rect(surf, (0, 0, 0), box)
         pygame.draw.rect(surf, DIM_TEXT, box, 1)
         self._taken.append(box)
-        line_h = font.get_linesize()
-        pad = self.w.line_px(4)
-        legend = [
-            (f"{CHART_LABELS[k]} {latest[k]:.3g} {'N s' if k == 'momentum_Ns' else 'J'}", c)
-            for k, c in CHART_COLORS.items()
-        ]
-        # Sized for the widest value the format gives, so the plot does not jitter.
-        widest = max(font.size(f"{CHART_LABELS[k]} -8.88e-88 N s")[0] for k in CHART_COLORS)
-        key_w = widest + 5 * pad
-        stacked = box.width < 2 * key_w
-        notes = _wrap(font, note, box.width - 20)[:2] if note and not self.chart_small else []
-        below = line_h * (len(notes) + (len(legend) if stacked else 0))
+        self.chart_text = []
+        line_h, pad = font.get_linesize(), self.w.line_px(4)
+        key, key_w, stacked = self._chart_key(box, latest)
+        room = box.height - 2 * pad - (len(key) * line_h if stacked else 0)
+        # The note goes under the plot (its axes' line and four lines tall at least) and under a key beside it.
+        most = room // line_h - max(5, 0 if stacked else len(key))
+        notes = chart_notes(font, note if not self.chart_small else None, box.width - 2 * pad, most)
         plot_w = box.width - 2 * pad if stacked else box.width - key_w - 3 * pad
-        plot = pygame.Rect(box.x + pad, box.y + pad, plot_w, box.height - 2 * pad - below)
+        plot = pygame.Rect(box.x + pad, box.y + pad + line_h, plot_w, room - (1 + len(notes)) * line_h)
         pygame.draw.rect(surf, (60, 60, 60), plot, 1)
-        t = series["time_s"]
-        if len(t) >= 2 and plot.width > 10 and plot.height > 10:
-            self._chart_lines(series, plot, latest)
-            top_e = chart_top(series["total_J"], latest.get("energy_scale_J", 0.0))
-            self._text(f"{top_e:.3g} J", (plot.x + 2, plot.y + 2), DIM_TEXT)
-            self._text(f"last {max(t[-1] - t[0], 0.0):.1f} s", (plot.x + 2, plot.bottom - line_h), DIM_TEXT)
+        self.chart_plot = plot
+        if len(series["time_s"]) >= 2 and plot.width > 10 and plot.height > 10:
+            self._chart_plot(series, plot, latest)
         x, y = (box.x + pad, plot.bottom) if stacked else (plot.right + pad, box.y + pad)
-        for text, color in legend:
+        spare = box.bottom - pad - len(notes) * line_h - y - len(key) * line_h
+        gap = max(0, min(pad // 2, spare // max(1, len(key) - 1)))
+        for text, color in key:
             mid = y + line_h // 2
             pygame.draw.line(surf, color, (x, mid), (x + 2 * pad, mid), self.w.line_px(3))
-            self._text(text, (x + 2 * pad + 4, y), color)
-            y += line_h + (pad // 2 if not (self.chart_small or stacked) else 0)
+            self._chart_text(text, (x + 2 * pad + 4, y), color)
+            y += line_h + gap
         for k, line in enumerate(notes):
-            self._text(line, (box.x + pad, box.bottom - pad - (len(notes) - k) * line_h), DIM_TEXT)
+            self._chart_text(line, (box.x + pad, box.bottom - pad - (len(notes) - k) * line_h), DIM_TEXT)
 
-    def _chart_lines(self, series: dict[str, np.ndarray], plot: pygame.Rect, latest: dict[str, float]) -> None:
+    def _chart_key(self, box: pygame.Rect, latest: dict[str, float]) -> tuple[list, int, bool]:
+        """The key's lines (text, colour), its width (px) and whether it goes under the plot: with the
+        values beside the plot where that leaves the plot half the box, else under it where the box is
+        tall (a side margin), else only the names beside it."""
+        font, pad, line_h = self.w.label_font, self.w.line_px(4), self.w.label_font.get_linesize()
+        # Sized for the widest value the format gives, so the plot does not jitter.
+        widest = max(font.size(key_text(k, -8.88e-88))[0] for k in CHART_COLORS)
+        key_w = widest + 5 * pad
+        full = [(key_text(k, latest[k]), c) for k, c in CHART_COLORS.items()]
+        if box.width >= 2 * key_w:
+            return full, key_w, False
+        if box.height - 2 * pad - len(full) * line_h >= 4 * line_h:
+            return full, key_w, True
+        names = [(SHORT_LABELS[k], c) for k, c in CHART_COLORS.items()]
+        return names, max(font.size(t)[0] for t, _ in names) + 5 * pad, False
+
+    def _chart_text(self, text: str, pos_px, color) -> pygame.Rect:
+        """One of the chart's lines of text, its box kept in `chart_text` (the layout tests read them)."""
+        rect = self._text(text, pos_px, color)
+        self.chart_text.append(rect)
+        return rect
+
+    def _chart_plot(self, series: dict[str, np.ndarray], plot: pygame.Rect, latest: dict[str, float]) -> None:
+        """The lines and the plot's labels: above it, the energy axis's top (J) at the left, the momentum axis's
+        (N s, in the |momentum| line's colour) at the right (inside the plot if they would meet); the span in it."""
+        font, line_h = self.w.label_font, self.w.label_font.get_linesize()
+        t = series["time_s"]
+        # Round-off (the chart's top is 0) lies on the axis: any positive top draws it there.
+        top_e = chart_top(series["total_J"], latest.get("energy_scale_J", 0.0))
+        top_p = chart_top(series["momentum_Ns"], latest.get("momentum_scale_Ns", 0.0))
+        self._chart_lines(series, plot, top_e or 1.0, top_p or 1.0)
+        left = self._chart_text(f"{top_e:.3g} J", (plot.x, plot.y - line_h), TEXT_COLOR)
+        text = f"{top_p:.3g} N s"
+        right = pygame.Rect((0, 0), font.size(text))
+        right.topright = (plot.right, plot.y - line_h)
+        if right.inflate(8, 0).colliderect(left):
+            right.topright = (plot.right - 2, plot.y + 2)
+        self._chart_text(text, right.topleft, CHART_COLORS["momentum_Ns"])
+        if plot.height >= 3 * line_h:
+            self._chart_text(f"last {max(t[-1] - t[0], 0.0):.1f} s", (plot.x + 2, plot.bottom - line_h), DIM_TEXT)
+
+    def _chart_lines(self, series: dict[str, np.ndarray], plot: pygame.Rect, top_e: float, top_p: float) -> None:
+        """Each series as a line, energies against `top_e` (J), |momentum| against `top_p` (N s)."""
         t = series["time_s"]
         span = max(t[-1] - t[0], 1e-9)
         xs = plot.x + (t - t[0]) / span * plot.width
-        # Round-off (the chart's top is 0) lies on the axis: any positive top draws it there.
-        top_e = chart_top(series["total_J"], latest.get("energy_scale_J", 0.0)) or 1.0
-        top_p = chart_top(series["momentum_Ns"], latest.get("momentum_scale_Ns", 0.0)) or 1.0
         # Decimate to about one point per pixel column.
         pick = np.unique(np.linspace(0, len(t) - 1, min(len(t), plot.width)).astype(int))
         thin, thick = self.w.line_px(1.5), self.w.line_px(3)
@@ -441,9 +489,38 @@ def table_corner(window, rect: pygame.Rect, corner: int) -> pygame.Rect:
 
 
 def chart_top(values: np.ndarray, scale: float) -> float:
-    """The top of a chart's axis: a tenth above the largest of `values`, or 0 if that is round-off of the
-    scene's `scale` (readout.py)."""
-    return 1.1 * max(0.0, readable(float(np.max(values)), scale)) if len(values) else 0.0
+    """The top of a chart's axis: the first round number (CHART_STEPS x 10^k) at least CHART_HEADROOM above the
+    largest of `values`, or 0 if that is round-off of the scene's `scale` (readout.py).
+
+    The axis follows what the chart shows, its window (CHART_WINDOW_S): a fling stays whole, at its true
+    height, while it is in view, and the axis comes down to the calm table's numbers as it leaves. Round
+    steps keep the label readable ("2.5 J") and the lines still while the window slides."""
+    largest = readable(float(np.max(values)), scale) if len(values) else 0.0
+    return round_up(CHART_HEADROOM * largest) if largest > 0 else 0.0
+
+
+def round_up(value: float) -> float:
+    """The least of CHART_STEPS x 10^k that is at least `value` (> 0)."""
+    exp = math.floor(math.log10(value))
+    for step in CHART_STEPS:
+        top = step * 10.0**exp
+        if top >= value * (1 - 1e-12):
+            return top
+    return 10.0 ** (exp + 1)
+
+
+def chart_notes(font: pygame.font.Font, note: str | None, width_px: int, most: int) -> list[str]:
+    """`note` wrapped to `width_px`, at most `most` lines (the plot keeps four lines' height): where it is
+    longer, its last line ends in "..."."""
+    lines = _wrap(font, note, width_px) if note and most > 0 else []
+    if len(lines) <= most:
+        return lines
+    return [*lines[: most - 1], panel_view.shorten(font, lines[most - 1] + " ...", width_px)]
+
+
+def key_text(key: str, value: float) -> str:
+    """A line of the chart's key: the quantity, its value and unit ("total 2.4 J", "|momentum| 0.5 N s")."""
+    return f"{CHART_LABELS[key]} {value:.3g} {'N s' if key == 'momentum_Ns' else 'J'}"
 
 
 def place_in_corner(window, rect: pygame.Rect, corner: int) -> pygame.Rect:

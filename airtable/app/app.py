@@ -441,6 +441,11 @@ class App:
         self._say_new_notices()
         for feature in self.features:
             feature.after_physics()
+        # An idle loop draws few frames on purpose: the corner says "idle", not a rate that reads as a slow
+        # machine, and the rate measured once anything moves again counts none of the idle frames.
+        self.window.idle = self.loop is not None and self.loop.idling
+        if self.window.idle:
+            self._fps_counter.restart()
         self.fps = self._fps_counter.tick(self.clock_s)
         scene = self.scene()
         if self.server is not None:
@@ -448,7 +453,7 @@ class App:
             shared.aids = self.shared_aids()  # the students see the teacher's aids too
             self.server.publish(shared)
         self.draw(scene)
-        self.stats.frame()
+        self.stats.frame(idle=self.window.idle)
 
     def shared_aids(self):
         """What the students' windows show of the teacher's aids, notes and lesson panels (aids_share.py)."""
@@ -489,9 +494,9 @@ class App:
         behind = self._physics_behind() if for_students else ""  # (the teacher's: in the heads-up lines)
         if behind:
             parts.append(f"{behind} (the teacher's computer's most)")
-        parts.append(f"t = {t.time_s:.2f} s")
         n, hits, walls = len(t.pos_m), t.collision_count, t.wall_collision_count
         parts.append(f"{hits} collision{'' if hits == 1 else 's'}, {walls} on walls")  # what a class counts along
+        parts.append(f"t = {t.time_s:.2f} s")
         parts.append("F1: help")  # the students' windows have their own F1
         parts.append(gravity_label(t))
         parts.append(f"correction: {t.puck_correction}")

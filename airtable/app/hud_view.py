@@ -16,6 +16,7 @@ opaque ground, so a zoomed or panned view passes under the text, never over it.
 
 from __future__ import annotations
 
+import re
 from collections.abc import Sequence
 from dataclasses import dataclass
 
@@ -29,6 +30,7 @@ BAND_LINES = 3  # the top band: the title (with the frame rate and PAUSED), then
 SIDE_MIN_SHARE = 0.18
 GROUND = (0, 0, 0)  # under the text: opaque
 HudLine = str | tuple[str, Sequence[int]]  # a line, or a line and its colour
+HINT = re.compile(r"\s*\([^()]*\)$")  # a closing remark in brackets: what a narrow window leaves out first
 
 
 @dataclass(frozen=True)
@@ -61,14 +63,36 @@ def fold_lines(lines: Sequence[HudLine], count: int, font: pygame.font.Font, wid
 
 
 def fit_parts(font: pygame.font.Font, parts: Sequence[str], width_px: int, separator: str = STATUS_SEPARATOR) -> str:
-    """As many of `parts` as fit `width_px`, dropping the least important (last) first.
+    """`parts` (most important first) joined by `separator`, made to fit `width_px` (fitting_parts)."""
+    return separator.join(fitting_parts(font, parts, width_px, separator))
 
-    The first part alone is shortened with an ellipsis if even it does not fit."""
-    for n in range(len(parts), 0, -1):
-        text = separator.join(parts[:n])
-        if font.size(text)[0] <= width_px:
-            return text
-    return panel_view.shorten(font, parts[0], width_px) if parts else ""
+
+def fitting_parts(
+    font: pygame.font.Font, parts: Sequence[str], width_px: int, separator: str = STATUS_SEPARATOR
+) -> list[str]:
+    """`parts` (most important first), made to fit `width_px` once joined by `separator`: first they lose
+    their hints, the least important first ("PREDICT: 2 of 5 predicted (F6 reveals)" reads "PREDICT: 2 of 5
+    predicted"), then the least important go whole. Only a first part too wide alone is cut, with "..."."""
+    parts = [p for p in parts if p]
+
+    def fits(shown: list[str]) -> bool:
+        return font.size(separator.join(shown))[0] <= width_px
+
+    for k in reversed(range(len(parts))):
+        if fits(parts):
+            return parts
+        parts[k] = without_hint(parts[k])
+    while len(parts) > 1 and not fits(parts):
+        parts.pop()
+    if parts and not fits(parts):
+        return [panel_view.shorten(font, parts[0], width_px)]
+    return parts
+
+
+def without_hint(part: str) -> str:
+    """`part` without a closing remark in brackets ("0 students (F2: roster)" -> "0 students")."""
+    short = HINT.sub("", part)
+    return short or part
 
 
 def _text(line: HudLine) -> str:
@@ -97,10 +121,10 @@ def draw_hud(
     style: HudStyle,
     title: str,
     lines: Sequence[HudLine],
-    fps: float | None,
+    fps: str | None,
     paused: bool,
 ) -> tuple[list[pygame.Rect], int, int]:
-    """The title, heads-up lines, frame rate (None: not shown) and PAUSED in their places; returns
+    """The title, heads-up lines, frame rate's text (None: not shown) and PAUSED in their places; returns
     the boxes drawn (for the aids to keep clear of), how far down the window the text goes, and how
     far the top right corner's boxes (frame rate, PAUSED) go beside the table (0: none there)."""
     if layout.side_px:
@@ -108,13 +132,13 @@ def draw_hud(
     return _draw_in_band(surface, layout, style, title, lines, fps, paused)
 
 
-def _fps_box(surface, style: HudStyle, fps: float | None, topright) -> pygame.Rect:
-    """The frame rate in a box at `topright`; with none to show, an empty box of no width there."""
+def _fps_box(surface, style: HudStyle, fps: str | None, topright) -> pygame.Rect:
+    """The frame rate's text ("60.0 fps", "idle") in a box at `topright`; with none, an empty box of no width."""
     font = style.font
     pad = font.get_height() // 2
     if fps is None:
         return pygame.Rect(topright[0], topright[1], 0, font.get_linesize())
-    label = font.render(f"{fps:5.1f} fps", True, style.text)
+    label = font.render(fps, True, style.text)
     box = label.get_rect(topright=topright).inflate(pad, pad // 4)
     box.topright = topright
     pygame.draw.rect(surface, GROUND, box)

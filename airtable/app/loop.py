@@ -143,6 +143,10 @@ class FpsCounter:
             self.fps = (len(times) - 1) / span
         return self.fps
 
+    def restart(self) -> None:
+        """Forget the frames counted so far (they came at another pace: the idle loop's)."""
+        self._times.clear()
+
 
 class FrameLoop:
     """Calls `frame(dt_s)` once per frame until it returns False or a limit is reached.
@@ -264,6 +268,11 @@ class IdlingLoop(FrameLoop):
         self.stepping = stepping
         self.full_period_s, self.idle_period_s = 1.0 / fps, 1.0 / idle_fps
         self.still, self.headless = still, headless
+
+    @property
+    def idling(self) -> bool:
+        """The wait before the coming frame is the idle one (the last frame found the window still)."""
+        return self.period_s != self.full_period_s
 
     def after_frame(self) -> None:
         """Call at the end of each frame: the next one comes at the full or the idle rate."""

@@ -8,7 +8,9 @@ is one line a teacher can compare between laptops:
 - fps comes from the wall-clock time between frames: the median frame and the
   slowest twentieth (p5 is the rate that 95 % of frames beat). A headless run of
   simulated time runs frames back to back, so there it is how fast this machine
-  goes. "n/a" until two frames have run.
+  goes. The wait before an idle frame (a still table: the loop draws a few a
+  second on purpose) is no measure of the machine and is left out. "n/a" until
+  two frames have run at the full rate.
 - cpu is the process's CPU time (every thread: the server's too) since the
   app started, in seconds: divided by the run's length, the share of one core.
 - peak memory is the most resident memory the process has used, in MB of
@@ -93,10 +95,10 @@ class RunStats:
         self._last: float | None = None
         self._cpu0 = cpu()
 
-    def frame(self) -> None:
-        """Count a frame that has just been drawn."""
+    def frame(self, idle: bool = False) -> None:
+        """Count a frame that has just been drawn; `idle`: it came at the idle loop's pace (its wait not timed)."""
         now = self.clock()
-        if self._last is not None:
+        if self._last is not None and not idle:
             self._frame_s.append(now - self._last)
         self._last = now
         self.frames += 1

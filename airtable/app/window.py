@@ -25,12 +25,12 @@ import pygame
 from airtable.app import panel_view
 from airtable.app.aids_paint import AidsPainter  # noqa: F401  (imported from here by the app)
 from airtable.app.environment import Environment, fitting_size_px
-from airtable.app.hud_view import HudLine, HudStyle, TextLayout, draw_hud, fit_parts, text_layout
+from airtable.app.hud_view import HudLine, HudStyle, TextLayout, draw_hud, fit_parts, fitting_parts, text_layout
 from airtable.app.lessons_paint import LessonsPainter  # noqa: F401  (imported from here by the student's window)
 from airtable.app.pucks_view import COLORKEY, MIN_PUCK_RADIUS_PX, PuckSprites, draw_pucks
 from airtable.app.timeline_paint import TimelinePainter  # noqa: F401  (imported from here by the student's window)
 from airtable.assets import ASSETS_DIR
-from airtable.model.scene import Scene
+from airtable.model.scene import STATUS_SEPARATOR, Scene
 
 BACKGROUND = (0, 0, 0)
 BACKGROUND_GRAVITY = (20, 20, 70)
@@ -47,6 +47,7 @@ REFERENCE_HEIGHT_PX = 720  # type sizes below are for a window this tall, and sc
 FONT_SIZES = {"label": (24, 22), "text": (28, 22), "big": (44, 30)}
 
 PAUSED = "PAUSED"
+IDLE = "idle"  # the frame rate's corner while the loop idles (loop.py's IdlingLoop)
 FRAMEBUFFER_HINT = "SDL_FRAMEBUFFER_ACCELERATION"
 
 
@@ -128,8 +129,12 @@ class GameWindow:
         self.corner_bottom_px = 0  # below the frame rate and PAUSED in the top right corner (margins layout)
         self.layout = TextLayout(0, 0)  # where the text goes (hud_view.py)
         self.show_fps = False  # the frame rate in a corner (--stats): not for the room
+        self.idle = False  # the loop idles (a still table): the corner says IDLE instead of the frame rate
         self.label_boxes: list[pygame.Rect] = []  # text drawn this frame; the aids place labels around it
+        self.hud_boxes: list[pygame.Rect] = []  # the window's own text this frame: cursors' names keep off it
         self.status_top_px = 0
+        self.status_boxes: list[tuple[str, pygame.Rect]] = []  # each part of the status line drawn, and where
+        self.cursor_boxes: list[pygame.Rect] = []  # the cursors' names drawn this frame
         self._windowed_at: tuple[int, int] | None = None  # where the window was before fullscreen (F11)
         if headless:
             self.windowed_size_px = tuple(int(v) for v in (size_px or env.size_px))
@@ -419,12 +424,13 @@ class GameWindow:
                 pygame.draw.polygon(self.surface, color, [qa[s], qb[s], rb[s], ra[s]])
 
     def _draw_cursors(self, scene: Scene) -> None:
+        self.cursor_boxes = []
         for cur in scene.cursors:
             if 0 <= cur.held < len(scene.pos_m):
                 start = self.env.to_screen(np.asarray(cur.cursor_m))
                 end = self.env.to_screen(scene.pos_m[cur.held])
                 pygame.draw.line(self.surface, cur.color, start, end, self.line_px(2))
-            self.draw_cursor(cur.name, cur.color, cur.cursor_m)
+            self.cursor_boxes.append(self.draw_cursor(cur.name, cur.color, cur.cursor_m))
 
     def draw_cursor(self, name: str, color: Sequence[int], cursor_m: Sequence[float]) -> pygame.Rect:
         """A coloured arrow with the client's name on dark ground, its tip at the cursor; returns the name's box."""
@@ -439,33 +445,55 @@ class GameWindow:
             if len(self._labels) > 256:
                 self._labels.clear()
             label = self._labels[key] = self.label_font.render(name, True, color, (0, 0, 0))  # on dark ground
-        box = label.get_rect(topleft=(x + 12 * u, y + 14 * u))
-        if box.right > self.surface.get_width():  # at the right edge, left of the arrow instead
-            box.right = int(x - 2 * u)
-        return self.surface.blit(label, box.clamp(self.surface.get_rect()))
+        return self.surface.blit(label, self._cursor_label_box(label.get_size(), x, y, u))
+
+    def _cursor_label_box(self, size: tuple[int, int], x: float, y: float, u: float) -> pygame.Rect:
+        """Where a cursor's name goes: beside its arrow (below right; at the right edge left of it; at the
+        bottom above it), on screen and off the window's own text (the heads-up lines, the status line);
+        where no such spot is, between the top band and the status bar."""
+        below, above = y + 14 * u, y - 2 * u - size[1]
+        free = self.surface.get_rect()
+        free.height = max(0, self.status_top_px - self.layout.top_px)
+        free.top = self.layout.top_px
+        right_of, left_of = int(x + 12 * u), int(x - 2 * u) - size[0]
+        spots = [pygame.Rect((left, int(top)), size) for top in (below, above) for left in (right_of, left_of)]
+        clear = [b for b in spots if free.contains(b) and b.collidelist(self.hud_boxes) < 0]
+        return clear[0] if clear else spots[0].clamp(free if free.height >= size[1] else self.surface.get_rect())
 
     def _draw_hud(self, scene: Scene, hud: Sequence[HudLine]) -> None:
         """The title, heads-up lines, frame rate and PAUSED in their places (hud_view.py), then the
-        status line along the bottom: as many of its parts as fit, the least important dropped."""
-        w, h = self.surface.get_size()
-        pad = self.font.get_height() // 2
+        status line along the bottom (_draw_status)."""
         parts = [p.strip() for p in scene.status_parts]
         paused = PAUSED in parts
         parts = [p for p in parts if p != PAUSED]
         style = HudStyle(self.font, self.big_font, TEXT_COLOR, DIM_TEXT, PAUSED_COLOR, self.line_px(3))
-        fps = scene.fps if self.show_fps else None
+        fps = (IDLE if self.idle else f"{scene.fps:5.1f} fps") if self.show_fps else None
         drawn = draw_hud(self.surface, self.layout, style, scene.title, hud, fps, paused)
         boxes, self.hud_bottom_px, self.corner_bottom_px = drawn
         self.label_boxes.extend(boxes)
-        bar_h = self.status_bar_px
+        self.hud_boxes = list(boxes)
+        self._draw_status(parts)
+
+    def _draw_status(self, parts: Sequence[str]) -> None:
+        """The status line in a bar along the bottom: its parts (most important first) as fit the width,
+        the least important shortened, then left out, each whole (hud_view.fitting_parts); `status_boxes`
+        says where each went."""
+        w, h = self.surface.get_size()
+        pad, bar_h = self.font.get_height() // 2, self.status_bar_px
         self.status_top_px = h - bar_h if parts else h
-        if parts:
-            bar = pygame.Rect(0, h - bar_h, w, bar_h)
-            self.surface.fill((0, 0, 0), bar)
-            self.label_boxes.append(bar)
-            text = fit_parts(self.font, parts, w - 2 * pad)
-            text_top = h - bar_h + self.timeline_strip_px + pad // 2
-            self.surface.blit(self.font.render(text, True, TEXT_COLOR), (pad, text_top))
+        self.status_boxes = []
+        if not parts:
+            return
+        bar = pygame.Rect(0, h - bar_h, w, bar_h)
+        self.surface.fill((0, 0, 0), bar)
+        self.label_boxes.append(bar)
+        self.hud_boxes.append(bar)
+        x, top = pad, h - bar_h + self.timeline_strip_px + pad // 2
+        gap = self.font.size(STATUS_SEPARATOR)[0]
+        for part in fitting_parts(self.font, parts, w - 2 * pad):
+            box = self.surface.blit(self.font.render(part, True, TEXT_COLOR), (x, top))
+            self.status_boxes.append((part, box))
+            x = box.right + gap
 
     def draw_banner(self, text: str) -> None:
         """A big message across the middle of the window."""
