@@ -65,7 +65,9 @@ resize = st.builds(
 )
 focus = st.just([pygame.event.Event(pygame.WINDOWFOCUSLOST), pygame.event.Event(pygame.WINDOWFOCUSGAINED)])
 actions = st.lists(
-    st.tuples(st.one_of(key, key, key, held_key, typing, drag, press_only, wheel, resize, resize, focus), st.integers(1, 3)),
+    st.tuples(
+        st.one_of(key, key, key, held_key, typing, drag, press_only, wheel, resize, resize, focus), st.integers(1, 3)
+    ),
     min_size=5,
     max_size=40,
 )
