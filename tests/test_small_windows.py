@@ -53,3 +53,17 @@ def test_every_panel_opens_and_draws_in_a_window_shrunk_to_a_strip(demos, size):
     press(app, pygame.K_F1)
     assert app.running and app.window.surface.get_size() == (1280, 720)
     assert app.table.n_pucks > 0 and app.table.time_s > 0.0
+
+
+@pytest.mark.parametrize("size", SIZES)
+def test_the_energy_chart_with_its_note_draws_in_a_strip(demos, size):
+    """Demo 5 without its damper: the chart explains the total's swing in a note under the plot, which in a
+    strip has fewer than no lines of room (an IndexError ended the app)."""
+    app = App(demos, demo_key="5", variation=1, headless=True)
+    pygame.event.clear()
+    press(app, pygame.K_c, frames=150)
+    assert app.aids.chart.euler_wiggle_note(app.table) is not None
+    resize(app, size)
+    for _ in range(3):
+        app.frame(FRAME_S)
+    assert app.running and app.window.surface.get_size() == size

@@ -512,7 +512,9 @@ def round_up(value: float) -> float:
 def chart_notes(font: pygame.font.Font, note: str | None, width_px: int, most: int) -> list[str]:
     """`note` wrapped to `width_px`, at most `most` lines (the plot keeps four lines' height): where it is
     longer, its last line ends in "..."."""
-    lines = _wrap(font, note, width_px) if note and most > 0 else []
+    if not note or most <= 0:
+        return []  # (no room: a window shrunk to a strip leaves a negative number of lines)
+    lines = _wrap(font, note, width_px)
     if len(lines) <= most:
         return lines
     return [*lines[: most - 1], panel_view.shorten(font, lines[most - 1] + " ...", width_px)]
