@@ -106,8 +106,9 @@ def test_a_row_named_twice_bounces_once() -> None:
     pos, vel, radius = np.array([[-0.02, 1.0], [1.0, 1.0]]), np.array([[-2.0, 0.5], [0.0, 0.0]]), np.full(2, 0.1)
     count, past = walls.resolve_walls(pos, vel, radius, np.array([2.0, 2.0]), 0.5, True, only=np.array([0, 1, 0]))
     assert count == 1 and past.tolist() == [0, 0]
-    # Mirrored by its 0.12 m penetration to x = 0.22 m, moving out at 0.5 * 2 m/s.
-    np.testing.assert_allclose(pos[0], [0.22, 1.0])
+    # Backed up its 0.12 m penetration and on at the bounce's 0.5 of its speed: x = 0.1 + 0.5 * 0.12 = 0.16 m
+    # (mirrored by the whole penetration, 0.22 m, before restitution below 1 counted), moving out at 0.5 * 2 m/s.
+    np.testing.assert_allclose(pos[0], [0.16, 1.0])
     np.testing.assert_allclose(vel[0], [1.0, 0.5])
 
 

@@ -61,7 +61,9 @@ CAPPED_NOTICE = (
 # left to the pair and contact stages: else pucks that collide inelastically in a cluster hit
 # each other again and again at ever smaller speeds (inelastic collapse): 200000 events in one
 # step of a 300-puck gas at restitution 0. At 0.9 that is 66 hits: a light puck squeezed between
-# a wall and a heavy one may bounce a dozen times in a step, and each of those is real.
+# a wall and a heavy one may bounce a dozen times in a step, and each of those is real. The same
+# for a puck and a wall below restitution 1 (the wall stage puts back what is left): a heavy puck
+# pushing a light one into a wall of restitution 0 made 100000 events, 2 to 3 s, in one step.
 REPEAT_MIN = 3
 REPEAT_DECAY = 1e-3
 
@@ -178,6 +180,8 @@ class _Step:
         self.zorigin = np.zeros(len(pos), dtype=complex)  # ... and their new origins
         self.version: dict[int, int] = {}  # per puck: how many times its path changed
         self.hit_pairs: dict[tuple[int, int], int] = {}  # how many times each pair hit
+        self.hit_walls: dict[tuple[int, int], int] = {}  # how many times each puck hit a wall across each axis
+        self.pinned: dict[int, complex] = {}  # pucks resting on a wall for the rest of the step: its normal
         self.hits = Hits()
         self.partners = None  # the pairs that may meet, per puck (see find_partners)
         self.only_fast: np.ndarray | None = None  # the pucks whose partners were found, if not all
@@ -376,6 +380,8 @@ class _Step:
             t = collision.wall_time(xa, va, r, size - r)
             if t is None or self.t_now + t > self.dt or not abs(va) > self._wall_rest(k, axis):
                 continue
+            if self.rules.cr_wall < 1.0 and self.hit_walls.get((k, axis), 0) >= repeat_max(self.rules.cr_wall):
+                continue  # (see REPEAT_DECAY: a puck squeezed against the wall by another)
             self.push(self.t_now + t, k, -1 - axis)
 
     def moving_faster_than_wall_rest(self, rows: list[int]) -> list[int]:
@@ -441,18 +447,28 @@ class _Step:
         x, v = self.at(k, self.t_now), self.zvel.item(k)
         e, a = self.rules.cr_wall, self.rules.accel_y_mps2
         self.hits.walls += 1
+        self.hit_walls[k, axis] = hits = self.hit_walls.get((k, axis), 0) + 1
+        if e < 1.0 and hits >= repeat_max(e):  # its last hit here: it rests on the wall (off_a_pinned)
+            self.pinned[k] = self.wall_normal(x, axis)
+            e = 0.0
         if axis == 0:
             self.set_path(k, x, complex(collision.bounce(v.real, e), v.imag))
         elif a == 0.0:
             self.set_path(k, x, complex(v.real, collision.bounce(v.imag, e)))
         else:
-            vy, offset = self.bounce_under_gravity(v.imag, a)
+            vy, offset = self.bounce_under_gravity(v.imag, a, e)
             self.set_path(k, x, complex(v.real, vy))
             self.offset[k] = complex(0.0, offset)
 
-    def bounce_under_gravity(self, vy: float, a: float) -> tuple[float, float]:
+    def wall_normal(self, x: complex, axis: int) -> complex:
+        """The normal into the table of the wall across `axis` nearer to x."""
+        if axis == 0:
+            return 1.0 if x.real < 0.5 * self.width else -1.0
+        return 1j if x.imag < 0.5 * self.height else -1j
+
+    def bounce_under_gravity(self, vy: float, a: float, e: float) -> tuple[float, float]:
         """(velocity along y of the path to the step's end, what to add to it at the end) after a
-        floor or ceiling hit now, under a pull a (m/s^2) along y; vy: the step's velocity.
+        floor or ceiling hit now, under a pull a (m/s^2) along y, at restitution e; vy: the step's velocity.
 
         Semi-implicit Euler samples a parabola exactly: over a step whose end velocity is vy,
         the puck is at y0 + (vy - a dt / 2) s + a s^2 / 2 at time s, and vy is that parabola's
@@ -462,7 +478,7 @@ class _Step:
         heights fall by e^2. (A straight path is kept for the rest of the step's hits.)
         """
         s, left = self.t_now, self.dt - self.t_now
-        leave = collision.bounce(vy - a * (0.5 * self.dt - s), self.rules.cr_wall)  # off the speed at contact
+        leave = collision.bounce(vy - a * (0.5 * self.dt - s), e)  # off the speed at contact
         end = leave + a * (0.5 * self.dt - s)  # the new parabola's velocity half a step before the end
         if left <= 0.0 and leave * vy < 0.0:
             return leave, end - leave  # a hit at the very end
@@ -487,12 +503,30 @@ class _Step:
             if _caught_overlapping(end, va - vb, reach)[0]:
                 n, overlap, seen = end, reach - abs(end), (xa + va * left, xb + vb * left)
         n /= abs(n)
-        new_a, new_b = collision.collide_along(n, va, vb, self.mass.item(a), self.mass.item(b), self.rules.cr_puck)
+        new_a, new_b = (
+            self.off_a_pinned(a, n, va, vb)
+            or self.off_a_pinned(b, -n, vb, va)[::-1]
+            or (collision.collide_along(n, va, vb, self.mass.item(a), self.mass.item(b), self.rules.cr_puck))
+        )
         self.set_path(a, xa, new_a)
         self.set_path(b, xb, new_b)
         after = (self.at(a, self.dt), self.at(b, self.dt)) if overlap else seen
         self.hits.rows.append((a, b, n, seen[1], overlap, reach, rb, *seen, *after, va, vb, new_a, new_b))
         self.hit_pairs[a, b] = self.hit_pairs.get((a, b), 0) + 1
+
+    def off_a_pinned(self, a: int, n: complex, va: complex, vb: complex) -> tuple[complex, complex] | tuple:
+        """(va, vb) after b hits puck a, which rests on a wall (pinned: its hits there reached repeat_max)
+        and which b pushes into it along n (from b to a): b bounces off the wall through a, its speed
+        along n reversed times cr_wall, a stays. () if a is not so pinned.
+
+        The exact run has infinitely many ever faster hits of a between b and the wall; at cr_wall 0
+        their limit is this one (b stops). Colliding a and b as a pair let b pass through a once a
+        could no longer hit the wall."""
+        wall = self.pinned.get(a)
+        if wall is None or vectors.dot(n, wall) >= 0.0:
+            return ()
+        towards = vectors.dot(vb, n)
+        return va, (vb - (1.0 + self.rules.cr_wall) * towards * n if towards > 0.0 else vb)
 
 
 def _moves(speed_sq, radius, dt: float, fraction: float):

@@ -6,7 +6,12 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from airtable.physics import collision, vectors
+from airtable.physics import broadphase, collision, vectors
+
+# Overlaps smaller than this (m) are round-off: left alone (pairs.OVERLAP_SLOP_M).
+OVERLAP_SLOP_M = 1e-9
+# Into the table from the left, bottom, right and top walls (collision.each_wall's order), as complex x + iy.
+NORMALS = (1.0, 1j, -1.0, -1j)
 
 if TYPE_CHECKING:
     from airtable.physics.context import StepContext
@@ -28,10 +33,50 @@ def again(table: Storage, ctx: StepContext, contacts_held: bool) -> None:
         rest = table.contact_solver.wall_rest(ctx.rest_walls)
         bounced, _ = resolve_walls(*_table_walls(table), rest=rest, hold_slow=True)
     elif ctx.moved is not None:
-        bounced, _ = resolve_walls(*_table_walls(table), only=ctx.moved)
+        bounced, back = resolve_walls(*_table_walls(table), only=ctx.moved)
+        if len(back) and table.puck_collisions:
+            off_the_wall(table.pos_m, table.vel_mps, table.radius_m, table.size_m, table.cr_wall, back)
     else:
         return
     table.wall_collision_count += bounced
+
+
+def off_the_wall(pos, vel, radius, size_m, cr_wall: float, rows: np.ndarray) -> None:
+    """Pucks overlapping one of `rows` (just put back inside, near the wall they were past: the nearest)
+    where the wall backs it: pushed off it by the whole overlap along the line of centres, in place, and
+    their speed towards it (the wall's frame) reversed times cr_wall, as if they had hit the wall through
+    it: no energy is gained. A row put back beyond a puck that is nearer its wall (mirrored through it)
+    goes on the wall instead: the wall backs it there.
+
+    A heavy puck pushing a light one into a wall below restitution 1 makes ever faster hits of the two (the
+    exact run has infinitely many; at cr_wall 0 the heavy one stops). Pair by pair, each step the pair stage
+    pushed the light puck into the wall, the wall put it back into the heavy one, and the overlap grew
+    until the heavy one passed through it. The wall backs a puck where taking the overlap along the line of
+    centres would put it past the wall: there it cannot give way.
+    """
+    z, zv = vectors.as_complex(pos), vectors.as_complex(vel)
+    for a in np.unique(rows).tolist():
+        za, ra = z.item(a), radius.item(a)
+        near = [b for b in broadphase.rows_near(z, radius, za, ra, -OVERLAP_SLOP_M).tolist() if b != a]
+        one = slice(a, a + 1)
+        rooms = [room.item(0) for room, _ in collision.each_wall(pos[one], vel[one], radius[one], size_m)]
+        k = rooms.index(min(rooms))
+        if any(vectors.dot(z.item(b) - za, NORMALS[k]) < 0.0 for b in near):  # put back through b: onto the wall
+            z[a] = za = za - rooms[k] * NORMALS[k]
+            rooms[k] = 0.0
+        for b in near:
+            d = z.item(b) - za
+            dist = abs(d)
+            if dist == 0.0:
+                continue
+            n = d / dist  # from a to b
+            overlap = ra + radius.item(b) - dist
+            if not any(overlap * vectors.dot(n, w) > room for w, room in zip(NORMALS, rooms, strict=True)):
+                continue  # a can give way: the pair stage's push stands
+            z[b] += overlap * n
+            vn = vectors.dot(zv.item(b), n)  # towards the wall, a part of it here (a's own motion is a's)
+            if vn < 0.0:
+                zv[b] -= (1.0 + cr_wall) * vn * n
 
 
 def _table_walls(table: Storage) -> tuple:
@@ -103,8 +148,11 @@ def _bounce_rows(pos, vel, radius, size_m, cr_wall: float, correction: bool, out
     below, above = p < lo, p > hi
     into = (below & (v < 0.0)) | (above & (v > 0.0))
     vectors.put(vel, out, np.where(into, collision.bounce(v, cr_wall), v))
-    # Mirrored by the penetration, or else left for the clamp below to put on the surface.
-    target = np.where(below, 2.0 * lo - p, np.where(above, 2.0 * hi - p, p)) if correction else p
+    # Mirrored by the penetration; where it moved into the wall, as two-step backs up a pair: back along its
+    # path to the surface and on from there at the bounce's speed, cr_wall times the penetration (on the
+    # surface at 0: it used to bounce as far as at 1). Without correction, the clamp below puts it on the surface.
+    e = np.where(into, cr_wall, 1.0)
+    target = np.where(below, (1.0 + e) * lo - e * p, np.where(above, (1.0 + e) * hi - e * p, p)) if correction else p
     # Clamp into [lo, hi]: a mirror of a huge penetration can land past the
     # opposite wall. A puck wider than the table (lo > hi) sits in the middle.
     half = 0.5 * size_m

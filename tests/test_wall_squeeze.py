@@ -1,0 +1,98 @@
+"""A light puck squeezed between a wall below restitution 1 and a heavy puck pushing it.
+
+The exact run has infinitely many hits in a finite time: the light puck goes back and
+forth between the wall and the heavy one ever faster, each wall hit taking some energy.
+At wall restitution 0 the limit is worked out by hand: the heavy puck's speed falls by
+(M - m) / (M + m) at each round trip, so it stops, touching the light puck, which
+touches the wall. Found by random scenes: in two-step the heavy puck passed through the
+light one (the pair stage pushed it into the wall, the wall put it back, the overlap
+grew); in perfect kiss one step ran 100000 hits, 2 to 3 s.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from hypothesis import example, given, settings
+from hypothesis import strategies as st
+
+from airtable.physics import events
+from airtable.physics.table import AirTable
+
+R_LIGHT, R_HEAVY = 0.1, 0.15
+SIZE = (4.0, 3.0)
+# Into the table from the left, bottom, right and top walls, and where each wall is along it.
+WALLS = (((1.0, 0.0), 0.0), ((0.0, 1.0), 0.0), ((-1.0, 0.0), SIZE[0]), ((0.0, -1.0), SIZE[1]))
+
+
+def squeeze(wall: int, ratio: float, speed: float, gap: float, cr_wall: float, mode: str) -> AirTable:
+    """The light puck `gap` m off `wall`, the heavy one (`ratio` times its mass per area) 0.3 m further
+    along the wall's normal, coming at it at `speed` m/s."""
+    (nx, ny), at = WALLS[wall]
+    table = AirTable(width_m=SIZE[0], height_m=SIZE[1])
+    table.reset_settings()
+    table.gravity_on = False
+    table.cr_puck, table.cr_wall, table.puck_correction = 1.0, cr_wall, mode
+    middle = np.array(SIZE) / 2.0
+    normal = np.array([nx, ny])
+
+    def along(d: float) -> np.ndarray:  # d m off the wall along its normal, across the middle of the table
+        return middle + (d - (middle @ normal + at)) * normal
+
+    table.add_puck(pos_m=along(R_LIGHT + gap), radius_m=R_LIGHT, density_kgpm2=1.0)
+    table.add_puck(pos_m=along(R_LIGHT + gap + 0.3 + R_LIGHT + R_HEAVY), radius_m=R_HEAVY, density_kgpm2=ratio,
+                   vel_mps=-speed * normal)  # fmt: skip
+    return table
+
+
+def off_the_wall(table: AirTable, wall: int) -> np.ndarray:
+    """Each puck's centre's distance from `wall` (m)."""
+    (nx, ny), at = WALLS[wall]
+    return table.pos_m @ np.array([nx, ny]) + at
+
+
+@settings(max_examples=60, derandomize=True, deadline=None)
+@given(
+    wall=st.integers(0, 3),
+    ratio=st.floats(10.0, 1e6),
+    speed=st.floats(0.2, 20.0),
+    gap=st.floats(0.0, 0.5),
+    cr_wall=st.sampled_from((0.0, 0.3, 0.7, 0.95)),
+    mode=st.sampled_from(("two-step", "perfect-kiss")),
+    dt=st.sampled_from((1 / 240, 1 / 60, 1 / 30)),
+)
+@example(wall=0, ratio=13.0, speed=17.0, gap=0.0, cr_wall=0.0, mode="two-step", dt=1 / 60)  # passed through
+@example(wall=0, ratio=10.0, speed=4.0, gap=0.0, cr_wall=0.95, mode="two-step", dt=1 / 30)  # mirrored through
+@example(wall=0, ratio=1e4, speed=2.0, gap=0.2, cr_wall=0.0, mode="perfect-kiss", dt=1 / 240)  # 100000 hits
+def test_the_heavy_puck_never_passes_the_squeezed_one_nor_gains_energy(wall, ratio, speed, gap, cr_wall, mode, dt):
+    table = squeeze(wall, ratio, speed, gap, cr_wall, mode)
+    start = table.kinetic_energy_J()
+    most = 2 * events.repeat_max(cr_wall) + 10  # a wall hit and a pair hit each round trip, a few more at first
+    for _ in range(round(2.0 / dt)):
+        hits = table.collision_count + table.wall_collision_count
+        table.step(dt)
+        light, heavy = off_the_wall(table, wall)
+        assert light >= R_LIGHT - 1e-9  # inside the wall
+        assert heavy - light >= R_LIGHT + R_HEAVY - 0.5 * R_LIGHT  # in order, overlapping under half the light one
+        assert table.kinetic_energy_J() <= start * (1 + 1e-9)
+        assert table.collision_count + table.wall_collision_count - hits <= most  # no storm of hits in a step
+
+
+@settings(max_examples=20, derandomize=True, deadline=None)
+@given(
+    wall=st.integers(0, 3),
+    ratio=st.floats(10.0, 1e6),
+    speed=st.floats(0.2, 20.0),
+    mode=st.sampled_from(("two-step", "perfect-kiss")),
+    dt=st.sampled_from((1 / 240, 1 / 60, 1 / 30)),
+)
+def test_at_wall_restitution_0_the_heavy_puck_stops_against_the_light_one_on_the_wall(wall, ratio, speed, mode, dt):
+    table = squeeze(wall, ratio, speed, 0.2, 0.0, mode)
+    reach = 0.2 + 0.3 + 2 * R_LIGHT + R_HEAVY  # the heavy puck's way to the squeeze
+    for _ in range(math.ceil((reach / speed + 0.5) / dt)):  # there, and half a second more
+        table.step(dt)
+    light, heavy = off_the_wall(table, wall)
+    assert light == np.float64(R_LIGHT) or abs(light - R_LIGHT) < 1e-9
+    assert abs(heavy - (2 * R_LIGHT + R_HEAVY)) < 1e-6
+    assert np.abs(table.vel_mps).max() < 1e-6 * speed
