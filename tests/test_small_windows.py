@@ -67,3 +67,29 @@ def test_the_energy_chart_with_its_note_draws_in_a_strip(demos, size):
     for _ in range(3):
         app.frame(FRAME_S)
     assert app.running and app.window.surface.get_size() == size
+
+
+def test_resizing_or_resetting_the_view_while_holding_a_puck_adds_no_energy(demos):
+    """A held puck, still on its string: the window resized (as F11 does) and the view zoomed then reset (q).
+    The pointer used to stay on the screen while the table moved under it: the string's end jumped to
+    another point of the table and yanked the puck (17 J at 640x480; a user saw 11 m/s after F11)."""
+    app = App(demos, demo_key="1", headless=True)
+    pygame.event.clear()
+    puck = app.table.pucks[0]
+    at = tuple(int(round(v)) for v in app.env.to_screen(puck.pos_m))
+    pygame.event.post(pygame.event.Event(pygame.MOUSEMOTION, pos=at, rel=(0, 0), buttons=(0, 0, 0)))
+    pygame.event.post(pygame.event.Event(pygame.MOUSEBUTTONDOWN, pos=at, button=1))
+    for _ in range(60):
+        app.frame(FRAME_S)
+    assert app.local.held is puck and app.table.kinetic_energy_J() < 1e-12
+    for size in ((1920, 1080), (640, 480), (1280, 200), (3840, 2160)):
+        resize(app, size)
+        for _ in range(30):
+            app.frame(FRAME_S)
+        assert app.table.kinetic_energy_J() < 1e-9, size
+    for _ in range(10):  # wheel zooms about the pointer: the table under it stays put
+        pygame.event.post(pygame.event.Event(pygame.MOUSEWHEEL, x=0, y=1, precise_x=0.0, precise_y=1.0, flipped=False))
+        app.frame(FRAME_S)
+    press(app, pygame.K_q, frames=30)  # the view back as it was
+    assert app.env.zoom == 1.0
+    assert app.local.held is puck and app.table.kinetic_energy_J() < 1e-9

@@ -68,6 +68,7 @@ class PlayerApp:
         self.predicting = StudentGuesses()  # our arrows in a prediction round
         self._motion: tuple = ()  # what moves, as the last frame showed it (see note_motion)
         self._moved_s = -math.inf  # when it last changed
+        self._pointer: tuple = ((), (), None)  # the last frame's pointer (px), view and point on the table
 
     def run(
         self, seconds: float | None = None, screenshot: str | None = None, until: Callable[[], bool] | None = None
@@ -105,6 +106,26 @@ class PlayerApp:
         self._frame()
         loop.after_frame()
         return until is None or not until()
+
+    def _pointer_on_the_table(self, env) -> np.ndarray:
+        """Where our pointer is on the table. While we hold a puck, a view that changed under a still pointer
+        (the teacher zoomed or reset the view, our window was resized) moves the pointer with the table:
+        left where it was on the screen, it came to another point of the table and the string yanked the
+        puck there."""
+        import pygame
+
+        pointer = pygame.mouse.get_pos()
+        view = (env.zoom, tuple(env.origin_m), tuple(env.size_px), tuple(env.offset_px))
+        last_pointer, last_view, last_m = self._pointer
+        if self.button and view != last_view and pointer == last_pointer and last_m is not None:
+            x, y = env.to_screen(last_m)
+            w, h = self.window.surface.get_size()
+            pointer = (min(max(round(x), 0), w - 1), min(max(round(y), 0), h - 1))
+            if not self.headless:
+                pygame.mouse.set_pos(pointer)
+        cursor_m = env.to_world(np.array(pointer, dtype=float))
+        self._pointer = (pointer, view, cursor_m)
+        return cursor_m
 
     def note_motion(self, scene: Scene, cursor_m: np.ndarray, now_s: float) -> None:
         """Remember what moves in this frame: the pucks, every cursor, our own input."""
@@ -266,7 +287,7 @@ class PlayerApp:
         # The teacher's view: the student sees what the projector shows.
         env.zoom = min(max(scene.zoom, MIN_ZOOM), MAX_ZOOM)
         env.origin_m = np.array(scene.origin_m, dtype=float)
-        cursor_m = env.to_world(np.array(pygame.mouse.get_pos(), dtype=float))
+        cursor_m = self._pointer_on_the_table(env)
         net.update_input(cursor_m, self.button, self.keys)
         self.note_motion(scene, cursor_m, time.monotonic())
         self.states_seen.add(net.state)
