@@ -11,6 +11,7 @@ import pygame
 import pytest
 from conftest import FRAME_S, press
 
+from airtable.app import panel_view
 from airtable.app.app import App
 
 # Keys that open, close or change what is drawn over the table (the key table's rows: F1 help,
@@ -93,3 +94,18 @@ def test_resizing_or_resetting_the_view_while_holding_a_puck_adds_no_energy(demo
     press(app, pygame.K_q, frames=30)  # the view back as it was
     assert app.env.zoom == 1.0
     assert app.local.held is puck and app.table.kinetic_energy_J() < 1e-9
+
+
+def test_a_panel_with_no_key_for_pages_says_so_and_the_note_is_cut_to_the_panel():
+    """The demo menu (Tab) in a small window read 'page 1 of 15: press F1 for the next': F1 opens the
+    help instead; and the note, wider than the panel, lost its left end ('5: press F1 for the next')."""
+    assert panel_view.page_note(0, 15, None) == "page 1 of 15: a larger window shows the rest"
+    assert panel_view.page_note(0, 3, "F1") == "page 1 of 3: press F1 for the next"
+    assert panel_view.page_note(2, 3, "L") == "page 3 of 3: L again closes it"
+    pygame.font.init()
+    font = pygame.font.Font(None, 20)
+    rows = [f"demo {k}: a title long enough to wrap in a narrow panel" for k in range(60)]
+    panel, pages = panel_view.render_panel(
+        (160, 120), "Demos", [("", rows)], font=font, title_font=font, small_font=font, page_key=None
+    )
+    assert pages > 1 and panel.get_size() == (160, 120)

@@ -149,6 +149,16 @@ def body_rect(size_px: tuple[int, int], font, title_font, small_font) -> pygame.
     return pygame.Rect(pad, top, size_px[0] - 2 * pad, size_px[1] - top - small_font.get_linesize() - pad // 2)
 
 
+def page_note(page: int, pages: int, page_key: str | None) -> str:
+    """The note under page `page` (from 0) of `pages`: which key turns them (None: none does, as in the menu,
+    which scrolls, or an error, which Esc hides)."""
+    if page_key is None:
+        then = "a larger window shows the rest"
+    else:
+        then = f"press {page_key} for the next" if page + 1 < pages else f"{page_key} again closes it"
+    return f"page {page + 1} of {pages}: {then}"
+
+
 def render_panel(
     size_px: tuple[int, int],
     title: str,
@@ -158,11 +168,11 @@ def render_panel(
     title_font: pygame.font.Font,
     small_font: pygame.font.Font,
     page: int = 0,
-    page_key: str = "F1",
+    page_key: str | None = "F1",
     fit: bool = False,
 ) -> tuple[pygame.Surface, int]:
     """An opaque panel of `size_px` with `title` and the page `page` of its text, and the page count;
-    `page_key` turns the pages (the note under a text of several says so). With `fit`, a text that
+    `page_key` turns the pages (the note under a text of several says so; None: no key does). With `fit`, a text that
     fits on one page gets a panel only as tall as it needs (the lecture notes: the table shows below)."""
     pad = font.get_height()
     if title_font.size(title)[0] > size_px[0] - 2 * pad:  # a long title in the body's type
@@ -180,7 +190,7 @@ def render_panel(
     for piece in pages[page]:
         panel.blit(font.render(piece.text, True, piece.color), (body.x + piece.x, body.y + piece.y))
     if len(pages) > 1:
-        then = f"press {page_key} for the next" if page + 1 < len(pages) else f"{page_key} again closes it"
-        note = small_font.render(f"page {page + 1} of {len(pages)}: {then}", True, DIM_TEXT)
+        text = shorten(small_font, page_note(page, len(pages), page_key), size_px[0] - 2 * pad)  # (cut, not clipped)
+        note = small_font.render(text, True, DIM_TEXT)
         panel.blit(note, note.get_rect(bottomright=(size_px[0] - pad, size_px[1] - pad // 4)))
     return panel, len(pages)

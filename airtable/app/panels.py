@@ -165,7 +165,9 @@ class Panels(Feature):
         elif panel == "help":
             rows = [(key_label(k) if has_own_key(k) else f"Tab, {k}", d.title) for k, d in host.demos.items()]
             keys = [(b.label, b.help) for b in self.key_rows]
-            self.help_pages = w.draw_panel("Keys", keys, side_title="Demos", side_rows=rows, page=self.help_page)
+            self.help_pages = w.draw_panel(
+                "Keys", keys, side_title="Demos", side_rows=rows, page=self.help_page, page_key="F1"
+            )
         elif panel == "notes":
             notes = [host.demo.notes or "(no notes)"]
             self.notes_pages = w.draw_panel(

@@ -552,14 +552,15 @@ class GameWindow:
         side_title: str = "",
         side_rows: Sequence[panel_view.Row] = (),
         page: int = 0,
-        page_key: str = "F1",
+        page_key: str | None = None,
     ) -> int:
         """A translucent panel over the table: a title, then rows of text; returns its number of pages.
 
         A row is either a line of text (wrapped to the panel) or a (key,
         description) pair shown in two columns, as on the help screen.
         `side_rows`, if any, follow under their own `side_title`. Rows flow
-        into columns and, if they still do not fit, onto pages: `page` picks one, `page_key` turns them.
+        into columns and, if they still do not fit, onto pages: `page` picks one, `page_key` turns them
+        (None: no key does; the note under the page says a larger window shows the rest).
         `large`: in the large type where the text fits on one page, the panel no taller than the text.
         """
         sections = [("", tuple(rows))]
