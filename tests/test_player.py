@@ -812,3 +812,27 @@ class _HoldFirstHello:
     def close(self) -> None:
         for sock in (self._listener, *self._socks):
             sock.close()
+
+
+def test_a_student_holding_a_puck_keeps_the_strings_end_when_the_teachers_view_changes(monkeypatch):
+    """The teacher zooms or resets the view (the student's window follows it) while the student holds a puck
+    and keeps the mouse still: the pointer goes with the table, so the string's end stays on its point of
+    the table (left on the screen, it came to another point and yanked the puck)."""
+    from airtable.app.environment import Environment
+
+    app = PlayerApp(NetPlayer("127.0.0.1", 1), headless=True)  # never connected: only the pointer's bookkeeping
+    app.window = type("Window", (), {"surface": pygame.Surface((1280, 720))})()
+    env = Environment((1280, 720), width_m=10.0)
+    pointer = [(400, 300)]  # the system's pointer, as a real window has it (moved by set_pos)
+    monkeypatch.setattr(pygame.mouse, "get_pos", lambda: pointer[0])
+    monkeypatch.setattr(pygame.mouse, "set_pos", lambda at: pointer.__setitem__(0, tuple(at)))
+    app.headless = False
+    app.button = 1
+    held_at = app._pointer_on_the_table(env).copy()
+    env.zoom_about((500, 350), 1.5)  # the teacher's wheel, about the teacher's own pointer (ours stays on screen)
+    np.testing.assert_allclose(app._pointer_on_the_table(env), held_at, atol=0.5 / env.px_per_m)  # to the pixel
+    env.reset()
+    np.testing.assert_allclose(app._pointer_on_the_table(env), held_at, atol=0.5 / env.px_per_m)
+    app.button = 0  # not holding: the pointer is where the mouse is, on whatever the view shows
+    env.zoom_about((900, 500), 2.5)
+    np.testing.assert_allclose(app._pointer_on_the_table(env), env.to_world(np.array(pointer[0], dtype=float)))
