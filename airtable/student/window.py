@@ -172,8 +172,10 @@ class PlayerApp:
         for event in events:
             if event.type == pygame.QUIT:
                 return False  # the window's close button: the student meant it
-            if self.window.handle_event(event):
-                continue  # a resize, or F11: fullscreen on or off
+            if self.window.handle_event(event):  # a resize, or F11: fullscreen on or off
+                if event.type == pygame.KEYDOWN:  # F11: the window moves under the pointer: let go of the puck
+                    self.button = 0
+                continue
             if event.type == pygame.KEYDOWN and not self._window_key(event.key):
                 return False
             if event.type == pygame.KEYDOWN and (event.key == pygame.K_ESCAPE or self._local_key(event.key)):
