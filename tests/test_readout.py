@@ -98,3 +98,15 @@ def test_the_values_panel_of_the_app_uses_the_scene_scale(demos):
     for r, v in zip(rows[:-1], raw, strict=True):
         small = v * app.table.mass_kg[r.row] <= ROUND_OFF * app.aids.chart.scale.momentum_Ns
         assert r.speed_mps == (0.0 if small else v)
+
+
+def test_figures_read_as_a_class_reads_them():
+    """The chart's axis read '2e+03 J' and the values '1.39e+03' (a user test): no exponent from 0.001 to a
+    million, every digit of a whole number, the exponent only beyond."""
+    from airtable.model.readout import figures
+
+    assert [figures(v) for v in (2000.0, 1390.4, 999.6, 12.34, 0.5, 0.0123, 0.001)] == [
+        "2000", "1390", "1000", "12.3", "0.5", "0.0123", "0.001",
+    ]  # fmt: skip
+    assert [figures(v, 4) for v in (1390.4, 12.345, 123456.7, -2000.0)] == ["1390", "12.35", "123457", "-2000"]
+    assert [figures(v) for v in (0.0, -0.0, 1e7, 1.5e-5)] == ["0", "0", "1e+07", "1.5e-05"]

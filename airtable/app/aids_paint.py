@@ -19,7 +19,7 @@ from airtable.app import panel_view
 from airtable.app.panel_view import ACCENT, DIM_TEXT, TEXT_COLOR
 from airtable.app.panel_view import wrap as _wrap
 from airtable.model.aids import VectorScale
-from airtable.model.readout import fixed, readable
+from airtable.model.readout import figures, fixed, readable
 
 ANNOTATION_NORMAL = (255, 230, 90)
 ANNOTATION_TANGENT = (90, 200, 255)
@@ -423,8 +423,8 @@ class AidsPainter:
         top_e = chart_top(series["total_J"], latest.get("energy_scale_J", 0.0))
         top_p = chart_top(series["momentum_Ns"], latest.get("momentum_scale_Ns", 0.0))
         self._chart_lines(series, plot, top_e or 1.0, top_p or 1.0)
-        left = self._chart_text(f"{top_e:.3g} J", (plot.x, plot.y - line_h), TEXT_COLOR)
-        text = f"{top_p:.3g} N s"
+        left = self._chart_text(f"{figures(top_e)} J", (plot.x, plot.y - line_h), TEXT_COLOR)
+        text = f"{figures(top_p)} N s"
         right = pygame.Rect((0, 0), font.size(text))
         right.topright = (plot.right, plot.y - line_h)
         if right.inflate(8, 0).colliderect(left):
@@ -522,7 +522,7 @@ def chart_notes(font: pygame.font.Font, note: str | None, width_px: int, most: i
 
 def key_text(key: str, value: float) -> str:
     """A line of the chart's key: the quantity, its value and unit ("total 2.4 J", "|momentum| 0.5 N s")."""
-    return f"{CHART_LABELS[key]} {value:.3g} {'N s' if key == 'momentum_Ns' else 'J'}"
+    return f"{CHART_LABELS[key]} {figures(value)} {'N s' if key == 'momentum_Ns' else 'J'}"
 
 
 def place_in_corner(window, rect: pygame.Rect, corner: int) -> pygame.Rect:

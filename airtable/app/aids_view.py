@@ -11,7 +11,7 @@ import numpy as np
 
 from airtable.model import aids
 from airtable.model.momenta import puck_number
-from airtable.model.readout import SceneScale, fixed
+from airtable.model.readout import SceneScale, figures, fixed
 
 DIM_FORCE = (200, 200, 200)
 COM_COLOR = (255, 255, 255)
@@ -30,18 +30,18 @@ def inspector_lines(table, puck, scale: SceneScale | None = None) -> list[str]:
     speed = float(np.hypot(*v))
     lines = [
         f"puck {puck_number(puck.index)}",
-        f"mass {m:.4g} kg   radius {puck.radius_m:.4g} m",
-        f"speed {speed:.4g} m/s",
+        f"mass {figures(m, 4)} kg   radius {figures(puck.radius_m, 4)} m",
+        f"speed {figures(speed, 4)} m/s",
         f"velocity ({fixed(v[0], 3)}, {fixed(v[1], 3)}) m/s",
-        f"kinetic energy {scale.energy(0.5 * m * speed**2):.4g} J",
+        f"kinetic energy {figures(scale.energy(0.5 * m * speed**2), 4)} J",
     ]
     if table.asleep[puck.index]:  # the engine's sleeping, made visible (physics/sleep.py)
         lines.append("asleep: the step skips it until disturbed")
     for spring in table.springs_on(puck)[:MAX_INSPECTED_SPRINGS]:
         other = spring.p2 if spring.p1.index == puck.index else spring.p1
-        line = f"spring to puck {puck_number(other.index)}: k {spring.k_Npm:.4g} N/m"
+        line = f"spring to puck {puck_number(other.index)}: k {figures(spring.k_Npm, 4)} N/m"
         if spring.k_effective_Npm != spring.k_Npm:
-            line += f", acts with {spring.k_effective_Npm:.4g} N/m (softened)"
+            line += f", acts with {figures(spring.k_effective_Npm, 4)} N/m (softened)"
         lines.append(line)
     return lines
 
@@ -79,6 +79,6 @@ def _draw_forces(paint, held, forces) -> list[tuple[str, tuple[int, int, int]]]:
     for source, f in forces.items():
         c = FORCE_COLORS[source]
         paint.arrow(held.pos_m, f * m_per_n, c, width=paint.w.line_px(3))
-        legend.append((f"force, {source}: {np.hypot(*f):.3g} N", c))
+        legend.append((f"force, {source}: {figures(np.hypot(*f))} N", c))
     legend.append((f"forces: an arrow 1 m long is {newtons:g} N", DIM_FORCE))
     return legend

@@ -18,7 +18,7 @@ import pygame
 from airtable.app.aids_paint import CHART_COLORS, CHART_CORNERS, draw_arrow_px, place_in_corner
 from airtable.app.panel_view import ACCENT, DIM_TEXT, TEXT_COLOR, panel_surface, shorten, wrap
 from airtable.model.momenta import FEW_PUCKS, VALUE_HEADINGS, MomentaView, PuckValues, fit_chains, tip_to_tail
-from airtable.model.readout import readable
+from airtable.model.readout import figures, readable
 
 VALUES_HINT = f"values: more than {FEW_PUCKS} pucks, so point at one"
 
@@ -40,8 +40,12 @@ def total_texts(total, scale: float) -> tuple[tuple[str, ...], tuple[str, ...]]:
     x, y = (readable(v, scale) for v in total)
     size = math.hypot(x, y)
     return (
-        (f"total ({x:.3g}, {y:.3g}) N s", f"({x:.3g}, {y:.3g}) N s", f"({x:.3g}, {y:.3g})"),
-        (f"|total| {size:.4g} N s", f"|p| {size:.4g} N s", f"{size:.4g}"),
+        (
+            f"total ({figures(x)}, {figures(y)}) N s",
+            f"({figures(x)}, {figures(y)}) N s",
+            f"({figures(x)}, {figures(y)})",
+        ),
+        (f"|total| {figures(size, 4)} N s", f"|p| {figures(size, 4)} N s", f"{figures(size, 4)}"),
     )
 
 

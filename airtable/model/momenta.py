@@ -18,7 +18,7 @@ from functools import cached_property
 
 import numpy as np
 
-from airtable.model.readout import SceneScale
+from airtable.model.readout import SceneScale, figures
 from airtable.physics.collision import Collisions
 from airtable.physics.table import AirTable, kinetic_energy_J
 
@@ -200,8 +200,8 @@ class PuckValues:
     row: int | None = None  # the puck's table row (None for the total)
 
     def cells(self) -> tuple[str, str, str, str, str]:
-        speed = "" if self.speed_mps is None else f"{self.speed_mps:.3g}"
-        return (self.name, f"{self.mass_kg:.3g}", speed, f"{self.momentum_Ns:.3g}", f"{self.kinetic_J:.3g}")
+        speed = "" if self.speed_mps is None else figures(self.speed_mps)
+        return (self.name, figures(self.mass_kg), speed, figures(self.momentum_Ns), figures(self.kinetic_J))
 
 
 VALUE_HEADINGS = ("puck", "m kg", "|v| m/s", "|p| N s", "KE J")  # mass, speed, momentum, kinetic energy

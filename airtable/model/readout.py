@@ -23,6 +23,20 @@ def fixed(value: float, decimals: int) -> str:
     return f"{round(float(value), decimals) + 0.0:.{decimals}f}"
 
 
+def figures(value: float, digits: int = 3) -> str:
+    """`value` to `digits` significant figures as a class reads it: no exponent from 0.001 to a million
+    ("2000", "1390", "0.0123", where "{:.3g}" wrote "2e+03" and "1.39e+03"), every digit of a whole number
+    of more figures; an exponent beyond that range, where there is no other way."""
+    value = float(value)
+    if value == 0.0 or not math.isfinite(value):
+        return f"{value + 0.0:g}"
+    if 1e-3 <= abs(value) < 1e6:
+        if abs(value) >= 10 ** (digits - 1):
+            return f"{round(value) + 0:d}"
+        return f"{value:.{digits}g}"
+    return f"{value:.{digits}g}"
+
+
 def readable(value: float, scale: float) -> float:
     """`value`, or 0.0 when it is within ROUND_OFF times `scale` of 0 (never -0.0)."""
     value = float(value)
