@@ -819,14 +819,15 @@ def test_a_student_holding_a_puck_keeps_the_strings_end_when_the_teachers_view_c
     and keeps the mouse still: the pointer goes with the table, so the string's end stays on its point of
     the table (left on the screen, it came to another point and yanked the puck)."""
     from airtable.app.environment import Environment
+    from airtable.app.window import GameWindow
 
     app = PlayerApp(NetPlayer("127.0.0.1", 1), headless=True)  # never connected: only the pointer's bookkeeping
-    app.window = type("Window", (), {"surface": pygame.Surface((1280, 720))})()
     env = Environment((1280, 720), width_m=10.0)
+    app.window = GameWindow(env, headless=True, size_px=(1280, 720))
     pointer = [(400, 300)]  # the system's pointer, as a real window has it (moved by set_pos)
     monkeypatch.setattr(pygame.mouse, "get_pos", lambda: pointer[0])
     monkeypatch.setattr(pygame.mouse, "set_pos", lambda at: pointer.__setitem__(0, tuple(at)))
-    app.headless = False
+    app.window.headless = False  # (its pointer: the one above)
     app.button = 1
     held_at = app._pointer_on_the_table(env).copy()
     env.zoom_about((500, 350), 1.5)  # the teacher's wheel, about the teacher's own pointer (ours stays on screen)

@@ -310,11 +310,7 @@ class App:
         point_m = self.env.to_world(self.mouse_px)
         yield
         if held:
-            x, y = self.env.to_screen(point_m)
-            w, h = self.window.surface.get_size()
-            self.mouse_px = (min(max(round(x), 0), w - 1), min(max(round(y), 0), h - 1))
-            if not self.window.headless:
-                pygame.mouse.set_pos(self.mouse_px)
+            self.mouse_px = self.window.put_pointer_on(point_m)
 
     def save_screenshot(self) -> None:
         path = unused_path(Path("screenshots"), time.strftime("airtable-%Y%m%d-%H%M%S"))

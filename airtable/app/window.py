@@ -172,6 +172,16 @@ class GameWindow:
                     self.surface = pygame.display.set_mode(self.windowed_size_px, pygame.RESIZABLE)
         self.fullscreen = fullscreen
 
+    def put_pointer_on(self, point_m) -> tuple[int, int]:
+        """Move the pointer (a real window's) over the table's point_m, or as near as the window reaches;
+        returns where (px)."""
+        x, y = self.env.to_screen(point_m)
+        w, h = self.surface.get_size()
+        at = (min(max(round(x), 0), w - 1), min(max(round(y), 0), h - 1))
+        if not self.headless:
+            pygame.mouse.set_pos(at)
+        return at
+
     def toggle_fullscreen(self) -> None:
         """Desktop fullscreen on or off (F11); the windowed size comes back after."""
         if self.headless:

@@ -118,11 +118,7 @@ class PlayerApp:
         view = (env.zoom, tuple(env.origin_m), tuple(env.size_px), tuple(env.offset_px))
         last_pointer, last_view, last_m = self._pointer
         if self.button and view != last_view and pointer == last_pointer and last_m is not None:
-            x, y = env.to_screen(last_m)
-            w, h = self.window.surface.get_size()
-            pointer = (min(max(round(x), 0), w - 1), min(max(round(y), 0), h - 1))
-            if not self.headless:
-                pygame.mouse.set_pos(pointer)
+            pointer = self.window.put_pointer_on(last_m)
         cursor_m = env.to_world(np.array(pointer, dtype=float))
         self._pointer = (pointer, view, cursor_m)
         return cursor_m
