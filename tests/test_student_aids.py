@@ -343,3 +343,20 @@ def test_a_student_turns_puck_numbers_on_for_their_own_window(classroom):
     centres = student.window.env.to_screen(teacher.table.pos_m).astype(int)
     for x, y in centres:
         assert (after[x - 6 : x + 7, y - 6 : y + 7] != before[x - 6 : x + 7, y - 6 : y + 7]).any(), (x, y)
+
+
+@pytest.mark.parametrize("bits", [0x7F800001, 0x7FC00000, 0x7F800000, 0x7F7FFFFF])  # signalling NaN, NaN, inf, 3.4e38
+def test_numbers_off_the_wire_that_are_no_physics_are_refused_without_a_warning(bits):
+    """A signalling NaN among an aids frame's float32s made numpy warn on the teacher's or student's console
+    ("invalid value encountered in cast") before the frame was refused: refused in a sentence, silently."""
+    import struct
+    import warnings
+
+    from airtable.net import aids_wire
+    from airtable.net.wire import Reader
+
+    data = struct.pack("<6f", 1.0, 2.0, 3.0, 4.0, 5.0, 6.0)[:-4] + struct.pack("<I", bits)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        with pytest.raises(ProtocolError, match="chart history samples that are not finite numbers"):
+            aids_wire._numbers(Reader(data, "aids"), (1, 6), "chart history samples")
