@@ -124,3 +124,15 @@ def test_f11_lets_go_of_a_held_puck(demos):
     before = app.table.kinetic_energy_J()  # (the grab's own small tug: a pixel off the centre)
     press(app, pygame.K_F11, frames=2)
     assert app.local.held is None and app.table.kinetic_energy_J() <= before * (1 + 1e-9)
+
+
+def test_a_narrow_values_panel_keeps_momentum_and_kinetic_energy():
+    """In fullscreen's side margin the values table kept mass and speed and lost KE (a user test): the
+    columns go mass first, then speed."""
+    from airtable.app.lessons_paint import shown_columns
+
+    widths = (50, 60, 70, 80, 90)  # puck, m, |v|, |p|, KE
+    assert shown_columns(widths, 350) == [0, 1, 2, 3, 4]
+    assert shown_columns(widths, 290) == [0, 2, 3, 4]  # no room for mass
+    assert shown_columns(widths, 220) == [0, 3, 4]  # nor for speed
+    assert shown_columns(widths, 130) == [0, 3]

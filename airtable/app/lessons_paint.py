@@ -57,6 +57,21 @@ def fitting(font: pygame.font.Font, texts: Sequence[str], width: int) -> str:
     return shorten(font, texts[-1], width)
 
 
+# Where the values panel is too narrow for every column, the first to go: mass, then speed. Momentum and
+# kinetic energy are what the lessons compare (a user test: fullscreen's margin kept m and |v|, lost KE).
+COLUMN_PRIORITY = (0, 3, 4, 2, 1)  # puck, |p|, KE, |v|, m (VALUE_HEADINGS' columns)
+
+
+def shown_columns(widths: Sequence[int], room: int) -> list[int]:
+    """The columns (in their order) that fit `room` px, taken by COLUMN_PRIORITY."""
+    shown, used = [], 0
+    for c in COLUMN_PRIORITY:
+        if used + widths[c] <= room:
+            shown.append(c)
+            used += widths[c]
+    return sorted(shown)
+
+
 class LessonsPainter:
     """Draws the momenta diagram and the values panel onto a GameWindow."""
 
@@ -206,6 +221,7 @@ class LessonsPainter:
         swatch = font.get_height()
         table = [(VALUE_HEADINGS, DIM_TEXT, None)]
         table += [(r.cells(), ACCENT if r.speed_mps is None else TEXT_COLOR, c) for r, c in zip(rows, colors)]
+        shown = shown_columns(widths, rect.width + pad)  # (a column's width holds its share of the padding)
         for k, (cells, color, puck_color) in enumerate(table):
             y = rect.y + pad + k * line_h
             if y + line_h > rect.bottom:
@@ -214,10 +230,7 @@ class LessonsPainter:
             if puck_color is not None:
                 r = swatch // 3
                 pygame.draw.circle(self.w.surface, tuple(int(v) for v in puck_color), (x + r, y + line_h // 2), r)
-            for c, text in enumerate(cells):
-                if x + widths[c] - 2 * pad > rect.right:
-                    break  # a narrow window: the columns that fit
-                shift = swatch if c == 0 else 0
-                self._text(text, (x + shift, y), color, font)
+            for c in shown:
+                self._text(cells[c], (x + (swatch if c == 0 else 0), y), color, font)
                 x += widths[c]
         return rect
