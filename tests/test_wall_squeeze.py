@@ -96,3 +96,36 @@ def test_at_wall_restitution_0_the_heavy_puck_stops_against_the_light_one_on_the
     assert light == np.float64(R_LIGHT) or abs(light - R_LIGHT) < 1e-9
     assert abs(heavy - (2 * R_LIGHT + R_HEAVY)) < 1e-6
     assert np.abs(table.vel_mps).max() < 1e-6 * speed
+
+
+@st.composite
+def crowds(draw):
+    """A table of random shape with pucks of radii over two decades and masses over four, fast and slow."""
+    width, height = draw(st.floats(0.8, 6.0)), draw(st.floats(0.8, 6.0))
+    table = AirTable(width_m=width, height_m=height)
+    table.reset_settings()
+    table.gravity_on = False
+    table.cr_puck = draw(st.sampled_from((0.0, 0.3, 1.0)))
+    table.cr_wall = draw(st.sampled_from((0.0, 0.3)))
+    table.puck_correction = draw(st.sampled_from(("two-step", "perfect-kiss")))
+    biggest = min(width, height) / 8
+    for _ in range(draw(st.integers(5, 15))):
+        r = biggest * 10 ** draw(st.floats(-2.0, 0.0))
+        at = (draw(st.floats(0.0, width)), draw(st.floats(0.0, height)))
+        speed = draw(st.sampled_from((0.3, 3.0, 10.0)))
+        angle = draw(st.floats(0.0, 2 * math.pi))
+        velocity = (speed * math.cos(angle), speed * math.sin(angle))
+        table.add_puck(pos_m=at, radius_m=r, density_kgpm2=10 ** draw(st.floats(-2.0, 2.0)), vel_mps=velocity)
+    return table
+
+
+@settings(max_examples=25, derandomize=True, deadline=None)
+@given(table=crowds(), dt=st.sampled_from((1 / 240, 1 / 60)))
+def test_crowds_by_walls_below_restitution_1_stay_inside_them(table, dt):
+    """Random scenes found pucks pushed off a puck the wall backs and into another wall (a narrow table, a
+    corner): 2 to 25 mm outside."""
+    for _ in range(60):
+        table.step(dt)
+        r = table.radius_m[:, None]
+        assert np.isfinite(table.pos_m).all()
+        assert (table.pos_m >= r - 1e-9).all() and (table.pos_m <= table.size_m - r + 1e-9).all()

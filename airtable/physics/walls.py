@@ -35,18 +35,20 @@ def again(table: Storage, ctx: StepContext, contacts_held: bool) -> None:
     elif ctx.moved is not None:
         bounced, back = resolve_walls(*_table_walls(table), only=ctx.moved)
         if len(back) and table.puck_collisions:
-            off_the_wall(table.pos_m, table.vel_mps, table.radius_m, table.size_m, table.cr_wall, back)
+            pushed = off_the_wall(table.pos_m, table.vel_mps, table.radius_m, table.size_m, table.cr_wall, back)
+            if pushed:  # (pushed off one wall, a puck may be pushed into another: a narrow table, a corner)
+                bounced += resolve_walls(*_table_walls(table), only=np.array(pushed, dtype=np.intp))[0]
     else:
         return
     table.wall_collision_count += bounced
 
 
-def off_the_wall(pos, vel, radius, size_m, cr_wall: float, rows: np.ndarray) -> None:
+def off_the_wall(pos, vel, radius, size_m, cr_wall: float, rows: np.ndarray) -> list[int]:
     """Pucks overlapping one of `rows` (just put back inside, near the wall they were past: the nearest)
     where the wall backs it: pushed off it by the whole overlap along the line of centres, in place, and
     their speed towards it (the wall's frame) reversed times cr_wall, as if they had hit the wall through
     it: no energy is gained. A row put back beyond a puck that is nearer its wall (mirrored through it)
-    goes on the wall instead: the wall backs it there.
+    goes on the wall instead: the wall backs it there. Returns the pucks pushed.
 
     A heavy puck pushing a light one into a wall below restitution 1 makes ever faster hits of the two (the
     exact run has infinitely many; at cr_wall 0 the heavy one stops). Pair by pair, each step the pair stage
@@ -55,6 +57,7 @@ def off_the_wall(pos, vel, radius, size_m, cr_wall: float, rows: np.ndarray) -> 
     centres would put it past the wall: there it cannot give way.
     """
     z, zv = vectors.as_complex(pos), vectors.as_complex(vel)
+    pushed = []
     for a in np.unique(rows).tolist():
         za, ra = z.item(a), radius.item(a)
         near = [b for b in broadphase.rows_near(z, radius, za, ra, -OVERLAP_SLOP_M).tolist() if b != a]
@@ -74,9 +77,11 @@ def off_the_wall(pos, vel, radius, size_m, cr_wall: float, rows: np.ndarray) -> 
             if not any(overlap * vectors.dot(n, w) > room for w, room in zip(NORMALS, rooms, strict=True)):
                 continue  # a can give way: the pair stage's push stands
             z[b] += overlap * n
+            pushed.append(b)
             vn = vectors.dot(zv.item(b), n)  # towards the wall, a part of it here (a's own motion is a's)
             if vn < 0.0:
                 zv[b] -= (1.0 + cr_wall) * vn * n
+    return pushed
 
 
 def _table_walls(table: Storage) -> tuple:
