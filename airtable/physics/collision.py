@@ -101,8 +101,13 @@ def contact_time(d, w, reach):
     return np.where(meets, c / np.where(meets, root - dw, 1.0), np.inf), root / reach
 
 
+# The four walls' unit normals pointing into the table (complex x + iy), in each_wall's order:
+# left, bottom, right and top.
+WALL_NORMALS = (1.0, 1j, -1.0, -1j)
+
+
 def each_wall(pos: np.ndarray, vel: np.ndarray, radius: np.ndarray, size_m) -> tuple:
-    """For the left, bottom, right and top walls, in that order (contacts.WALL_NORMALS'): each puck's
+    """For the left, bottom, right and top walls, in that order (WALL_NORMALS'): each puck's
     room between its edge and the wall (m; negative: past it) and its speed away from it (m/s)."""
     x, y, vx, vy = pos[:, 0], pos[:, 1], vel[:, 0], vel[:, 1]
     width, height = size_m

@@ -102,9 +102,7 @@ SLOP_M = 2e-5
 # Share of the overlap beyond the slop pushed out per step.
 POSITION_FRACTION = 0.4
 MAX_PUSH_MPS = 0.5
-# The four walls as unit normals pointing into the table (complex x + iy):
-# left, bottom, right, top.
-WALL_NORMALS = np.array([1.0, 1j, -1.0, -1j])
+WALL_NORMALS = np.array(collision.WALL_NORMALS)  # (an array: taken per contact)
 
 
 def rest_for_restitution(rest: np.ndarray, cr: float) -> np.ndarray:

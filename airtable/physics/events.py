@@ -461,10 +461,9 @@ class _Step:
             self.offset[k] = complex(0.0, offset)
 
     def wall_normal(self, x: complex, axis: int) -> complex:
-        """The normal into the table of the wall across `axis` nearer to x."""
-        if axis == 0:
-            return 1.0 if x.real < 0.5 * self.width else -1.0
-        return 1j if x.imag < 0.5 * self.height else -1j
+        """The normal into the table of the wall across `axis` nearer to x (collision.WALL_NORMALS)."""
+        at, size = (x.real, self.width) if axis == 0 else (x.imag, self.height)
+        return collision.WALL_NORMALS[axis if at < 0.5 * size else axis + 2]
 
     def bounce_under_gravity(self, vy: float, a: float, e: float) -> tuple[float, float]:
         """(velocity along y of the path to the step's end, what to add to it at the end) after a

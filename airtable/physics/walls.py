@@ -7,11 +7,8 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from airtable.physics import broadphase, collision, vectors
-
-# Overlaps smaller than this (m) are round-off: left alone (pairs.OVERLAP_SLOP_M).
-OVERLAP_SLOP_M = 1e-9
-# Into the table from the left, bottom, right and top walls (collision.each_wall's order), as complex x + iy.
-NORMALS = (1.0, 1j, -1.0, -1j)
+from airtable.physics.collision import WALL_NORMALS
+from airtable.physics.pairs import OVERLAP_SLOP_M
 
 if TYPE_CHECKING:
     from airtable.physics.context import StepContext
@@ -64,8 +61,8 @@ def off_the_wall(pos, vel, radius, size_m, cr_wall: float, rows: np.ndarray) -> 
         one = slice(a, a + 1)
         rooms = [room.item(0) for room, _ in collision.each_wall(pos[one], vel[one], radius[one], size_m)]
         k = rooms.index(min(rooms))
-        if any(vectors.dot(z.item(b) - za, NORMALS[k]) < 0.0 for b in near):  # put back through b: onto the wall
-            z[a] = za = za - rooms[k] * NORMALS[k]
+        if any(vectors.dot(z.item(b) - za, WALL_NORMALS[k]) < 0.0 for b in near):  # put back through b: onto the wall
+            z[a] = za = za - rooms[k] * WALL_NORMALS[k]
             rooms[k] = 0.0
         for b in near:
             d = z.item(b) - za
@@ -74,7 +71,7 @@ def off_the_wall(pos, vel, radius, size_m, cr_wall: float, rows: np.ndarray) -> 
                 continue
             n = d / dist  # from a to b
             overlap = ra + radius.item(b) - dist
-            if not any(overlap * vectors.dot(n, w) > room for w, room in zip(NORMALS, rooms, strict=True)):
+            if not any(overlap * vectors.dot(n, w) > room for w, room in zip(WALL_NORMALS, rooms, strict=True)):
                 continue  # a can give way: the pair stage's push stands
             z[b] += overlap * n
             pushed.append(b)
