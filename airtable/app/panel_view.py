@@ -168,7 +168,7 @@ def render_panel(
     title_font: pygame.font.Font,
     small_font: pygame.font.Font,
     page: int = 0,
-    page_key: str | None = "F1",
+    page_key: str | None = None,
     fit: bool = False,
 ) -> tuple[pygame.Surface, int]:
     """An opaque panel of `size_px` with `title` and the page `page` of its text, and the page count;
