@@ -430,6 +430,27 @@ def test_two_step_keeps_the_order_of_a_row_of_touching_pucks() -> None:
         assert all(b - a > 2 * r - 1e-6 for a, b in zip(x, x[1:])), x
 
 
+def test_two_step_keeps_order_when_a_big_slow_puck_knocks_a_small_one_into_a_third() -> None:
+    # A user test's case (from a random row): a 1 m puck moving 40 % of its radius a step hits a 3 cm
+    # puck touching a 2 cm one. Slow for the big puck, the hit went to the pair stage, whose
+    # correction moved the small puck 8.5 cm: through its neighbour. By hand (elastic, one line):
+    # big 30 kg at v -> v (30 - 28) / 58; small 28 kg -> 60 v / 58, then it hits the 0.15 kg one:
+    # small -> (60 v / 58) (28 - 0.15) / 28.15, the last -> (60 v / 58) 56 / 28.15.
+    dt, v = 1 / 120, 0.4 * 1.0 * 120  # 48 m/s: 0.4 m a step
+    table = AirTable(40.0, 6.0)
+    table.puck_correction = "two-step"
+    big = table.add_puck((4.0, 3.0), 1.0, 30.0 / math.pi, (v, 0.0))
+    small = table.add_puck((5.5, 3.0), 0.03, 28.0 / (math.pi * 0.03**2))
+    last = table.add_puck((5.55, 3.0), 0.02, 0.15 / (math.pi * 0.02**2))
+    for _ in range(20):
+        table.step(dt)
+        x = [big.pos_m[0], small.pos_m[0], last.pos_m[0]]
+        assert x[1] - x[0] > 1.03 - 1e-6 and x[2] - x[1] > 0.05 - 1e-6, x
+    u = 60.0 * v / 58.0
+    expected = [v * 2.0 / 58.0, u * 27.85 / 28.15, u * 56.0 / 28.15]
+    np.testing.assert_allclose([big.vel_mps[0], small.vel_mps[0], last.vel_mps[0]], expected, rtol=1e-9)
+
+
 def test_two_step_keeps_the_course_ratio() -> None:
     # Head on at restitution 1: the correction parts the pair by as much as it overlapped
     # (overlap / separation 1.0000); at e = 0.5 by half of it.

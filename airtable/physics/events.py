@@ -18,13 +18,14 @@ path longer than that is checked against every puck.
 
 What is left to later stages: hits slower than a puck's rest speed, and pairs
 that pressed on each other in the last step (the contact stage holds those).
-Outside perfect kiss only fast pucks' pair hits are predicted (those moving
-FAST_FRACTION of their radius in a step: they could pass through); the pair
+Outside perfect kiss only fast pairs' hits are predicted (a puck of the pair
+moving FAST_FRACTION of the smaller one's radius in a step: it could pass
+through the small one, or knock it through a third); the pair
 stage sees the others overlapping. Of those, a hit the step's end would catch
 overlapping and approaching is left to the pair stage too, which resolves it
 the course's way (two-step: backed up t_p = overlap / normal speed along the
 line of centres there; "off": velocities only), unless a puck of the pair
-moves CHAIN_FRACTION of its radius in a step: in two-step that hit is resolved
+moves CHAIN_FRACTION of the smaller one's radius in a step: in two-step that hit is resolved
 here, at dt - t_p along the line of centres at the step's end (the pair ends
 where the two-step correction puts it), so the hits a shot starts down a row of
 touching pucks come in order. A hit the end would catch too late (past the
@@ -188,6 +189,7 @@ class _Step:
         self.speed_sq = vectors.squared_abs(self.zvel)  # each puck's speed squared on its first path
         speed = math.sqrt(float(self.speed_sq.max())) if len(vel) else 0.0
         self.travel = speed * dt  # the farthest any puck moves this step on its first path (m)
+        self.r_min = float(radius.min()) if len(radius) else 0.0
         # The pairs found hold every pair that can meet while each path stays within `covered`
         # of its puck's step end; `reach_out` is the farthest any present path strays.
         self.covered = self.reach_out = 2.0 * self.travel
@@ -226,7 +228,7 @@ class _Step:
         # With the partners of the fast pucks only (find_partners), a puck made fast looks too.
         end = self.zpos.item(k)
         stray = max(abs(x - end), abs(x + v * (self.dt - self.t_now) - end))
-        newly_fast = self.only_fast is not None and not self.only_fast[k] and self.fast(k)
+        newly_fast = self.only_fast is not None and not self.only_fast[k] and self.fast_for_any(k)
         if stray > self.covered or newly_fast:
             if newly_fast:
                 self.only_fast[k] = True  # (its partners are then all found: once is enough)
@@ -272,13 +274,24 @@ class _Step:
         return bool(self.fast_rows().any())
 
     def fast_rows(self) -> np.ndarray:
-        """Which pucks move FAST_FRACTION of their radius in the step on their first paths."""
-        return _moves(self.speed_sq, self.radius, self.dt, FAST_FRACTION)
+        """Which pucks move FAST_FRACTION of the smallest radius in the step on their first paths: those
+        that may be in a fast pair (fast)."""
+        return _moves(self.speed_sq, self.r_min, self.dt, FAST_FRACTION)
 
-    def fast(self, k, fraction: float = FAST_FRACTION):
-        """Whether puck k (a row, or an array of rows) moves `fraction` of its radius in a step on its
-        present path."""
-        return _moves(vectors.squared_abs(either.take(self.zvel, k)), either.take(self.radius, k), self.dt, fraction)
+    def fast_for_any(self, k: int) -> bool:
+        """Whether puck k moves FAST_FRACTION of the smallest radius in a step on its present path."""
+        return _moves(vectors.squared_abs(self.zvel.item(k)), self.r_min, self.dt, FAST_FRACTION)
+
+    def fast(self, a, b, fraction: float = FAST_FRACTION):
+        """Whether a puck of the pair (a, b) (rows, or arrays of rows) moves `fraction` of the smaller
+        one's radius in a step on its present path: a big puck's slow push can send a small one
+        through its next neighbour as surely as a fast small puck can pass through one."""
+        speed_sq = either.maximum(
+            vectors.squared_abs(either.take(self.zvel, a)), vectors.squared_abs(either.take(self.zvel, b))
+        )
+        return _moves(
+            speed_sq, either.minimum(either.take(self.radius, a), either.take(self.radius, b)), self.dt, fraction
+        )
 
     def find_partners(self, neighbours) -> None:
         """The pairs that may meet during the step, on any path within 2 travels of the step's ends."""
@@ -309,9 +322,13 @@ class _Step:
         close = (dw - ww * self.dt < 0.0) & (vectors.squared_abs(d - w * s) < reach * reach)
         if self.rules.rest is not None:
             close &= ww > np.maximum(self.rules.rest.take(i), self.rules.rest.take(j)) ** 2
-        if self.rules.pairs != "perfect-kiss":  # only where a puck is fast: the others are seen overlapping
-            fast = self.fast_rows()
-            close &= fast.take(i) | fast.take(j)
+        if self.rules.pairs != "perfect-kiss":  # only fast pairs: the others are seen overlapping
+            close &= _moves(
+                np.maximum(self.speed_sq.take(i), self.speed_sq.take(j)),
+                np.minimum(self.radius.take(i), self.radius.take(j)),
+                self.dt,
+                FAST_FRACTION,
+            )
         k = close.nonzero()[0]
         if self.rules.held is not None and len(k):
             k = k.take((~self.rules.held(i.take(k), j.take(k))).nonzero()[0])
@@ -325,7 +342,7 @@ class _Step:
         at once), or one pair (a and b ints) in Python numbers, by the same lines (either.py)."""
         rules = self.rules
         if rules.pairs != "perfect-kiss":  # the pair stage sees the others overlapping, if they hit
-            fast = self.fast(a) | self.fast(b)
+            fast = self.fast(a, b)
             if not either.count(fast):
                 return  # no hit of theirs is this stage's: none is worked out
         t, speed = self.next_hit(a, b)
@@ -367,7 +384,7 @@ class _Step:
             return t, speed
         caught, t_p, u = _caught_overlapping(d + w * (dt - t_now), w, reach)
         if mode == "two-step":  # a puck over its radius a step may start a chain: its hits in order here
-            chain = self.fast(a, CHAIN_FRACTION) | self.fast(b, CHAIN_FRACTION)
+            chain = self.fast(a, b, CHAIN_FRACTION)
             here = caught & chain
             t, speed = either.where(here, either.maximum(dt - t_p, t_now), t), either.where(here, u, speed)
             caught = either.where(chain, False, caught)
