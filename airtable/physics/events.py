@@ -42,7 +42,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from airtable.physics import broadphase, collision, either, vectors
+from airtable.physics import broadphase, collapse, collision, either, vectors
 from airtable.physics.collision import PairRecords
 from airtable.physics.walls import room_to_walls
 
@@ -76,6 +76,9 @@ def repeat_max(cr: float) -> int:
     return max(REPEAT_MIN, math.ceil(math.log(REPEAT_DECAY) / math.log(cr)))
 
 
+# A stuck pair (Step.stick) approaching slower than this (m/s) is left alone: round-off of the last
+# cluster solved, not a hit (solving it again would change nothing and queue it again, at once).
+STUCK_SPEED_MPS = 1e-9
 # In two-step, pair hits are predicted when some puck moves this share of the smallest radius
 # in a step; below it nobody can pass through a puck, and the pair stage sees every hit.
 FAST_FRACTION = 0.5
@@ -180,7 +183,8 @@ class _Step:
         self.changed = np.zeros(len(pos), dtype=bool)  # the pucks whose path changed ...
         self.zorigin = np.zeros(len(pos), dtype=complex)  # ... and their new origins
         self.version: dict[int, int] = {}  # per puck: how many times its path changed
-        self.hit_pairs: dict[tuple[int, int], int] = {}  # how many times each pair hit
+        self.hit_pairs: dict[tuple[int, int], int] = {}  # how many times each pair (i < j) hit
+        self.stuck: dict[int, set[int]] = {}  # per puck: those it sticks to for the rest of the step (stick)
         self.hit_walls: dict[tuple[int, int], int] = {}  # how many times each puck hit a wall across each axis
         self.pinned: dict[int, complex] = {}  # pucks resting on a wall for the rest of the step: its normal
         self.hits = Hits()
@@ -361,10 +365,7 @@ class _Step:
             self.push_pair(t.item(k), a.item(k), b.item(k))
 
     def push_pair(self, t: float, a: int, b: int) -> None:
-        """Queue a hit of the pair (a, b) at t, unless below restitution 1 it has hit repeat_max times already."""
-        cr = self.rules.cr_puck
-        if cr < 1.0 and self.hit_pairs.get((a, b), 0) >= repeat_max(cr):
-            return
+        """Queue a hit of the pair (a, b) at t (a stuck pair's: see stick)."""
         self.push(t, a, b)
 
     def next_hit(self, a, b):
@@ -455,9 +456,8 @@ class _Step:
                 self.bounce(a, -1 - b)
                 self.predict(a)
             else:
-                self.collide(a, b)
-                self.predict(a)
-                self.predict(b)
+                for k in self.collide(a, b):  # the pucks whose paths it changed
+                    self.predict(k)
 
     def bounce(self, k: int, axis: int) -> None:
         """Puck k reaches the wall across `axis` now: its normal velocity reverses times cr_wall."""
@@ -503,12 +503,17 @@ class _Step:
             return 0.0, 0.0  # it would be back at the wall within the step: it lands there
         return path, end - path
 
-    def collide(self, a: int, b: int) -> None:
-        """a and b hit now: they collide along the normal (collision.collide_along).
+    def collide(self, a: int, b: int) -> tuple[int, ...]:
+        """a and b hit now: they collide along the normal (collision.collide_along); returns the
+        pucks whose paths changed.
 
         The normal is the line of centres now; in two-step, for a pair the end of
         the step would catch overlapping and approaching, the line of centres there.
+        Below restitution 1, a pair's repeat_max-th hit in a step and any after it stick (stick).
         """
+        cr = self.rules.cr_puck
+        if cr < 1.0 and (b in self.stuck.get(a, ()) or self.hit_pairs.get(_key(a, b), 0) + 1 >= repeat_max(cr)):
+            return self.stick(a, b)
         xa, xb = self.at(a, self.t_now), self.at(b, self.t_now)
         va, vb = self.zvel.item(a), self.zvel.item(b)
         rb = self.radius.item(b)
@@ -528,7 +533,61 @@ class _Step:
         self.set_path(b, xb, new_b)
         after = (self.at(a, self.dt), self.at(b, self.dt)) if overlap else seen
         self.hits.rows.append((a, b, n, seen[1], overlap, reach, rb, *seen, *after, va, vb, new_a, new_b))
-        self.hit_pairs[a, b] = self.hit_pairs.get((a, b), 0) + 1
+        self.hit_pairs[_key(a, b)] = self.hit_pairs.get(_key(a, b), 0) + 1
+        return a, b
+
+    def stick(self, a: int, b: int) -> tuple[int, ...]:
+        """The pair (a, b) sticks for the rest of the step: it, every stuck pair touching it and the walls
+        pinned pucks among them rest on collide at once, perfectly inelastically (collapse.py); returns
+        the pucks whose paths changed (none if nothing approached faster than round-off)."""
+        self.stuck.setdefault(a, set()).add(b)
+        self.stuck.setdefault(b, set()).add(a)
+        bodies, pairs = self.stuck_cluster(a, b)
+        x = {k: self.at(k, self.t_now) for k in bodies}
+        v = {k: self.zvel.item(k) for k in bodies}
+        ends = pairs + [(k, -1) for k in bodies if k in self.pinned]
+        n = np.array([(x[p] - x[q]) / abs(x[p] - x[q]) if q >= 0 else self.pinned[p] for p, q in ends])
+        vn = np.array([vectors.dot(v[p] - (v[q] if q >= 0 else 0.0), n_k) for (p, q), n_k in zip(ends, n)])
+        if not (vn < -STUCK_SPEED_MPS).any():
+            return ()
+        at = {k: i for i, k in enumerate(bodies)}
+        p_a, p_b = np.array([at[p] for p, _ in ends]), np.array([at[q] if q >= 0 else -1 for _, q in ends])
+        push = collapse.impulses(n, vn, p_a, p_b, 1.0 / self.mass.take(bodies)) * n
+        new = dict(v)
+        for (p, q), dv in zip(ends, push.tolist()):
+            new[p] += dv / self.mass.item(p)
+            if q >= 0:
+                new[q] -= dv / self.mass.item(q)
+        for (p, q), dv, n_k in zip(ends, push.tolist(), n.tolist()):
+            if dv and q >= 0:
+                reach, rq = self.radius.item(p) + self.radius.item(q), self.radius.item(q)
+                self.hits.rows.append(
+                    (p, q, n_k, x[q], 0.0, reach, rq, x[p], x[q], x[p], x[q], v[p], v[q], new[p], new[q])
+                )
+                self.hit_pairs[_key(p, q)] = self.hit_pairs.get(_key(p, q), 0) + 1
+        changed = tuple(k for k in bodies if new[k] != v[k])
+        for k in changed:
+            self.set_path(k, x[k], new[k])
+        return changed
+
+    def stuck_cluster(self, a: int, b: int) -> tuple[list[int], list[tuple[int, int]]]:
+        """(the pucks, the pairs i < j) of the stuck pairs touching now that (a, b) reaches through others."""
+        bodies, pairs, todo = [a, b], [_key(a, b)], [a, b]
+        while todo:  # (each puck once: bounded by the table)
+            p = todo.pop()
+            for q in sorted(self.stuck.get(p, ())):
+                if _key(p, q) in pairs or not self.touching(p, q):
+                    continue
+                pairs.append(_key(p, q))
+                if q not in bodies:
+                    bodies.append(q)
+                    todo.append(q)
+        return bodies, pairs
+
+    def touching(self, p: int, q: int) -> bool:
+        """Whether pucks p and q touch now (within round-off of their reach)."""
+        reach = self.radius.item(p) + self.radius.item(q)
+        return abs(self.at(p, self.t_now) - self.at(q, self.t_now)) <= reach * (1.0 + 1e-9)
 
     def off_a_pinned(self, a: int, n: complex, va: complex, vb: complex) -> tuple[complex, complex] | tuple:
         """(va, vb) after b hits puck a, which rests on a wall (pinned: its hits there reached repeat_max)
@@ -543,6 +602,11 @@ class _Step:
             return ()
         towards = vectors.dot(vb, n)
         return va, (vb - (1.0 + self.rules.cr_wall) * towards * n if towards > 0.0 else vb)
+
+
+def _key(a: int, b: int) -> tuple[int, int]:
+    """One key per pair, whichever puck is named first."""
+    return (a, b) if a < b else (b, a)
 
 
 def _moves(speed_sq, radius, dt: float, fraction: float):

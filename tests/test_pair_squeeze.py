@@ -1,0 +1,84 @@
+"""A light puck squeezed between two heavier ones below restitution 1 (collapse.py, events.Step.stick).
+
+The exact run has infinitely many ever smaller hits in a finite time (inelastic collapse) and
+ends with the three moving together. Found by a user test's random rows: the engine capped a
+pair's hits in a step and left the rest to the overlap correction, which let the light puck
+pass through (a 1 kg cue at 100 m/s, a 0.1 kg puck touching a 1 kg one, restitution 0; and a
+0.1 g one at restitution 0.95, which ended 30 m ahead at 157 m/s).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from hypothesis import example, given, settings
+from hypothesis import strategies as st
+
+from airtable.physics import collapse
+from airtable.physics.table import AirTable
+
+R = 0.1
+
+
+def row(cue_kg: float, light_kg: float, heavy_kg: float, speed: float, cr: float) -> AirTable:
+    """On one line mid-table (no wall within reach): the cue at `speed`, 1.8 m behind a light puck that
+    touches a still heavy one."""
+    table = AirTable(400.0, 20.0)
+    table.puck_correction = "perfect-kiss"
+    table.cr_puck = cr
+    for x, kg, v in ((198.0, cue_kg, speed), (200.0, light_kg, 0.0), (200.0 + 2 * R, heavy_kg, 0.0)):
+        table.add_puck((x, 10.0), R, kg / (math.pi * R * R), (v, 0.0))
+    return table
+
+
+def run(table: AirTable, dt: float, seconds: float = 0.6) -> None:
+    """Step until the row is well past its hits, checking the order and the energy every step."""
+    start = table.kinetic_energy_J()
+    for _ in range(round(seconds / dt)):
+        table.step(dt)
+        x = table.pos_m[:, 0]
+        assert x[1] - x[0] > 2 * R - 1e-6 and x[2] - x[1] > 2 * R - 1e-6, x  # in order, never through
+        assert table.kinetic_energy_J() <= start * (1 + 1e-12)
+
+
+@settings(max_examples=40, derandomize=True, deadline=None)
+@given(
+    ratio=st.floats(2.0, 1e4),
+    heavy=st.floats(0.2, 5.0),
+    speed=st.floats(5.0, 150.0),
+    cr=st.sampled_from([0.0, 0.5, 0.9]) | st.floats(0.0, 0.95),
+    dt=st.sampled_from([1 / 240, 1 / 60, 1 / 30]),
+)
+@example(ratio=10.0, heavy=1.0, speed=100.0, cr=0.0, dt=1 / 60)  # the light puck ended past the heavy one
+@example(ratio=1e4, heavy=1.0, speed=20.0, cr=0.95, dt=1 / 30)  # 30 m ahead at 157 m/s
+def test_a_squeezed_light_puck_never_passes_through_nor_gains_energy(ratio, heavy, speed, cr, dt) -> None:
+    table = row(1.0, heavy / ratio, heavy, speed, cr)
+    momentum = table.momentum_Ns().copy()
+    run(table, dt)
+    np.testing.assert_allclose(table.momentum_Ns(), momentum, rtol=1e-9, atol=1e-9)
+
+
+@pytest.mark.parametrize("dt", [1 / 240, 1 / 60, 1 / 30])
+@pytest.mark.parametrize("light_kg", [0.1, 1e-4])
+def test_at_restitution_0_the_three_move_on_together(light_kg: float, dt: float) -> None:
+    # By hand: nothing bounces at restitution 0, so all three end at the total momentum over the total mass.
+    table = row(1.0, light_kg, 1.0, 100.0, 0.0)
+    run(table, dt)
+    np.testing.assert_allclose(table.vel_mps[:, 0], 100.0 / (2.0 + light_kg), rtol=1e-9)
+    np.testing.assert_allclose(np.diff(table.pos_m[:, 0]), 2 * R, atol=1e-6)  # side by side
+
+
+def test_the_cluster_impulses_stop_every_approach_and_only_push() -> None:
+    # A light puck (0.001 kg) between a 1 kg one coming at 3 m/s and a 2 kg one on a wall, by hand:
+    # all three stop (the wall takes it all): impulses 3 N s on each contact, and none pulls.
+    # Contacts (a, b) with normals from b to a: (light, cue), (heavy, light), (heavy, the wall on its right).
+    n = np.array([1.0 + 0j, 1.0 + 0j, -1.0 + 0j])
+    a, b = np.array([1, 2, 2]), np.array([0, 1, -1])
+    inv = 1.0 / np.array([1.0, 0.001, 2.0])
+    vn = np.array([0.0 - 3.0, 0.0, 0.0])  # the cue (body 0) moves at 3 m/s towards +x, into the light one
+    p = collapse.impulses(n, vn, a, b, inv)
+    np.testing.assert_allclose(p, [3.0, 3.0, 3.0], rtol=1e-9)
+    # Parting contacts get nothing: the cue moving away.
+    assert collapse.impulses(n[:1], np.array([2.0]), a[:1], b[:1], inv).tolist() == [0.0]
