@@ -6,7 +6,7 @@ import pygame
 import pytest
 
 from airtable.app.app import BINDINGS, App
-from airtable.app.controls import HELP_ORDER, KeyTable, help_rows
+from airtable.app.controls import HELP_ORDER, KeyTable, by_position, help_rows
 from airtable.app.feature import Binding, Feature
 
 
@@ -37,3 +37,26 @@ def test_a_key_bound_twice_is_refused():
 
     with pytest.raises(ValueError, match="bound already"):
         KeyTable([Twice(None), Twice(None)])
+
+
+def _key(kind: int, key: int, scancode: int, text: str = "") -> pygame.event.Event:
+    return pygame.event.Event(kind, key=key, scancode=scancode, mod=0, unicode=text)
+
+
+def test_a_russian_layout_keeps_the_letter_keys(demos):
+    """A user test: with `setxkbmap ru` the G key (SDL's key code: "п", its code point) and the C key did
+    nothing. Letters of any layout act as the Latin letter on the same key (scancodes of A to Z: 4 to 29)."""
+    app = App(demos, headless=True)
+    gravity = app.table.gravity_on
+    g_key = 4 + ord("g") - ord("a")  # the scancode of the G key
+    app.handle_event(_key(pygame.KEYDOWN, ord("п"), g_key, "п"))
+    app.handle_event(_key(pygame.KEYUP, ord("п"), g_key))
+    assert app.table.gravity_on is not gravity
+    assert not app.keys_down  # released as it was pressed
+    # Named keys and Latin letters are left as they are; the text typed stays the layout's.
+    f1 = _key(pygame.KEYDOWN, pygame.K_F1, 58)
+    assert by_position(f1) is f1
+    latin = by_position(_key(pygame.KEYDOWN, pygame.K_q, 4 + ord("q") - ord("a"), "q"))
+    assert latin.key == pygame.K_q
+    assert by_position(_key(pygame.KEYDOWN, ord("с"), 6, "с")).unicode == "с"  # the C key: "с" typed
+    assert by_position(_key(pygame.KEYDOWN, ord("с"), 6, "с")).key == pygame.K_c

@@ -25,7 +25,7 @@ import numpy as np
 import pygame
 
 from airtable.app.aids_share import shared_aids, shared_lessons
-from airtable.app.controls import KeyTable, demo_key_for, help_rows
+from airtable.app.controls import KeyTable, by_position, demo_key_for, help_rows
 from airtable.app.demo_loader import Demo, DemoError, DemoShelf, error_from_exception, key_label
 from airtable.app.environment import Environment
 from airtable.app.feature import Binding, Feature
@@ -384,6 +384,7 @@ class App:
     def handle_event(self, event: pygame.event.Event) -> None:
         """The features first (an open panel, the roster, a prediction round), then the key table and the
         demo keys, the mouse, and the window's size."""
+        event = by_position(event)  # letters of any layout, where they sit on the keyboard
         if event.type == pygame.KEYUP:
             self.keys_down.discard(event.key)
             return

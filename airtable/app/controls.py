@@ -16,6 +16,23 @@ import pygame
 
 from airtable.app.feature import Binding, Key
 
+# SDL names a letter key after the keyboard layout: on a Russian one the G key is "п" (the key
+# code is the letter's code point), which no binding names. Such keys are read by where they sit
+# on the keyboard instead: the scancodes of A to Z (USB usage ids 4 to 29, in pygame's events).
+LETTER_SCANCODES = range(4, 30)
+
+
+def by_position(event: pygame.event.Event) -> pygame.event.Event:
+    """A key event for a letter of another alphabet, as the Latin letter on the same key (g for "п" on a
+    Russian layout); any other event as it is. The text typed (event.unicode) stays the layout's."""
+    if event.type not in (pygame.KEYDOWN, pygame.KEYUP) or event.key < 0x80 or event.key & (1 << 30):
+        return event  # ASCII, or a key named by its place already (F1, arrows: SDL's scancode mask)
+    scancode = getattr(event, "scancode", 0)
+    if scancode not in LETTER_SCANCODES:
+        return event
+    return pygame.event.Event(event.type, {**event.dict, "key": pygame.K_a + scancode - LETTER_SCANCODES[0]})
+
+
 # The help screen's rows, top to bottom: the order a teacher meets the keys in, not the owners'.
 HELP_ORDER = (
     "1-9, 0",

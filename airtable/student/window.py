@@ -16,6 +16,7 @@ from collections.abc import Callable, Sequence
 
 import numpy as np
 
+from airtable.app.controls import by_position
 from airtable.app.loop import IdlingLoop, signals_end_the_run
 from airtable.app.overlays import EscapeBurst
 from airtable.app.predict import StudentGuesses
@@ -165,7 +166,7 @@ class PlayerApp:
         """Mouse buttons and keys; False when the user quits (window closed or Esc)."""
         import pygame
 
-        for event in events:
+        for event in map(by_position, events):  # letters of any layout, where they sit on the keyboard
             if event.type == pygame.QUIT:
                 return False  # the window's close button: the student meant it
             if self.window.handle_event(event):  # a resize, or F11: fullscreen on or off
