@@ -290,6 +290,65 @@ def test_protocol_version_mismatch_both_ways(capsys, cleanup):
     assert "server speaks airtable protocol 1" in line and "\n" not in line.strip()
 
 
+class SilentFirstRelay:
+    """Between the player and a table: the first connection is accepted and left silent (a relay on a
+    slow link, or a busy teacher's laptop: the kernel acknowledges, nothing answers); later ones are
+    passed through both ways."""
+
+    def __init__(self, port: int) -> None:
+        self.listener = socket.create_server(("127.0.0.1", 0))
+        self.port, self.target = self.listener.getsockname()[1], port
+        self.socks: list[socket.socket] = []
+        self.threads = [threading.Thread(target=self._serve, daemon=True)]
+        self.threads[0].start()
+
+    def _serve(self) -> None:
+        for n in range(3):  # bounded: the silent one, then a passed one or two
+            try:
+                conn, _ = self.listener.accept()
+            except OSError:
+                return
+            self.socks.append(conn)
+            if n:
+                far = socket.create_connection(("127.0.0.1", self.target))
+                self.socks.append(far)
+                for a, b in ((conn, far), (far, conn)):
+                    t = threading.Thread(target=self._pass, args=(a, b), daemon=True)
+                    self.threads.append(t)
+                    t.start()
+
+    @staticmethod
+    def _pass(a: socket.socket, b: socket.socket) -> None:
+        with contextlib.suppress(OSError):
+            while data := a.recv(65536):  # ends when either side closes
+                b.sendall(data)
+
+    def close(self) -> None:
+        self.listener.close()
+        for sock in self.socks:
+            with contextlib.suppress(OSError):
+                sock.shutdown(socket.SHUT_RDWR)
+            sock.close()
+        for t in self.threads:
+            t.join(timeout=5)
+
+
+def test_a_handshake_that_meets_silence_is_tried_again_not_called_another_program(cleanup):
+    """A user test: through a 300 ms relay with an outage at the join, the client quit with "accepted the
+    connection but did not answer within 5 s; is it an airtable server?" (the relay acknowledged at once,
+    so the kernel saw a quick link). Silence is never proof of another program: it is tried again."""
+    server, _ = start_table(cleanup)
+    relay = SilentFirstRelay(server.port)
+    cleanup(relay.close)
+    net = player(cleanup, relay.port, name="Ann", timeout_s=0.5)
+    assert net.connect() is None  # no PlayerError: waiting to try again
+    assert net.state is PlayerState.RETRYING
+    assert "has not answered within 0.5 s" in net.banner_text and "trying again" in net.banner_text
+    assert "airtable server" not in net.banner_text
+    wait_until(lambda: net.state is PlayerState.CONNECTED, what="the second try to join", timeout_s=20)
+    assert net.welcome.name.endswith("Ann")
+
+
 def test_something_else_on_the_port(capsys, cleanup):
     fake = FakeServer(b"HTTP/1.1 400 Bad Request\r\n\r\n")
     cleanup(fake.close)

@@ -319,3 +319,40 @@ def test_nbytes_follows_a_cut(tmp_path):
     fill(rec, table, 5, 0.01)
     rec.close()
     assert rec.nbytes == rec.puck_path.stat().st_size + rec.energy_path.stat().st_size
+
+
+def test_a_demo_left_before_x_keeps_its_recording_for_the_next_x(demos, tmp_path, monkeypatch):
+    """A user test: demo 7 ran 20 s, then 2, then x: only demo 2's 3 s were written, and the quit
+    question said nothing of the 20 s. A demo left unexported now keeps its recording until x."""
+    monkeypatch.chdir(tmp_path)
+    app = App(demos, demo_key="7", headless=True)
+    pygame.event.clear()
+    for _ in range(150):  # 2.5 s of demo 7
+        app.frame(FRAME_S)
+    press(app, pygame.K_2)
+    for _ in range(150):  # 2.5 s of demo 2
+        app.frame(FRAME_S)
+    assert app.lessons.unexported_s() == pytest.approx(5.0, abs=0.05)  # both, as quitting would lose
+    assert any("5 s of recording not exported" in line for line in app.quit_would_lose())
+    press(app, pygame.K_2)  # restarted after 2.5 s: kept too
+    press(app, pygame.K_x)
+    files = sorted(p.name for p in (tmp_path / "recordings").glob("*.csv") if not p.stem.endswith("_energy"))
+    assert [name.split("-")[0] for name in files] == ["demo2", "demo2", "demo7"], files
+    spans = sorted(len(read_csv(tmp_path / "recordings" / name.replace(".csv", "_energy.csv"))[1]) for name in files)
+    assert spans[-1] >= round(2.5 * 240)  # demo 7's 2.5 s, every step, from its start
+    assert app.lessons.unexported_s() < 0.1 and not app.lessons.kept  # (the frame after x)
+
+
+def test_x_in_the_quit_question_exports_as_the_question_says(demos, tmp_path, monkeypatch):
+    """A user test: the question said "(x exports it)", and x only closed it."""
+    monkeypatch.chdir(tmp_path)
+    app = App(demos, demo_key="1", headless=True)
+    pygame.event.clear()
+    for _ in range(180):
+        app.frame(FRAME_S)
+    press(app, pygame.K_ESCAPE)
+    assert app.panels.panel() == "quit"
+    press(app, pygame.K_x)
+    assert app.panels.panel() is None and app.running
+    assert list((tmp_path / "recordings").glob("demo1-*_energy.csv"))
+    assert not app.quit_would_lose()

@@ -33,6 +33,11 @@ RECORDINGS_DIR = Path("recordings")  # where the export key writes, created on d
 SPOOL_MAX_PUCKS = 200
 # ... and it stops at this size on disk (demo 4 in motion writes about 100 MB a minute).
 SPOOL_MAX_BYTES = 4 * 2**30
+# A demo left (another started, or it restarted) with at least this much recording not exported keeps
+# it until x exports it with the demo on the table (a user test lost 20 s of demo 7 by pressing 2); at
+# most this many such recordings, the oldest going first.
+KEEP_UNEXPORTED_S = 2.0
+MAX_KEPT = 20
 
 
 class Lessons(Feature):
@@ -42,7 +47,8 @@ class Lessons(Feature):
     spool file in a folder of its own that goes when the app ends, which the export
     key (x) copies, so x gives the demo from its start and a later x the later part
     too; with `--record FILE.csv` (`record_into`) the recording is the file itself, and
-    a demo started later records to FILE-2.csv, FILE-3.csv, ...
+    a demo started later records to FILE-2.csv, FILE-3.csv, ... A demo left before x
+    exported its recording keeps it (`kept`): the next x exports those too.
     """
 
     show_momenta = OverlayFlag("momenta")  # the momenta diagram (d)
@@ -57,6 +63,8 @@ class Lessons(Feature):
         self.record_to: Path | None = None  # --record's NAME.csv: recordings are kept there
         self.recorded: list[Recorder] = []  # the --record recordings of this run, the current one last
         self.recorder: Recorder | None = None
+        self.recording_key = ""  # the demo the recording is of
+        self.kept: list[tuple[str, Recorder, float]] = []  # demos left unexported: (key, recording, seconds)
         self.exported_to_s = -1.0  # the recording's time up to which it was exported
         self.show_numbers = False  # each puck's number drawn on it (k); kept from demo to demo
         self.momenta = MomentaLog()
@@ -75,16 +83,20 @@ class Lessons(Feature):
     def record_into(self, path: Path, table: AirTable) -> None:
         """Keep the recordings in `path` (--record): the demo on the table records there from now, afresh."""
         self.record_to = Path(path)
+        if self.recorder is not None and self.recorder not in self.recorded:  # (before any step, as --record)
+            self.recorder.close()
+            self._drop(self.recorder)
+            self.recorder = None
         self._begin_recording(table)
 
     def _begin_recording(self, table: AirTable) -> None:
         if self.recorder is not None:
             self.recorder.close()
-            if self.recorder not in self.recorded:
-                for p in (self.recorder.puck_path, self.recorder.energy_path):
-                    p.unlink(missing_ok=True)  # a spool: the old demo's recording is not kept
+            if self.recorder not in self.recorded:  # a spool: kept only if x has not exported it
+                self._keep_or_drop(self.recording_key, self.recorder, self._unexported(self.recorder))
+        self.recording_key = self.host.demo_key
         if self.record_to is None:
-            self.recorder = Recorder(Path(self._spool.name) / "demo.csv")
+            self.recorder = Recorder(free_csv_pair(Path(self._spool.name), "demo"))
         else:
             first = not self.recorded
             path = self.record_to if first else free_csv_pair(self.record_to.parent, self.record_to.stem)
@@ -114,13 +126,32 @@ class Lessons(Feature):
         if self.momenta.latest is not None and self.momenta.latest.t_s > t_s:
             self.momenta.clear()
 
-    def unexported_s(self) -> float:
-        """Seconds of the recording that quitting now would lose: none with --record (it is all in its file),
-        else the demo's recording since the last export (x)."""
-        rec = self.recorder
+    def _keep_or_drop(self, key: str, rec: Recorder, unexported_s: float) -> None:
+        """A spool recording whose demo was left: kept for x if it holds KEEP_UNEXPORTED_S not exported."""
+        if unexported_s >= KEEP_UNEXPORTED_S:
+            self.kept.append((key, rec, unexported_s))
+            if len(self.kept) <= MAX_KEPT:
+                return
+            key, rec, unexported_s = self.kept.pop(0)
+            self.host.say(f"demo {key}'s recording ({unexported_s:.0f} s not exported) dropped: x keeps them")
+        self._drop(rec)
+
+    @staticmethod
+    def _drop(rec: Recorder) -> None:
+        """A spool recording's files, gone."""
+        for p in (rec.puck_path, rec.energy_path):
+            p.unlink(missing_ok=True)
+
+    def _unexported(self, rec: Recorder | None) -> float:
+        """Seconds of the demo's recording since the last export (x); none with --record (all in its file)."""
         if rec is None or rec in self.recorded or rec.newest_s is None:
             return 0.0
         return max(0.0, rec.newest_s - max(rec.first_s, self.exported_to_s))
+
+    def unexported_s(self) -> float:
+        """Seconds of recording that quitting now would lose: the demo's since the last export, and the
+        demos' left before x exported them."""
+        return self._unexported(self.recorder) + sum(s for _, _, s in self.kept)
 
     def after_step(self, table: AirTable) -> None:
         self._sample(table)
@@ -140,14 +171,25 @@ class Lessons(Feature):
         self.host.say(shown if self.show_numbers else "puck numbers hidden")
 
     def export_recording(self) -> None:
-        """Copy the demo's recording so far to recordings/demo<key>-<time>.csv (and _energy.csv); say where."""
-        rec, say = self.recorder, self.host.say
-        if rec.samples == 0:  # no file of headers only: say why there is nothing, and how to get it
-            why = f" ({rec.error})" if rec.error else ""
-            say(f"nothing recorded yet{why}", lasting=True)
-            print(f"airtable: nothing to export: no step was recorded{why}", file=sys.stderr)
-            return
-        stem = f"demo{self.host.demo_key}-{time.strftime('%Y%m%d-%H%M%S')}"
+        """Copy the demo's recording so far to recordings/demo<key>-<time>.csv (and _energy.csv), and those
+        of demos left before x exported them; say where."""
+        earlier = []
+        while self.kept:
+            key, rec, _ = self.kept[0]
+            pucks = self._copy_out(rec, key)
+            if pucks is None:
+                return  # (said why; the rest stay kept)
+            earlier.append(pucks)
+            self.kept.pop(0)
+            self._drop(rec)
+        self._export_current()
+        if earlier:
+            print(f"recorded {len(earlier)} earlier demos' runs to {earlier[0].parent.resolve()}", flush=True)
+            self.host.say(f"{self.host.message} (and {len(earlier)} earlier demos' runs)", lasting=True)
+
+    def _copy_out(self, rec: Recorder, key: str) -> Path | None:
+        """Copy `rec`'s pair of files to recordings/demo<key>-<time>.csv; the puck file's path (None: said why)."""
+        stem = f"demo{key}-{time.strftime('%Y%m%d-%H%M%S')}"
         try:
             RECORDINGS_DIR.mkdir(parents=True, exist_ok=True)
             rec.flush()
@@ -155,9 +197,22 @@ class Lessons(Feature):
             shutil.copyfile(rec.puck_path, pucks)
             shutil.copyfile(rec.energy_path, energy)
         except OSError as exc:
-            say(f"could not write the recording: {exc.strerror or exc}")
+            self.host.say(f"could not write the recording: {exc.strerror or exc}")
             print(f"airtable: could not write the recording: {exc}", file=sys.stderr)
+            return None
+        return pucks
+
+    def _export_current(self) -> None:
+        rec, say = self.recorder, self.host.say
+        if rec.samples == 0:  # no file of headers only: say why there is nothing, and how to get it
+            why = f" ({rec.error})" if rec.error else ""
+            say(f"nothing recorded yet{why}", lasting=True)
+            print(f"airtable: nothing to export: no step was recorded{why}", file=sys.stderr)
             return
+        pucks = self._copy_out(rec, self.host.demo_key)
+        if pucks is None:
+            return
+        energy = csv_pair(pucks)[1]
         self.exported_to_s = self.host.table.time_s
         stopped = f"; it stopped: {rec.error}" if rec.error else ""
         print(f"recorded {rec.summary()} to {pucks.resolve()} and {energy.name}{stopped}", flush=True)

@@ -79,6 +79,9 @@ class Panels(Feature):
             return False
         if event.key in MODIFIER_KEYS:
             return True  # Shift or Ctrl alone answers nothing: it starts a key
+        if panel == "quit" and event.key == pygame.K_x:
+            self.close_panel()
+            return False  # the question says "x exports it": x stays, and exports
         if panel == "menu" and event.key == pygame.K_TAB:
             self.menu = None
         elif panel == "menu":
