@@ -601,8 +601,8 @@ def test_password(make_server, clients):
         got = c.next_frame()
         return got is not None and got[0] == proto.WELCOME and proto.parse_welcome(got[1])
 
-    # C1 is held for the Ann who left (she may come back with her token): this one is C2.
-    assert wait_until(joined, what="the wait after a wrong password to end").label == "C2 Ann"
+    # C1 is held for the Ann who left (she may come back with her token), her name too: this one is C2 Ann 2.
+    assert wait_until(joined, what="the wait after a wrong password to end").label == "C2 Ann 2"
 
 
 def test_wrong_passwords_earn_a_growing_wait_then_a_lockout_and_few_log_lines(make_server, clients, caplog):

@@ -66,11 +66,25 @@ def test_a_proven_seat_comes_back_and_a_wrong_proof_asks_for_nothing(make_server
     for c in (bo, ann):
         c.send(proto.encode_bye())
     wait_until(lambda: server.player_names() == ["C3 Cy"], what="C1 and C2 to be given up")
-    mallory, nonce = claim(server.port, 2, "Ann", None)
+    mallory, nonce = claim(server.port, 2, "Mal", None)  # (dropped at once: her seat and name are held)
     assert mallory.client != "C2"  # a wrong proof is no claim: some free seat, not Ann's
     back, again = claim(server.port, 2, "Ann", token)
     assert (back.client, back.label) == ("C2", "C2 Ann")
     assert nonce != again  # a new nonce for every challenge
+
+
+def test_a_student_away_keeps_her_name_and_a_newcomer_of_that_name_is_numbered(make_server, clients):  # noqa: F811
+    """A user test: Ann's laptop was away; a newcomer typed "Ann" and got "C5 Ann"; Ann came back to
+    her seat as "C1 Ann 2". A held seat holds its name too."""
+    server = make_server(token_key=b"k" * 32)
+    ann = clients(server.port)
+    token = ann.hello("Ann").token
+    ann.close()  # a drop, no goodbye: the seat is held
+    wait_until(lambda: server.player_names() == [], what="Ann's drop to be noticed")
+    newcomer = clients(server.port).hello("Ann")
+    assert (newcomer.client, newcomer.label) == ("C2", "C2 Ann 2")
+    back, _ = claim(server.port, 1, "Ann", token)
+    assert (back.client, back.label) == ("C1", "C1 Ann")
 
 
 @pytest.mark.parametrize(

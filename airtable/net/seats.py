@@ -2,8 +2,9 @@
 
 When a student's connection ends without a goodbye (the Wi-Fi dropped, the lid was closed, the
 server timed them out), their seat is held for HOLD_S: a newcomer gets the lowest number that is
-neither taken nor held, and the student who comes back with the seat's token (identity.py) gets
-their own number, name and colour again. A seat is given up by a goodbye or the teacher's removal,
+neither taken nor held, nor a name a held seat's student had (a newcomer "Ann" is "Ann 2" while
+Ann is away), and the student who comes back with the seat's token (identity.py) gets their own
+number, name and colour again. A seat is given up by a goodbye or the teacher's removal,
 and when its hold runs out. Owned by the server's network thread.
 """
 
@@ -21,18 +22,26 @@ class HeldSeats:
     def __init__(self, hold_s: float = HOLD_S) -> None:
         self.hold_s = float(hold_s)
         self._until: dict[int, float] = {}
+        self._names: dict[int, str] = {}  # the name each held seat's student had (as shown, without the label)
 
-    def hold(self, number: int, now: float) -> None:
-        """Keep seat `number` for its student until now + hold_s."""
+    def hold(self, number: int, now: float, name: str = "") -> None:
+        """Keep seat `number` (and `name`, its student's) for its student until now + hold_s."""
         if len(self._until) >= MAX_HELD:
             self._forget_old(now)
             if len(self._until) >= MAX_HELD:
-                self._until.pop(min(self._until, key=self._until.__getitem__))
+                self.give_back(min(self._until, key=self._until.__getitem__))
         self._until[number] = now + self.hold_s
+        self._names[number] = name
 
     def give_back(self, number: int) -> None:
         """The seat is its student's again (or given up): no longer held."""
         self._until.pop(number, None)
+        self._names.pop(number, None)
+
+    def names(self, now: float) -> list[str]:
+        """The names of the students whose seats are held now (kept for them, as their seats are)."""
+        self._forget_old(now)
+        return [self._names[n] for n in sorted(self._until) if self._names.get(n)]
 
     def is_held(self, number: int, now: float) -> bool:
         until = self._until.get(number)
@@ -53,4 +62,4 @@ class HeldSeats:
 
     def _forget_old(self, now: float) -> None:
         for number in [n for n, until in self._until.items() if now >= until]:
-            del self._until[number]
+            self.give_back(number)

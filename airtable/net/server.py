@@ -887,11 +887,12 @@ class GameServer:
                 self._door_notice = (notice, time.monotonic() + NOTICE_S)
 
     def _distinct(self, name: str | None) -> str | None:
-        """`name` as the table shows it: "Ann 2" when an "Ann" (or an "Αnn", in look-alike letters) plays."""
+        """`name` as the table shows it: "Ann 2" when an "Ann" (or an "Αnn", in look-alike letters) plays,
+        or is away with a seat held for her (she gets her name back when she returns)."""
         if not name:
             return name
-        playing = (self._conns[cid].name.partition(" ")[2] for cid in self._numbers.values())
-        return distinct_name(name, playing)
+        playing = [self._conns[cid].name.partition(" ")[2] for cid in self._numbers.values()]
+        return distinct_name(name, playing + self._held.names(time.monotonic()))
 
     def _take_over(self, conn: Connection, hello: proto.Hello) -> None:
         """A student back with their seat's token, while their old connection still holds it (it has
@@ -974,7 +975,7 @@ class GameServer:
         if conn.number and self._numbers.get(conn.number) == conn.cid:
             del self._numbers[conn.number]
             if conn.keep_seat:  # a drop, not a goodbye or a removal: held for their return
-                self._held.hold(conn.number, time.monotonic())
+                self._held.hold(conn.number, time.monotonic(), conn.name.partition(" ")[2])
             self._gate.seat_freed(conn.host)
             with self._lock:
                 self._names.pop(conn.number, None)
