@@ -311,3 +311,18 @@ def test_when_the_student_with_the_floor_leaves_everyone_acts_again(served):
     frames_until(app, lambda: server.floor is None, "the floor to come back")
     assert app.message == "the student with the floor left: everyone's cursor acts again"
     assert not any(p.startswith(room.FLOOR_PREFIX) for p in app.scene().status_parts)
+
+
+@pytest.mark.parametrize("size", [(640, 480), (1280, 720), (3840, 2160)])
+def test_the_roster_columns_hold_a_two_digit_seat_and_a_name_of_the_longest_allowed(demos, size):
+    """A user test: every seat from C10 up had a blank label (its column fitted two characters), and a
+    20-letter name showed as "Wolfgang Am..." with room to spare."""
+    app = App(demos, headless=True, window_size_px=size)
+    font, em = app.window.font, app.window.font.get_height()
+    seat_room = (roster_view.COLUMNS_EM[2] - roster_view.COLUMNS_EM[1]) * em - em // 2
+    name_room = (roster_view.COLUMNS_EM[3] - roster_view.COLUMNS_EM[2]) * em - em // 2
+    assert font.size("C30")[0] <= seat_room
+    longest = "Wolfgang Amadeus Moz"
+    assert len(longest) == proto.MAX_NAME_CHARS and font.size(longest)[0] <= name_room
+    lag_room = (roster_view.COLUMNS_EM[5] - roster_view.COLUMNS_EM[4]) * em - em // 2
+    assert font.size("1250 ms")[0] <= lag_room

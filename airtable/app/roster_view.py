@@ -28,7 +28,7 @@ HINTS = (
 )
 HEADINGS = ("seat", "", "rate", "lag", "warnings")
 # Columns, in font heights from the left: swatch, seat, name, rate, lag, flags.
-COLUMNS_EM = (0.0, 1.2, 3.0, 11.5, 15.0, 20.0)  # lag: room for "1250 ms"
+COLUMNS_EM = (0.0, 1.2, 3.9, 17.6, 21.1, 26.1)  # seat: room for "C30"; name: 20 letters; lag: "1250 ms"
 IDLE_FLAG_S = 60.0  # no input change for this long: "idle" in the roster
 
 
