@@ -349,6 +349,24 @@ def test_a_handshake_that_meets_silence_is_tried_again_not_called_another_progra
     assert net.welcome.name.endswith("Ann")
 
 
+def test_the_window_says_when_the_table_it_shows_is_frozen_and_for_how_long_it_reconnects(cleanup, monkeypatch):
+    """A user test: in an outage the window still said "connected" over a frozen table for 10 s, and after
+    the teacher quit "reconnecting..." for 50 s with no time: no way to tell a drop from a closed table."""
+    import airtable.net.player as player_module
+
+    monkeypatch.setattr(player_module, "STALE_S", 0.3)
+    server, loop = start_table(cleanup)
+    net = player(cleanup, server.port, name="Ann")
+    net.connect()
+    wait_until(lambda: net.state is PlayerState.CONNECTED and net.banner_text is None, what="snapshots")
+    loop.stop()  # the teacher's table stops sending (its loop froze, or the link did)
+    wait_until(lambda: net.banner_text and "nothing from the teacher's table for" in net.banner_text, what="stale")
+    server.stop()  # the teacher quits: the player reconnects, and says for how long
+    wait_until(lambda: net.state is PlayerState.RETRYING, what="the drop to be noticed")
+    wait_until(lambda: net.banner_text.endswith(" s)"), what="the time since the table was lost")
+    assert net.banner_text.startswith("reconnecting to the teacher's table...") or "trying again" in net.banner_text
+
+
 def test_something_else_on_the_port(capsys, cleanup):
     fake = FakeServer(b"HTTP/1.1 400 Bad Request\r\n\r\n")
     cleanup(fake.close)

@@ -32,6 +32,7 @@ from airtable.net.udp_inputs import UdpInputs
 
 CONNECT_TIMEOUT_S = 5.0
 SILENCE_S = 10.0  # no snapshot for this long: the server is gone (snapshots come 30 times a second)
+STALE_S = 2.0  # no snapshot for this long: the window says so (the table it shows is frozen)
 MAX_INPUT_HZ = 60.0
 HEARTBEAT_S = 1.0
 RESEND_S = 0.05  # an input whose datagram is not yet acknowledged goes again after this
@@ -158,6 +159,8 @@ class NetPlayer:
         self.first_backoff_s = first_backoff_s  # the first wait after the server went away
         self.full_backoff_s = full_backoff_s  # the least wait before asking a full table again
         self.state = PlayerState.CONNECTING
+        self.heard_s = time.monotonic()  # when the server was last heard from (monotonic s)
+        self.lost_s: float | None = None  # when the connection was lost, while reconnecting
         self.error: str | None = None
         self.waiting_because: str | None = None  # the server's sentence while WAITING
         self.next_try: float = 0.0  # time.monotonic() of the next attempt while RETRYING or WAITING
@@ -200,8 +203,12 @@ class NetPlayer:
     def banner_text(self) -> str | None:
         """A line across the window while the player cannot play, else None."""
         wait = max(0, math.ceil(self.next_try - time.monotonic()))
+        now = time.monotonic()
         if self.state == PlayerState.RETRYING:
-            return self.waiting_because or RECONNECTING
+            since = f" ({now - self.lost_s:.0f} s)" if self.lost_s is not None and now - self.lost_s >= 1.0 else ""
+            return (self.waiting_because or RECONNECTING) + since
+        if self.state == PlayerState.CONNECTED and now - self.heard_s >= STALE_S:  # a frozen table, said so
+            return f"nothing from the teacher's table for {now - self.heard_s:.0f} s: the network? waiting..."
         if self.state == PlayerState.WAITING:  # the server's reason, up to its advice
             reason = (self.waiting_because or "the table cannot take you yet").split(";")[0]
             reason = "the table is full" if reason.startswith("server full") else reason
@@ -344,6 +351,7 @@ class NetPlayer:
             self.round = None  # a round under way comes again after the WELCOME
             self.state = PlayerState.CONNECTED
             self.waiting_because = None
+            self.heard_s, self.lost_s = time.monotonic(), None
 
     def _slow_link(self, sentence: str) -> None:
         """A handshake timed out on a slow link: wait longer next time, and say so."""
@@ -377,6 +385,7 @@ class NetPlayer:
                 self.state, self.error = PlayerState.FAILED, fatal
                 return
             self.state, self.waiting_because = PlayerState.RETRYING, None
+            self.lost_s = self.heard_s  # (the table has been frozen since)
             opened = None
 
     def _read(self, sock: socket.socket, reader: proto.FrameReader, frames: list) -> str | None:
@@ -386,7 +395,7 @@ class NetPlayer:
             while not self._closed.is_set():
                 now = time.monotonic()
                 if frames:
-                    last_rx = now
+                    last_rx = self.heard_s = now
                     self._take(frames, now)
                 elif now - last_rx > max(SILENCE_S, self.timeout_s):
                     return None
