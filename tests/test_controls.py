@@ -60,3 +60,20 @@ def test_a_russian_layout_keeps_the_letter_keys(demos):
     assert latin.key == pygame.K_q
     assert by_position(_key(pygame.KEYDOWN, ord("с"), 6, "с")).unicode == "с"  # the C key: "с" typed
     assert by_position(_key(pygame.KEYDOWN, ord("с"), 6, "с")).key == pygame.K_c
+
+
+def test_ctrl_or_alt_with_a_key_bound_alone_does_nothing_and_ctrl_q_asks_to_quit(demos):
+    """A user test: Ctrl+W lowered the wall restitution, Ctrl+Q reset the view, Ctrl+Alt+S saved a demo
+    twice over: a chord is not the key alone. Ctrl+Q and Ctrl+W quit as desktop programs do, asking first."""
+    app = App(demos, demo_key="5", headless=True)
+    cr_wall, demo = app.table.cr_wall, app.demo_key
+    for mod in (pygame.KMOD_LCTRL, pygame.KMOD_LALT, pygame.KMOD_LCTRL | pygame.KMOD_LSHIFT):
+        for key in (pygame.K_e, pygame.K_g, pygame.K_1):
+            app.handle_event(pygame.event.Event(pygame.KEYDOWN, key=key, scancode=0, mod=mod, unicode=""))
+    assert app.table.cr_wall == cr_wall and app.demo_key == demo and app.running
+    for _ in range(150):  # a recording to lose: quitting asks
+        app.frame(1 / 60)
+    app.handle_event(pygame.event.Event(pygame.KEYDOWN, key=pygame.K_q, scancode=0, mod=pygame.KMOD_LCTRL, unicode=""))
+    assert app.panels.panel() == "quit" and app.running
+    app.handle_event(pygame.event.Event(pygame.KEYDOWN, key=pygame.K_w, scancode=0, mod=pygame.KMOD_LCTRL, unicode=""))
+    assert not app.running  # asked, and asked again: it quits

@@ -16,6 +16,13 @@ import pygame
 
 from airtable.app.feature import Binding, Key
 
+# A key held with one of these and bound to nothing with it does nothing (not what it does alone).
+CHORD_MODS = pygame.KMOD_CTRL | pygame.KMOD_ALT | pygame.KMOD_GUI
+# The modifier keys themselves (pressed alone, they start a chord).
+MODIFIER_KEYS = frozenset(
+    getattr(pygame, f"K_{side}{name}") for side in "LR" for name in ("SHIFT", "CTRL", "ALT", "META", "SUPER")
+)
+
 # SDL names a letter key after the keyboard layout: on a Russian one the G key is "п" (the key
 # code is the letter's code point), which no binding names. Such keys are read by where they sit
 # on the keyboard instead: the scancodes of A to Z (USB usage ids 4 to 29, in pygame's events).
@@ -137,6 +144,8 @@ class KeyTable:
         """A KEYDOWN: run its action (a key with Ctrl or Shift first, as Ctrl+S); False if it has none."""
         mod = getattr(event, "mod", 0)
         action = next((a for (mask, key), a in self._modified.items() if key == event.key and mod & mask), None)
+        if action is None and mod & CHORD_MODS:
+            return event.key not in MODIFIER_KEYS  # Ctrl+W is not w (it lowered the wall restitution): nothing
         action = action or self._press.get(event.key)
         if action is None:
             return False

@@ -15,6 +15,7 @@ from typing import TYPE_CHECKING
 
 import pygame
 
+from airtable.app.controls import MODIFIER_KEYS
 from airtable.app.demo_loader import has_own_key, key_label
 from airtable.app.feature import Binding, Feature
 from airtable.app.menu import DemoMenu
@@ -29,9 +30,6 @@ ERROR_TITLES = {
     "build": "Demo {key} could not be built",
     "event": "Demo {key}: a timed event failed",
 }
-MODIFIER_KEYS = frozenset(
-    getattr(pygame, f"K_{side}{name}") for side in "LR" for name in ("SHIFT", "CTRL", "ALT", "META", "SUPER")
-)
 
 
 class Panels(Feature):
@@ -82,6 +80,8 @@ class Panels(Feature):
         if panel == "quit" and event.key == pygame.K_x:
             self.close_panel()
             return False  # the question says "x exports it": x stays, and exports
+        if panel == "quit" and getattr(event, "mod", 0) & pygame.KMOD_CTRL and event.key in (pygame.K_q, pygame.K_w):
+            return False  # Ctrl+Q again, as Esc again: it quits
         if panel == "menu" and event.key == pygame.K_TAB:
             self.menu = None
         elif panel == "menu":
@@ -188,5 +188,13 @@ class Panels(Feature):
         Binding("Tab", "demo menu: every demo; arrows and Enter, or type its key", {pygame.K_TAB: open_menu}),
         Binding("l", "lecture notes for this demo (again: next page)", {pygame.K_l: toggle_notes}),
         Binding("F1", "this help screen (again: next page); F2-F5: the room", {pygame.K_F1: toggle_help}),
-        Binding("Esc", "close what is open (the newest first); else asks: Esc again quits", {pygame.K_ESCAPE: escape}),
+        Binding(
+            "Esc",
+            "close what is open (the newest first); else asks: Esc again quits. Ctrl+Q / Ctrl+W: quit (asking first)",
+            {
+                pygame.K_ESCAPE: escape,
+                (pygame.KMOD_CTRL, pygame.K_q): close_window,
+                (pygame.KMOD_CTRL, pygame.K_w): close_window,
+            },
+        ),
     )
