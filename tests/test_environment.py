@@ -174,3 +174,16 @@ def test_window_size_from_the_command_line() -> None:
     for bad in ("big", "1280", "10x10", "1280x720x3"):
         with pytest.raises(ValueError, match="1280x720|at least"):
             parse_size(bad)
+
+
+def test_the_view_note_says_the_zoom_and_when_the_table_is_out_of_sight() -> None:
+    """A user test: zoomed in on empty space the window was plain black, with no hint of the zoom."""
+    env = Environment(width_m=10.0, height_m=8.7556)
+    assert env.view_note() == ""
+    env.zoom_about((450, 394), 4.0)  # about the window's middle: the table fills it
+    assert env.view_note() == "zoom x4"
+    env.pan((5000, 0))  # 5000 px to the right: the table's left edge is past the window's right
+    assert env.view_note() == "zoom x4, the table is out of sight"
+    env.reset()
+    env.pan((10, 0))  # panned a little, zoom 1: still a moved view
+    assert env.view_note() == "zoom x1"

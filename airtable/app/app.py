@@ -508,6 +508,9 @@ class App:
         parts = ["PAUSED"] if self.paused else []
         for feature in self.features:
             parts.extend(feature.status_parts(for_students))  # hands off, the floor, the round, rewound
+        view = self.env.view_note()
+        if view:  # (zoomed far in, the window is black: say so, and how to get back)
+            parts.append(view if for_students else f"{view} (q: the whole table)")
         if self.speed != 1.0:
             parts.append(f"slow motion x1/{round(1 / self.speed)}")
         behind = self._physics_behind() if for_students else ""  # (the teacher's: in the heads-up lines)

@@ -114,6 +114,18 @@ class Environment:
         width, height = self.width_m * self.fit_px_per_m, self.height_m * self.fit_px_per_m
         return (self.offset_px[0], self.size_px[1] - self.offset_px[1] - height, width, height)
 
+    def view_note(self) -> str:
+        """What the status line says of the view: "" for the whole table; else how far it is zoomed, and
+        whether the table is out of sight (zoomed in on empty space the window is plain black)."""
+        if self.zoom == 1.0 and not self.origin_m.any():
+            return ""
+        corners = self.to_screen(np.array([[0.0, 0.0], [self.width_m, self.height_m]]))
+        (x0, y1), (x1, y0) = corners
+        w, h = self.size_px
+        if x1 < 0 or x0 > w or y1 < 0 or y0 > h:
+            return f"zoom x{self.zoom:.3g}, the table is out of sight"
+        return f"zoom x{self.zoom:.3g}"
+
     # ------------------------------------------------------------ transform
 
     def to_screen(self, points_m) -> np.ndarray:
