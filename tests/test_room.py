@@ -326,3 +326,21 @@ def test_the_roster_columns_hold_a_two_digit_seat_and_a_name_of_the_longest_allo
     assert len(longest) == proto.MAX_NAME_CHARS and font.size(longest)[0] <= name_room
     lag_room = (roster_view.COLUMNS_EM[5] - roster_view.COLUMNS_EM[4]) * em - em // 2
     assert font.size("1250 ms")[0] <= lag_room
+
+
+def test_a_student_who_dropped_shows_as_away_while_the_seat_is_held(served, monkeypatch):
+    """A user test: three laptops frozen 30 s: the header said "0 students", the roster "nobody has joined
+    yet", though their seats were kept and they all came back. Away students are counted and listed."""
+    app, server, join = served
+    ann = join("Ann")
+    join("Bo")
+    ann.close()  # no goodbye: the lid closed
+    frames_until(app, lambda: server.away(), "Ann's drop to be noticed")
+    assert [name for name, _ in server.away()] == ["C1 Ann"]
+    assert "1 student, 1 away (F2: roster)" in app.room.hud_lines()
+    drawn: list[list] = []
+    draw = roster_view.draw_roster
+    monkeypatch.setattr(room, "draw_roster", lambda *a, **k: drawn.append(k["away"]) or draw(*a, **k))
+    press(app, pygame.K_F2)
+    app.frame(FRAME_S)
+    assert drawn and [name for name, _ in drawn[-1]] == ["C1 Ann"]

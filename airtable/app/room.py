@@ -86,9 +86,10 @@ class Room(Feature):
         alerts = [self.alert(), server.door_notice if server is not None else None]
         lines: list = [(alert, ALERT_COLOR) for alert in alerts if alert]  # first: a narrow band keeps the first
         if server is not None:
-            n = server.player_count
+            n, away = server.player_count, len(server.away())
             lines.extend(server.join_lines())
-            lines.append(f"{n} student{'' if n == 1 else 's'} (F2: roster)")
+            gone = f", {away} away" if away else ""  # (their seats are held: they were vanishing from the count)
+            lines.append(f"{n} student{'' if n == 1 else 's'}{gone} (F2: roster)")
         return lines
 
     def status_parts(self, for_students: bool) -> list[str]:
@@ -112,8 +113,9 @@ class Room(Feature):
         server = self.host.server
         most = server.max_clients if server is not None else 0
         seats, window = self.seats(), self.host.window
+        away = [(self.label(name), s) for name, s in server.away()] if server is not None else []
         self.row_boxes, self.panel_box = draw_roster(
-            window, seats, selected=self.selected, label=self.label, most=most, anonymous=self.anonymous
+            window, seats, selected=self.selected, label=self.label, most=most, anonymous=self.anonymous, away=away
         )
 
     # ------------------------------------------------------------ keys and clicks

@@ -48,10 +48,18 @@ def _row_texts(seat: Seat, label: str) -> list[str]:
 
 
 def draw_roster(
-    w, seats: Sequence[Seat], *, selected: int, label: Callable[[str], str], most: int, anonymous: bool
+    w,
+    seats: Sequence[Seat],
+    *,
+    selected: int,
+    label: Callable[[str], str],
+    most: int,
+    anonymous: bool,
+    away: Sequence[tuple[str, float]] = (),
 ) -> tuple[list[tuple[int, pygame.Rect]], pygame.Rect]:
     """The roster panel on GameWindow `w`, the `selected` row highlighted, names as `label` gives them,
-    `most` seats in all; returns each row's (number, box) and the panel's box, for clicks."""
+    `most` seats in all, and the students `away` (label, seconds) whose seats are held for them under the
+    title; returns each row's (number, box) and the panel's box, for clicks."""
     rect = w.panel_rect()
     font, pad = w.font, w.font.get_height() // 2
     surf = panel_view.panel_surface(rect.size)
@@ -66,6 +74,10 @@ def draw_roster(
     for hint in HINTS:
         surf.blit(font.render(panel_view.shorten(font, hint, rect.w - 2 * pad), True, panel_view.DIM_TEXT), (pad, y))
         y += font.get_linesize()
+    if away:  # dropped, seats held: they come back by themselves
+        line = "away (seat kept): " + ", ".join(f"{name} {s:.0f} s" for name, s in away)
+        surf.blit(font.render(panel_view.shorten(font, line, rect.w - 2 * pad), True, WARN_COLOR), (pad, y))
+        y += font.get_linesize()
     y += font.get_linesize() // 2
     em = font.get_height()
     for k, heading in enumerate(HEADINGS):
@@ -76,7 +88,8 @@ def draw_roster(
     first = max(0, min(selected - fits + 1, n - fits))
     row_boxes = []
     if not seats:
-        surf.blit(font.render("nobody has joined yet", True, panel_view.DIM_TEXT), (pad, y))
+        empty = "nobody plays now" if away else "nobody has joined yet"
+        surf.blit(font.render(empty, True, panel_view.DIM_TEXT), (pad, y))
     for i, seat in enumerate(seats[first : first + fits], start=first):
         box = pygame.Rect(pad // 2, y, rect.w - pad, line_h)
         if i == selected:

@@ -38,6 +38,11 @@ class HeldSeats:
         self._until.pop(number, None)
         self._names.pop(number, None)
 
+    def away(self, now: float) -> list[tuple[int, str, float]]:
+        """(seat number, name, seconds since the drop) of each seat held now, lowest first."""
+        self._forget_old(now)
+        return [(n, self._names.get(n, ""), now - (self._until[n] - self.hold_s)) for n in sorted(self._until)]
+
     def names(self, now: float) -> list[str]:
         """The names of the students whose seats are held now (kept for them, as their seats are)."""
         self._forget_old(now)

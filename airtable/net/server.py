@@ -262,6 +262,7 @@ class GameServer:
         self._snapshot_seq = 0
         self._names: dict[int, str] = {}  # player number -> name, for player_names()
         self._roster: tuple[Seat, ...] = ()
+        self._away: tuple[tuple[str, float], ...] = ()  # held seats (the network thread writes, under _lock)
         self._commands: list[Callable[[], None]] = []  # from the game loop, run by the network thread
         self._table_size_m: tuple[float, float] = proto.DEFAULT_TABLE_SIZE_M  # plain tuple: replaced, never mutated
         self.predictions = PredictionBook()  # the predict-then-reveal round's guesses (has its own lock)
@@ -457,6 +458,11 @@ class GameServer:
         """Every seat in player-number order (refreshed ten times a second)."""
         with self._lock:
             return list(self._roster)
+
+    def away(self) -> list[tuple[str, float]]:
+        """The students who dropped and whose seats are held for them: ("C3 Ann", seconds away), by seat."""
+        with self._lock:
+            return list(self._away)
 
     def remove(self, number: int, reason: str = "") -> bool:
         """Remove player C<number>, who gets an ERROR saying so; False if no such player."""
@@ -1069,8 +1075,9 @@ class GameServer:
                     far_off,
                 )
             )
+        away = tuple((f"C{n}" + (f" {name}" if name else ""), s) for n, name, s in self._held.away(now))
         with self._lock:
-            self._roster = tuple(seats)
+            self._roster, self._away = tuple(seats), away
 
     def _say_bye(self) -> None:
         """Best effort: tell players the server is going, so they show 'server gone'."""
