@@ -529,6 +529,8 @@ class _Step:
             or self.off_a_pinned(b, -n, vb, va)[::-1]
             or (collision.collide_along(n, va, vb, self.mass.item(a), self.mass.item(b), self.rules.cr_puck))
         )
+        if new_a == va and new_b == vb:
+            return ()  # nothing changed (round-off): predicting the same hit again would never end
         self.set_path(a, xa, new_a)
         self.set_path(b, xb, new_b)
         after = (self.at(a, self.dt), self.at(b, self.dt)) if overlap else seen
@@ -538,15 +540,17 @@ class _Step:
 
     def stick(self, a: int, b: int) -> tuple[int, ...]:
         """The pair (a, b) sticks for the rest of the step: it, every stuck pair touching it and the walls
-        pinned pucks among them rest on collide at once, perfectly inelastically (collapse.py); returns
-        the pucks whose paths changed (none if nothing approached faster than round-off)."""
+        its pucks touch collide at once, perfectly inelastically (collapse.py); returns the pucks whose
+        paths changed (none if nothing approached faster than round-off). (A light puck stuck to a heavy
+        one and bouncing off an elastic wall between them hit each several thousand times a step.)"""
         self.stuck.setdefault(a, set()).add(b)
         self.stuck.setdefault(b, set()).add(a)
         bodies, pairs = self.stuck_cluster(a, b)
         x = {k: self.at(k, self.t_now) for k in bodies}
         v = {k: self.zvel.item(k) for k in bodies}
-        ends = pairs + [(k, -1) for k in bodies if k in self.pinned]
-        n = np.array([(x[p] - x[q]) / abs(x[p] - x[q]) if q >= 0 else self.pinned[p] for p, q in ends])
+        walls = [(k, normal) for k in bodies for normal in self.walls_touched(k, x[k])]
+        ends = pairs + [(k, -1) for k, _ in walls]
+        n = np.array([(x[p] - x[q]) / abs(x[p] - x[q]) for p, q in pairs] + [normal for _, normal in walls])
         vn = np.array([vectors.dot(v[p] - (v[q] if q >= 0 else 0.0), n_k) for (p, q), n_k in zip(ends, n)])
         if not (vn < -STUCK_SPEED_MPS).any():
             return ()
@@ -569,6 +573,16 @@ class _Step:
         for k in changed:
             self.set_path(k, x[k], new[k])
         return changed
+
+    def walls_touched(self, k: int, x: complex) -> list[complex]:
+        """The normals into the table of the walls puck k at x touches now (within round-off), and of the
+        wall it is pinned to (bounce)."""
+        r = self.radius.item(k)
+        tol = r * 1e-9
+        room = (x.real - r, x.imag - r, self.width - x.real - r, self.height - x.imag - r)  # (each_wall's order)
+        out = [normal for gap, normal in zip(room, collision.WALL_NORMALS) if gap <= tol]
+        pinned = self.pinned.get(k)
+        return out if pinned is None or pinned in out else [*out, pinned]
 
     def stuck_cluster(self, a: int, b: int) -> tuple[list[int], list[tuple[int, int]]]:
         """(the pucks, the pairs i < j) of the stuck pairs touching now that (a, b) reaches through others."""
@@ -598,10 +612,10 @@ class _Step:
         their limit is this one (b stops). Colliding a and b as a pair let b pass through a once a
         could no longer hit the wall."""
         wall = self.pinned.get(a)
-        if wall is None or vectors.dot(n, wall) >= 0.0:
-            return ()
         towards = vectors.dot(vb, n)
-        return va, (vb - (1.0 + self.rules.cr_wall) * towards * n if towards > 0.0 else vb)
+        if wall is None or vectors.dot(n, wall) >= 0.0 or not towards > 0.0:
+            return ()  # (b does not push a into the wall: a, sliding along it into b, hits it as any puck)
+        return va, vb - (1.0 + self.rules.cr_wall) * towards * n
 
 
 def _key(a: int, b: int) -> tuple[int, int]:
