@@ -70,6 +70,32 @@ def test_pressing_a_demo_key_reads_its_file_again_after_an_edit(tmp_path, capsys
     assert app.build_error is None and app.panels.panel() is None and len(app.table.pucks) == 4
 
 
+def test_a_demo_file_broken_while_it_runs_stays_in_the_menu_and_the_heading_says_what_failed(tmp_path):
+    """A user test: a syntax error in the running demo s1, then Tab: s1 left the menu, the error was on the
+    terminal only, and the heading said "Demo 1: Five pucks" over s1's table. After a failed start and
+    Esc, the heading named the built-in demo whose key the broken file had taken."""
+    mine = tmp_path / "s1.py"
+    mine.write_text(demo_source("s1", pucks=2))
+    app = make_app(tmp_path, key="s1")
+    mine.write_text(SYNTAX_ERROR.replace("'5'", "'s1'"))
+    press(app, pygame.K_TAB)
+    assert ("s1", "s1.py: does not load") in app.panels.menu.items
+    assert "s1.py, line 3: syntax error" in app.message
+    for ch in "s1":
+        press(app, pygame.key.key_code(ch), unicode=ch)
+    press(app, pygame.K_RETURN)
+    assert app.panels.panel() == "error" and app.caption() == "Demo s1: s1.py (does not load)"
+    press(app, pygame.K_ESCAPE)  # hides the error: the heading still says what failed
+    assert app.panels.panel() is None and app.caption() == "Demo s1: s1.py (does not load)"
+    theirs = tmp_path / "eight.py"
+    theirs.write_text(demo_source("8", pucks=2, build_line=RAISES))
+    press(app, pygame.K_8)
+    press(app, pygame.K_ESCAPE)
+    assert app.caption() == "Demo 8: Mine (not built)"  # not the built-in 8's title
+    press(app, pygame.K_1)
+    assert app.caption().startswith("Demo 1: ")
+
+
 def test_a_file_that_failed_at_start_loads_once_fixed(tmp_path):
     broken = tmp_path / "late.py"
     broken.write_text("KEY = 't1'\nTITLE = 'x'\ndef build(table, variation=0)\n")

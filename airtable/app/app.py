@@ -156,6 +156,7 @@ class App:
         self._students_seen: tuple = ()  # the students' cursors when last looked at
         self.loop: IdlingLoop | None = None  # while run() runs
         self.demo_key = ""
+        self.failed_start: str | None = None  # the heading while the demo last started failed (caption)
         self.demo_path: Path | None = None
         self.variation = 0
 
@@ -228,6 +229,9 @@ class App:
             except Exception as exc:  # a teacher's demo may fail in any way; the app goes on
                 self._demo_failed(exc, "build")
                 self.table.clear()
+        # The heading names what failed until another start, also once Esc hid the error (it named the
+        # built-in demo whose key the broken file had taken, over an empty table).
+        self.failed_start = None if self.build_error is None else self._failed_caption(demo)
         self.stepper.reset(demo.dt_s if demo else self.stepper.dt_s)
         self.aids.trails = demo.trails if demo else False
         for feature in self.features:
@@ -247,9 +251,12 @@ class App:
         self.report(self.build_error)
 
     def caption(self) -> str:
-        if self.build_error is not None and self.build_error.stage == "load":
-            return f"Demo {self.demo_key}: {self.build_error.path.name}"
-        return self.demo.label(self.variation)
+        return self.failed_start or self.demo.label(self.variation)
+
+    def _failed_caption(self, demo: Demo | None) -> str:
+        if self.build_error.stage == "load" or demo is None:
+            return f"Demo {key_label(self.demo_key)}: {self.build_error.path.name} (does not load)"
+        return f"{demo.label(self.variation)} (not built)"
 
     def next_variation(self, step: int) -> None:
         """Left/Right: the demo's previous or next variation; at either end it stays (a step round the end

@@ -254,6 +254,14 @@ class DemoShelf:
         self.errors = errors
         return fresh
 
+    def broken_keys(self) -> dict[str, DemoError]:
+        """Each key a file gave that now fails to load, and no other file gives: its error."""
+        return {
+            self._last_key[path]: item
+            for path, (_, item) in self._loaded.items()
+            if isinstance(item, DemoError) and path in self._last_key and self._last_key[path] not in self.demos
+        }
+
     def broken(self, key: str) -> DemoError | None:
         """The load error of the file that last gave demo `key`, if that file now fails."""
         for path, (_, item) in self._loaded.items():

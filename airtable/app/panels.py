@@ -16,7 +16,7 @@ from typing import TYPE_CHECKING
 import pygame
 
 from airtable.app.controls import MODIFIER_KEYS
-from airtable.app.demo_loader import has_own_key, key_label
+from airtable.app.demo_loader import has_own_key, key_label, key_order
 from airtable.app.feature import Binding, Feature
 from airtable.app.menu import DemoMenu
 from airtable.app.overlays import EscapeBurst, OverlayFlag, OverlayValue
@@ -130,7 +130,11 @@ class Panels(Feature):
         host = self.host
         for error in host.shelf.refresh():
             host.report(error)
-        self.menu = DemoMenu([(key, demo.title) for key, demo in host.demos.items()], current=host.demo_key)
+            host.say(str(error), lasting=True)  # (it was on the terminal only, and the demo left the menu)
+        # A demo whose file now fails stays in the menu, marked: picking it shows why (its key does too).
+        items = [(key, demo.title) for key, demo in host.demos.items()]
+        items += [(key, f"{error.path.name}: does not load") for key, error in host.shelf.broken_keys().items()]
+        self.menu = DemoMenu(sorted(items, key=lambda item: key_order(item[0])), current=host.demo_key)
 
     def toggle_notes(self) -> None:
         """L: the demo's lecture notes; again for their next page, if they have more than one; then closed."""
