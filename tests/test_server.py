@@ -937,7 +937,12 @@ def test_a_name_the_teachers_screen_cannot_draw_is_refused_with_a_sentence(make_
         c = clients(server.port)
         c.send(proto.encode_hello(name))
         sentence = c.expect_error()
-        assert f"{ch!r} (U+{ord(ch):04X}), which the teacher's screen cannot draw" in sentence
+        assert f"{ch!r} (U+{ord(ch):04X}), which the teacher's screen's font cannot draw" in sentence
+    # A user test: "Zoë" typed as e and a combining mark was refused; "Nguyễn" was told to use Latin letters.
+    assert clients(server.port).hello("Chloe\u0308").name == "Chlo\u00eb"
+    c = clients(server.port)
+    c.send(proto.encode_hello("Nguyễn"))
+    assert "write 'e' for it" in c.expect_error()
 
 
 def test_a_student_who_mistyped_the_password_twice_gets_in_with_the_right_one(make_server, clients):

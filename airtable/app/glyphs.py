@@ -9,6 +9,8 @@ draw with a sentence.
 
 from __future__ import annotations
 
+import unicodedata
+
 import pygame
 
 # The font's scripts all lie below this (Latin, Greek, Cyrillic, punctuation, arrows).
@@ -43,7 +45,6 @@ class NameCheck:
         ch = next((c for c in name if not c.isspace() and c not in self.drawable), None)
         if ch is None:
             return None
-        return (
-            f"the name has {ch!r} (U+{ord(ch):04X}), which the teacher's screen cannot draw; "
-            "pick a name in Latin, Greek or Cyrillic letters or digits"
-        )
+        base = unicodedata.normalize("NFD", ch)[0]  # the letter without its accents ("e" for "ễ")
+        instead = f"write {base!r} for it" if base != ch and base in self.drawable else "pick other letters or digits"
+        return f"the name has {ch!r} (U+{ord(ch):04X}), which the teacher's screen's font cannot draw; {instead}"

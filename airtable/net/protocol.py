@@ -282,7 +282,7 @@ def check_name(name: object) -> str:
     like another player's "C<n>" label (names.py; spaces around are dropped)."""
     if not isinstance(name, str):
         raise ProtocolError(f"the name must be text, not {_short(name)}")
-    name = name.strip()
+    name = unicodedata.normalize("NFC", name).strip()  # "Zoë" typed as e and a combining mark: one letter
     if not name:
         raise ProtocolError("the name is empty; pick a name with a letter or digit, like Ann")
     if len(name) > MAX_NAME_CHARS:
