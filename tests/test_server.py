@@ -713,7 +713,7 @@ def test_seats_per_computer_are_limited_with_a_clear_sentence(make_server, clien
     clients(server.port).hello()
     third = clients(server.port)
     third.send(proto.encode_hello())
-    assert "your computer already plays with 2 windows" in third.expect_error()
+    assert "2 windows from your address (127.0.0.1) play already" in third.expect_error()
     assert clients(server.port, source="127.0.0.2").hello().client == "C3"
     first.send(proto.encode_bye())  # a freed seat can be taken again from the same computer
     wait_until(lambda: server.player_count == 2, what="the BYE")

@@ -86,8 +86,8 @@ class Gate:
             return None
         self.turned_away[host] += 1
         return (
-            f"your computer already plays with {self.players[host]} windows, the most one address ({host}) may; "
-            f"close one of them, or, if your class shares one router, ask the teacher to {ALLOW_A_CLASS}"
+            f"{self.players[host]} windows from your address ({host}) play already, the most one address may "
+            f"(a class behind one router counts as one computer); ask the teacher to {ALLOW_A_CLASS}"
         )
 
     def teacher_notice(self) -> str | None:
@@ -96,9 +96,9 @@ class Gate:
             return None
         host, count = self.turned_away.most_common(1)[0]
         # Short enough for one line of a 4:3 projector's top band.
-        return (
-            f"{count} student{'' if count == 1 else 's'} at {host} could not join: "
-            "a class behind one router? start with --per-address 40"
+        return (  # the fix first: a narrow band cuts the end
+            f"start with --per-address 40: {count} student{'' if count == 1 else 's'} at {host} "
+            "could not join (a class behind one router?)"
         )
 
     @property

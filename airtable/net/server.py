@@ -853,9 +853,11 @@ class GameServer:
             return
         self._take_over(conn, hello)
         refusal = self._gate.seat_refusal(conn.host, password_given=self.password is not None)
-        if refusal is not None:
+        if refusal is not None:  # the student's window waits and asks again: the teacher may let the class in
             self._tell_teacher(self._gate.teacher_notice())
-        if refusal is None and hello.name and self._name_refusal is not None:
+            self._fail(conn, refusal, retry=True)
+            return
+        if hello.name and self._name_refusal is not None:
             refusal = self._name_refusal(hello.name)
         if refusal is not None:
             self._fail(conn, refusal)
