@@ -104,7 +104,8 @@ def test_the_count_is_always_shown_and_f2_lists_every_seat(served):
     assert "2 students (F2: roster)" in app.hud_lines()
     press(app, pygame.K_F2)
     assert app.panels.panel() == "roster"
-    frames_until(app, lambda: len(server.roster()) == 2 and server.roster()[1].far_off, "the far-off cursor")
+    # (the rows drawn, not only the server's roster: the network thread refreshes it between frames)
+    frames_until(app, lambda: len(app.room.row_boxes) == 2 and server.roster()[1].far_off, "the far-off cursor")
     assert [n for n, _ in app.room.row_boxes] == [1, 2]
     seat = server.roster()[1]
     assert roster_view.seat_flags(seat) == "cursor far off the table"
