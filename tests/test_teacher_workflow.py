@@ -54,7 +54,9 @@ def test_pressing_a_demo_key_reads_its_file_again_after_an_edit(tmp_path, capsys
     mine.write_text(SYNTAX_ERROR)
     press(app, pygame.K_5)
     assert app.panels.panel() == "error" and app.build_error.stage == "load"
-    assert len(app.table.pucks) == 0  # not the built-in demo 5 in its place
+    # Not the built-in demo 5 in its place: the table that ran stays while the file is mended (a user
+    # test: a typo in the running demo's file emptied the table).
+    assert len(app.table.pucks) == 3 and "its last run goes on" in app.caption()
     assert f"{mine}:3: syntax error" in capsys.readouterr().err
 
     press(app, pygame.K_6)
@@ -84,9 +86,10 @@ def test_a_demo_file_broken_while_it_runs_stays_in_the_menu_and_the_heading_says
     for ch in "s1":
         press(app, pygame.key.key_code(ch), unicode=ch)
     press(app, pygame.K_RETURN)
-    assert app.panels.panel() == "error" and app.caption() == "Demo s1: s1.py (does not load)"
+    heading = "Demo s1: s1.py (does not load: its last run goes on)"  # (its own key: the table stays)
+    assert app.panels.panel() == "error" and app.caption() == heading and len(app.table.pucks) == 2
     press(app, pygame.K_ESCAPE)  # hides the error: the heading still says what failed
-    assert app.panels.panel() is None and app.caption() == "Demo s1: s1.py (does not load)"
+    assert app.panels.panel() is None and app.caption() == heading
     theirs = tmp_path / "eight.py"
     theirs.write_text(demo_source("8", pucks=2, build_line=RAISES))
     press(app, pygame.K_8)

@@ -43,6 +43,7 @@ from airtable.app.world import LiveEdits, gravity_label
 from airtable.model import aids
 from airtable.model.client import LOCAL_COLOR, Client, cursor_pulls
 from airtable.model.scene import STATUS_SEPARATOR, Scene
+from airtable.physics import state
 from airtable.physics.table import TABLE_HEIGHT_M, TABLE_WIDTH_M, AirTable
 
 MESSAGE_S = 4.0
@@ -217,6 +218,8 @@ class App:
         demo = self.demos.get(key) if broken is None else None
         if self.build_error is not None:
             self.paused = False  # the pause came with the error; a new start runs
+        # Its own key again with its file broken meanwhile: the table that ran stays while the file is mended.
+        running = state.capture(self.table) if key == self.demo_key and self.failed_start is None else None
         self.demo_key, self.demo_path = key, (demo.path if demo else broken.path)
         if variation is None:
             variation = demo.default_variation if demo else 0
@@ -229,9 +232,11 @@ class App:
             except Exception as exc:  # a teacher's demo may fail in any way; the app goes on
                 self._demo_failed(exc, "build")
                 self.table.clear()
+        if self.build_error is not None and running is not None:
+            state.restore(self.table, running)
         # The heading names what failed until another start, also once Esc hid the error (it named the
         # built-in demo whose key the broken file had taken, over an empty table).
-        self.failed_start = None if self.build_error is None else self._failed_caption(demo)
+        self.failed_start = None if self.build_error is None else self._failed_caption(demo, running is not None)
         self.stepper.reset(demo.dt_s if demo else self.stepper.dt_s)
         self.aids.trails = demo.trails if demo else False
         for feature in self.features:
@@ -253,10 +258,11 @@ class App:
     def caption(self) -> str:
         return self.failed_start or self.demo.label(self.variation)
 
-    def _failed_caption(self, demo: Demo | None) -> str:
+    def _failed_caption(self, demo: Demo | None, runs_on: bool) -> str:
+        on = ": its last run goes on" if runs_on else ""
         if self.build_error.stage == "load" or demo is None:
-            return f"Demo {key_label(self.demo_key)}: {self.build_error.path.name} (does not load)"
-        return f"{demo.label(self.variation)} (not built)"
+            return f"Demo {key_label(self.demo_key)}: {self.build_error.path.name} (does not load{on})"
+        return f"{demo.label(self.variation)} (not built{on})"
 
     def next_variation(self, step: int) -> None:
         """Left/Right: the demo's previous or next variation; at either end it stays (a step round the end
