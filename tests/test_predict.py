@@ -483,3 +483,14 @@ def test_the_students_predict_lines_are_on_an_opaque_box_clear_of_the_walls(serv
         assert win.surface.get_at((block.right - 2, block.bottom - 2))[:3] == (0, 0, 0)
     finally:
         net.close()
+
+
+def test_esc_while_students_guess_asks_before_it_throws_the_guesses_away(tmp_path):
+    """A user test: one Esc during a prediction round ended it, every student's guess gone."""
+    app = head_on_app(tmp_path)
+    press(app, pygame.K_F6)
+    assert app.predict.round.state == "open"
+    press(app, pygame.K_ESCAPE)
+    assert app.predict.round.active and "Esc again ends the prediction round" in app.message
+    press(app, pygame.K_ESCAPE)
+    assert not app.predict.round.active and app.running

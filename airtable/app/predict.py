@@ -166,6 +166,7 @@ class PredictRound:
 # ---------------------------------------------------------------- the teacher's side
 
 FROZEN_NOTICE = "the table stays frozen while students predict: F6 reveals"
+ESC_AGAIN_S = 3.0  # while students guess, a second Esc within this ends the round (s)
 
 
 class Predict(Feature):
@@ -177,6 +178,7 @@ class Predict(Feature):
         super().__init__(host)
         self.room = room  # an anonymous projector hides the names on the arrows
         self.round = PredictRound()
+        self._end_asked_until = -math.inf  # (clock_s) until when a second Esc ends an open round
 
     def _book(self):
         server = self.host.server
@@ -239,9 +241,14 @@ class Predict(Feature):
         self.publish()
 
     def on_escape(self) -> bool:
-        """Esc during a round ends it, as closing an overlay would; the table stays paused."""
+        """Esc during a round ends it, as closing an overlay would; the table stays paused. While the
+        students guess, only a second Esc within ESC_AGAIN_S does (one Esc threw every guess away)."""
         if not self.round.active:
             return False
+        if self.round.state == "open" and self.host.clock_s > self._end_asked_until:
+            self._end_asked_until = self.host.clock_s + ESC_AGAIN_S
+            self.host.say("Esc again ends the prediction round, and the students' guesses go (F6 reveals)")
+            return True
         self.round.close()
         self.publish()
         self.host.paused = True
