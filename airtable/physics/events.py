@@ -79,6 +79,9 @@ def repeat_max(cr: float) -> int:
 # A stuck pair (Step.stick) approaching slower than this (m/s) is left alone: round-off of the last
 # cluster solved, not a hit (solving it again would change nothing and queue it again, at once).
 STUCK_SPEED_MPS = 1e-9
+# A stuck pair's solves in one step stop after this many (a bound: each solve leaves its cluster at rest
+# along its contacts, so a few suffice; what is left, if anything, the pair stage puts apart).
+STUCK_SOLVES_MAX = 200
 # In two-step, pair hits are predicted when some puck moves this share of the smallest radius
 # in a step; below it nobody can pass through a puck, and the pair stage sees every hit.
 FAST_FRACTION = 0.5
@@ -185,6 +188,7 @@ class _Step:
         self.version: dict[int, int] = {}  # per puck: how many times its path changed
         self.hit_pairs: dict[tuple[int, int], int] = {}  # how many times each pair (i < j) hit
         self.stuck: dict[int, set[int]] = {}  # per puck: those it sticks to for the rest of the step (stick)
+        self.solves: dict[tuple[int, int], int] = {}  # how many times each stuck pair (i < j) was solved
         self.hit_walls: dict[tuple[int, int], int] = {}  # how many times each puck hit a wall across each axis
         self.pinned: dict[int, complex] = {}  # pucks resting on a wall for the rest of the step: its normal
         self.hits = Hits()
@@ -513,7 +517,8 @@ class _Step:
         """
         cr = self.rules.cr_puck
         if cr < 1.0 and (b in self.stuck.get(a, ()) or self.hit_pairs.get(_key(a, b), 0) + 1 >= repeat_max(cr)):
-            return self.stick(a, b)
+            self.solves[_key(a, b)] = solves = self.solves.get(_key(a, b), 0) + 1
+            return self.stick(a, b) if solves <= STUCK_SOLVES_MAX else ()
         xa, xb = self.at(a, self.t_now), self.at(b, self.t_now)
         va, vb = self.zvel.item(a), self.zvel.item(b)
         rb = self.radius.item(b)
