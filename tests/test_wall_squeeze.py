@@ -157,7 +157,9 @@ def random_crowd(seed: int, wide: bool) -> tuple[AirTable, float]:
     return table, rng.choice((1 / 240, 1 / 60, 1 / 30) if wide else (1 / 240, 1 / 60))
 
 
-@pytest.mark.parametrize(("seed", "wide"), [(7, False), (15, False), (204, False), (1014, True), (1244, True)])
+@pytest.mark.parametrize(
+    ("seed", "wide"), [(7, False), (15, False), (204, False), (1014, True), (1244, True), (2030, True)]
+)
 def test_scenes_a_random_search_found_slow_resolve_few_hits_a_step(seed, wide):
     """Each step of these resolved thousands of hits (100000 in one: 4 to 20 s), most of them a light puck
     stuck to a heavy one and bouncing off an elastic wall between them, or a puck resting on a wall (its

@@ -189,6 +189,7 @@ class _Step:
         self.hit_pairs: dict[tuple[int, int], int] = {}  # how many times each pair (i < j) hit
         self.stuck: dict[int, set[int]] = {}  # per puck: those it sticks to for the rest of the step (stick)
         self.solves: dict[tuple[int, int], int] = {}  # how many times each stuck pair (i < j) was solved
+        self.first_speed: dict[tuple[int, int], float] = {}  # each pair's approach speed at its first hit
         self.hit_walls: dict[tuple[int, int], int] = {}  # how many times each puck hit a wall across each axis
         self.pinned: dict[int, complex] = {}  # pucks resting on a wall for the rest of the step: its normal
         self.hits = Hits()
@@ -363,13 +364,16 @@ class _Step:
             ok &= ~_held(rules.held, a, b)
         if not isinstance(ok, np.ndarray):  # one pair
             if ok:
-                self.push_pair(t, a, b)
+                self.push_pair(t, a, b, speed)
             return
         for k in ok.nonzero()[0].tolist():
-            self.push_pair(t.item(k), a.item(k), b.item(k))
+            self.push_pair(t.item(k), a.item(k), b.item(k), speed.item(k))
 
-    def push_pair(self, t: float, a: int, b: int) -> None:
-        """Queue a hit of the pair (a, b) at t (a stuck pair's: see stick)."""
+    def push_pair(self, t: float, a: int, b: int, speed: float) -> None:
+        """Queue a hit of the pair (a, b) at t, approaching at `speed`; not a stuck pair's slower than
+        STUCK_SPEED_MPS (the round-off its last solve left)."""
+        if speed <= STUCK_SPEED_MPS and b in self.stuck.get(a, ()):
+            return
         self.push(t, a, b)
 
     def next_hit(self, a, b):
@@ -513,12 +517,11 @@ class _Step:
 
         The normal is the line of centres now; in two-step, for a pair the end of
         the step would catch overlapping and approaching, the line of centres there.
-        Below restitution 1, a pair's repeat_max-th hit in a step and any after it stick (stick).
+        Below restitution 1, a pair's repeat_max-th hit in a step and any after it are `capped`.
         """
-        cr = self.rules.cr_puck
-        if cr < 1.0 and (b in self.stuck.get(a, ()) or self.hit_pairs.get(_key(a, b), 0) + 1 >= repeat_max(cr)):
-            self.solves[_key(a, b)] = solves = self.solves.get(_key(a, b), 0) + 1
-            return self.stick(a, b) if solves <= STUCK_SOLVES_MAX else ()
+        capped = self.capped(a, b)
+        if capped is not None:
+            return capped
         xa, xb = self.at(a, self.t_now), self.at(b, self.t_now)
         va, vb = self.zvel.item(a), self.zvel.item(b)
         rb = self.radius.item(b)
@@ -541,7 +544,28 @@ class _Step:
         after = (self.at(a, self.dt), self.at(b, self.dt)) if overlap else seen
         self.hits.rows.append((a, b, n, seen[1], overlap, reach, rb, *seen, *after, va, vb, new_a, new_b))
         self.hit_pairs[_key(a, b)] = self.hit_pairs.get(_key(a, b), 0) + 1
+        self.first_speed.setdefault(_key(a, b), -vectors.dot(va - vb, n))
         return a, b
+
+    def capped(self, a: int, b: int) -> tuple[int, ...] | None:
+        """Below restitution 1, what a pair's hit does once the pair has hit repeat_max times in the step: the
+        pucks whose paths it changed; None: it is an ordinary hit. Approaching REPEAT_DECAY as fast as at
+        its first hit or slower, as the cap expects (a cluster's collapse), nothing: the pair stage parts
+        what is left. Faster (a squeeze: a heavy puck keeps pushing a light one), the pair sticks (stick).
+        A pair with a puck resting on a wall (pinned) or stuck counts as inelastic as the wall: an elastic
+        puck between a heavy one and a puck pinned in a corner was hit 50000 times at one moment."""
+        key, cr = _key(a, b), self.rules.cr_puck
+        if a in self.pinned or b in self.pinned or a in self.stuck or b in self.stuck:
+            cr = min(cr, self.rules.cr_wall)
+        stuck = b in self.stuck.get(a, ())
+        if cr >= 1.0 or not (stuck or self.hit_pairs.get(key, 0) + 1 >= repeat_max(cr)):
+            return None
+        if not stuck:
+            x, w = self.at(a, self.t_now) - self.at(b, self.t_now), self.zvel.item(a) - self.zvel.item(b)
+            if -vectors.dot(w, x) / abs(x) <= REPEAT_DECAY * self.first_speed.get(key, math.inf):
+                return ()
+        self.solves[key] = solves = self.solves.get(key, 0) + 1
+        return self.stick(a, b) if solves <= STUCK_SOLVES_MAX else ()
 
     def stick(self, a: int, b: int) -> tuple[int, ...]:
         """The pair (a, b) sticks for the rest of the step: it, every stuck pair touching it and the walls
