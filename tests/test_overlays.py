@@ -207,11 +207,14 @@ def test_mashing_esc_clears_the_screen_and_asks_but_never_quits(demos):
 
 
 def test_esc_ends_a_prediction_round_before_it_asks_to_quit(demos):
-    """A round is under way over the table (F6): Esc ends it, as it closes an overlay; the next Esc asks."""
+    """A round is under way over the table (F6): Esc ends it, as it closes an overlay (asking first while the
+    students guess: Esc again); the next Esc asks to quit."""
     app = App(demos, demo_key="3", headless=True)
     pygame.event.clear()
     press(app, pygame.K_F6)
     assert app.predict.round.state == "open" and app.paused
+    press(app, pygame.K_ESCAPE)
+    assert app.predict.round.state == "open" and "Esc again ends the prediction round" in app.message
     press(app, pygame.K_ESCAPE)
     assert app.running and app.predict.round.state == "closed" and app.panels.panel() is None and app.paused
     press(app, pygame.K_ESCAPE)
