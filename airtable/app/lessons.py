@@ -133,7 +133,7 @@ class Lessons(Feature):
             if len(self.kept) <= MAX_KEPT:
                 return
             key, rec, unexported_s = self.kept.pop(0)
-            self.host.say(f"demo {key}'s recording ({unexported_s:.0f} s not exported) dropped: x keeps them")
+            self.host.say(f"demo {key}'s recording dropped ({unexported_s:.0f} s): x exports the {MAX_KEPT} kept")
         self._drop(rec)
 
     @staticmethod
