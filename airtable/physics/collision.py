@@ -106,12 +106,18 @@ def contact_time(d, w, reach):
 WALL_NORMALS = (1.0, 1j, -1.0, -1j)
 
 
+def wall_rooms(x, y, radius, size_m) -> tuple:
+    """The room (m; negative: past it) between the edge of a puck of `radius` centred at (x, y) and the
+    left, bottom, right and top walls, in that order (WALL_NORMALS'): numbers, or arrays of them."""
+    width, height = size_m
+    return (x - radius, y - radius, width - x - radius, height - y - radius)
+
+
 def each_wall(pos: np.ndarray, vel: np.ndarray, radius: np.ndarray, size_m) -> tuple:
     """For the left, bottom, right and top walls, in that order (WALL_NORMALS'): each puck's
     room between its edge and the wall (m; negative: past it) and its speed away from it (m/s)."""
-    x, y, vx, vy = pos[:, 0], pos[:, 1], vel[:, 0], vel[:, 1]
-    width, height = size_m
-    return ((x - radius, vx), (y - radius, vy), (width - x - radius, -vx), (height - y - radius, -vy))
+    vx, vy = vel[:, 0], vel[:, 1]
+    return tuple(zip(wall_rooms(pos[:, 0], pos[:, 1], radius, size_m), (vx, vy, -vx, -vy), strict=True))
 
 
 def wall_time(x: float, v: float, lo: float, hi: float) -> float | None:

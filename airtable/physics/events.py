@@ -543,8 +543,10 @@ class _Step:
         self.set_path(b, xb, new_b)
         after = (self.at(a, self.dt), self.at(b, self.dt)) if overlap else seen
         self.hits.rows.append((a, b, n, seen[1], overlap, reach, rb, *seen, *after, va, vb, new_a, new_b))
-        self.hit_pairs[_key(a, b)] = self.hit_pairs.get(_key(a, b), 0) + 1
-        self.first_speed.setdefault(_key(a, b), -vectors.dot(va - vb, n))
+        key = _key(a, b)
+        self.hit_pairs[key] = self.hit_pairs.get(key, 0) + 1
+        if key not in self.first_speed:  # (a pair in the pi setup hits thousands of times a step)
+            self.first_speed[key] = -vectors.dot(va - vb, n)
         return a, b
 
     def capped(self, a: int, b: int) -> tuple[int, ...] | None:
@@ -607,9 +609,8 @@ class _Step:
         """The normals into the table of the walls puck k at x touches now (within round-off), and of the
         wall it is pinned to (bounce)."""
         r = self.radius.item(k)
-        tol = r * 1e-9
-        room = (x.real - r, x.imag - r, self.width - x.real - r, self.height - x.imag - r)  # (each_wall's order)
-        out = [normal for gap, normal in zip(room, collision.WALL_NORMALS) if gap <= tol]
+        rooms = collision.wall_rooms(x.real, x.imag, r, (self.width, self.height))
+        out = [normal for room, normal in zip(rooms, collision.WALL_NORMALS, strict=True) if room <= r * 1e-9]
         pinned = self.pinned.get(k)
         return out if pinned is None or pinned in out else [*out, pinned]
 

@@ -58,8 +58,7 @@ def off_the_wall(pos, vel, radius, size_m, cr_wall: float, rows: np.ndarray) -> 
     for a in np.unique(rows).tolist():
         za, ra = z.item(a), radius.item(a)
         near = [b for b in broadphase.rows_near(z, radius, za, ra, -OVERLAP_SLOP_M).tolist() if b != a]
-        one = slice(a, a + 1)
-        rooms = [room.item(0) for room, _ in collision.each_wall(pos[one], vel[one], radius[one], size_m)]
+        rooms = list(collision.wall_rooms(za.real, za.imag, ra, size_m))
         k = rooms.index(min(rooms))
         if any(vectors.dot(z.item(b) - za, WALL_NORMALS[k]) < 0.0 for b in near):  # put back through b: onto the wall
             z[a] = za = za - rooms[k] * WALL_NORMALS[k]
