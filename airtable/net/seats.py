@@ -43,11 +43,6 @@ class HeldSeats:
         self._forget_old(now)
         return [(n, self._names.get(n, ""), now - (self._until[n] - self.hold_s)) for n in sorted(self._until)]
 
-    def names(self, now: float) -> list[str]:
-        """The names of the students whose seats are held now (kept for them, as their seats are)."""
-        self._forget_old(now)
-        return [self._names[n] for n in sorted(self._until) if self._names.get(n)]
-
     def is_held(self, number: int, now: float) -> bool:
         until = self._until.get(number)
         return until is not None and now < until

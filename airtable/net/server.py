@@ -900,7 +900,8 @@ class GameServer:
         if not name:
             return name
         playing = [self._conns[cid].name.partition(" ")[2] for cid in self._numbers.values()]
-        return distinct_name(name, playing + self._held.names(time.monotonic()))
+        away = [held for _, held, _ in self._held.away(time.monotonic()) if held]
+        return distinct_name(name, playing + away)
 
     def _take_over(self, conn: Connection, hello: proto.Hello) -> None:
         """A student back with their seat's token, while their old connection still holds it (it has
