@@ -21,6 +21,15 @@ from airtable.cli import main
 from airtable.physics.table import AirTable
 
 
+def app_after_frames(demos, key: str, frames: int, **options) -> App:
+    """A headless App on demo `key` after `frames` frames of FRAME_S (its recording that long)."""
+    app = App(demos, demo_key=key, headless=True, **options)
+    pygame.event.clear()
+    for _ in range(frames):
+        app.frame(FRAME_S)
+    return app
+
+
 def read_csv(path) -> tuple[list[str], list[list[float]]]:
     with open(path, newline="", encoding="utf-8") as f:
         rows = list(csv.reader(f))
@@ -176,10 +185,7 @@ def test_csv_pair_names():
 
 def test_the_export_key_gives_the_demo_so_far_and_later_the_later_part_too(demos, tmp_path, monkeypatch):
     monkeypatch.chdir(tmp_path)
-    app = App(demos, demo_key="1", headless=True)
-    pygame.event.clear()
-    for _ in range(30):
-        app.frame(FRAME_S)
+    app = app_after_frames(demos, "1", 30)
     press(app, pygame.K_x)
     written = sorted(p.name for p in (tmp_path / "recordings").iterdir())
     assert len(written) == 2 and written[0].endswith(".csv") and written[1].endswith("_energy.csv")
@@ -198,10 +204,7 @@ def test_the_export_key_gives_the_demo_so_far_and_later_the_later_part_too(demos
 
 def test_the_export_after_a_rewind_leaves_out_the_dropped_future(demos, tmp_path, monkeypatch):
     monkeypatch.chdir(tmp_path)
-    app = App(demos, demo_key="1", headless=True)
-    pygame.event.clear()
-    for _ in range(60):
-        app.frame(FRAME_S)
+    app = app_after_frames(demos, "1", 60)
     press(app, pygame.K_SPACE)
     for _ in range(20):
         press(app, pygame.K_COMMA)  # back 20 frames
@@ -216,10 +219,7 @@ def test_the_export_after_a_rewind_leaves_out_the_dropped_future(demos, tmp_path
 
 
 def test_quitting_loses_the_unexported_part_only_without_record(demos, tmp_path):
-    app = App(demos, demo_key="1", headless=True)
-    pygame.event.clear()
-    for _ in range(180):
-        app.frame(FRAME_S)
+    app = app_after_frames(demos, "1", 180)
     assert app.lessons.unexported_s() == pytest.approx(3.0)
     app.lessons.record_into(tmp_path / "all.csv", app.table)  # as --record does: every row is in its file
     for _ in range(180):
@@ -264,10 +264,7 @@ def test_a_crowd_too_big_for_the_export_key_is_not_recorded_and_x_says_why(demos
     from airtable.app.lessons import SPOOL_MAX_PUCKS
 
     monkeypatch.chdir(tmp_path)
-    app = App(demos, demo_key="1", headless=True)
-    pygame.event.clear()
-    for _ in range(10):
-        app.frame(FRAME_S)
+    app = app_after_frames(demos, "1", 10)
     for k in range(SPOOL_MAX_PUCKS):  # a crowd added live
         app.table.add_puck((0.3 + 0.45 * (k % 20), 0.3 + 0.45 * (k // 20)), radius_m=0.1)
     for _ in range(10):
@@ -281,10 +278,7 @@ def test_a_crowd_too_big_for_the_export_key_is_not_recorded_and_x_says_why(demos
 def test_x_on_a_demo_too_big_to_record_writes_nothing_and_says_why_first(demos, tmp_path, monkeypatch):
     """The 10000-puck gas: x wrote two files of headers only, and the window cut the reason off."""
     monkeypatch.chdir(tmp_path)
-    app = App(demos, demo_key="0p", headless=True, window_size_px=(640, 480))  # 2000 pucks
-    pygame.event.clear()
-    for _ in range(5):
-        app.frame(FRAME_S)
+    app = app_after_frames(demos, "0p", 5, window_size_px=(640, 480))  # 2000 pucks
     press(app, pygame.K_x)
     assert not (tmp_path / "recordings").exists() or not list((tmp_path / "recordings").iterdir())
     assert app.message.startswith("nothing recorded yet (over 200 pucks: --record FILE.csv records every puck)")
@@ -296,10 +290,7 @@ def test_the_recording_for_x_stops_at_its_size_on_disk_and_x_says_so(demos, tmp_
 
     monkeypatch.chdir(tmp_path)
     monkeypatch.setattr(lessons, "SPOOL_MAX_BYTES", 20_000)
-    app = App(demos, demo_key="1", headless=True)  # five pucks: about 570 bytes a step
-    pygame.event.clear()
-    for _ in range(30):
-        app.frame(FRAME_S)
+    app = app_after_frames(demos, "1", 30)  # five pucks: about 570 bytes a step
     rec = app.lessons.recorder
     assert rec.closed and 20_000 < rec.nbytes < 21_000 and "GB written" in rec.error
     press(app, pygame.K_x)
@@ -325,10 +316,7 @@ def test_a_demo_left_before_x_keeps_its_recording_for_the_next_x(demos, tmp_path
     """A user test: demo 7 ran 20 s, then 2, then x: only demo 2's 3 s were written, and the quit
     question said nothing of the 20 s. A demo left unexported now keeps its recording until x."""
     monkeypatch.chdir(tmp_path)
-    app = App(demos, demo_key="7", headless=True)
-    pygame.event.clear()
-    for _ in range(150):  # 2.5 s of demo 7
-        app.frame(FRAME_S)
+    app = app_after_frames(demos, "7", 150)  # 2.5 s of demo 7
     press(app, pygame.K_2)
     for _ in range(150):  # 2.5 s of demo 2
         app.frame(FRAME_S)
@@ -346,10 +334,7 @@ def test_a_demo_left_before_x_keeps_its_recording_for_the_next_x(demos, tmp_path
 def test_x_in_the_quit_question_exports_as_the_question_says(demos, tmp_path, monkeypatch):
     """A user test: the question said "(x exports it)", and x only closed it."""
     monkeypatch.chdir(tmp_path)
-    app = App(demos, demo_key="1", headless=True)
-    pygame.event.clear()
-    for _ in range(180):
-        app.frame(FRAME_S)
+    app = app_after_frames(demos, "1", 180)
     press(app, pygame.K_ESCAPE)
     assert app.panels.panel() == "quit"
     press(app, pygame.K_x)
