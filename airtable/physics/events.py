@@ -89,6 +89,10 @@ FAST_FRACTION = 0.5
 # (it resolves it the same way), unless a puck of the pair moves this share of its radius in a step:
 # then the hits it starts down a row of touching pucks come here, in order, or the row's end swaps.
 CHAIN_FRACTION = 1.0
+# In two-step, a hit the step's end catches overlapping is the pair stage's if its pucks' masses are within
+# this ratio: its correction moves each puck its mass share of it, and a puck much lighter than its partner
+# moves nearly all of it, into its next neighbour (a light puck between heavy ones was pushed through one).
+LIKE_MASSES = 2.0
 # A puck whose path changed has its hits with up to this many partners predicted one by one in
 # Python numbers (a few microseconds each), with more at once in numpy (some sixty calls whatever
 # their number): the same lines either way (either.py), the same bits.
@@ -199,6 +203,8 @@ class _Step:
         speed = math.sqrt(float(self.speed_sq.max())) if len(vel) else 0.0
         self.travel = speed * dt  # the farthest any puck moves this step on its first path (m)
         self.r_min = float(radius.min()) if len(radius) else 0.0
+        # In two-step with masses unlike (LIKE_MASSES), slow hits may be this stage's too (ours_after).
+        self.unlike = rules.pairs == "two-step" and len(mass) > 0 and float(mass.max()) > LIKE_MASSES * float(mass.min())
         # The pairs found hold every pair that can meet while each path stays within `covered`
         # of its puck's step end; `reach_out` is the farthest any present path strays.
         self.covered = self.reach_out = 2.0 * self.travel
@@ -278,7 +284,11 @@ class _Step:
         those of fast pucks (a gas whose pucks all move under FAST_FRACTION of their radius has none)."""
         if self.rules.pairs == "perfect-kiss":
             return True
-        if self.rules.pairs == "none" or self.travel < 0.999 * FAST_FRACTION * float(self.radius.min()):
+        if self.rules.pairs == "none":
+            return False
+        if self.unlike:
+            return True  # (the hits of unlike pucks the step's end catches are ours: ours_after)
+        if self.travel < 0.999 * FAST_FRACTION * self.r_min:
             return False  # the fastest puck is not fast for the smallest one (a gas): no need to look at each
         return bool(self.fast_rows().any())
 
@@ -302,13 +312,31 @@ class _Step:
             speed_sq, either.minimum(either.take(self.radius, a), either.take(self.radius, b)), self.dt, fraction
         )
 
+    def ours_after(self, a, b):
+        """Whether the step's end catches the pair (a, b) overlapping and approaching (two-step's case)
+        and its hit is yet this stage's, to come in its order (rows, or arrays of rows): the pair
+        stage's correction moves each puck its mass share of it, so a puck much lighter than its partner
+        (LIKE_MASSES) is moved nearly all of it, into its next neighbour; and a hit that leaves a puck
+        moving FAST_FRACTION of the smallest radius a step may send it through its next neighbour."""
+        va, vb = either.take(self.zvel, a), either.take(self.zvel, b)
+        end = self.at(a, self.dt) - self.at(b, self.dt)
+        caught, _, _ = _caught_overlapping(end, va - vb, either.take(self.radius, a) + either.take(self.radius, b))
+        if not either.count(caught):
+            return caught  # (most pairs a puck's new path is checked against)
+        ma, mb = either.take(self.mass, a), either.take(self.mass, b)
+        n = end / either.where(caught, vectors.length(end), 1.0)
+        new_a, new_b = collision.collide_along(n, va, vb, ma, mb, self.rules.cr_puck)
+        speed_sq = either.maximum(vectors.squared_abs(new_a), vectors.squared_abs(new_b))
+        unlike = either.maximum(ma, mb) > LIKE_MASSES * either.minimum(ma, mb)
+        return caught & (unlike | _moves(speed_sq, self.r_min, self.dt, FAST_FRACTION))
+
     def find_partners(self, neighbours) -> None:
         """The pairs that may meet during the step, on any path within 2 travels of the step's ends."""
         pos = vectors.as_rows(self.zpos)
         found = neighbours.pairs_while_moving(pos, self.radius, 2.0 * self.travel)
         if found is not None:
             self.partners = neighbours.partners()
-        elif self.rules.pairs != "perfect-kiss":  # only fast pucks' hits are predicted: their partners
+        elif self.rules.pairs != "perfect-kiss" and not self.unlike:  # only fast pucks' hits: their partners
             self.only_fast = self.fast_rows()
             i, j = broadphase.pairs_near(pos, self.radius, self.only_fast.nonzero()[0], 4.0 * self.travel)
             self.partners = broadphase.Partners(i, j, len(pos))
@@ -332,12 +360,12 @@ class _Step:
         if self.rules.rest is not None:
             close &= ww > np.maximum(self.rules.rest.take(i), self.rules.rest.take(j)) ** 2
         if self.rules.pairs != "perfect-kiss":  # only fast pairs: the others are seen overlapping
-            close &= _moves(
-                np.maximum(self.speed_sq.take(i), self.speed_sq.take(j)),
-                np.minimum(self.radius.take(i), self.radius.take(j)),
-                self.dt,
-                FAST_FRACTION,
-            )
+            speed_sq = np.maximum(self.speed_sq.take(i), self.speed_sq.take(j))
+            fast = _moves(speed_sq, np.minimum(self.radius.take(i), self.radius.take(j)), self.dt, FAST_FRACTION)
+            slow = (close & ~fast).nonzero()[0] if self.rules.pairs == "two-step" else ()
+            if len(slow):  # (some of them ours too: ours_after)
+                fast[slow] = self.ours_after(i.take(slow), j.take(slow))
+            close &= fast
         k = close.nonzero()[0]
         if self.rules.held is not None and len(k):
             k = k.take((~self.rules.held(i.take(k), j.take(k))).nonzero()[0])
@@ -349,12 +377,15 @@ class _Step:
         """Queue the next hit of each pair (a[k], b[k]) on their present paths, if it comes within the
         step, in the pairs' order: numpy arrays of rows (a step's first pairs, or a puck's many partners,
         at once), or one pair (a and b ints) in Python numbers, by the same lines (either.py)."""
-        rules = self.rules
+        rules, ours = self.rules, False
         if rules.pairs != "perfect-kiss":  # the pair stage sees the others overlapping, if they hit
             fast = self.fast(a, b)
+            if rules.pairs == "two-step":
+                ours = self.ours_after(a, b)  # (hits the pair stage would see that are ours all the same)
+                fast = fast | ours
             if not either.count(fast):
                 return  # no hit of theirs is this stage's: none is worked out
-        t, speed = self.next_hit(a, b)
+        t, speed = self.next_hit(a, b, ours)
         ok = t <= self.dt  # (inf where they never meet)
         if rules.pairs != "perfect-kiss":
             ok &= fast
@@ -376,13 +407,14 @@ class _Step:
             return
         self.push(t, a, b)
 
-    def next_hit(self, a, b):
+    def next_hit(self, a, b, ours=False):
         """(t, u) for the pairs (a, b) on their present paths: when they next hit (s into the step; inf if
         never) and how fast they then approach along the normal (m/s); arrays, or one pair (predict_pairs).
 
         A hit the step's end would catch overlapping and approaching is the pair stage's (never, here),
-        except in two-step where a puck of the pair moves CHAIN_FRACTION of its radius in a step: then
-        it comes t_p before the end (the course's case; see the module docstring).
+        except in two-step where a puck of the pair moves CHAIN_FRACTION of its radius in a step, or
+        the hit is otherwise ours (`ours`: ours_after): then it comes t_p before the end (the course's
+        case; see the module docstring).
         """
         t_now, dt, mode = self.t_now, self.dt, self.rules.pairs
         d, w = self.at(a, t_now) - self.at(b, t_now), either.take(self.zvel, a) - either.take(self.zvel, b)
@@ -393,7 +425,7 @@ class _Step:
             return t, speed
         caught, t_p, u = _caught_overlapping(d + w * (dt - t_now), w, reach)
         if mode == "two-step":  # a puck over its radius a step may start a chain: its hits in order here
-            chain = self.fast(a, b, CHAIN_FRACTION)
+            chain = self.fast(a, b, CHAIN_FRACTION) | ours  # (ours: the slow hits that are ours all the same)
             here = caught & chain
             t, speed = either.where(here, either.maximum(dt - t_p, t_now), t), either.where(here, u, speed)
             caught = either.where(chain, False, caught)
