@@ -20,7 +20,8 @@ What is left to later stages: hits slower than a puck's rest speed, and pairs
 that pressed on each other in the last step (the contact stage holds those).
 Outside perfect kiss only fast pairs' hits are predicted (a puck of the pair
 moving FAST_FRACTION of the smaller one's radius in a step: it could pass
-through the small one, or knock it through a third); the pair
+through the small one, or knock it through a third) and, in two-step, those of
+unlike pucks and those that make a puck fast (Step.ours_after); the pair
 stage sees the others overlapping. Of those, a hit the step's end would catch
 overlapping and approaching is left to the pair stage too, which resolves it
 the course's way (two-step: backed up t_p = overlap / normal speed along the
@@ -204,7 +205,8 @@ class _Step:
         self.travel = speed * dt  # the farthest any puck moves this step on its first path (m)
         self.r_min = float(radius.min()) if len(radius) else 0.0
         # In two-step with masses unlike (LIKE_MASSES), slow hits may be this stage's too (ours_after).
-        self.unlike = rules.pairs == "two-step" and len(mass) > 0 and float(mass.max()) > LIKE_MASSES * float(mass.min())
+        self.unlike = rules.pairs == "two-step" and len(mass) > 0
+        self.unlike = self.unlike and float(mass.max()) > LIKE_MASSES * float(mass.min())
         # The pairs found hold every pair that can meet while each path stays within `covered`
         # of its puck's step end; `reach_out` is the farthest any present path strays.
         self.covered = self.reach_out = 2.0 * self.travel
