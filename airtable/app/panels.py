@@ -161,7 +161,7 @@ class Panels(Feature):
     def draw(self) -> None:
         panel, w, host = self.panel(), self.host.window, self.host
         if panel == "quit":
-            w.draw_question("Quit?", [*host.quit_would_lose(), "Esc again to quit; any other key to stay."])
+            w.draw_question("Quit?", [*host.quit_would_lose(), "Esc (or Ctrl+Q) again to quit; any other key to stay."])
         elif panel == "menu":
             rows = self.menu.rows(visible=w.panel_rows() - 2, label=key_label)  # the footer under them
             w.draw_panel("Demos", [*rows, self.menu.footer()])

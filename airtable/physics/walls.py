@@ -134,11 +134,9 @@ def resolve_walls(
 
 def room_to_walls(pos: np.ndarray, radius: np.ndarray, size_m) -> np.ndarray:
     """Each puck's room between its edge and the nearest wall of the box [0, size_m] (m; negative:
-    past it, NaN for a NaN position)."""
-    # Column by column: numpy broadcasts an (N, 1) radius against (N, 2) rows several times slower.
-    x, y = pos[:, 0], pos[:, 1]
-    width, height = (float(size_m[0]), float(size_m[1]))
-    return np.minimum(np.minimum(x, y), np.minimum(width - x, height - y)) - radius
+    past it, NaN for a NaN position): the least of its collision.wall_rooms."""
+    left, bottom, right, top = collision.wall_rooms(pos[:, 0], pos[:, 1], radius, (float(size_m[0]), float(size_m[1])))
+    return np.minimum(np.minimum(left, bottom), np.minimum(right, top))
 
 
 def _bounce_rows(pos, vel, radius, size_m, cr_wall: float, correction: bool, out: np.ndarray) -> int:
