@@ -338,8 +338,10 @@ class _Step:
         found = neighbours.pairs_while_moving(pos, self.radius, 2.0 * self.travel)
         if found is not None:
             self.partners = neighbours.partners()
-        elif self.rules.pairs != "perfect-kiss" and not self.unlike:  # only fast pucks' hits: their partners
+        elif self.rules.pairs != "perfect-kiss":  # only fast pucks' hits (and ours_after's): their partners
             self.only_fast = self.fast_rows()
+            if self.unlike:
+                self.only_fast[self.in_unlike_overlaps(neighbours)] = True
             i, j = broadphase.pairs_near(pos, self.radius, self.only_fast.nonzero()[0], 4.0 * self.travel)
             self.partners = broadphase.Partners(i, j, len(pos))
         else:  # paths longer than the list's skin: the pairs within reach of them now
@@ -348,6 +350,17 @@ class _Step:
             near = broadphase.squared_distances(pos, i, j) < (self.radius.take(i) + self.radius.take(j) + margin) ** 2
             i, j = i.take(near.nonzero()[0]), j.take(near.nonzero()[0])
             self.partners = broadphase.Partners(i, j, len(pos))
+
+    def in_unlike_overlaps(self, neighbours) -> np.ndarray:
+        """The pucks of the pairs of unlike masses (LIKE_MASSES) that the step's end finds overlapping: those
+        whose hits may be ours though they are slow (ours_after)."""
+        pos = vectors.as_rows(self.zpos)
+        i, j, reach = neighbours.pairs(pos, self.radius)  # (the list the pair stage reads next)
+        k = (broadphase.squared_distances(pos, i, j) < reach * reach).nonzero()[0]
+        i, j = i.take(k), j.take(k)
+        m_i, m_j = self.mass.take(i), self.mass.take(j)
+        k = (np.maximum(m_i, m_j) > LIKE_MASSES * np.minimum(m_i, m_j)).nonzero()[0]
+        return np.concatenate([i.take(k), j.take(k)])
 
     def first_pairs(self) -> tuple[np.ndarray, np.ndarray]:
         """The pairs that on their first paths may touch during the step, approaching faster than they rest."""
