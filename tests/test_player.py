@@ -914,3 +914,17 @@ def test_a_student_holding_a_puck_keeps_the_strings_end_when_the_teachers_view_c
     app.button = 0  # not holding: the pointer is where the mouse is, on whatever the view shows
     env.zoom_about((900, 500), 2.5)
     np.testing.assert_allclose(app._pointer_on_the_table(env), env.to_world(np.array(pointer[0], dtype=float)))
+
+
+def test_a_slow_join_says_so_on_the_terminal_before_the_window_opens(cleanup):
+    """A user test: through an outage at the join, nothing showed for 8 s (the window opens once the first
+    handshake ends). A join that takes over a second says so at once; a quick refusal prints nothing more."""
+    silent = socket.create_server(("127.0.0.1", 0))  # accepts (the kernel does), never answers
+    cleanup(silent.close)
+    port = silent.getsockname()[1]
+    args = [f"127.0.0.1:{port}", "--headless", "--seconds", "0.2"]
+    code = f"import sys; from airtable.client_cli import main; sys.exit(main({args!r}))"
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
+    lines = out.stdout.splitlines()
+    assert lines and lines[0] == f"airtable-client: joining the table at 127.0.0.1:{port}...", out
+    assert "has not answered within" in out.stdout, out

@@ -7,12 +7,17 @@ import argparse
 import math
 import os
 import sys
+import threading
 from collections.abc import Sequence
 
 from airtable.arguments import OneLineParser
 from airtable.net import protocol as proto
 from airtable.net.player import NetPlayer, PlayerError
 from airtable.student.window import PlayerApp
+
+# A join that takes longer than this (s) says so on the terminal: the window opens only once the first
+# handshake has ended (answered, refused or timed out), which on a slow link takes seconds.
+JOIN_NOTICE_S = 1.0
 
 
 def _parse_args(argv: Sequence[str] | None) -> argparse.Namespace:
@@ -42,6 +47,10 @@ def main(argv: Sequence[str] | None = None) -> int:
         print(f"airtable-client: {e}", file=sys.stderr)
         return 2  # a bad argument, as argparse's own refusals
     net = NetPlayer(host, port, name=name, password=args.password)
+    saying = f"airtable-client: joining the table at {net.address}..."
+    joining = threading.Timer(JOIN_NOTICE_S, print, [saying], {"flush": True})
+    joining.daemon = True
+    joining.start()
     try:
         welcome = net.connect()
     except PlayerError as e:
@@ -49,6 +58,8 @@ def main(argv: Sequence[str] | None = None) -> int:
         return 1
     except KeyboardInterrupt:
         return 1
+    finally:
+        joining.cancel()
     if welcome is None:
         print(f"airtable-client: {net.waiting_because} (Esc quits)")
     else:
