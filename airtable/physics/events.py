@@ -168,6 +168,8 @@ def resolve_hits(pos, vel, radius, mass, size_m, dt: float, rules: Rules, neighb
     for k in step.moving_faster_than_wall_rest(past) if past else ():
         step.predict_walls(k)
     if step.predicts_pairs():
+        if step.unlike:
+            step.find_unlike_contacts(neighbours)
         step.find_partners(neighbours)
         step.predict_pairs(*step.first_pairs())
     step.run()
@@ -207,6 +209,7 @@ class _Step:
         # In two-step with masses unlike (LIKE_MASSES), slow hits may be this stage's too (ours_after).
         self.unlike = rules.pairs == "two-step" and len(mass) > 0
         self.unlike = self.unlike and float(mass.max()) > LIKE_MASSES * float(mass.min())
+        self.in_unlike_contact: np.ndarray | None = None  # per puck (find_unlike_contacts)
         # The pairs found hold every pair that can meet while each path stays within `covered`
         # of its puck's step end; `reach_out` is the farthest any present path strays.
         self.covered = self.reach_out = 2.0 * self.travel
@@ -318,8 +321,10 @@ class _Step:
         """Whether the step's end catches the pair (a, b) overlapping and approaching (two-step's case)
         and its hit is yet this stage's, to come in its order (rows, or arrays of rows): the pair
         stage's correction moves each puck its mass share of it, so a puck much lighter than its partner
-        (LIKE_MASSES) is moved nearly all of it, into its next neighbour; and a hit that leaves a puck
-        moving FAST_FRACTION of the smallest radius a step may send it through its next neighbour."""
+        (LIKE_MASSES) is moved nearly all of it, into its next neighbour (and light pucks in contact with
+        an unlike pair, squeezed between heavy ones, were moved back and forth between this stage and
+        that one); and a hit that leaves a puck moving FAST_FRACTION of the smallest radius a step may
+        send it through its next neighbour."""
         va, vb = either.take(self.zvel, a), either.take(self.zvel, b)
         end = self.at(a, self.dt) - self.at(b, self.dt)
         caught, _, _ = _caught_overlapping(end, va - vb, either.take(self.radius, a) + either.take(self.radius, b))
@@ -330,6 +335,8 @@ class _Step:
         new_a, new_b = collision.collide_along(n, va, vb, ma, mb, self.rules.cr_puck)
         speed_sq = either.maximum(vectors.squared_abs(new_a), vectors.squared_abs(new_b))
         unlike = either.maximum(ma, mb) > LIKE_MASSES * either.minimum(ma, mb)
+        if self.in_unlike_contact is not None:  # (a like pair squeezed between heavy pucks: the squeeze is ours)
+            unlike = unlike | either.take(self.in_unlike_contact, a) | either.take(self.in_unlike_contact, b)
         return caught & (unlike | _moves(speed_sq, self.r_min, self.dt, FAST_FRACTION))
 
     def find_partners(self, neighbours) -> None:
@@ -340,8 +347,8 @@ class _Step:
             self.partners = neighbours.partners()
         elif self.rules.pairs != "perfect-kiss":  # only fast pucks' hits (and ours_after's): their partners
             self.only_fast = self.fast_rows()
-            if self.unlike:
-                self.only_fast[self.in_unlike_overlaps(neighbours)] = True
+            if self.in_unlike_contact is not None:
+                self.only_fast |= self.in_unlike_contact
             i, j = broadphase.pairs_near(pos, self.radius, self.only_fast.nonzero()[0], 4.0 * self.travel)
             self.partners = broadphase.Partners(i, j, len(pos))
         else:  # paths longer than the list's skin: the pairs within reach of them now
@@ -351,16 +358,17 @@ class _Step:
             i, j = i.take(near.nonzero()[0]), j.take(near.nonzero()[0])
             self.partners = broadphase.Partners(i, j, len(pos))
 
-    def in_unlike_overlaps(self, neighbours) -> np.ndarray:
-        """The pucks of the pairs of unlike masses (LIKE_MASSES) that the step's end finds overlapping: those
-        whose hits may be ours though they are slow (ours_after)."""
+    def find_unlike_contacts(self, neighbours) -> None:
+        """Mark the pucks of the pairs of unlike masses (LIKE_MASSES) that touch or overlap at the step's end:
+        their hits, and those of the pairs they are in, may be ours though slow (ours_after)."""
         pos = vectors.as_rows(self.zpos)
         i, j, reach = neighbours.pairs(pos, self.radius)  # (the list the pair stage reads next)
-        k = (broadphase.squared_distances(pos, i, j) < reach * reach).nonzero()[0]
+        k = (broadphase.squared_distances(pos, i, j) <= (reach * (1.0 + 1e-9)) ** 2).nonzero()[0]
         i, j = i.take(k), j.take(k)
         m_i, m_j = self.mass.take(i), self.mass.take(j)
         k = (np.maximum(m_i, m_j) > LIKE_MASSES * np.minimum(m_i, m_j)).nonzero()[0]
-        return np.concatenate([i.take(k), j.take(k)])
+        self.in_unlike_contact = np.zeros(len(pos), dtype=bool)
+        self.in_unlike_contact[i.take(k)] = self.in_unlike_contact[j.take(k)] = True
 
     def first_pairs(self) -> tuple[np.ndarray, np.ndarray]:
         """The pairs that on their first paths may touch during the step, approaching faster than they rest."""
