@@ -21,7 +21,8 @@ that pressed on each other in the last step (the contact stage holds those).
 Outside perfect kiss only fast pairs' hits are predicted (a puck of the pair
 moving FAST_FRACTION of the smaller one's radius in a step: it could pass
 through the small one, or knock it through a third) and, in two-step, those of
-unlike pucks and those that make a puck fast (Step.ours_after); the pair
+unlike pucks, of pucks touching them and those that make a puck fast
+(Step.ours_after); the pair
 stage sees the others overlapping. Of those, a hit the step's end would catch
 overlapping and approaching is left to the pair stage too, which resolves it
 the course's way (two-step: backed up t_p = overlap / normal speed along the
@@ -207,8 +208,8 @@ class _Step:
         self.travel = speed * dt  # the farthest any puck moves this step on its first path (m)
         self.r_min = float(radius.min()) if len(radius) else 0.0
         # In two-step with masses unlike (LIKE_MASSES), slow hits may be this stage's too (ours_after).
-        self.unlike = rules.pairs == "two-step" and len(mass) > 0
-        self.unlike = self.unlike and float(mass.max()) > LIKE_MASSES * float(mass.min())
+        m_min, m_max = (float(mass.min()), float(mass.max())) if len(mass) else (0.0, 0.0)
+        self.unlike = rules.pairs == "two-step" and m_max > LIKE_MASSES * m_min
         self.in_unlike_contact: np.ndarray | None = None  # per puck (find_unlike_contacts)
         # The pairs found hold every pair that can meet while each path stays within `covered`
         # of its puck's step end; `reach_out` is the farthest any present path strays.
@@ -286,7 +287,8 @@ class _Step:
 
     def predicts_pairs(self) -> bool:
         """Whether any pair hit is this stage's: in perfect kiss every one; in the other modes only
-        those of fast pucks (a gas whose pucks all move under FAST_FRACTION of their radius has none)."""
+        those of fast pucks (a gas whose pucks all move under FAST_FRACTION of their radius has none)
+        and, in two-step among unlike masses, those of ours_after."""
         if self.rules.pairs == "perfect-kiss":
             return True
         if self.rules.pairs == "none":
