@@ -361,16 +361,24 @@ class _Step:
             self.partners = broadphase.Partners(i, j, len(pos))
 
     def find_unlike_contacts(self, neighbours) -> None:
-        """Mark the pucks of the pairs of unlike masses (LIKE_MASSES) that touch or overlap at the step's end:
-        their hits, and those of the pairs they are in, may be ours though slow (ours_after)."""
+        """Mark the pucks of every cluster of touching (or overlapping) pucks at the step's end that holds a
+        pair of unlike masses (LIKE_MASSES): their hits may be ours though slow (ours_after). (Light pucks
+        squeezed between heavy ones: the heavy pairs' hits here and the light ones' in the pair stage
+        undid each other every step.)"""
         pos = vectors.as_rows(self.zpos)
         i, j, reach = neighbours.pairs(pos, self.radius)  # (the list the pair stage reads next)
         k = (broadphase.squared_distances(pos, i, j) <= (reach * (1.0 + 1e-9)) ** 2).nonzero()[0]
         i, j = i.take(k), j.take(k)
         m_i, m_j = self.mass.take(i), self.mass.take(j)
-        k = (np.maximum(m_i, m_j) > LIKE_MASSES * np.minimum(m_i, m_j)).nonzero()[0]
-        self.in_unlike_contact = np.zeros(len(pos), dtype=bool)
-        self.in_unlike_contact[i.take(k)] = self.in_unlike_contact[j.take(k)] = True
+        unlike = (np.maximum(m_i, m_j) > LIKE_MASSES * np.minimum(m_i, m_j)).nonzero()[0]
+        cluster = np.arange(len(pos))  # each puck's cluster: the least row it reaches through touching pairs
+        for _ in range(len(pos)):  # (bounded: each pass carries the least row one pair further)
+            least = np.minimum(cluster.take(i), cluster.take(j))
+            if not np.count_nonzero((least != cluster.take(i)) | (least != cluster.take(j))):
+                break
+            np.minimum.at(cluster, i, least)
+            np.minimum.at(cluster, j, least)
+        self.in_unlike_contact = np.isin(cluster, cluster.take(i.take(unlike)))
 
     def first_pairs(self) -> tuple[np.ndarray, np.ndarray]:
         """The pairs that on their first paths may touch during the step, approaching faster than they rest."""
