@@ -715,7 +715,6 @@ class _Step:
             return ()  # (b does not push a into the wall: a, sliding along it into b, hits it as any puck)
         return va, vb - (1.0 + self.rules.cr_wall) * towards * n
 
-
     def held_on_wall(self, a: int, b: int, n: complex) -> complex | None:
         """The normal of a wall puck a rests on (the contacts held it there in the last step: its wall rest
         speed is infinite) that b, much heavier (LIKE_MASSES), pushes it into along n; else None. Such a
