@@ -323,10 +323,10 @@ class _Step:
         """Whether the step's end catches the pair (a, b) overlapping and approaching (two-step's case)
         and its hit is yet this stage's, to come in its order (rows, or arrays of rows): the pair
         stage's correction moves each puck its mass share of it, so a puck much lighter than its partner
-        (LIKE_MASSES) is moved nearly all of it, into its next neighbour (and light pucks in contact with
-        an unlike pair, squeezed between heavy ones, were moved back and forth between this stage and
-        that one); and a hit that leaves a puck moving FAST_FRACTION of the smallest radius a step may
-        send it through its next neighbour."""
+        (LIKE_MASSES) is moved nearly all of it, into its next neighbour (and light pucks in a cluster
+        with an unlike pair, squeezed between heavy ones, were moved back and forth between this stage
+        and that one: find_unlike_contacts); and a hit that leaves a puck moving FAST_FRACTION of the
+        smallest radius a step may send it through its next neighbour."""
         va, vb = either.take(self.zvel, a), either.take(self.zvel, b)
         end = self.at(a, self.dt) - self.at(b, self.dt)
         caught, _, _ = _caught_overlapping(end, va - vb, either.take(self.radius, a) + either.take(self.radius, b))
