@@ -202,8 +202,8 @@ class NetPlayer:
     @property
     def banner_text(self) -> str | None:
         """A line across the window while the player cannot play, else None."""
-        wait = max(0, math.ceil(self.next_try - time.monotonic()))
         now = time.monotonic()
+        wait = max(0, math.ceil(self.next_try - now))
         if self.state == PlayerState.RETRYING:
             since = f" ({now - self.lost_s:.0f} s)" if self.lost_s is not None and now - self.lost_s >= 1.0 else ""
             return (self.waiting_because or RECONNECTING) + since

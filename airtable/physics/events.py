@@ -208,8 +208,7 @@ class _Step:
         self.travel = speed * dt  # the farthest any puck moves this step on its first path (m)
         self.r_min = float(radius.min()) if len(radius) else 0.0
         # In two-step with masses unlike (LIKE_MASSES), slow hits may be this stage's too (ours_after).
-        m_min, m_max = (float(mass.min()), float(mass.max())) if len(mass) else (0.0, 0.0)
-        self.unlike = rules.pairs == "two-step" and m_max > LIKE_MASSES * m_min
+        self.unlike = rules.pairs == "two-step" and len(mass) > 0 and _unlike(float(mass.min()), float(mass.max()))
         self.in_unlike_contact: np.ndarray | None = None  # per puck (find_unlike_contacts)
         # The pairs found hold every pair that can meet while each path stays within `covered`
         # of its puck's step end; `reach_out` is the farthest any present path strays.
@@ -336,7 +335,7 @@ class _Step:
         n = end / either.where(caught, vectors.length(end), 1.0)
         new_a, new_b = collision.collide_along(n, va, vb, ma, mb, self.rules.cr_puck)
         speed_sq = either.maximum(vectors.squared_abs(new_a), vectors.squared_abs(new_b))
-        unlike = either.maximum(ma, mb) > LIKE_MASSES * either.minimum(ma, mb)
+        unlike = _unlike(ma, mb)
         if self.in_unlike_contact is not None:  # (a like pair squeezed between heavy pucks: the squeeze is ours)
             unlike = unlike | either.take(self.in_unlike_contact, a) | either.take(self.in_unlike_contact, b)
         return caught & (unlike | _moves(speed_sq, self.r_min, self.dt, FAST_FRACTION))
@@ -369,8 +368,7 @@ class _Step:
         i, j, reach = neighbours.pairs(pos, self.radius)  # (the list the pair stage reads next)
         k = (broadphase.squared_distances(pos, i, j) <= (reach * (1.0 + 1e-9)) ** 2).nonzero()[0]
         i, j = i.take(k), j.take(k)
-        m_i, m_j = self.mass.take(i), self.mass.take(j)
-        unlike = (np.maximum(m_i, m_j) > LIKE_MASSES * np.minimum(m_i, m_j)).nonzero()[0]
+        unlike = _unlike(self.mass.take(i), self.mass.take(j)).nonzero()[0]
         cluster = np.arange(len(pos))  # each puck's cluster: the least row it reaches through touching pairs
         for _ in range(len(pos)):  # (bounded: each pass carries the least row one pair further)
             least = np.minimum(cluster.take(i), cluster.take(j))
@@ -749,6 +747,11 @@ def _held(held: Callable[[np.ndarray, np.ndarray], np.ndarray], a, b):
     if isinstance(a, np.ndarray):
         return held(np.minimum(a, b), np.maximum(a, b))
     return bool(held(np.array([min(a, b)]), np.array([max(a, b)])).item(0))
+
+
+def _unlike(m1, m2):
+    """Whether masses m1 and m2 differ by over LIKE_MASSES times (numbers, or arrays of them)."""
+    return either.maximum(m1, m2) > LIKE_MASSES * either.minimum(m1, m2)
 
 
 def _in_time(t, t_now, dt: float):
