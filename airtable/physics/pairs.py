@@ -148,18 +148,13 @@ def disjoint_rounds(i: np.ndarray, j: np.ndarray, since=None, shared: np.ndarray
     # A pair whose pucks are in no other pair can go in any round: the first.
     # For the others, level[k] = how many earlier pairs form a chain into
     # pair k. One pass in Python over just those, a handful per step.
-    ks = shared.tolist()
     if since is not None:  # the earliest contact first (a stable sort: ties keep the pairs' order)
-        t = since(shared).tolist()
-        ks = [ks[x] for x in sorted(range(len(ks)), key=lambda x: -t[x])]
-    later: dict[int, list[int]] = {}  # the pairs of each round after the first
-    for k, level in zip(ks, _chain_levels([i.item(k) for k in ks], [j.item(k) for k in ks])):
-        if level:
-            later.setdefault(level, []).append(k)
-    first = np.ones(m, dtype=bool)
-    first[[k for ks in later.values() for k in ks]] = False
-    # Each round in the pairs' order (what sorting by round, keeping the order, gives).
-    return [first.nonzero()[0]] + [np.array(sorted(later[r]), dtype=np.intp) for r in range(1, len(later) + 1)]
+        shared = shared.take(np.argsort(-since(shared), kind="stable"))
+    level = np.zeros(m, dtype=np.intp)
+    level[shared] = _chain_levels(i.take(shared).tolist(), j.take(shared).tolist())
+    # Each round in the pairs' order: a stable sort by round.
+    by_round, ends = np.argsort(level, kind="stable"), np.cumsum(np.bincount(level)).tolist()
+    return [by_round[start:end] for start, end in zip([0, *ends], ends)]
 
 
 def _chain_levels(i: list[int], j: list[int]) -> list[int]:
@@ -167,7 +162,8 @@ def _chain_levels(i: list[int], j: list[int]) -> list[int]:
     busy_until: dict[int, int] = {}  # per puck: first level at which it is free again
     levels = []
     for a, b in zip(i, j, strict=True):
-        lvl = max(busy_until.get(a, 0), busy_until.get(b, 0))
+        la, lb = busy_until.get(a, 0), busy_until.get(b, 0)
+        lvl = la if la > lb else lb
         levels.append(lvl)
         busy_until[a] = busy_until[b] = lvl + 1
     return levels
