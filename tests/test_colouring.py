@@ -133,6 +133,52 @@ def test_the_order_looked_at_where_it_can_break_is_the_order_looked_at_everywher
         assert everywhere is now  # nothing changed: still in order
 
 
+def _fit_in_passes(rounds: np.ndarray, a: np.ndarray, b: np.ndarray, band: np.ndarray) -> np.ndarray:
+    """The colouring as its docstring defines it, in passes, written out plainly: in each pass, every
+    new contact whose priority is the lowest among the new contacts left at each of its bodies (the
+    sink aside) takes the first round free at both bodies, after their rounds of lower bands."""
+    rounds = rounds.copy()
+    left = [int(k) for k in np.flatnonzero(rounds < 0)]
+    prio = {k: int(colouring.priorities(np.array([k]), band)[0]) for k in left}
+    for _ in range(len(left)):  # (each pass takes at least the lowest priority left)
+        if not left:
+            break
+
+        def bodies(k: int) -> list[int]:
+            return [int(x) for x in (a[k], b[k]) if x != SINK]
+
+        first = [k for k in left if all(prio[k] <= min(prio[o] for o in left if x in bodies(o)) for x in bodies(k))]
+        for k in first:
+            at = [o for o in range(len(a)) if rounds[o] >= 0 and set(bodies(o)) & set(bodies(k))]
+            after = max([rounds[o] + 1 for o in at if band[o] < band[k]], default=0)
+            busy = {int(rounds[o]) for o in at}
+            rounds[k] = next(r for r in range(after, after + len(a) + 1) if r not in busy)
+        left = [k for k in left if k not in first]
+    used = np.flatnonzero(np.bincount(rounds))
+    return np.searchsorted(used, rounds)  # the empty rounds dropped
+
+
+@settings(max_examples=200, deadline=None)
+@given(contact_graphs(), st.data())
+def test_contacts_fitted_one_by_one_take_the_rounds_the_passes_give(graph, data) -> None:
+    a, b, band = graph
+    rounds = colouring.fit(np.full(len(a), -1), a, b, SINK, band)
+    new = np.array(data.draw(st.lists(st.booleans(), min_size=len(a), max_size=len(a))))
+    for start in (np.full(len(a), -1), np.where(new, -1, rounds)):
+        np.testing.assert_array_equal(colouring.fit(start, a, b, SINK, band), _fit_in_passes(start, a, b, band))
+
+
+def test_a_heap_of_pucks_all_touching_is_coloured_as_few_rounds_as_a_body_needs_and_at_most_twice() -> None:
+    # 40 pucks dropped on one spot: each touches the 39 others. A body with 39 contacts needs 39
+    # rounds; greedy needs at most 2 * 39 - 1.
+    a, b = (x.astype(np.intp) for x in np.triu_indices(40, k=1))
+    rounds = colouring.fit(np.full(len(a), -1), a, b, 40)
+    for r in range(rounds.max() + 1):
+        bodies = np.concatenate([a[rounds == r], b[rounds == r]])
+        assert len(bodies) == len(set(bodies.tolist()))
+    assert 39 <= rounds.max() + 1 <= 77
+
+
 def test_a_woken_body_splits_a_round_it_appeared_twice_in() -> None:
     # Contacts 0 and 1 share body 5, which slept (the sink stood for it): in one round then. Awake,
     # it is a body again: keep() sends the later contact back to be fitted in.

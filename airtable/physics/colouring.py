@@ -31,7 +31,6 @@ import numpy as np
 # Knuth's multiplicative hash: odd, so it maps 0 .. 2^32 - 1 onto themselves one to one.
 _GOLDEN = np.uint64(0x9E3779B1)
 _LOW_32 = np.uint64((1 << 32) - 1)
-_NONE = np.iinfo(np.uint64).max
 
 
 def priorities(contacts: np.ndarray, band: np.ndarray | None = None) -> np.ndarray:
@@ -98,68 +97,55 @@ def keep_order(rounds: np.ndarray, a: np.ndarray, b: np.ndarray, sink: int, band
 def fit(rounds: np.ndarray, a: np.ndarray, b: np.ndarray, sink: int, band=None) -> np.ndarray:
     """Rounds for every contact: the kept ones (rounds >= 0) stay, the new ones (-1) are fitted in.
 
-    The new contacts are taken in passes: in each, those first by `priorities` (lowest first)
-    among the remaining new contacts of both their bodies, which share no body, each take the
-    first round free at both their bodies and after every round where one of them has a
-    contact of a lower `band` (None: all in one band). Empty rounds are dropped.
+    The new contacts are taken one by one by `priorities` (lowest first); each takes the first
+    round free at both its bodies and after every round where one of them has a contact of a
+    lower `band` (None: all in one band). Empty rounds are dropped. (Taken in passes, each of the
+    contacts first at both their bodies, all at once, gives the same rounds: a contact sees the
+    same contacts before it. In a heap of pucks dropped on one spot, every puck touching every
+    other, those passes cost the number of pucks times the contacts; this costs the contacts.)
     """
     new = np.flatnonzero(rounds < 0)
     if len(new) == 0:
         return _dense(rounds)
     band = np.zeros(len(rounds), dtype=np.int16) if band is None else band
     rounds = rounds.copy()
-    taken = _taken(rounds, a, b, sink, band, new)
-    while len(new):
-        pick = _first_by_priority(new, a, b, sink, priorities(new, band))
-        k = new.take(np.flatnonzero(pick))
-        taken, r = _first_free(taken, a.take(k), b.take(k), band.take(k))
+    new = new.take(np.argsort(priorities(new, band)))  # (distinct priorities: no ties)
+    used, lower = _taken(rounds, a, b, sink, band, new)
+    for k, x, y, level in zip(new.tolist(), a.take(new).tolist(), b.take(new).tolist(), band.take(new).tolist()):
+        after = 0  # the first round after every round of a contact of a lower band at x or y
+        for marks in (lower.get(x), lower.get(y)):
+            for other, last in (marks or {}).items():
+                if other < level and last >= after:
+                    after = last + 1
+        busy = used.get(x, 0) | used.get(y, 0) | ((1 << after) - 1)
+        r = (~busy & (busy + 1)).bit_length() - 1  # the lowest round not busy
         rounds[k] = r
-        taken[a.take(k), r] = taken[b.take(k), r] = band.take(k) + 1
-        taken[sink] = 0
-        new = new.take(np.flatnonzero(~pick))
+        _take(used, lower, sink, x, r, level)
+        _take(used, lower, sink, y, r, level)
     return _dense(rounds)
 
 
-def _taken(rounds, a, b, sink: int, band, new: np.ndarray) -> np.ndarray:
-    """(bodies, rounds + room) the band + 1 of each body's contact in each round (0: free), for
-    the bodies of the `new` contacts (the others are not asked about)."""
+def _taken(rounds, a, b, sink: int, band, new: np.ndarray) -> tuple[dict, dict]:
+    """For the bodies of the `new` contacts (the others are not asked about) but the sink: each
+    one's rounds taken by its kept contacts, as bits of a number, and the latest of them per band."""
     asked = np.zeros(sink + 1, dtype=bool)
     asked[a.take(new)] = asked[b.take(new)] = True
     asked[sink] = False
     old = np.flatnonzero((asked.take(a) | asked.take(b)) & (rounds >= 0))
-    width = int(rounds.max()) + 9  # room for 8 more rounds, and more if they fill (_first_free)
-    taken = np.zeros((sink + 1, width), dtype=np.int16)
-    r, mark = rounds.take(old), band.take(old) + 1
-    flat = taken.reshape(-1)  # a view: one-dimensional indices are cheaper than pairs of them
-    flat[a.take(old) * width + r] = mark
-    flat[b.take(old) * width + r] = mark
-    taken[sink] = 0
-    return taken
+    used: dict[int, int] = {}
+    lower: dict[int, dict[int, int]] = {}
+    bodies = np.concatenate([a.take(old), b.take(old)]).tolist()
+    for body, r, level in zip(bodies, rounds.take(old).tolist() * 2, band.take(old).tolist() * 2, strict=True):
+        _take(used, lower, sink, body, r, level)
+    return used, lower
 
 
-def _first_by_priority(new, a, b, sink: int, p) -> np.ndarray:
-    """Which of the `new` contacts come first by their priorities p among the new contacts of both their bodies."""
-    ra, rb = a.take(new), b.take(new)
-    best = np.full(sink + 1, _NONE, dtype=np.uint64)
-    np.minimum.at(best, ra, p)
-    np.minimum.at(best, rb, p)
-    best[sink] = 0  # the sink is never taken: a contact on it is first there
-    return ((best.take(ra) == p) | (ra == sink)) & ((best.take(rb) == p) | (rb == sink))
-
-
-def _first_free(taken, a, b, band) -> tuple[np.ndarray, np.ndarray]:
-    """For contacts sharing no body: the first round free at both bodies and after their bodies'
-    rounds of a lower band (widening `taken` if some have none); return taken and the rounds."""
-    ta, tb = taken.take(a, axis=0), taken.take(b, axis=0)
-    level = band[:, None]
-    lower = ((ta > 0) & (ta <= level)) | ((tb > 0) & (tb <= level))
-    width = taken.shape[1]
-    after = np.where(lower.any(axis=1), width - np.argmax(lower[:, ::-1], axis=1), 0)
-    free = (ta == 0) & (tb == 0) & (np.arange(width) >= after[:, None])
-    if not free.any(axis=1).all():  # no room left in some row: twice as many rounds, and again
-        wider = np.hstack([taken, np.zeros_like(taken)])
-        return _first_free(wider, a, b, band)
-    return taken, np.argmax(free, axis=1)
+def _take(used: dict, lower: dict, sink: int, body: int, r: int, level: int) -> None:
+    """Round r is taken at `body` by a contact of band `level` (the sink is never taken)."""
+    if body != sink:
+        used[body] = used.get(body, 0) | (1 << r)
+        marks = lower.setdefault(body, {})
+        marks[level] = max(marks.get(level, -1), r)
 
 
 def _dense(rounds: np.ndarray) -> np.ndarray:
