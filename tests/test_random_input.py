@@ -16,7 +16,8 @@ from hypothesis import strategies as st
 from airtable.app.app import App
 
 # Every key a hand may hit but Esc (Esc, a pause, Esc quits on purpose: tests/test_overlays.py) and
-# Right (it climbs to the 10000-puck variations: right, but too slow for a test of many frames).
+# Right (it climbs to the 10000-puck variations: right, but too slow for a test of many frames);
+# Ctrl+Q and Ctrl+W quit on purpose too (asking first only if something would be lost): see `key`.
 KEYS = (
     *(getattr(pygame, f"K_{c}") for c in "abcdefghijklmnopqrstuvwxyz0123456789"),
     *(getattr(pygame, f"K_F{n}") for n in range(1, 13)),
@@ -37,7 +38,7 @@ key = st.builds(
     st.sampled_from(KEYS),
     st.sampled_from(MODS),
     st.sampled_from(("", *TEXT)),
-)
+).filter(lambda events: not (events[0].key in (pygame.K_q, pygame.K_w) and events[0].mod & pygame.KMOD_CTRL))
 held_key = st.builds(  # pressed in one frame, let go some frames later (zoom, inspect, hands off)
     lambda k: [pygame.event.Event(pygame.KEYDOWN, key=k, mod=0, unicode="", scancode=0)],
     st.sampled_from((pygame.K_h, pygame.K_n, pygame.K_i, pygame.K_LCTRL)),

@@ -194,7 +194,8 @@ class Panels(Feature):
         Binding("F1", "this help screen (again: next page); F2-F5: the room", {pygame.K_F1: toggle_help}),
         Binding(
             "Esc",
-            "close what is open (the newest first); else asks: Esc again quits. Ctrl+Q / Ctrl+W: quit (asking first)",
+            "close what is open (the newest first); else asks: Esc again quits. Ctrl+Q / Ctrl+W: quit "
+            "(asking first if students or an unexported recording would be lost)",
             {
                 pygame.K_ESCAPE: escape,
                 (pygame.KMOD_CTRL, pygame.K_q): close_window,
