@@ -60,8 +60,10 @@ def test_pressing_a_demo_key_reads_its_file_again_after_an_edit(tmp_path, capsys
     assert f"{mine}:3: syntax error" in capsys.readouterr().err
 
     press(app, pygame.K_6)
-    press(app, pygame.K_5)  # from another demo, too: the error, not the built-in 5
-    assert app.panels.panel() == "error" and len(app.table.pucks) == 0
+    triangle = app.table.pos_m.copy()
+    press(app, pygame.K_5)  # from another demo, too: the error, not the built-in 5, over the table that ran
+    assert app.panels.panel() == "error" and np.array_equal(app.table.pos_m, triangle)
+    assert app.demo_key == "6" and app.caption() == f"Demo 5: mine.py (does not load: {app.demo.label(0)} goes on)"
     mine.write_text(demo_source("5", pucks=4, build_line=RAISES))
     press(app, pygame.K_5)
     assert app.build_error is not None and app.build_error.stage == "build"
@@ -70,6 +72,24 @@ def test_pressing_a_demo_key_reads_its_file_again_after_an_edit(tmp_path, capsys
     mine.write_text(demo_source("5", pucks=4))  # fixed: the next press builds it
     press(app, pygame.K_5)
     assert app.build_error is None and app.panels.panel() is None and len(app.table.pucks) == 4
+
+
+def test_a_demo_that_fails_to_build_leaves_the_lesson_s_table_and_ctrl_s_saves_that_under_its_title(tmp_path):
+    """A user test: Jelly ran, a demo file whose build raises was picked: the error, then an empty table;
+    after a failed load, Ctrl+S saved the jelly titled "Five pucks" (the first demo)."""
+    (tmp_path / "s1.py").write_text(demo_source("s1", pucks=4, build_line=RAISES))
+    (tmp_path / "s2.py").write_text(demo_source("s2"))
+    app = make_app(tmp_path, key="6p")
+    (tmp_path / "s2.py").write_text(SYNTAX_ERROR.replace("'5'", "'s2'"))  # broken while the app runs
+    jelly, title, label = len(app.table.pucks), app.demo.title, app.demo.label(app.variation)
+    for broken in ("s1", "s2"):
+        app.start_demo(broken)
+        assert app.panels.panel() == "error" and len(app.table.pucks) == jelly and f"{label} goes on" in app.caption()
+        assert f"Demo {broken} could not be" in app.panels._error_text()[0]
+        press(app, pygame.K_ESCAPE)
+    saved = app.lessons.save_moment(tmp_path / "saved.py")
+    text = saved.read_text()
+    assert f"TITLE = '{title}, saved at t = " in text and f"Saved from {label} at" in text and "Five pucks" not in text
 
 
 def test_a_demo_file_broken_while_it_runs_stays_in_the_menu_and_the_heading_says_what_failed(tmp_path):
@@ -94,7 +114,8 @@ def test_a_demo_file_broken_while_it_runs_stays_in_the_menu_and_the_heading_says
     theirs.write_text(demo_source("8", pucks=2, build_line=RAISES))
     press(app, pygame.K_8)
     press(app, pygame.K_ESCAPE)
-    assert app.caption() == "Demo 8: Mine (not built)"  # not the built-in 8's title
+    # Not the built-in 8's title; s1's run goes on (its file is still broken: it ran as loaded before).
+    assert app.caption() == "Demo 8: Mine (not built: Demo s1: Mine goes on)" and len(app.table.pucks) == 2
     press(app, pygame.K_1)
     assert app.caption().startswith("Demo 1: ")
 

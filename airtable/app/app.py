@@ -156,7 +156,9 @@ class App:
         self.last_input_s = 0.0  # clock_s of the last input, local or a student's
         self._students_seen: tuple = ()  # the students' cursors when last looked at
         self.loop: IdlingLoop | None = None  # while run() runs
-        self.demo_key = ""
+        self.demo_key = ""  # the demo on the table
+        self.running_demo: Demo | None = None  # the demo whose run is on the table (its file may be broken since)
+        self.error_key = ""  # the demo whose start failed last (the error panel's), while build_error is set
         self.failed_start: str | None = None  # the heading while the demo last started failed (caption)
         self.demo_path: Path | None = None
         self.variation = 0
@@ -190,7 +192,7 @@ class App:
 
     @property
     def demo(self) -> Demo:
-        return self.demos.get(self.demo_key) or next(iter(self.demos.values()))
+        return self.demos.get(self.demo_key) or self.running_demo or next(iter(self.demos.values()))
 
     @property
     def dt_s(self) -> float:
@@ -218,9 +220,11 @@ class App:
         demo = self.demos.get(key) if broken is None else None
         if self.build_error is not None:
             self.paused = False  # the pause came with the error; a new start runs
-        # Its own key again with its file broken meanwhile: the table that ran stays while the file is mended.
-        running = state.capture(self.table) if key == self.demo_key and self.failed_start is None else None
-        self.demo_key, self.demo_path = key, (demo.path if demo else broken.path)
+        # A demo that fails to load or build leaves the table that ran, whichever demo it was (a user test:
+        # the lesson's table emptied), and the app goes on as that demo (Ctrl+S saves it under its title).
+        ran = (self.demo_key, self.demo_path, self.variation) if self.running_demo is not None else None
+        running = state.capture(self.table) if ran is not None else None
+        self.demo_key, self.demo_path, self.error_key = key, (demo.path if demo else broken.path), key
         if variation is None:
             variation = demo.default_variation if demo else 0
         self.variation = variation % len(demo.variations) if demo and demo.variations else 0
@@ -232,11 +236,17 @@ class App:
             except Exception as exc:  # a teacher's demo may fail in any way; the app goes on
                 self._demo_failed(exc, "build")
                 self.table.clear()
-        if self.build_error is not None and running is not None:
-            state.restore(self.table, running)
+        if self.build_error is None:
+            self.running_demo = demo
         # The heading names what failed until another start, also once Esc hid the error (it named the
         # built-in demo whose key the broken file had taken, over an empty table).
-        self.failed_start = None if self.build_error is None else self._failed_caption(demo, running is not None)
+        self.failed_start = None if self.build_error is None else self._failed_caption(demo, ran)
+        if self.build_error is not None and running is not None:
+            state.restore(self.table, running)
+            self.demo_key, self.demo_path, self.variation = ran
+            demo = self.demo
+        elif self.build_error is not None:
+            self.running_demo = None  # an empty table
         self.stepper.reset(demo.dt_s if demo else self.stepper.dt_s)
         self.aids.trails = demo.trails if demo else False
         for feature in self.features:
@@ -258,10 +268,15 @@ class App:
     def caption(self) -> str:
         return self.failed_start or self.demo.label(self.variation)
 
-    def _failed_caption(self, demo: Demo | None, runs_on: bool) -> str:
-        on = ": its last run goes on" if runs_on else ""
+    def _failed_caption(self, demo: Demo | None, ran: tuple | None) -> str:
+        """The heading after a failed start; `ran`: (key, path, variation) of the demo whose run goes on."""
+        on = ""
+        if ran is not None:
+            on = (
+                ": its last run goes on" if ran[0] == self.error_key else f": {self.running_demo.label(ran[2])} goes on"
+            )
         if self.build_error.stage == "load" or demo is None:
-            return f"Demo {key_label(self.demo_key)}: {self.build_error.path.name} (does not load{on})"
+            return f"Demo {key_label(self.error_key)}: {self.build_error.path.name} (does not load{on})"
         return f"{demo.label(self.variation)} (not built{on})"
 
     def next_variation(self, step: int) -> None:

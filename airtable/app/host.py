@@ -30,7 +30,8 @@ class Host(Protocol):
     local: Client
     server: object | None  # the GameServer, None without one (--no-server)
     shelf: DemoShelf
-    demo_key: str
+    demo_key: str  # the demo on the table
+    error_key: str  # the demo whose start failed last
     variation: int
     build_error: DemoError | None
     paused: bool

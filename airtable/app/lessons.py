@@ -233,7 +233,9 @@ class Lessons(Feature):
         key = free_key(host.demos, folder)
         target = Path(path) if path is not None else folder / f"{key}.py"
         title = f"{host.demo.title}, saved at t = {host.table.time_s:.2f} s"
-        source = demo_source(host.table, key=key, title=title, dt_s=host.dt_s, origin=f"from {host.caption()}")
+        source = demo_source(
+            host.table, key=key, title=title, dt_s=host.dt_s, origin=f"from {host.demo.label(host.variation)}"
+        )
         try:
             write_demo(target, source)
         except OSError as exc:

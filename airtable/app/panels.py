@@ -183,7 +183,7 @@ class Panels(Feature):
 
     def _error_text(self) -> tuple[str, list[str]]:
         """The demo error panel's title and lines: what failed, and how to try again."""
-        key = self.host.demo_key
+        key = self.host.error_key if self.host.build_error.stage != "event" else self.host.demo_key
         title = ERROR_TITLES[self.host.build_error.stage].format(key=key_label(key))
         again = f"press {key_label(key)} again" if has_own_key(key) else "pick it in Tab's menu"
         return title, [str(self.host.build_error), f"Fix the file, then {again}. Esc hides this."]
