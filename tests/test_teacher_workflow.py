@@ -358,3 +358,31 @@ def test_every_demo_starts_the_way_the_help_says(demos):
             digit = pygame.key.key_code(label[-1])
             press(app, digit, mod=pygame.KMOD_SHIFT if label.startswith("Shift+") else 0)
         assert app.demo_key == key, label
+
+
+def test_a_frame_whose_physics_takes_seconds_pauses_the_table_so_esc_still_quits():
+    """A user test: a demo file's typo (a puck at 1e9 m/s) or 20000 pucks made each frame's physics take
+    seconds; keys acted seconds late and Esc, Esc never quit. Now such a frame pauses the table."""
+    app = make_app(key="1")
+    clock = iter(range(0, 10**6, 2))  # seconds: every look at the clock finds 2 s gone
+    app.stepper.clock, app.stepper.budget_s = lambda: float(next(clock)), 0.01  # as in real time
+    app.stepper.reset()
+    for _ in range(3):  # (the first frame after a reset spans building the demo)
+        app.frame(FRAME_S)
+    assert app.paused and app.message.startswith("paused: one frame's physics took 4.0 s")  # (two looks)
+    t = app.table.time_s
+    app.frame(FRAME_S)
+    assert app.table.time_s == t  # no step while paused: frames are quick again
+    press(app, pygame.K_ESCAPE)
+    assert app.panels.panel() == "quit"
+    escape_again(app)
+    assert not app.running
+
+
+def test_in_simulated_frames_slow_physics_never_pauses():
+    app = make_app(key="1")
+    clock = iter(range(0, 10**6, 2))
+    app.stepper.clock = lambda: float(next(clock))  # (no budget: frames of fixed length, tests and headless runs)
+    for _ in range(3):
+        app.frame(FRAME_S)
+    assert not app.paused and app.table.time_s > 0.0

@@ -53,6 +53,8 @@ NOTICE_S = 12.0
 GRAB_WITHIN_PX = 8.0
 # Closing the window asks first when leaving would lose at least this much recording.
 UNEXPORTED_ASK_S = 2.0
+# A frame's physics that takes longer than this (s) in real time pauses the table (_pause_if_stalled).
+STALL_PAUSE_S = 1.0
 DEFAULT_FPS = 60.0  # when the display does not say its refresh rate
 MAX_FPS = 240.0
 # A still table (paused, or nothing moving) with nobody at it redraws this often,
@@ -485,6 +487,7 @@ class App:
             feature.before_physics()
         if not self.paused:
             self.stepper.run(frame_dt_s, self.speed, self.physics_step)
+            self._pause_if_stalled()
         self._say_new_notices()
         for feature in self.features:
             feature.after_physics()
@@ -507,6 +510,14 @@ class App:
         notes = (self.demo.notes or "(no notes)") if self.panels.show_notes and self.demo is not None else None
         lessons = shared_lessons(self.lessons, self.rewind.timeline_shown(), self.table, self.clients)
         return shared_aids(self.aids, self.table, self.painter, self.clock_s, notes, lessons)
+
+    def _pause_if_stalled(self) -> None:
+        """In real time, a frame whose physics took over STALL_PAUSE_S pauses the table: a demo far too heavy
+        (a typo's 1e9 m/s, 20000 pucks on top of each other) otherwise answers keys, Esc too, seconds late."""
+        took = self.stepper.last_run_s
+        if self.stepper.budget_s is not None and took > STALL_PAUSE_S:
+            self.paused = True
+            self.say(f"paused: one frame's physics took {took:.1f} s, too slow to answer keys (Space runs on)")
 
     def _say_new_notices(self) -> None:
         """Each sentence the table adds to its notices (a softened spring, say) is said once, here and on stderr."""

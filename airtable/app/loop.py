@@ -78,6 +78,7 @@ class FixedStep:
         self.clock = clock
         self._asked: deque[tuple[float, int, int]] = deque()  # (clock, steps asked, steps run) per frame
         self._ended: float | None = None  # when the last frame's steps ended (the clock's)
+        self.last_run_s = 0.0  # how long the last frame's steps took (the clock's)
 
     def reset(self, dt_s: float | None = None) -> None:
         if dt_s is not None:
@@ -100,6 +101,7 @@ class FixedStep:
             if budget is not None and self.clock() - start > budget:
                 break
         first, now = self._ended is None, self.clock()
+        self.last_run_s = now - start
         self._ended = now
         if not first:  # (the first frame after a reset spans building the demo: not the physics' pace)
             self._asked.append((now, asked, ran))
