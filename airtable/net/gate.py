@@ -61,7 +61,9 @@ class Gate:
         self.limit_loopback = limit_loopback
         self.handshakes: Counter[str] = Counter()
         self.players: Counter[str] = Counter()
-        self.turned_away: Counter[str] = Counter()  # seats refused per address, for the teacher's notice
+        # The names refused a seat per address, for the teacher's notice: a refused window asks again every
+        # few seconds, and each try counted as a student made three students read as 33 (a user test).
+        self.turned_away: dict[str, set[str]] = {}
         self._guesses: dict[str, _Guesses] = {}
         self._open = 0
 
@@ -77,14 +79,15 @@ class Gate:
             )
         return None
 
-    def seat_refusal(self, host: str, password_given: bool = False) -> str | None:
+    def seat_refusal(self, host: str, password_given: bool = False, name: str | None = None) -> str | None:
         """Why `host` may not take one more seat, or None.
 
         `password_given`: the student gave the table's password, which is the teacher's own
-        door, so a class behind one router (one address to the server) may come in."""
+        door, so a class behind one router (one address to the server) may come in. `name`: the
+        student's (None: none given), to count students, not tries."""
         if password_given or not self._limited(host) or self.players[host] < self.players_per_address:
             return None
-        self.turned_away[host] += 1
+        self.turned_away.setdefault(host, set()).add(name or "")
         return (
             f"{self.players[host]} windows from your address ({host}) play already, the most one address may "
             f"(a class behind one router counts as one computer); ask the teacher to {ALLOW_A_CLASS}"
@@ -94,12 +97,11 @@ class Gate:
         """One line for the projector and the log while students are turned away per address, else None."""
         if not self.turned_away:
             return None
-        host, count = self.turned_away.most_common(1)[0]
+        host, names = max(self.turned_away.items(), key=lambda item: len(item[1]))
+        # Nameless windows cannot be told apart (nor counted): then "students", no number.
+        who = "students" if "" in names else f"{len(names)} student{'' if len(names) == 1 else 's'}"
         # Short enough for one line of a 4:3 projector's top band.
-        return (  # the fix first: a narrow band cuts the end
-            f"start with --per-address 40: {count} student{'' if count == 1 else 's'} at {host} "
-            "could not join (a class behind one router?)"
-        )
+        return f"start with --per-address 40: {who} at {host} could not join (a class behind one router?)"
 
     @property
     def handshakes_open(self) -> int:

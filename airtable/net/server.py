@@ -852,7 +852,7 @@ class GameServer:
         if not self._password_ok(conn, hello, now):
             return
         self._take_over(conn, hello)
-        refusal = self._gate.seat_refusal(conn.host, password_given=self.password is not None)
+        refusal = self._gate.seat_refusal(conn.host, self.password is not None, hello.name)
         if refusal is not None:  # the student's window waits and asks again: the teacher may let the class in
             self._tell_teacher(self._gate.teacher_notice())
             self._fail(conn, refusal, retry=True)
