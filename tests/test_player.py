@@ -15,7 +15,7 @@ import time
 import numpy as np
 import pygame
 import pytest
-from conftest import server_frames, wait_until
+from conftest import WAIT_S, server_frames, wait_until
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 from test_server import RawClient
@@ -928,3 +928,18 @@ def test_a_slow_join_says_so_on_the_terminal_before_the_window_opens(cleanup):
     lines = out.stdout.splitlines()
     assert lines and lines[0] == f"airtable-client: joining the table at 127.0.0.1:{port}...", out
     assert "has not answered within" in out.stdout, out
+
+
+def test_a_student_who_waited_for_a_place_reads_on_the_terminal_when_they_are_in(capsys, cleanup):
+    """A user test: after "trying again" or "server full", the terminal never said that joining worked."""
+    server, _ = start_table(cleanup, max_clients=1)
+    first = RawClient(server.port)
+    cleanup(first.close)
+    first.hello()
+    net = player(cleanup, server.port)
+    assert net.connect() is None  # waiting for a place
+    first.send(proto.encode_bye())
+    cleanup(pygame.quit)
+    assert PlayerApp(net, headless=True).run(seconds=WAIT_S, until=lambda: net.welcome is not None) == 0
+    out = capsys.readouterr().out
+    assert f"airtable-client: connected to 127.0.0.1:{server.port}; you are C1" in out

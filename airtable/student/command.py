@@ -13,7 +13,7 @@ from collections.abc import Sequence
 from airtable.arguments import OneLineParser
 from airtable.net import protocol as proto
 from airtable.net.player import NetPlayer, PlayerError
-from airtable.student.window import PlayerApp
+from airtable.student.window import PlayerApp, joined_sentence
 
 # A join that takes longer than this (s) says so on the terminal: the window opens only once the first
 # handshake has ended (answered, refused or timed out), which on a slow link takes seconds.
@@ -63,7 +63,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     if welcome is None:
         print(f"airtable-client: {net.waiting_because} (Esc quits)")
     else:
-        print(f"airtable-client: connected to {net.address}; you are {welcome.label}")
+        print(joined_sentence(net.address, welcome))
     if args.headless:
         os.environ.setdefault("SDL_VIDEODRIVER", "dummy")  # no screen: pygame's events still need a driver
     else:

@@ -42,6 +42,11 @@ MAX_PUCK_LOOKS = 1024
 MAX_SPRING_SPAN_PX = 20_000_000
 
 
+def joined_sentence(address: str, welcome: proto.Welcome) -> str:
+    """What the terminal says once a student is at the table (at the start, after a wait, or back)."""
+    return f"airtable-client: connected to {address}; you are {welcome.label}"
+
+
 class PlayerApp:
     """The pygame window of a player: the server's table from snapshots, our cursor drawn locally."""
 
@@ -271,6 +276,8 @@ class PlayerApp:
             return
         old_width = self._table_size()[0]
         self._welcome = welcome
+        # The terminal's last word was a wait or a retry (a user test: joined, and it never said so).
+        print(joined_sentence(self.net.address, welcome), flush=True)
         self.window.set_caption(self._caption())
         if welcome.width_m != old_width:  # the teacher restarted with another table
             self.window.set_env(self._new_env())
