@@ -386,3 +386,14 @@ def test_in_simulated_frames_slow_physics_never_pauses():
     for _ in range(3):
         app.frame(FRAME_S)
     assert not app.paused and app.table.time_s > 0.0
+
+
+def test_another_demo_starts_on_the_whole_table_and_a_restart_keeps_the_view():
+    """A user test: zoomed x10.8 on the grid, key 7 showed Newton's cradle as one giant puck on every screen."""
+    app = make_app(key="3")
+    whole = app.env.zoom
+    app.zoom(10.8)
+    press(app, pygame.K_3)  # the same demo again: the teacher's view stays
+    assert app.env.zoom == pytest.approx(10.8 * whole)
+    press(app, pygame.K_7)
+    assert app.env.zoom == whole and "Demo 7" in app.caption()

@@ -233,27 +233,33 @@ class App:
         self._clear_table()
         self.build_error = broken
         if demo is not None:
-            try:
-                demo.build(self.table, self.variation)
-            except Exception as exc:  # a teacher's demo may fail in any way; the app goes on
-                self._demo_failed(exc, "build")
-                self.table.clear()
-        if self.build_error is None:
-            self.running_demo = demo
+            self._build(demo)
         # The heading names what failed until another start, also once Esc hid the error (it named the
         # built-in demo whose key the broken file had taken, over an empty table).
         self.failed_start = None if self.build_error is None else self._failed_caption(demo, ran)
-        if self.build_error is not None and running is not None:
+        if self.build_error is None:
+            if ran is not None and ran[0] != key:
+                self.env.reset()  # another demo: the whole table (zoomed on a puck, it was one giant puck)
+            self.running_demo = demo
+        elif running is not None:
             state.restore(self.table, running)
             self.demo_key, self.demo_path, self.variation = ran
             demo = self.demo
-        elif self.build_error is not None:
+        else:
             self.running_demo = None  # an empty table
         self.stepper.reset(demo.dt_s if demo else self.stepper.dt_s)
         self.aids.trails = demo.trails if demo else False
         for feature in self.features:
             feature.on_demo_start(self.table)
         self.window.set_caption(f"Air Table - {self.caption()}")
+
+    def _build(self, demo: Demo) -> None:
+        """Build `demo` on the cleared table; an exception becomes the demo's error (build_error)."""
+        try:
+            demo.build(self.table, self.variation)
+        except Exception as exc:  # a teacher's demo may fail in any way; the app goes on
+            self._demo_failed(exc, "build")
+            self.table.clear()
 
     def _clear_table(self) -> None:
         self.table.clear()
