@@ -69,6 +69,7 @@ def test_a_name_that_reads_like_a_seat_label_is_refused_with_a_sentence(name):
     with pytest.raises(proto.ProtocolError) as err:
         proto.check_name(name)
     assert "looks like a player label" in str(err.value) and "pick a name" in str(err.value)
+    assert "without C or S and a number" in str(err.value)  # (a user test: "Sam S2" was told "without C")
 
 
 @pytest.mark.parametrize(

@@ -300,7 +300,8 @@ def check_name(name: object) -> str:
     name = " ".join(part for part in name.split(" ") if part)
     if looks_like_label(name):  # also in look-alike letters: "С1" with a Cyrillic С, "C-1", "C¹"
         raise ProtocolError(
-            f"the name {_short(name)} looks like a player label such as C7; pick a name without C and a number"
+            f"the name {_short(name)} looks like a player label such as C7 or S7; "
+            "pick a name without C or S and a number"
         )
     return name
 
