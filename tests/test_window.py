@@ -330,3 +330,21 @@ def test_a_cursors_name_stays_whole_on_screen_on_dark_ground(size) -> None:
         assert win.surface.get_rect().contains(box) and box.width >= win.label_font.size("teacher")[0]
         corner = tuple(win.surface.get_at(box.topleft))[:3]
         assert corner == (0, 0, 0)  # the name's own dark ground
+
+
+@pytest.mark.parametrize("size", [(640, 480), (1280, 720)])
+def test_a_banner_wraps_its_sentence_instead_of_cutting_the_advice(size) -> None:
+    """A user test: the student's banner read "nothing from the teacher's table for 9 s: the network..."."""
+    from airtable.app.window import ACCENT
+
+    win = window(size)
+    sentence = "nothing from the teacher's table for 9 s: the network to it may be down; your seat is kept"
+    lines = panel_view.wrap(win.big_font, sentence, size[0] - 40)
+    assert 1 < len(lines) <= 3 and " ".join(lines) == sentence  # the whole advice fits in three lines
+    win.surface.fill((0, 0, 0))
+    win.draw_banner(sentence)
+    pixels = pygame.surfarray.pixels3d(win.surface)
+    accent = np.all(pixels == np.array(ACCENT), axis=2)
+    rows = np.flatnonzero(accent[size[0] // 4 : 3 * size[0] // 4].any(axis=0))  # text rows, frame aside
+    text_rows = rows[(rows > rows.min() + 3) & (rows < rows.max() - 3)]  # the box's frame lines dropped
+    assert np.ptp(text_rows) > (len(lines) - 0.7) * win.big_font.get_linesize()  # one line each

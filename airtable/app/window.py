@@ -32,6 +32,8 @@ from airtable.app.timeline_paint import TimelinePainter  # noqa: F401  (imported
 from airtable.assets import ASSETS_DIR
 from airtable.model.scene import STATUS_SEPARATOR, Scene
 
+BANNER_LINES = 3  # a banner's sentence wraps over at most this many lines; the last is cut to fit
+
 BACKGROUND = (0, 0, 0)
 BACKGROUND_GRAVITY = (20, 20, 70)
 BACKGROUND_NO_CORRECTION = (40, 40, 40)
@@ -506,14 +508,26 @@ class GameWindow:
             x = box.right + gap
 
     def draw_banner(self, text: str) -> None:
-        """A big message across the middle of the window."""
+        """A big message across the middle of the window, over up to BANNER_LINES lines (a user test: one
+        line cut "...: the network..." before the advice)."""
         w, h = self.surface.get_size()
-        label = self.big_font.render(fit_parts(self.big_font, [text], w - 40), True, ACCENT)
-        pad = self.font.get_height()
-        box = label.get_rect(center=(w // 2, h // 2)).inflate(pad, pad // 2)
+        lines = panel_view.wrap(self.big_font, text, w - 40)
+        if not lines:
+            return
+        if len(lines) > BANNER_LINES:
+            lines = [
+                *lines[: BANNER_LINES - 1],
+                fit_parts(self.big_font, [" ".join(lines[BANNER_LINES - 1 :])], w - 40),
+            ]
+        labels = [self.big_font.render(line, True, ACCENT) for line in lines]
+        pad, step = self.font.get_height(), self.big_font.get_linesize()
+        inner = pygame.Rect(0, 0, max(label.get_width() for label in labels), step * len(labels))
+        inner.center = (w // 2, h // 2)
+        box = inner.inflate(pad, pad // 2)
         pygame.draw.rect(self.surface, (0, 0, 0), box)
         pygame.draw.rect(self.surface, ACCENT, box, self.line_px(2))
-        self.surface.blit(label, label.get_rect(center=box.center))
+        for k, label in enumerate(labels):
+            self.surface.blit(label, label.get_rect(midtop=(w // 2, inner.top + k * step)))
 
     def panel_rect(self) -> pygame.Rect:
         """Where panels go: under the top band, or between the side margins (the join line stays
