@@ -41,6 +41,9 @@ FIRST_FULL_BACKOFF_S = 1.0  # the table is full: ask again after this, then less
 MAX_BACKOFF_S = 4.0
 MAX_PATIENCE_S = 30.0  # the longest a handshake is waited for, on a link found slow
 RECONNECTING = "reconnecting to the teacher's table..."
+# After the server's BYE: the teacher quit or restarted the app, not the network (a user test: the same
+# "reconnecting" as a Wi-Fi drop).
+TABLE_CLOSED = "the teacher closed the table: waiting for it to open again..."
 
 
 class PlayerError(Exception):
@@ -163,6 +166,7 @@ class NetPlayer:
         self.lost_s: float | None = None  # when the connection was lost, while reconnecting
         self.error: str | None = None
         self.waiting_because: str | None = None  # the server's sentence while WAITING
+        self._said_bye = False  # the server said BYE on the connection that just ended
         self.next_try: float = 0.0  # time.monotonic() of the next attempt while RETRYING or WAITING
         self.welcome: proto.Welcome | None = None
         self.reconnects = 0
@@ -384,7 +388,8 @@ class NetPlayer:
             if fatal is not None:
                 self.state, self.error = PlayerState.FAILED, fatal
                 return
-            self.state, self.waiting_because = PlayerState.RETRYING, None
+            self.state, self.waiting_because = PlayerState.RETRYING, TABLE_CLOSED if self._said_bye else None
+            self._said_bye = False
             self.lost_s = self.heard_s  # (the table has been frozen since)
             opened = None
 
@@ -444,6 +449,7 @@ class NetPlayer:
                 sentence, retry = proto.parse_error_message(payload)
                 raise _ConnectionEndedError(None if retry else sentence)
             elif frame_type == proto.BYE:
+                self._said_bye = True
                 raise _ConnectionEndedError()
             else:  # a newer server's message: not for this client
                 self.skipped(f"left out {proto.FRAME_NAMES[frame_type]} messages, which this client does not use")
