@@ -76,3 +76,23 @@ def test_about_fifty_players_per_process():
     assert default_processes(100) >= 1
     with pytest.raises(ValueError, match="--processes"):
         run_load("127.0.0.1", 1, clients=2, seconds=1.0, processes=3)
+
+
+def test_an_echo_is_timed_from_its_own_send_not_from_an_earlier_lap_of_the_cursor():
+    """A user test: every run measured a cursor echo p99 of 6.3 s, the lap of the tool's cursor path: a
+    place sent but never shown (the table shows only the newest input) matched its next lap's echo."""
+    from airtable.model.scene import CursorView
+    from airtable.net import protocol as proto
+    from airtable.net.player import empty_scene
+    from tools.rawplayer import RawPlayer, _key
+
+    p = RawPlayer("127.0.0.1", 1, "Bo", welcome=proto.Welcome("C1", (255, 255, 255), 10.0, 8.0))
+    path = [(1.0, 1.0), (2.0, 1.0), (3.0, 1.0)]
+    for lap in range(2):
+        for k, place in enumerate(path):
+            p.sent.setdefault(_key(place), 10.0 * lap + k)  # as send_input remembers them, at 1 s apart
+        for k in ((0, 2), (1, 2))[lap]:  # the first lap's middle place never shown, the next lap's is
+            scene = empty_scene(10.0, 8.0)
+            scene.cursors = (CursorView(p.welcome.label, (255, 255, 255), path[k]),)
+            p._look(scene, 10.0 * lap + k + 0.02)
+    assert p.latencies_s == pytest.approx([0.02] * 4)
