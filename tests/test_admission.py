@@ -64,7 +64,10 @@ def test_the_teachers_window_shows_how_to_let_a_class_in(make_server, clients, d
     window = app.window
     assert not window.layout.side_px
     width = window.surface.get_width() - window.font.get_height()  # the band's line, less its padding
-    assert fold_lines(shown, BAND_LINES - 1, window.font, width)[0][0].startswith(alert.partition(" (")[0])
+    folded = fold_lines(shown, BAND_LINES - 1, window.font, width)
+    assert folded[0][0].startswith(alert.partition(" (")[0])
+    # The join line stays whole for the students still to come (a user test: it went, the count stayed).
+    assert any(str(line).startswith("join with: airtable-client") for line in folded)
 
 
 def test_eight_students_from_one_address_join_once_the_teacher_allows_it(make_server, clients):  # noqa: F811

@@ -87,9 +87,11 @@ class Room(Feature):
         lines: list = [(alert, ALERT_COLOR) for alert in alerts if alert]  # first: a narrow band keeps the first
         if server is not None:
             n, away = server.player_count, len(server.away())
-            lines.extend(server.join_lines())
             gone = f", {away} away" if away else ""  # (their seats are held: they were vanishing from the count)
-            lines.append(f"{n} student{'' if n == 1 else 's'}{gone} (F2: roster)")
+            count = f"{n} student{'' if n == 1 else 's'}{gone} (F2: roster)"
+            # Under an alert, a narrow band folds the first lines into one and keeps the last whole: the
+            # join line last then, or late students lose it (a user test: the count stayed, the join line went).
+            lines.extend([count, *server.join_lines()] if len(lines) else [*server.join_lines(), count])
         return lines
 
     def status_parts(self, for_students: bool) -> list[str]:
