@@ -397,3 +397,25 @@ def test_another_demo_starts_on_the_whole_table_and_a_restart_keeps_the_view():
     assert app.env.zoom == pytest.approx(10.8 * whole)
     press(app, pygame.K_7)
     assert app.env.zoom == whole and "Demo 7" in app.caption()
+
+
+def test_the_teachers_arrow_goes_when_the_pointer_leaves_the_window_unless_a_drag_goes_on():
+    """A user test: the "teacher" arrow stayed parked at the table's edge, on every student's screen too."""
+    app = make_app(key="2")
+
+    def names() -> list[str]:
+        return [c.name for c in app.scene().cursors]
+
+    teacher = app.local.name
+    app.frame(FRAME_S)
+    assert teacher in names()
+    pygame.event.post(pygame.event.Event(pygame.WINDOWLEAVE))
+    app.frame(FRAME_S)
+    assert teacher not in names()
+    pygame.event.post(pygame.event.Event(pygame.MOUSEMOTION, pos=(300, 300), rel=(1, 1), buttons=(0, 0, 0)))
+    app.frame(FRAME_S)
+    assert teacher in names()
+    pygame.event.post(pygame.event.Event(pygame.MOUSEBUTTONDOWN, pos=(300, 300), button=1))
+    pygame.event.post(pygame.event.Event(pygame.WINDOWLEAVE))  # dragging out of the window: the string holds
+    app.frame(FRAME_S)
+    assert teacher in names()

@@ -437,9 +437,14 @@ class App:
         elif event.type in (pygame.VIDEORESIZE, pygame.WINDOWSIZECHANGED):
             with self._pointer_kept_on_the_table():
                 self.window.handle_event(event)  # the table and the type follow the new size
+        elif event.type in (pygame.WINDOWLEAVE, pygame.WINDOWENTER):
+            # The pointer left the window: no "teacher" arrow parked at the table's edge on every screen (a
+            # user test), unless a puck is held: a drag goes on outside.
+            self.local.active = event.type == pygame.WINDOWENTER or bool(self.mouse_button)
 
     def _handle_mouse(self, event: pygame.event.Event) -> None:
         if event.type == pygame.MOUSEMOTION:
+            self.local.active = True  # (back in the window, whatever said so)
             if self.panning:
                 self.env.pan(event.rel)
                 self.window.clear_trails()
