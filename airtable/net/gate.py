@@ -38,6 +38,10 @@ def is_loopback(host: str) -> bool:
         return False
 
 
+# The teacher's notice counts refused students by name up to this many per address.
+MAX_NAMES_COUNTED = 1000
+
+
 @dataclass
 class _Guesses:
     wrong: int = 0
@@ -87,7 +91,9 @@ class Gate:
         student's (None: none given), to count students, not tries."""
         if password_given or not self._limited(host) or self.players[host] < self.players_per_address:
             return None
-        self.turned_away.setdefault(host, set()).add(name or "")
+        names = self.turned_away.setdefault(host, set())
+        if len(names) < MAX_NAMES_COUNTED:  # (bounded: a flood of made-up names cannot grow it)
+            names.add(name or "")
         return (
             f"{self.players[host]} windows from your address ({host}) play already, the most one address may "
             f"(a class behind one router counts as one computer); ask the teacher to {ALLOW_A_CLASS}"
