@@ -377,6 +377,7 @@ def test_the_window_says_when_the_table_it_shows_is_frozen_and_for_how_long_it_r
     wait_until(lambda: net.state is PlayerState.CONNECTED and net.banner_text is None, what="snapshots")
     loop.stop()  # the teacher's table stops sending (its loop froze, or the link did)
     wait_until(lambda: net.banner_text and "nothing from the teacher's table for" in net.banner_text, what="stale")
+    assert net.status_text.startswith(f"connected to {net.address}, nothing heard for ")  # not plain "connected"
     server.stop()  # the teacher quits: the player reconnects, and says for how long
     wait_until(lambda: net.state is PlayerState.RETRYING, what="the drop to be noticed")
     wait_until(lambda: net.banner_text.endswith(" s)"), what="the time since the table was lost")

@@ -196,6 +196,9 @@ class NetPlayer:
     def status_text(self) -> str:
         """The connection state as the HUD shows it."""
         if self.state == PlayerState.CONNECTED:
+            silent = time.monotonic() - self.heard_s
+            if silent >= STALE_S:  # (a user test: "connected" under a banner saying nothing came for 9 s)
+                return f"connected to {self.address}, nothing heard for {silent:.0f} s"
             return f"connected to {self.address}"
         if self.state == PlayerState.FAILED:
             return self.error or "failed"
