@@ -219,3 +219,21 @@ def test_esc_ends_a_prediction_round_before_it_asks_to_quit(demos):
     assert app.running and app.predict.round.state == "closed" and app.panels.panel() is None and app.paused
     press(app, pygame.K_ESCAPE)
     assert app.running and app.panels.panel() == "quit"
+
+
+def test_the_quit_question_says_how_long_it_waits_for_the_second_esc(demos):
+    """A user test: the question vanished after a few seconds, unexplained, while it was being read."""
+    from airtable.app.panels import QUIT_CONFIRM_S
+
+    app = App(demos, demo_key="1", headless=True)
+    asked = []
+    draw_question = app.window.draw_question
+    app.window.draw_question = lambda title, lines: asked.append(lines[-1]) or draw_question(title, lines)
+    press(app, pygame.K_ESCAPE)
+    assert app.panels.panel() == "quit" and f"again within {QUIT_CONFIRM_S:.0f} s to quit" in asked[-1]
+    for _ in range(round(2.5 / FRAME_S)):
+        app.frame(FRAME_S)
+    assert f"again within {QUIT_CONFIRM_S - 2:.0f} s to quit" in asked[-1]
+    for _ in range(round(2.0 / FRAME_S)):
+        app.frame(FRAME_S)
+    assert app.panels.panel() is None and app.running  # it said so: closed, the lesson goes on

@@ -10,6 +10,7 @@ asked quits, once the burst of Escs that got there has paused.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Sequence
 from typing import TYPE_CHECKING
 
@@ -161,7 +162,10 @@ class Panels(Feature):
     def draw(self) -> None:
         panel, w, host = self.panel(), self.host.window, self.host
         if panel == "quit":
-            w.draw_question("Quit?", [*host.quit_would_lose(), "Esc (or Ctrl+Q) again to quit; any other key to stay."])
+            # The question closes by itself: it says when (a user test: it vanished, unexplained, as it was read).
+            left = max(1, math.ceil(self.quit_armed_until - host.clock_s))
+            again = f"Esc (or Ctrl+Q) again within {left} s to quit; any other key to stay."
+            w.draw_question("Quit?", [*host.quit_would_lose(), again])
         elif panel == "menu":
             rows = self.menu.rows(visible=w.panel_rows() - 2, label=key_label)  # the footer under them
             w.draw_panel("Demos", [*rows, self.menu.footer()])
