@@ -494,3 +494,14 @@ def test_esc_while_students_guess_asks_before_it_throws_the_guesses_away(tmp_pat
     assert app.predict.round.active and "Esc again ends the prediction round" in app.message
     press(app, pygame.K_ESCAPE)
     assert not app.predict.round.active and app.running
+
+
+@pytest.mark.parametrize("gravity", [False, True])
+def test_a_reveal_over_a_still_table_settles_at_once_and_a_drop_from_rest_still_plays(demos, gravity):
+    """A user test: demo 2 at rest, F6 F6: "playing until the collision is over" for 8 s, none coming."""
+    app = App(demos, demo_key="2", headless=True)
+    app.table.gravity_on = gravity  # with gravity, the pucks at rest in the air fall: something comes
+    press(app, pygame.K_F6)
+    press(app, pygame.K_F6)
+    frames_until(app, lambda: app.predict.round.settled, "the reveal to settle", max_frames=int(9.0 / FRAME_S))
+    assert (app.table.time_s < 0.1) is (not gravity)  # at once when still; played out when they fall

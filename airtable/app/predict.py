@@ -41,6 +41,7 @@ TIMEOUT_S = 8.0  # table time after which the reveal freezes anyway
 WITHIN_DEG = 5.0  # "within 5 deg"
 WITHIN_SPEED = 0.2  # "speeds within 20 %"
 RESTING_MPS = 0.05  # a true speed below this: the puck stops, and direction means nothing
+STILL_MPS = 1e-4  # every puck slower than this a step after the reveal: nothing is coming (a drop from rest is not)
 LOCAL_LABEL = "teacher"
 LOCAL_COLOR = (120, 255, 120)
 
@@ -135,7 +136,10 @@ class PredictRound:
         if table.collision_count != self._hits:
             self._hits, self._last_hit_s, self._seen_collision = table.collision_count, table.time_s, True
         quiet = table.time_s - self._last_hit_s >= SETTLE_S
-        return (self._seen_collision and quiet) or table.time_s - self._started_s >= TIMEOUT_S
+        # A table still a step after the reveal has no collision to come (a user test: "playing until the
+        # collision is over" for 8 s over pucks at rest).
+        still = table.time_s > self._started_s and not np.any(np.abs(table.vel_mps) >= STILL_MPS)
+        return (self._seen_collision and quiet) or still or table.time_s - self._started_s >= TIMEOUT_S
 
     def settle(self, table) -> None:
         """Freeze on the truth: every predictable puck's velocity now, and the summary."""
