@@ -91,7 +91,7 @@ class Room(Feature):
             count = f"{n} student{'' if n == 1 else 's'}{gone} (F2: roster)"
             # Under an alert, a narrow band folds the first lines into one and keeps the last whole: the
             # join line last then, or late students lose it (a user test: the count stayed, the join line went).
-            lines.extend([count, *server.join_lines()] if len(lines) else [*server.join_lines(), count])
+            lines.extend([count, *server.join_lines()] if lines else [*server.join_lines(), count])
         return lines
 
     def status_parts(self, for_students: bool) -> list[str]:

@@ -196,8 +196,8 @@ class NetPlayer:
     def status_text(self) -> str:
         """The connection state as the HUD shows it."""
         if self.state == PlayerState.CONNECTED:
-            silent = time.monotonic() - self.heard_s
-            if silent >= STALE_S:  # (a user test: "connected" under a banner saying nothing came for 9 s)
+            silent = self._silent_s(time.monotonic())
+            if silent is not None:  # (a user test: "connected" under a banner saying nothing came for 9 s)
                 return f"connected to {self.address}, nothing heard for {silent:.0f} s"
             return f"connected to {self.address}"
         if self.state == PlayerState.FAILED:
@@ -205,6 +205,11 @@ class NetPlayer:
         if self.state in (PlayerState.RETRYING, PlayerState.WAITING):
             return self.banner_text or ""
         return f"{self.state.value} {self.address}"
+
+    def _silent_s(self, now: float) -> float | None:
+        """How long a connected table has sent nothing (s), once that is STALE_S or more; else None."""
+        silent = now - self.heard_s
+        return silent if self.state == PlayerState.CONNECTED and silent >= STALE_S else None
 
     @property
     def banner_text(self) -> str | None:
@@ -214,8 +219,9 @@ class NetPlayer:
         if self.state == PlayerState.RETRYING:
             since = f" ({now - self.lost_s:.0f} s)" if self.lost_s is not None and now - self.lost_s >= 1.0 else ""
             return (self.waiting_because or RECONNECTING) + since
-        if self.state == PlayerState.CONNECTED and now - self.heard_s >= STALE_S:  # a frozen table, said so
-            return f"nothing from the teacher's table for {now - self.heard_s:.0f} s: the network? waiting..."
+        silent = self._silent_s(now)
+        if silent is not None:  # a frozen table, said so
+            return f"nothing from the teacher's table for {silent:.0f} s: the network? waiting..."
         if self.state == PlayerState.WAITING:  # the server's reason, up to its advice
             reason = (self.waiting_because or "the table cannot take you yet").split(";")[0]
             reason = "the table is full" if reason.startswith("server full") else reason
