@@ -132,6 +132,36 @@ def test_a_file_that_failed_at_start_loads_once_fixed(tmp_path):
     assert app.demo_key == "t1" and len(app.table.pucks) == 2
 
 
+def test_the_first_key_after_a_load_notice_also_does_its_work(tmp_path):
+    """A user test: the teacher's first key (3, for demo 3) only closed the "could not load" notice."""
+    (tmp_path / "late.py").write_text("KEY = 't1'\nTITLE = 'x'\ndef build(table, variation=0)\n")
+    app = make_app(tmp_path)
+    assert app.panels.panel() == "notice"
+    press(app, pygame.K_3)
+    assert app.panels.panel() is None and app.demo_key == "3"
+    app = make_app(tmp_path)
+    paused = app.paused
+    press(app, pygame.K_SPACE)  # Space, as Enter, only goes on: it does not pause the table as well
+    assert app.panels.panel() is None and app.paused == paused and app.demo_key == "1"
+    app = make_app(tmp_path)
+    press(app, pygame.K_ESCAPE)  # Esc closes the notice, and asks nothing
+    assert app.panels.panel() is None and app.running
+
+
+def test_the_demo_menu_takes_letters_of_any_layout_by_their_key(tmp_path):
+    """A user test: Cyrillic typed into the Tab menu was ignored. On a Russian layout the T key types "е";
+    demo keys are Latin, so the menu reads the key where it sits, as the table's keys do."""
+    for key in ("t1", "t2"):
+        (tmp_path / f"{key}.py").write_text(demo_source(key, pucks=3))
+    app = make_app(tmp_path)
+    press(app, pygame.K_TAB)
+    t_key = 4 + ord("t") - ord("a")  # the T key's scancode
+    for key, text, scancode in ((ord("е"), "е", t_key), (pygame.K_2, "2", 0)):
+        pygame.event.post(pygame.event.Event(pygame.KEYDOWN, key=key, mod=0, unicode=text, scancode=scancode))
+        app.frame(FRAME_S)
+    assert app.demo_key == "t2" and len(app.table.pucks) == 3 and app.panels.panel() is None
+
+
 def test_demo_keys_sort_naturally_everywhere(tmp_path, capsys):
     for key in ("t10", "t2", "t1"):
         (tmp_path / f"demo_{key}.py").write_text(demo_source(key))

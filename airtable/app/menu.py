@@ -36,6 +36,8 @@ class DemoMenu:
             return None
         if name in ("return", "enter"):
             return self.items[self.selected][0]
+        if text and not text.isascii() and len(name) == 1 and name.isascii():
+            text = name  # a letter of another layout ("е"): demo keys are Latin, taken by where the key sits
         if name == "backspace":
             self.typed = self.typed[:-1]
         elif text and text.isprintable() and not text.isspace():

@@ -25,6 +25,8 @@ from airtable.app.overlays import EscapeBurst, OverlayFlag, OverlayValue
 if TYPE_CHECKING:
     from airtable.app.host import Host
 
+# Keys that only close a "press any key" notice; any other key closes it and does its work too.
+GO_ON_KEYS = frozenset((pygame.K_SPACE, pygame.K_RETURN, pygame.K_KP_ENTER))
 QUIT_CONFIRM_S = 4.0  # the quit question waits this long for a second Esc (or window close)
 ERROR_TITLES = {
     "load": "Demo {key} could not be loaded",
@@ -92,6 +94,8 @@ class Panels(Feature):
                 self.host.start_demo(picked)
         else:
             self.close_panel()  # "press any key to go on"; any key but Esc keeps the table running
+            # The notice is news, not a question: a teacher's first key (3 for demo 3) also does its work.
+            return panel != "notice" or event.key in GO_ON_KEYS
         return True
 
     # ------------------------------------------------------------ quitting
