@@ -158,6 +158,24 @@ def test_the_inspectors_words_leave_its_puck_and_the_status_line_in_view_even_in
         assert box.bottom <= app.window.status_top_px  # the status line too
 
 
+def test_a_long_velocity_arrow_stops_above_the_status_line_and_below_the_top_band(demos):
+    """A user test: the arrow of a fast puck near the table's bottom ran over the status line."""
+    for down in (True, False):
+        app = make_app(demos, "1")
+        app.paused = True
+        p = app.table.pucks[0]
+        p.pos_m = (app.table.width_m / 2, p.radius_m * 1.01 if down else app.table.height_m - p.radius_m * 1.01)
+        p.vel_mps = (0.0, -8.0 if down else 8.0)  # a 2 m/s scale: an arrow longer than the table is high
+        press(app, pygame.K_v)
+        pixels = frame_pixels(app)  # (x, y, rgb)
+        arrow = np.all(pixels == (120, 220, 255), axis=2)
+        w = app.window
+        x = int(w.env.to_screen(np.array([p.pos_m]))[0, 0])
+        column = arrow[x - 2 : x + 3]  # the arrow's shaft, straight up or down from the puck
+        assert column.any()
+        assert not column[:, w.status_top_px :].any() and not column[:, : w.layout.top_px].any()
+
+
 def test_slow_motion_runs_fewer_steps_of_the_same_size(demos):
     app = make_app(demos, "1")
     for factor in (0.5, 0.25, 0.125, 0.0625, 1.0):

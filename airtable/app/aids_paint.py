@@ -200,8 +200,14 @@ class AidsPainter:
             return
         ends = self.w.env.to_screen(np.concatenate([starts_m, starts_m + vectors_m]).astype(float)).tolist()
         width = width or self.w.line_px(2)
-        for a, b in zip(ends[: len(starts_m)], ends[len(starts_m) :]):
-            draw_arrow_px(self.w.surface, color, a, b, width, head_widths=5.0)
+        surface = self.w.surface
+        clip = surface.get_clip()
+        surface.set_clip(clip.clip(self.w.world_area()))  # a user test: long arrows covered the status line
+        try:
+            for a, b in zip(ends[: len(starts_m)], ends[len(starts_m) :]):
+                draw_arrow_px(surface, color, a, b, width, head_widths=5.0)
+        finally:
+            surface.set_clip(clip)
 
     def marker(self, point_m, color, label: str) -> None:
         x, y = self._px(point_m)

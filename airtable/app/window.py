@@ -459,14 +459,19 @@ class GameWindow:
             label = self._labels[key] = self.label_font.render(name, True, color, (0, 0, 0))  # on dark ground
         return self.surface.blit(label, self._cursor_label_box(label.get_size(), x, y, u))
 
+    def world_area(self) -> pygame.Rect:
+        """The window between the top band of text and the status bar: where drawings on the table may go
+        (an arrow running off the table stops there, not over the status line)."""
+        return pygame.Rect(
+            0, self.layout.top_px, self.surface.get_width(), max(0, self.status_top_px - self.layout.top_px)
+        )
+
     def _cursor_label_box(self, size: tuple[int, int], x: float, y: float, u: float) -> pygame.Rect:
         """Where a cursor's name goes: beside its arrow (below right; at the right edge left of it; at the
         bottom above it), on screen and off the window's own text (the heads-up lines, the status line);
         where no such spot is, between the top band and the status bar."""
         below, above = y + 14 * u, y - 2 * u - size[1]
-        free = self.surface.get_rect()
-        free.height = max(0, self.status_top_px - self.layout.top_px)
-        free.top = self.layout.top_px
+        free = self.world_area()
         right_of, left_of = int(x + 12 * u), int(x - 2 * u) - size[0]
         spots = [pygame.Rect((left, int(top)), size) for top in (below, above) for left in (right_of, left_of)]
         clear = [b for b in spots if free.contains(b) and b.collidelist(self.hud_boxes) < 0]
