@@ -191,14 +191,19 @@ def test_player_joins_sees_the_table_and_drags_a_puck(cleanup):
 
 
 def test_update_input_clamps_what_the_server_would_refuse(cleanup):
-    server, _ = start_table(cleanup)
+    server, loop = start_table(cleanup)
     net = player(cleanup, server.port)
     net.connect()
     assert net.update_input((1e300, -1e300), 7, ["ok", "x" * 40])
-    # The server took it: the cursor shows up in the snapshots, where the clamp put it.
+    # The server took it: its cursor is where the clamp put it (off the table: not drawn, so read there).
     x0, y0, x1, y1 = proto.cursor_limits(10.0, 8.7556)
-    mine = wait_until(lambda: net.latest() and net.latest().cursors, what="our cursor in a snapshot")
-    assert mine[0].cursor_m == (x1, y0) and mine[0].button == 0
+
+    def mine():
+        with loop.lock:
+            return [(tuple(c.cursor_m), c.button, c.active) for c in loop.clients[1:]]
+
+    wait_until(lambda: mine() and mine()[0][0] != (0.0, 0.0), what="our cursor at the server")
+    assert mine() == [((x1, y0), 0, False)]
     assert net.state == net.CONNECTED and server.player_names() == ["C1"]
 
 

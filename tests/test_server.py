@@ -411,6 +411,25 @@ def test_joins_leaves_and_cursors_are_applied_every_frame_even_without_steps(mak
     assert game.table.time_s == 0.0, "no physics step ran"
 
 
+def test_a_cursor_off_the_table_is_hidden_unless_it_drags(make_server, clients):
+    """A user test: students whose pointer was off the table (outside their window, or never in it) had
+    their names piled in the projector's top left corner. Off the table a cursor is not shown; a drag
+    that leaves the table still is."""
+    server = make_server()
+    game = GameLoop(server, one_puck_table())
+    c = clients(server.port)
+    c.hello("Ann")
+    c.send(proto.encode_input((-0.5, game.table.height_m + 0.5), 0))  # above and left of the table
+    player = wait_until(lambda: (p := game.update()) and p[0], what="the join")
+    wait_until(lambda: game.update() and tuple(player.cursor_m) != (0.0, 0.0), what="the first input")
+    assert not player.active
+    c.send(proto.encode_input((2.0, 3.0), 0))
+    wait_until(lambda: game.update() and player.active, what="the cursor on the table")
+    c.send(proto.encode_input((-0.5, 3.0), 1))  # the button held off the table: a drag, shown
+    wait_until(lambda: game.update() and tuple(player.cursor_m) == (-0.5, 3.0), what="the drag")
+    assert player.active
+
+
 def test_the_event_queue_stays_bounded_while_nobody_takes_it(make_server):
     """2,000 join/leave cycles while the game loop never calls update_clients.
 

@@ -107,6 +107,12 @@ def client_color(number: int) -> tuple[int, int, int]:
             return (round(r * 255), round(g * 255), round(b * 255))
 
 
+def _on_table(cursor_m, size_m: tuple[float, float]) -> bool:
+    """Whether a cursor is on a table of `size_m` (its edge included)."""
+    x, y = cursor_m
+    return 0.0 <= x <= size_m[0] and 0.0 <= y <= size_m[1]
+
+
 def lan_addresses() -> list[str]:
     """This machine's IPv4 LAN addresses, without any network traffic.
 
@@ -520,7 +526,9 @@ class GameServer:
                     if client is not None:
                         button = record.button if self.may_act(self._seat_of.get(cid, 0)) else 0
                         client.set_input(table, record.cursor_m, button)  # INPUT's keys are not used
-                        client.active = True
+                        # A pointer off the table (outside the student's window, or never in it) is not
+                        # shown: a user test saw twenty such names piled in the projector's corner.
+                        client.active = bool(button) or _on_table(record.cursor_m, self._table_size_m)
         self._hold_back()
 
     def may_act(self, number: int) -> bool:
