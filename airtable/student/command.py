@@ -61,7 +61,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     finally:
         joining.cancel()
     if welcome is None:
-        print(f"airtable-client: {net.waiting_because} (Esc quits)")
+        leave = "Ctrl+C quits" if args.headless else "Esc quits"  # no window: no Esc to press
+        print(f"airtable-client: {net.waiting_because} ({leave})")
     else:
         print(joined_sentence(net.address, welcome))
     if args.headless:
