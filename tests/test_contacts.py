@@ -9,6 +9,7 @@ import pytest
 
 from airtable.physics import broadphase, contacts, resting
 from airtable.physics.forces import GRAVITY_MPS2
+from airtable.physics.rest_speeds import RestSpeeds
 from airtable.physics.table import AirTable
 
 
@@ -58,6 +59,11 @@ def _sequential(c, vel, mass, dt, sweeps=5000):
     return w
 
 
+def everywhere(n: int, rest_mps: float) -> RestSpeeds:
+    """Rest speeds of `rest_mps` for every contact of n pucks, whatever its direction (as rest_speed_mps)."""
+    return RestSpeeds(np.zeros(n, dtype=complex), rest_mps, 1.0, 1.0)
+
+
 def test_the_stage_solves_the_contact_problem(monkeypatch) -> None:
     # The rounds solve contacts that share no puck all at once, and the later
     # iterations are sped up (conjugate-gradient-like steps); the answer must
@@ -69,13 +75,13 @@ def test_the_stage_solves_the_contact_problem(monkeypatch) -> None:
     pos, vel, radius, mass = _small_pile()
     dt = 1 / 240
     size = np.array([1.0, 1.0])
-    rest = np.full(len(pos), 2 * 9.8 * dt)
+    rest = everywhere(len(pos), 2 * 9.8 * dt)
     solver = contacts.ContactSolver()
     i, j = broadphase.find_candidate_pairs(pos, radius)
     candidates = (i, j, broadphase.pair_reach(radius, i, j))
     margin = contacts.MARGIN_M + (2.0 * float(np.abs(vel).max()) + contacts.MAX_PUSH_MPS) * dt
     pc = contacts._pair_contacts(pos, vel, *candidates, rest, solver.held, margin)
-    wc = contacts._wall_contacts(pos, vel, radius, size, solver.wall_rest(rest), margin)
+    wc = contacts._wall_contacts(pos, vel, radius, size, solver.wall_rest(rest.walls), margin)
     c = contacts._Contacts(
         *(np.concatenate([getattr(pc, f), getattr(wc, f)]) for f in contacts._Contacts.__dataclass_fields__)
     )
@@ -102,7 +108,7 @@ def test_a_puck_resting_on_the_floor_converges_at_once() -> None:
     radius, mass = np.array([0.1]), np.array([0.3 * np.pi * 0.01])
     none = np.empty(0, dtype=np.intp)
     solver = contacts.ContactSolver()
-    rest = np.array([2 * 9.8 / 240])
+    rest = everywhere(1, 2 * 9.8 / 240)
     assert solver.solve(pos, vel, radius, mass, np.array([1.0, 1.0]), (none, none, np.empty(0)), rest, 1 / 240)
     assert solver.count == 1 and solver.iterations == 2 < contacts.ITERATIONS
     assert vel[0, 1] == 0.0 and vel[0, 0] == 0.0
@@ -146,7 +152,7 @@ def test_a_contact_of_the_last_step_stays_one_a_little_further_apart() -> None:
     radius, mass = np.full(2, 0.1), np.full(2, 0.01)
     i, j = np.array([0]), np.array([1])
     candidates = (i, j, np.array([0.2]))
-    rest = np.full(2, 0.1)
+    rest = everywhere(2, 0.1)
 
     def count(solver: contacts.ContactSolver, gap_m: float) -> int:
         pos, vel = np.array([[4.0, 4.0], [4.2 + gap_m, 4.0]]), np.zeros((2, 2))

@@ -15,6 +15,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from airtable.physics import events
+from airtable.physics.rest_speeds import RestSpeeds
 
 
 def _step(seed: int, n: int, mode: str, dt: float, resting: bool) -> events._Step:
@@ -24,7 +25,8 @@ def _step(seed: int, n: int, mode: str, dt: float, resting: bool) -> events._Ste
     mass = rng.uniform(0.1, 3.0, n)
     pos = rng.uniform(0.1, 0.9, (n, 2))
     vel = rng.uniform(-4.0, 4.0, (n, 2)) * rng.choice([0.0, 0.1, 1.0, 10.0], (n, 1))
-    rest = rng.uniform(0.0, 0.5, n) if resting else None
+    press = rng.uniform(0.0, 0.5, n) * np.exp(1j * rng.uniform(0.0, 2 * np.pi, n)) * rng.choice([0.0, 1.0], n)
+    rest = RestSpeeds(press, 0.0, 1.0, 1.0) if resting else None
     held_pairs = {(i, j) for i in range(n) for j in range(i + 1, n) if rng.random() < 0.2} if resting else set()
 
     def held(i: np.ndarray, j: np.ndarray) -> np.ndarray:

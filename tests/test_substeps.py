@@ -267,7 +267,9 @@ def test_forces_set_from_outside_act_through_every_piece_of_a_step() -> None:
     """A step in pieces (a stiff spring pressing two pucks together) gives a far puck pushed by a
     force set on it F dt / m, as a step in one piece does."""
     table = AirTable()
-    _squeezed(table, 2, 3000.0, [0.5], [(0.0, 0.0), (0.0, 0.0)])
+    a = table.add_puck(pos_m=(4.88, 4.0), radius_m=0.12, density_kgpm2=0.3)
+    b = table.add_puck(pos_m=(5.12, 4.0), radius_m=0.12, density_kgpm2=0.3)  # touching
+    table.add_spring(a, b, length_m=0.2, k_Npm=3000.0, damper_Nspm=0.0)  # shorter: it presses them together
     free = table.add_puck(pos_m=(1.0, 1.0), radius_m=0.1, density_kgpm2=0.3)
     for _ in range(5):
         table.step(DT_S)  # (the pair touches: its contacts are held)

@@ -212,6 +212,13 @@ class PairRecords:
         self.count = int(count)  # how many collisions (a numpy count is not a plain int: state.py saves it)
         self._columns, self._pick, self._rows = columns, pick, rows
 
+    def hit_rows(self) -> np.ndarray:
+        """The rows of the pucks that collided (i, then j; a row may repeat)."""
+        if self._rows:
+            return np.array([row[k] for k in (0, 1) for row in self._rows], dtype=np.intp)
+        i, j = self._columns[0], self._columns[1]
+        return np.concatenate((i, j) if self._pick is None else (i.take(self._pick), j.take(self._pick)))
+
     def columns(self) -> tuple:
         """The fields of `Collisions.of_pairs`, one numpy column each."""
         if self._rows:

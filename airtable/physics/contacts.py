@@ -12,7 +12,7 @@ Which contacts: pairs and puck-wall contacts that touch or nearly touch
 and HOLD_M more for last step's contacts) and approach slower than the
 rest speed over the restitution (faster ones
 are collisions: they keep the course's model; at restitution 0 no contact
-is: see rest_for_restitution), and pairs that pressed on each other in the last
+is: see rest_speeds.py), and pairs that pressed on each other in the last
 step, whatever their speed. Each contact k has a normal
 n (from body b to body a; a wall is a body that never moves) and asks:
 
@@ -105,22 +105,6 @@ MAX_PUSH_MPS = 0.5
 WALL_NORMALS = np.array(collision.WALL_NORMALS)  # (an array: taken per contact)
 
 
-def rest_for_restitution(rest: np.ndarray, cr: float) -> np.ndarray:
-    """Rest speeds (m/s) for contacts of restitution cr: a contact rests when its bounce, cr times
-    its approach, would be slower than `rest`, so when it approaches slower than rest / cr.
-
-    At cr = 0 every pressed contact rests, however fast: a perfectly inelastic hit and a
-    resting contact ask the same (no approach after it), and only the contact stage solves
-    them all together, as a stack or a slab landing needs (pair by pair, a chain of 6 pucks
-    takes more passes than a step has). Not pressed (rest 0): left to the collision stages.
-    """
-    if cr >= 1.0:
-        return rest
-    if cr <= 0.0:
-        return np.where(rest > 0.0, np.inf, 0.0)
-    return rest / cr
-
-
 def margin_m(vel: np.ndarray, dt: float) -> float:
     """How far apart (m) a pair or a puck and a wall may be where the step began and still be a contact:
     MARGIN_M, plus as far as this stage may move two pucks towards each other in the step."""
@@ -157,7 +141,7 @@ def _pair_contacts(pos, vel, ci, cj, reach, rest, held, margin, kept=None) -> _C
     i, j = ci.take(near), cj.take(near)
     n, dist = vectors.unit_vectors(vectors.take(d, near), i + j)
     vn = vectors.dot_rows(vectors.take(vel, i) - vectors.take(vel, j), n)
-    slow = vn >= -np.maximum(rest.take(i), rest.take(j))
+    slow = vn >= -rest.pairs(i, j, vectors.as_complex(np.ascontiguousarray(n)))
     fast = np.flatnonzero(~slow)  # few, even in a pile: look only these up among the held pairs
     slow[fast] = held(i.take(fast), j.take(fast))
     slow = np.flatnonzero(slow)
@@ -235,16 +219,30 @@ class ContactSolver:
         found = np.searchsorted(self._keys, keys).clip(0, len(self._keys) - 1)
         return found, self._keys.take(found) == keys
 
+    def piled(self, n: int) -> np.ndarray | None:
+        """(n,) which pucks were in a contact with another puck in the last step (None: none were, or the
+        rows changed): pucks in a pile, pressed every way by their neighbours (rest_speeds.py)."""
+        if len(self._keys) == 0 or self._rows != n:
+            return None
+        row, other = np.divmod(self._keys, self._rows + 4)
+        pairs = np.flatnonzero(other < self._rows)
+        if len(pairs) == 0:
+            return None
+        out = np.zeros(n, dtype=bool)
+        out[row.take(pairs)] = True
+        out[other.take(pairs)] = True
+        return out
+
     def held_pairs(self) -> bool:
         """Whether the last step held two pucks against each other (not only pucks on walls)."""
         return bool(len(self._keys)) and bool((self._keys % (self._rows + 4) < self._rows).any())
 
     def wall_rest(self, rest: np.ndarray) -> np.ndarray:
-        """(N, 2) rest speeds towards the walls along x and y: infinite where the puck pressed
-        on a wall across that axis in the last step (it rests there whatever its speed)."""
+        """The (N, 2) rest speeds `rest` towards the walls across x and y, made infinite where the puck
+        pressed on a wall across that axis in the last step (it rests there whatever its speed)."""
         if self._wall_rest is not None and self._wall_rest[0] is rest and self._wall_rest[1] is self._impulses:
             return self._wall_rest[2]  # asked again within the step (walls, then contacts): the same answer
-        out = columns(rest, rest)
+        out = rest.copy()
         self._wall_rest = (rest, self._impulses, out)
         if len(self._keys) == 0 or self._rows != len(rest):
             return out
@@ -261,14 +259,12 @@ class ContactSolver:
         self.__init__()
 
     def solve(
-        self, pos, vel, radius, mass, size_m, candidates, rest, dt, asleep=None, rest_walls=None, began=None,
-        margin=None,
+        self, pos, vel, radius, mass, size_m, candidates, rest, dt, asleep=None, began=None, margin=None,
     ) -> bool:  # fmt: skip
         """Solve the resting contacts in place; return whether there were any.
 
-        candidates: (i, j, reach) pairs that may touch; rest: each puck's rest
-        speed (m/s): contacts approaching slower than it are resting (towards
-        the walls, rest_walls if given); asleep:
+        candidates: (i, j, reach) pairs that may touch; rest: the step's rest
+        speeds (rest_speeds.RestSpeeds): contacts approaching slower are resting; asleep:
         which pucks sleep (sleep.py), or None: to the awake pucks a sleeper is
         immovable, and its contacts with the walls and with other sleepers are
         left out. began: the positions when the step began (None: unknown, every contact
@@ -291,8 +287,7 @@ class ContactSolver:
             moved[plain] = 0.0
         start = pos - (vel - moved) * dt
         pc = _pair_contacts(start, vel, ci, cj, reach, rest, self.held, margin, self.kept)
-        rest_walls = rest if rest_walls is None else rest_walls
-        wc = _wall_contacts(start, vel, radius, size_m, self.wall_rest(rest_walls), margin)
+        wc = _wall_contacts(start, vel, radius, size_m, self.wall_rest(rest.walls), margin)
         if asleep is not None:
             wc = _Contacts(*(getattr(wc, f).take(np.flatnonzero(~asleep.take(wc.a))) for f in _FIELDS))
         c = _Contacts(*(np.concatenate([getattr(pc, f), getattr(wc, f)]) for f in _FIELDS))

@@ -14,6 +14,7 @@ import numpy as np
 
 from airtable.physics.collision import PairRecords
 from airtable.physics.forces import Pull
+from airtable.physics.rest_speeds import RestSpeeds
 
 
 @dataclass(slots=True)
@@ -22,10 +23,10 @@ class StepContext:
     pulls: Sequence[Pull]  # the cursor strings acting in this step
     began: np.ndarray | None = None  # the positions when the step began (the contacts start there)
     sleepers: np.ndarray | None = None  # the rows that sleep through this step (None: none)
-    kick: np.ndarray | float | None = None  # the speed the forces gave each puck (a number: all; None: nothing)
-    rest: np.ndarray | None = None  # each puck's rest speed towards other pucks (None: every contact collides)
-    rest_walls: np.ndarray | None = None  # ... and towards the walls
-    wall_rest: np.ndarray | None = None  # rest_walls where the contacts held a puck on a wall last step
+    kick: np.ndarray | None = None  # the velocity the forces gave each puck ((N, 2), or (2,): all; None: nothing)
+    rest: RestSpeeds | None = None  # which contacts rest instead of bouncing (None: every contact collides)
+    wall_rest: np.ndarray | None = None  # (N, 2) rest.walls, infinite where a puck was held on a wall last step
     maybe_past: np.ndarray | None = None  # the rows that may be past a wall after the hits (None: any)
+    bounced: list[int] = field(default_factory=list)  # the rows of this step's wall hits (the hit stage's)
     moved: np.ndarray | None = None  # the rows the pair stage moved (a row may repeat; None: none)
     records: list[PairRecords] = field(default_factory=list)  # what this step's puck-puck collisions did (raw)

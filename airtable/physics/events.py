@@ -46,6 +46,7 @@ import numpy as np
 
 from airtable.physics import broadphase, collapse, collision, either, vectors
 from airtable.physics.collision import PairRecords
+from airtable.physics.rest_speeds import RestSpeeds
 from airtable.physics.walls import room_to_walls
 
 if TYPE_CHECKING:
@@ -110,7 +111,7 @@ class Rules:
     pairs: str  # the correction mode ("perfect-kiss", "two-step", "off"), or "none": no pair hits
     walls: bool  # wall hits at their time (wall_correction); else the wall stage puts pucks back
     accel_y_mps2: float = 0.0  # gravity's part of the step's velocity change (0 or -g)
-    rest: np.ndarray | None = None  # per puck: pair hits slower than this rest (contacts.py)
+    rest: RestSpeeds | None = None  # pair hits slower than their rest speed rest (rest_speeds.py)
     wall_rest: np.ndarray | None = None  # per puck (N,) or per puck and axis (N, 2), for walls
     held: Callable[[np.ndarray, np.ndarray], np.ndarray] | None = None  # pairs (i < j) resting: the contacts'
 
@@ -123,6 +124,7 @@ class Hits:
     # the fields of Collisions.of_pairs (collision.PairRecords), one hit each, vectors complex
     rows: list = field(default_factory=list)
     walls: int = 0
+    bounced: list = field(default_factory=list)  # the rows of the wall hits, one a hit
     capped: bool = False
     maybe_past: np.ndarray | None = None  # the rows that may still be past a wall (None: any)
 
@@ -148,6 +150,7 @@ def hits_in_order(table: Storage, ctx: StepContext) -> None:
     pucks = (table.pos_m, table.vel_mps, table.radius_m, table.mass_kg)
     hits = resolve_hits(*pucks, table.size_m, ctx.dt, rules, table.neighbour_list)
     table.wall_collision_count += hits.walls
+    ctx.bounced = hits.bounced
     if hits.rows:
         ctx.records.append(hits.records())
         table.collision_count += len(hits.rows)
@@ -388,8 +391,8 @@ class _Step:
         s = np.minimum(np.maximum(dw / np.where(ww > 0.0, ww, 1.0), 0.0), self.dt)  # time back from the end
         reach = self.radius.take(i) + self.radius.take(j)
         close = (dw - ww * self.dt < 0.0) & (vectors.squared_abs(d - w * s) < reach * reach)
-        if self.rules.rest is not None:
-            close &= ww > np.maximum(self.rules.rest.take(i), self.rules.rest.take(j)) ** 2
+        if self.rules.rest is not None:  # (ww: at least the approach along the line of centres, squared)
+            close &= ww > self.rules.rest.pairs(i, j, d) ** 2
         if self.rules.pairs != "perfect-kiss":  # only fast pairs: the others are seen overlapping
             speed_sq = np.maximum(self.speed_sq.take(i), self.speed_sq.take(j))
             fast = _moves(speed_sq, np.minimum(self.radius.take(i), self.radius.take(j)), self.dt, FAST_FRACTION)
@@ -421,7 +424,7 @@ class _Step:
         if rules.pairs != "perfect-kiss":
             ok &= fast
         if rules.rest is not None:  # slower: a resting contact, the contact stage's
-            ok &= speed > either.maximum(either.take(rules.rest, a), either.take(rules.rest, b))
+            ok &= speed > rules.rest.pairs(a, b, self.at(a, self.t_now) - self.at(b, self.t_now))
         if rules.held is not None and either.count(ok):  # pressed on each other in the last step: resting
             ok &= ~_held(rules.held, a, b)
         if not isinstance(ok, np.ndarray):  # one pair
@@ -535,6 +538,7 @@ class _Step:
         x, v = self.at(k, self.t_now), self.zvel.item(k)
         e, a = self.rules.cr_wall, self.rules.accel_y_mps2
         self.hits.walls += 1
+        self.hits.bounced.append(k)
         self.hit_walls[k, axis] = hits = self.hit_walls.get((k, axis), 0) + 1
         if e < 1.0 and hits >= repeat_max(e):  # its last hit here: it rests on the wall (off_a_pinned)
             self.pinned[k] = self.wall_normal(x, axis)
@@ -596,11 +600,13 @@ class _Step:
             if caught and (_in_time(self.dt - t_p, self.t_now, self.dt) or self.fast(a, b, CHAIN_FRACTION)):
                 n, overlap, seen = end, reach - abs(end), (xa + va * left, xb + vb * left)
         n /= abs(n)
-        new_a, new_b = (
-            self.off_a_pinned(a, b, n, va, vb)
-            or self.off_a_pinned(b, a, -n, vb, va)[::-1]
-            or (collision.collide_along(n, va, vb, self.mass.item(a), self.mass.item(b), self.rules.cr_puck))
-        )
+        pinned = self.off_a_pinned(a, b, n, va, vb, xb)
+        if pinned:
+            new_a, new_b, xb = pinned
+        elif pinned := self.off_a_pinned(b, a, -n, vb, va, xa):
+            new_b, new_a, xa = pinned
+        else:
+            new_a, new_b = collision.collide_along(n, va, vb, self.mass.item(a), self.mass.item(b), self.rules.cr_puck)
         if new_a == va and new_b == vb:
             return ()  # nothing changed (round-off): predicting the same hit again would never end
         self.set_path(a, xa, new_a)
@@ -697,21 +703,37 @@ class _Step:
         reach = self.radius.item(p) + self.radius.item(q)
         return abs(self.at(p, self.t_now) - self.at(q, self.t_now)) <= reach * (1.0 + 1e-9)
 
-    def off_a_pinned(self, a: int, b: int, n: complex, va: complex, vb: complex) -> tuple[complex, complex] | tuple:
-        """(va, vb) after b hits puck a, which rests on a wall (pinned: its hits there reached repeat_max)
-        and which b pushes into it along n (from b to a): b bounces off the wall through a, its speed
-        along n reversed times cr_wall, a stays. () if a is not so pinned.
+    def off_a_pinned(self, a: int, b: int, n: complex, va: complex, vb: complex, xb: complex) -> tuple:
+        """(va, vb, xb) after b, now at xb, hits puck a, which rests on a wall (pinned: its hits there reached
+        repeat_max; or held there by the contacts) and which b pushes into it along n (from b to a): b
+        bounces off the wall through a, its speed along n reversed times cr_wall, a stays. () if a is not
+        so pinned.
 
         The exact run has infinitely many ever faster hits of a between b and the wall; at cr_wall 0
         their limit is this one (b stops). Colliding a and b as a pair let b pass through a once a
-        could no longer hit the wall."""
-        wall = self.pinned.get(a)
+        could no longer hit the wall. A puck the contacts hold on the wall moves into it on its path
+        here (by this step's gravity, say), where the contacts will put it back: b, which met it there,
+        is moved out of where it rests as a bounce there would have left it (a 50 kg puck landing at
+        dt 1/30 on a 4 kg one on the floor ended 5.6 mm deep in it)."""
+        wall, held = self.pinned.get(a), False
         if wall is None:
-            wall = self.held_on_wall(a, b, n)
+            wall, held = self.held_on_wall(a, b, n), True
         towards = vectors.dot(vb, n)
         if wall is None or vectors.dot(n, wall) >= 0.0 or not towards > 0.0:
             return ()  # (b does not push a into the wall: a, sliding along it into b, hits it as any puck)
-        return va, vb - (1.0 + self.rules.cr_wall) * towards * n
+        e = self.rules.cr_wall
+        if held:
+            overlap = self.radius.item(a) + self.radius.item(b) - abs(xb - self.on_wall(a, wall))
+            if overlap > 0.0:
+                xb -= (1.0 + e) * overlap * n
+        return va, vb - (1.0 + e) * towards * n, xb
+
+    def on_wall(self, k: int, wall: complex) -> complex:
+        """Where puck k rests on the wall whose normal into the table is `wall`, beside where it is now."""
+        x, r = self.at(k, self.t_now), self.radius.item(k)
+        if wall.real:
+            return complex(r if wall.real > 0.0 else self.width - r, x.imag)
+        return complex(x.real, r if wall.imag > 0.0 else self.height - r)
 
     def held_on_wall(self, a: int, b: int, n: complex) -> complex | None:
         """The normal of a wall puck a rests on (the contacts held it there in the last step: its wall rest

@@ -14,7 +14,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from airtable.physics import forces, implicit, substeps, vectors
+from airtable.physics import forces, implicit, substeps
 
 if TYPE_CHECKING:
     from airtable.physics.context import StepContext
@@ -34,7 +34,7 @@ MAX_SPEED_MPS = 1e8
 
 def forces_and_integrate(table: Storage, ctx: StepContext) -> None:
     """Forces and integration in as many substeps as the springs need (substeps.py); sets ctx.kick,
-    the speed the whole step's forces gave each puck. Forces written from outside act in every substep."""
+    the velocity the whole step's forces gave each puck. Forces written from outside act in every substep."""
     n = 1
     if table.n_springs:
         n = substeps.count(table.mass_kg, *table.spring_ends, table.spring_k_Npm, ctx.dt)
@@ -63,12 +63,12 @@ def add_forces(table: Storage, pulls, dt: float) -> forces.Implicit | None:
     return parts
 
 
-def integrate(table: Storage, ctx: StepContext, parts: forces.Implicit | None, dt: float) -> np.ndarray | float | None:
+def integrate(table: Storage, ctx: StepContext, parts: forces.Implicit | None, dt: float) -> np.ndarray | None:
     """Semi-implicit Euler: v += (F/m + g) dt (the implicit parts solved for), then x += v dt.
 
-    Returns the speed the forces and gravity added to each puck (a number
-    if the same for all), or None if nothing pushed: the contact stage's
-    rest speeds come from it.
+    Returns the velocity the forces and gravity added to each puck ((N, 2),
+    or (2,) if the same for all), or None if nothing pushed: the contact
+    stage's rest speeds come from it (resting.rest_speeds).
     """
     pos, vel, force, mass = table.pos_m, table.vel_mps, table.force_N, table.mass_kg
     kick = None
@@ -78,16 +78,16 @@ def integrate(table: Storage, ctx: StepContext, parts: forces.Implicit | None, d
             rhs[:, 1] -= table.gravity_mps2 * dt * mass
         dv = implicit_velocity_change(table, parts, rhs, dt)
         vel += dv
-        kick = vectors.lengths(dv)
+        kick = dv
     elif force.any():  # usually nothing pushes: skip the (N, 2) update (any() beats count_nonzero on floats)
         dv = force * (dt / mass)[:, None]
         if table.gravity_on:
             dv[:, 1] -= table.gravity_mps2 * dt
         vel += dv
-        kick = vectors.lengths(dv)
+        kick = dv
     elif table.gravity_on:
         vel[:, 1] -= table.gravity_mps2 * dt
-        kick = table.gravity_mps2 * dt
+        kick = np.array([0.0, -table.gravity_mps2 * dt])
     if ctx.sleepers is not None:
         vel[ctx.sleepers] = 0.0  # sleepers stay where they are
     _cap_speeds(vel)

@@ -13,7 +13,8 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from airtable.physics import contacts
+from airtable.physics import contacts, vectors
+from airtable.physics.rest_speeds import RestSpeeds
 from airtable.physics.storage import non_negative
 
 if TYPE_CHECKING:
@@ -30,23 +31,24 @@ MARGIN_TRIES = 3
 
 
 def rest_speeds(table: Storage, ctx: StepContext) -> None:
-    """Each puck's rest speeds towards other pucks and towards the walls (ctx.rest, ctx.rest_walls;
-    None: all zero), and the walls' with the contacts' hold of last step (ctx.wall_rest).
+    """The step's rest speeds (ctx.rest, rest_speeds.py; None: every contact collides) and the walls'
+    with the contacts' hold of last step (ctx.wall_rest).
 
-    The rest speed is rest_speed_mps, and where this step's forces gave the puck a kick,
-    PRESSED_REST_MPS and twice the kick; a contact rests when its bounce would be slower
-    than that (contacts.rest_for_restitution: at restitution 0, always).
+    Where this step's forces gave a puck a kick dv, it presses along dv at PRESSED_REST_MPS or twice
+    the kick, whichever is more; the table's rest_speed_mps holds in every direction.
     """
     floor = non_negative(table.rest_speed_mps, "rest_speed_mps")
     if ctx.kick is None and floor == 0.0:
         return  # nothing presses: every contact is a collision, as in the course's model
-    rest = np.full(table.n_pucks, floor)
+    press = np.zeros(table.n_pucks, dtype=complex)
     if ctx.kick is not None:
-        kick = np.asarray(ctx.kick)
-        np.maximum(rest, np.where(kick > 0.0, np.maximum(2.0 * kick, PRESSED_REST_MPS), 0.0), out=rest)
-    ctx.rest = contacts.rest_for_restitution(rest, table.cr_puck)
-    ctx.rest_walls = contacts.rest_for_restitution(rest, table.cr_wall)
-    ctx.wall_rest = table.contact_solver.wall_rest(ctx.rest_walls)
+        kick = np.broadcast_to(vectors.as_complex(np.ascontiguousarray(ctx.kick, dtype=float)), press.shape)
+        size = np.abs(kick)
+        pressed = np.flatnonzero(size > 0.0)
+        along = kick.take(pressed) / size.take(pressed)
+        press[pressed] = along * np.maximum(2.0 * size.take(pressed), PRESSED_REST_MPS)
+    ctx.rest = RestSpeeds(press, floor, table.cr_puck, table.cr_wall, table.contact_solver.piled(table.n_pucks))
+    ctx.wall_rest = table.contact_solver.wall_rest(ctx.rest.walls)
 
 
 def hold(table: Storage, ctx: StepContext) -> bool:
@@ -74,7 +76,7 @@ def hold(table: Storage, ctx: StepContext) -> bool:
     margin = contacts.margin_m(table.vel_mps, ctx.dt)
     for tries in range(1, MARGIN_TRIES + 1):
         before = table.pos_m.copy(), table.vel_mps.copy(), solver.save()
-        held = solver.solve(*pucks, table.size_m, candidates, *rest, ctx.rest_walls, ctx.began, margin)
+        held = solver.solve(*pucks, table.size_m, candidates, *rest, ctx.began, margin)
         needed = contacts.margin_m(table.vel_mps, ctx.dt)
         if needed - contacts.MARGIN_M <= margin or tries == MARGIN_TRIES:  # a pair left out cannot close its gap
             return held

@@ -13,8 +13,9 @@ while; we do the same, puck by puck (Box2D does it per island):
   puck stays still exactly anyway) and never a puck on a spring.
 * it wakes when anything touches or moves it: a velocity, position or force
   written from outside (a drag, a throw, reverse time, a restore), a cursor
-  string, an awake puck moving faster than WAKE_MPS (or pulled, however
-  slowly) coming within reach, or a collision that gives it a velocity; and
+  string, an awake puck coming to touch it (however slowly), or one already
+  touching it moving faster than WAKE_MPS (or pulled, however slowly), or a
+  collision that gives it a velocity; and
   with it every sleeper joined to it by touching sleepers (its island, as
   Box2D wakes islands), so that none stays up when what held it moves.
   Everything wakes when the world changes: gravity, the table's size, a puck
@@ -46,7 +47,7 @@ if TYPE_CHECKING:
 SLEEP_MPS = 0.05
 SLEEP_DRIFT_M = 0.005
 SLEEP_S = 0.5
-# A sleeper wakes when an awake puck faster than this (m/s) comes within reach.
+# A sleeper wakes when an awake puck touching it moves faster than this (m/s).
 WAKE_MPS = 0.1
 # Extra room (m) in "within reach": what a step moves a puck, plus this.
 WAKE_SKIN_M = 1e-3
@@ -89,22 +90,29 @@ def island(pos, rows: np.ndarray, asleep, candidates) -> np.ndarray:
 
 
 def near_movers(pos, vel, asleep, candidates, dt: float, pulled: np.ndarray = ()) -> np.ndarray:
-    """The sleepers (rows) within reach of an awake puck faster than WAKE_MPS, or pulled by a cursor
-    string (a slow drag pushes too): the sum of the radii, plus what that puck moves in a step, plus
-    WAKE_SKIN_M."""
+    """The sleepers (rows) an awake puck may touch in this step, unless it touches them already and is
+    neither faster than WAKE_MPS nor pulled by a cursor string (a slow drag pushes too). "May touch":
+    within the sum of the radii, plus what the awake puck moves in a step, plus WAKE_SKIN_M.
+
+    A puck that rests on a sleeper touches it already: it wakes nothing. One that comes to touch it,
+    however slowly, wakes it, as a contact beginning to touch wakes a body in Box2D: a sleeper is a wall
+    to the contacts, and a puck sliding along the floor at 5 cm/s stopped dead at one (a user test)."""
     ci, cj, reach = candidates
-    speed = vectors.lengths(vel)
-    mover = speed > WAKE_MPS
-    mover[pulled] = True
-    mover &= ~asleep
-    if not mover.any():
+    awake = ~asleep
+    pick = np.flatnonzero((awake.take(ci) & asleep.take(cj)) | (awake.take(cj) & asleep.take(ci)))
+    if len(pick) == 0:
         return np.empty(0, dtype=np.intp)
-    pick = np.flatnonzero((mover.take(ci) & asleep.take(cj)) | (mover.take(cj) & asleep.take(ci)))
-    i, j = ci.take(pick), cj.take(pick)
-    lim = reach.take(pick) + np.maximum(speed.take(i), speed.take(j)) * dt + WAKE_SKIN_M
-    close = np.flatnonzero(vectors.squared_lengths(vectors.take(pos, i) - vectors.take(pos, j)) < lim * lim)
-    i, j = i.take(close), j.take(close)
-    return np.unique(np.concatenate([i.take(np.flatnonzero(asleep.take(i))), j.take(np.flatnonzero(asleep.take(j)))]))
+    i, j, reach = ci.take(pick), cj.take(pick), reach.take(pick)
+    speed = vectors.lengths(vel)
+    fast = speed > WAKE_MPS
+    fast[pulled] = True
+    mover = np.where(awake.take(i), i, j)  # the awake puck of each pair
+    squared = vectors.squared_lengths(vectors.take(pos, i) - vectors.take(pos, j))
+    lim = reach + speed.take(mover) * dt + WAKE_SKIN_M
+    touching = squared < (reach + WAKE_SKIN_M) ** 2
+    wake = np.flatnonzero((squared < lim * lim) & (fast.take(mover) | ~touching))
+    i, j = i.take(wake), j.take(wake)
+    return np.unique(np.where(asleep.take(i), i, j))
 
 
 def still_for_long(pos, vel, still, anchor, asleep, free, dt: float) -> np.ndarray | None:
@@ -214,6 +222,10 @@ def fall_asleep(table: Storage, ctx: StepContext) -> None:
     free[b] = False
     free[[p.row for p in ctx.pulls]] = False
     still, anchor = columns.view("still"), columns.view("rest_pos")
+    # A puck that hit something in this step is not at rest: a slow one bouncing off a wall stayed within
+    # SLEEP_DRIFT_M of where its still time began for SLEEP_S, and fell asleep leaving it (a user test).
+    hit = [np.array(ctx.bounced, dtype=np.intp), *(r.hit_rows() for r in ctx.records)]
+    still[np.concatenate(hit if ctx.moved is None else [*hit, ctx.moved])] = 0.0
     ready = still_for_long(pos, vel, still, anchor, asleep, free, ctx.dt)
     if ready is not None:
         candidates = table.neighbour_list.pairs(pos, table.radius_m)

@@ -184,8 +184,9 @@ class Storage:
         self.puck_collisions = True
         # Contacts approaching slower than this (m/s) are resting: held up by
         # the contact stage, with no bounce. Where forces press a puck, its
-        # contacts also rest below PRESSED_REST_MPS and twice what the step's
-        # forces add to its speed (2 g dt under gravity).
+        # contacts along the press also rest below PRESSED_REST_MPS and twice
+        # what the step's forces add to its speed (2 g dt under gravity; see
+        # rest_speeds.py).
         self.rest_speed_mps = 0.0
 
     def clear_storage(self) -> None:

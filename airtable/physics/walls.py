@@ -27,7 +27,7 @@ def again(table: Storage, ctx: StepContext, contacts_held: bool) -> None:
     without a bounce where it rests, if the contacts held some (`contacts_held`); else only the pucks
     the pair stage moved."""
     if contacts_held:
-        rest = table.contact_solver.wall_rest(ctx.rest_walls)
+        rest = table.contact_solver.wall_rest(ctx.rest.walls)
         bounced, _ = resolve_walls(*_table_walls(table), rest=rest, hold_slow=True)
     elif ctx.moved is not None:
         bounced, back = resolve_walls(*_table_walls(table), only=ctx.moved)

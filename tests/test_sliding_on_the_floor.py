@@ -1,0 +1,72 @@
+"""Under gravity, pucks sliding along the floor collide with each other and the side walls as without it.
+
+A user test: with gravity on, two pucks sliding along the floor into each other at 0.15 m/s stuck
+together at restitution 1, a puck at 2 cm/s stopped dead at the side wall, and a puck at 5 cm/s
+stopped at a sleeping one, their momentum gone. Gravity presses them on the floor, not on each other
+or on a side wall: those hits are collisions at their restitution, however slow.
+
+By hand, for a head-on hit along the floor of a puck of mass ma at speed v on a still one of mass mb
+at restitution e (the course's 1D collision along the normal): afterwards
+    va = (ma - e mb) v / (ma + mb),    vb = (1 + e) ma v / (ma + mb),
+and a puck hitting a side wall at v leaves it at e v.
+"""
+
+from __future__ import annotations
+
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from airtable.physics.table import AirTable
+
+FLOOR_R = 0.25
+GAP_M = 0.1
+
+
+def _floor_pair(v: float, density_b: float, e: float, dt: float, sleeping: bool, mode: str):
+    """Puck a sliding along the floor at v into a still puck b GAP_M ahead; run until a quarter second
+    after b has moved (b falls asleep while a comes, if `sleeping`)."""
+    table = AirTable()
+    table.gravity_on, table.sleeping, table.puck_correction = True, sleeping, mode
+    table.cr_puck = e
+    a = table.add_puck((3.0, FLOOR_R), FLOOR_R, vel_mps=(v, 0.0))
+    b = table.add_puck((3.0 + 2 * FLOOR_R + GAP_M, FLOOR_R), FLOOR_R, density_kgpm2=0.3 * density_b)
+    after = round(0.25 / dt)
+    for _ in range(round((GAP_M / v + 1.0) / dt)):
+        table.step(dt)
+        after -= b.vel_mps[0] != 0.0
+        if after == 0:
+            break
+    assert after == 0, "b was hit"
+    return table, a, b
+
+
+@settings(max_examples=25, deadline=None, derandomize=True)
+@given(
+    v=st.floats(0.01, 0.5),
+    density_b=st.floats(0.1, 10.0),
+    e=st.sampled_from([0.0, 0.5, 0.9, 1.0]),
+    dt=st.sampled_from([1 / 240, 1 / 60]),
+    sleeping=st.booleans(),
+    mode=st.sampled_from(["perfect-kiss", "two-step"]),
+)
+def test_a_hit_along_the_floor_keeps_momentum_and_its_restitution(v, density_b, e, dt, sleeping, mode) -> None:
+    table, a, b = _floor_pair(v, density_b, e, dt, sleeping, mode)
+    ma, mb = table.mass_kg[0], table.mass_kg[1]
+    assert a.vel_mps[0] == pytest.approx((ma - e * mb) * v / (ma + mb), abs=1e-9)
+    assert b.vel_mps[0] == pytest.approx((1 + e) * ma * v / (ma + mb), abs=1e-9)
+    for puck in (a, b):  # and still on the floor
+        assert puck.pos_m[1] == pytest.approx(FLOOR_R, abs=1e-6) and abs(puck.vel_mps[1]) < 1e-6
+
+
+@pytest.mark.parametrize("e", [1.0, 0.7])
+@pytest.mark.parametrize("v", [0.02, 0.1])
+def test_a_puck_sliding_into_a_side_wall_bounces_at_its_restitution(v: float, e: float) -> None:
+    table = AirTable()
+    table.gravity_on, table.cr_wall = True, e
+    puck = table.add_puck((table.width_m - FLOOR_R - 0.2, FLOOR_R), FLOOR_R, vel_mps=(v, 0.0))
+    for _ in range(round(2 * 0.2 / v * 240)):  # there and back
+        table.step(1 / 240)
+    assert puck.vel_mps[0] == pytest.approx(-e * v, abs=1e-9)
+    assert table.wall_collision_count == 1
+    assert puck.pos_m[1] == pytest.approx(FLOOR_R, abs=1e-6)
