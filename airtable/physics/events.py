@@ -392,7 +392,7 @@ class _Step:
         reach = self.radius.take(i) + self.radius.take(j)
         close = (dw - ww * self.dt < 0.0) & (vectors.squared_abs(d - w * s) < reach * reach)
         if self.rules.rest is not None:  # (ww: at least the approach along the line of centres, squared)
-            close &= ww > self.rules.rest.pairs(i, j, d) ** 2
+            close &= ww > self.rules.rest.pairs(i, j, d - w * self.dt) ** 2  # (their line at t = 0, as predict_pairs)
         if self.rules.pairs != "perfect-kiss":  # only fast pairs: the others are seen overlapping
             speed_sq = np.maximum(self.speed_sq.take(i), self.speed_sq.take(j))
             fast = _moves(speed_sq, np.minimum(self.radius.take(i), self.radius.take(j)), self.dt, FAST_FRACTION)

@@ -8,9 +8,9 @@ rests by as much as its normal n lies along the kick: |press . n|, where
 `press` is the puck's rest speed (resting.rest_speeds) along dv. Under
 gravity a puck landing on another, or on the floor, rests; two pucks sliding
 along the floor into each other, or a puck into a side wall, collide at
-their restitution however slowly (a user test: at 0.15 m/s two such pucks
-stuck together, and a 5 cm/s puck stopped dead at a sleeping one, its
-momentum gone). A puck in a pile, though (one in a contact with another puck
+their restitution however slowly (rested every way, two such pucks met at
+0.15 m/s and stuck together, and a 5 cm/s puck stopped dead at a sleeping
+one, its momentum gone). A puck in a pile, though (one in a contact with another puck
 in the last step), is pressed every way by its neighbours: its contacts rest
 by its whole rest speed, whatever their direction, so that a pile settles
 instead of its pucks bouncing off their neighbours at a few cm/s. `floor`

@@ -96,7 +96,7 @@ def near_movers(pos, vel, asleep, candidates, dt: float, pulled: np.ndarray = ()
 
     A puck that rests on a sleeper touches it already: it wakes nothing. One that comes to touch it,
     however slowly, wakes it, as a contact beginning to touch wakes a body in Box2D: a sleeper is a wall
-    to the contacts, and a puck sliding along the floor at 5 cm/s stopped dead at one (a user test)."""
+    to the contacts, and a puck sliding along the floor at 5 cm/s stopped dead at one."""
     ci, cj, reach = candidates
     awake = ~asleep
     pick = np.flatnonzero((awake.take(ci) & asleep.take(cj)) | (awake.take(cj) & asleep.take(ci)))
@@ -223,7 +223,7 @@ def fall_asleep(table: Storage, ctx: StepContext) -> None:
     free[[p.row for p in ctx.pulls]] = False
     still, anchor = columns.view("still"), columns.view("rest_pos")
     # A puck that hit something in this step is not at rest: a slow one bouncing off a wall stayed within
-    # SLEEP_DRIFT_M of where its still time began for SLEEP_S, and fell asleep leaving it (a user test).
+    # SLEEP_DRIFT_M of where its still time began for SLEEP_S, and fell asleep leaving it.
     hit = [np.array(ctx.bounced, dtype=np.intp), *(r.hit_rows() for r in ctx.records)]
     still[np.concatenate(hit if ctx.moved is None else [*hit, ctx.moved])] = 0.0
     ready = still_for_long(pos, vel, still, anchor, asleep, free, ctx.dt)
