@@ -47,7 +47,7 @@ import math
 
 import numpy as np
 
-from airtable.physics import collision, vectors
+from airtable.physics import broadphase, collision, vectors
 from airtable.physics.events import FAST_FRACTION
 
 # Per puck, the sum of k h^2 / m each substep may take explicitly: a pair of equal
@@ -80,7 +80,29 @@ def for_contacts(table, dt_s: float) -> int:
     if table.n_springs == 0:
         return 1
     n = count(table.mass_kg, *table.spring_ends, table.spring_k_Npm, dt_s)
-    return n if n > 1 and (table.contact_solver.held_pairs() or _hits_a_wall(table, dt_s)) else 1
+    if n == 1:
+        return 1
+    return n if table.contact_solver.held_pairs() or _hits_a_wall(table, dt_s) or _may_meet(table, dt_s) else 1
+
+
+def _may_meet(table, dt_s: float) -> bool:
+    """Whether a puck on springs may reach another puck within the step, by its speed and what its springs
+    pull now (a pull's dt^2 travel, twice over: the pull grows as the spring stretches). Substeps would
+    carry it there and through, unseen: two 14 g pucks pulled together by a 3000 N/m spring flew through
+    each other at 150 m/s."""
+    if not table.puck_collisions:
+        return False
+    pos, a, b = table.pos_m, *table.spring_ends
+    pull = table.spring_k_Npm * np.abs(vectors.lengths(pos[a] - pos[b]) - table.spring_length_m)
+    n = len(pos)
+    travel = (
+        vectors.lengths(table.vel_mps) * dt_s
+        + (np.bincount(a, pull, n) + np.bincount(b, pull, n)) / table.mass_kg * dt_s**2
+    )
+    sprung = np.unique(np.concatenate((a, b)))
+    i, j = broadphase.pairs_near(pos, table.radius_m, sprung, 2.0 * float(travel.take(sprung).max()))
+    gap = vectors.lengths(pos[i] - pos[j]) - table.radius_m[i] - table.radius_m[j]
+    return bool((gap < travel[i] + travel[j]).any())
 
 
 def _hits_a_wall(table, dt_s: float) -> bool:
