@@ -489,10 +489,16 @@ class _Step:
         return np.array(rows).take(fast.nonzero()[0]).tolist()
 
     def _wall_rest(self, k: int, axis: int) -> float:
+        """Puck k's rest speed towards the walls across `axis`. Held on a wall in the last step, it rests
+        there whatever its speed, unless a hit in this step drove it in: then it bounces (a puck dropped on
+        one sliding along the floor stuck to it, half the energy gone, where the lower one was held)."""
         rest = self.rules.wall_rest
         if rest is None:
             return 0.0
-        return rest.item(k) if rest.ndim == 1 else rest.item(k, axis)
+        speed = rest.item(k) if rest.ndim == 1 else rest.item(k, axis)
+        if speed == math.inf and self.changed.item(k) and self.rules.rest is not None:
+            return self.rules.rest.walls.item(k, axis)
+        return speed
 
     def predict(self, k: int) -> None:
         """Every next hit of puck k (its path just changed)."""
