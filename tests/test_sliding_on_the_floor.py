@@ -103,3 +103,17 @@ def test_a_puck_dropped_on_one_sliding_along_the_floor_bounces_as_on_one_at_rest
         assert end - start == pytest.approx(at_rest[2] - at_rest[1], abs=1e-6)
     assert at_rest[0] == pytest.approx(3.2, abs=0.02 if dt < 1 / 100 else 0.05)
     assert at_rest[2] == pytest.approx(at_rest[1], rel=0.01 if dt < 1 / 100 else 0.03)
+
+
+@pytest.mark.parametrize("v", [0.001, 0.005, 0.011])
+def test_a_lone_puck_sliding_slowly_along_the_floor_keeps_sliding(v: float) -> None:
+    """A helper's user test: under gravity a lone puck sliding along the floor slower than 1.2 cm/s stopped
+    dead after half a second (it fell asleep: it stayed within SLEEP_DRIFT_M, 5 mm, of where it was slow).
+    On a frictionless table it slides on; a puck resting among others still falls asleep."""
+    table = AirTable()
+    table.gravity_on = True
+    puck = table.add_puck((3.0, FLOOR_R), FLOOR_R, vel_mps=(v, 0.0))
+    for _ in range(2 * 240):
+        table.step(1 / 240)
+    assert puck.vel_mps[0] == v and not table.asleep.any()
+    assert puck.pos_m[0] == pytest.approx(3.0 + 2 * v, abs=1e-9)
