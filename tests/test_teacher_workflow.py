@@ -137,6 +137,11 @@ def test_the_first_key_after_a_load_notice_also_does_its_work(tmp_path):
     (tmp_path / "late.py").write_text("KEY = 't1'\nTITLE = 'x'\ndef build(table, variation=0)\n")
     app = make_app(tmp_path)
     assert app.panels.panel() == "notice"
+    shown: list = []
+    draw_panel = app.window.draw_panel
+    app.window.draw_panel = lambda title, rows, **k: (shown.extend(rows), draw_panel(title, rows, **k))
+    app.frame(FRAME_S)
+    assert any(str(row).startswith("Space or Enter goes on; any other key goes on and does its work") for row in shown)
     press(app, pygame.K_3)
     assert app.panels.panel() is None and app.demo_key == "3"
     app = make_app(tmp_path)

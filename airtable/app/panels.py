@@ -25,8 +25,10 @@ from airtable.app.overlays import EscapeBurst, OverlayFlag, OverlayValue
 if TYPE_CHECKING:
     from airtable.app.host import Host
 
-# Keys that only close a "press any key" notice; any other key closes it and does its work too.
+# Keys that only close a "press any key" notice; any other key closes it and does its work too, as it says
+# (a user test: the first key, 3 for demo 3, was lost; the next one: g turned gravity on unannounced).
 GO_ON_KEYS = frozenset((pygame.K_SPACE, pygame.K_RETURN, pygame.K_KP_ENTER))
+GO_ON = "Space or Enter goes on; any other key goes on and does its work (3: demo 3)."
 QUIT_CONFIRM_S = 4.0  # the quit question waits this long for a second Esc (or window close)
 ERROR_TITLES = {
     "load": "Demo {key} could not be loaded",
@@ -176,7 +178,7 @@ class Panels(Feature):
         elif panel == "error":
             w.draw_panel(*self._error_text())
         elif panel == "notice":
-            w.draw_panel("Some demo files could not be loaded", [*self.notice, "Press any key to go on."])
+            w.draw_panel("Some demo files could not be loaded", [*self.notice, GO_ON])
         elif panel == "help":
             rows = [(key_label(k) if has_own_key(k) else f"Tab, {k}", d.title) for k, d in host.demos.items()]
             keys = [(b.label, b.help) for b in self.key_rows]
