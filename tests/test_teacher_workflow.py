@@ -165,6 +165,11 @@ def test_the_demo_menu_takes_letters_of_any_layout_by_their_key(tmp_path):
         pygame.event.post(pygame.event.Event(pygame.KEYDOWN, key=key, mod=0, unicode=text, scancode=scancode))
         app.frame(FRAME_S)
     assert app.demo_key == "t2" and len(app.table.pucks) == 3 and app.panels.panel() is None
+    press(app, pygame.K_TAB)
+    for ch in "жq":  # a letter that is no key on this layout's keyboard, and one no demo key starts with
+        pygame.event.post(pygame.event.Event(pygame.KEYDOWN, key=ord(ch), mod=0, unicode=ch, scancode=0))
+        app.frame(FRAME_S)
+    assert app.panels.menu.footer().endswith("; no demo key starts with жq (Backspace)")
 
 
 def test_demo_keys_sort_naturally_everywhere(tmp_path, capsys):

@@ -69,4 +69,6 @@ class DemoMenu:
 
     def footer(self) -> str:
         typed = f"; typed so far: {self.typed}" if self.typed else ""
+        if self.typed and not any(k.lower().startswith(self.typed.lower()) for k, _ in self.items):
+            typed = f"; no demo key starts with {self.typed} (Backspace)"  # a user test: no word that nothing matched
         return f"{self.selected + 1} of {len(self.items)}. Up / Down and Enter, or type a key; Esc or Tab closes{typed}"
