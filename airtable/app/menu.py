@@ -46,9 +46,13 @@ class DemoMenu:
             return None
         return self._match()
 
+    def _starting(self) -> list[int]:
+        """The rows whose demo key starts with what was typed."""
+        return [i for i, (k, _) in enumerate(self.items) if k.lower().startswith(self.typed.lower())]
+
     def _match(self) -> str | None:
         keys = [k for k, _ in self.items]
-        starting = [i for i, k in enumerate(keys) if k.lower().startswith(self.typed.lower())]
+        starting = self._starting()
         if not self.typed or not starting:
             return None
         self.selected = starting[0]
@@ -69,6 +73,6 @@ class DemoMenu:
 
     def footer(self) -> str:
         typed = f"; typed so far: {self.typed}" if self.typed else ""
-        if self.typed and not any(k.lower().startswith(self.typed.lower()) for k, _ in self.items):
+        if self.typed and not self._starting():
             typed = f"; no demo key starts with {self.typed} (Backspace)"  # a user test: no word that nothing matched
         return f"{self.selected + 1} of {len(self.items)}. Up / Down and Enter, or type a key; Esc or Tab closes{typed}"

@@ -140,11 +140,12 @@ def still_for_long(pos, vel, still, anchor, asleep, free, dt: float) -> np.ndarr
     return ready if (ready & awake).any() else None
 
 
-def sliding_alone(pos, vel, anchor, still, ready, candidates) -> np.ndarray:
-    """Which of the `ready` pucks touch no other puck and slide (SLEEP_JITTER_M): a helper's user test saw lone
-    pucks on the floor under 1.2 cm/s stop dead, 0.5 s after they began, on a frictionless table."""
+def sliding_alone(pos, vel, anchor, still, ready, touching_pairs) -> np.ndarray:
+    """Which of the `ready` pucks touch no other puck (`touching_pairs`: i, j) and slide (SLEEP_JITTER_M): a
+    helper's user test saw lone pucks on the floor under 1.2 cm/s stop dead, 0.5 s after they began, on a
+    frictionless table."""
     out = np.zeros(len(pos), dtype=bool)
-    i, j = touching(pos, candidates)
+    i, j = touching_pairs
     alone = ready.copy()
     alone[i] = False
     alone[j] = False
@@ -154,11 +155,12 @@ def sliding_alone(pos, vel, anchor, still, ready, candidates) -> np.ndarray:
     return out
 
 
-def with_still_neighbours(pos, ready, asleep, candidates) -> np.ndarray:
-    """The awake `ready` pucks (rows) every touching neighbour of which is ready or asleep: they fall asleep."""
+def with_still_neighbours(ready, asleep, touching_pairs) -> np.ndarray:
+    """The awake `ready` pucks (rows) every touching neighbour of which (`touching_pairs`: i, j) is ready or
+    asleep: they fall asleep."""
     ok = ready | asleep  # a neighbour that lets a puck sleep
-    i, j = touching(pos, candidates)
-    blocked = np.zeros(len(pos), dtype=bool)
+    i, j = touching_pairs
+    blocked = np.zeros(len(ready), dtype=bool)
     blocked[i.take(np.flatnonzero(~ok.take(j)))] = True
     blocked[j.take(np.flatnonzero(~ok.take(i)))] = True
     return np.flatnonzero(ready & ~asleep & ~blocked)
@@ -247,9 +249,9 @@ def fall_asleep(table: Storage, ctx: StepContext) -> None:
     still[np.concatenate(hit if ctx.moved is None else [*hit, ctx.moved])] = 0.0
     ready = still_for_long(pos, vel, still, anchor, asleep, free, ctx.dt)
     if ready is not None:
-        candidates = table.neighbour_list.pairs(pos, table.radius_m)
-        ready &= ~sliding_alone(pos, vel, anchor, still, ready, candidates)
-        asleep[with_still_neighbours(pos, ready, asleep, candidates)] = True
+        touching_pairs = touching(pos, table.neighbour_list.pairs(pos, table.radius_m))
+        ready &= ~sliding_alone(pos, vel, anchor, still, ready, touching_pairs)
+        asleep[with_still_neighbours(ready, asleep, touching_pairs)] = True
     sleepers = np.flatnonzero(asleep)
     if len(sleepers):
         vel[sleepers] = 0.0
