@@ -17,6 +17,7 @@ from airtable.app.app import App
 from airtable.app.demo_loader import BUILTIN_DIR, DemoShelf, key_order
 from airtable.app.window import GameWindow
 from airtable.cli import main
+from airtable.physics.table import AirTable
 
 
 def demo_source(key: str, pucks: int = 1, build_line: str = "", title: str = "Mine") -> str:
@@ -90,6 +91,27 @@ def test_a_demo_that_fails_to_build_leaves_the_lesson_s_table_and_ctrl_s_saves_t
     saved = app.lessons.save_moment(tmp_path / "saved.py")
     text = saved.read_text()
     assert f"TITLE = '{title}, saved at t = " in text and f"Saved from {label} at" in text and "Five pucks" not in text
+
+
+def test_a_demo_whose_first_build_fails_leaves_none_of_its_settings(tmp_path):
+    """A user test: the app started on a demo whose build turned gravity on and then raised: an empty
+    table with gravity on (and its restitution) under "not built"."""
+    settings = "".join(
+        f"    {line}\n"
+        for line in ("table.gravity_on = True", "table.cr_puck = table.cr_wall = 0.3", "table.puck_correction = 'off'")
+    )
+    (tmp_path / "s1.py").write_text(demo_source("s1", pucks=3, build_line=settings + RAISES))
+    app = make_app(tmp_path, key="s1")
+    fresh = AirTable()  # (a new table has the settings reset_settings gives)
+    assert app.panels.panel() == "error" and "not built" in app.caption() and len(app.table.pucks) == 0
+    t = app.table
+    assert (t.gravity_on, t.cr_puck, t.cr_wall, t.puck_correction) == (
+        fresh.gravity_on,
+        fresh.cr_puck,
+        fresh.cr_wall,
+        fresh.puck_correction,
+    )
+    assert not t.gravity_on and t.cr_puck == 1.0
 
 
 def test_a_demo_file_broken_while_it_runs_stays_in_the_menu_and_the_heading_says_what_failed(tmp_path):

@@ -259,7 +259,10 @@ class App:
             demo.build(self.table, self.variation)
         except Exception as exc:  # a teacher's demo may fail in any way; the app goes on
             self._demo_failed(exc, "build")
+            # Nothing of it stays: an empty table with the settings its build had set so far (gravity on) was
+            # the failed demo's half, under the caption "not built".
             self.table.clear()
+            self.table.reset_settings()
 
     def _clear_table(self) -> None:
         self.table.clear()
