@@ -4,9 +4,12 @@ The momenta diagram, as PhET's Collision Lab draws it: every puck's momentum
 m v as an arrow, tip to tail, so the arrow from the first tail to the last
 tip is the total; once just before the latest collision and once just after
 it, at one shared scale, so a student sees the total come out the same.
-"Before" is each puck's velocity as the step's first collision involving it
-found it (after that step's forces); "after" is the velocity at the end of
-the step. The pucks that did not collide have the same arrow in both.
+"Before" is each colliding puck's velocity when the step began, before its
+forces; "after" is the velocity at the end of the step. (The velocity a
+collision found had the step's forces in it: a puck sliding on the floor
+met its partner moving down by gravity's g dt, which the floor takes back
+later in the step, and its arrow pointed down before, flat after.) The
+pucks that did not collide have the same arrow in both.
 """
 
 from __future__ import annotations
@@ -101,20 +104,24 @@ def _seen(table: AirTable) -> tuple | None:
     collisions = table.last_collisions_later()  # joined only if the diagram is drawn
     if collisions is None:
         return None
-    return float(table.time_s), collisions, table.vel_mps.copy(), table.mass_kg.copy(), table.color_rgb.copy()
+    began = table.last_step_began_vel_mps  # (None after a restore: a step has run since, so not here)
+    return float(table.time_s), collisions, began, table.vel_mps.copy(), table.mass_kg.copy(), table.color_rgb.copy()
 
 
 def _momenta_around(
-    t_s: float, collisions: Callable[[], Collisions], vel_after: np.ndarray, mass_kg: np.ndarray, colors: np.ndarray
+    t_s: float,
+    collisions: Callable[[], Collisions],
+    vel_began: np.ndarray,
+    vel_after: np.ndarray,
+    mass_kg: np.ndarray,
+    colors: np.ndarray,
 ) -> MomentaAround:
-    """The momenta around the collisions() of a step that ended at t_s with velocities `vel_after`."""
+    """The momenta around the collisions() of a step that began with velocities `vel_began` and ended at
+    t_s with `vel_after`."""
     c = collisions()
     vel_before = vel_after.copy()
-    # Each puck's velocity when its first collision of the step found it.
     rows = np.stack([c.i, c.j], axis=1).ravel()
-    vels = np.stack([c.vel_i_before, c.vel_j_before], axis=1).reshape(-1, 2)
-    _, first = np.unique(rows, return_index=True)
-    vel_before[rows[first]] = vels[first]
+    vel_before[rows] = vel_began[rows]
     collided = np.zeros(len(vel_after), dtype=bool)
     collided[rows] = True
     mass = mass_kg[:, None]
