@@ -83,8 +83,7 @@ def _blocks(font, sections: Sequence[tuple[str, Sequence[Row]]], col_w: int) -> 
     """Each row as a block of (x offset, text, colour) lines that must stay together."""
     blocks = []
     for heading, rows in sections:
-        if heading:  # a blank line, then the heading (the blank is dropped at a column's top)
-            blocks.append([(0, "", ACCENT), (0, heading, ACCENT)] if blocks else [(0, heading, ACCENT)])
+        first = len(blocks)
         keys = [r[0] for r in rows if isinstance(r, tuple)]
         gap = font.get_height()
         key_w = min(max((font.size(k)[0] for k in keys), default=0), col_w // 3) + gap
@@ -98,6 +97,10 @@ def _blocks(font, sections: Sequence[tuple[str, Sequence[Row]]], col_w: int) -> 
                     blocks.append([(-1, key, ACCENT), *lines])
             else:
                 blocks.append([(0, line, TEXT_COLOR) for line in wrap(font, row, col_w) or [""]])
+        if heading:  # a blank line, then the heading (the blank is dropped at a column's top), kept with
+            # its first row: alone at the foot of a column it headed nothing (help page 2 at 1280x720)
+            head = [(0, "", ACCENT), (0, heading, ACCENT)] if first else [(0, heading, ACCENT)]
+            blocks[first:first] = [head + (blocks.pop(first) if len(blocks) > first else [])]
     return blocks
 
 
@@ -126,10 +129,10 @@ def layout(
         if used == 0 and block[0][1] == "":  # no blank line at the top of a column
             block = block[1:]
         x0 = col * (col_w + gap)
-        y = used * line_h
+        beside = None  # a key that goes beside the next line (its description's first)
         for x, text, color in block:
-            if x < 0:  # a key beside the first line of its description
-                pages[-1].append(Piece(x0, y, text, color))
+            if x < 0:
+                beside = (text, color)
                 continue
             if used >= rows_per_col:  # a block taller than a column goes on in the next one
                 col, used = col + 1, 0
@@ -137,6 +140,9 @@ def layout(
                     pages.append([])
                     col = 0
                 x0 = col * (col_w + gap)
+            if beside is not None:
+                pages[-1].append(Piece(x0, used * line_h, *beside))
+                beside = None
             pages[-1].append(Piece(x0 + x, used * line_h, text, color))
             used += 1
     return pages
