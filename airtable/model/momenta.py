@@ -8,8 +8,10 @@ it, at one shared scale, so a student sees the total come out the same.
 forces; "after" is the velocity at the end of the step. (The velocity a
 collision found had the step's forces in it: a puck sliding on the floor
 met its partner moving down by gravity's g dt, which the floor takes back
-later in the step, and its arrow pointed down before, flat after.) The
-pucks that did not collide have the same arrow in both.
+later in the step, and its arrow pointed down before, flat after.) So the
+totals differ by what acted from outside over the step: nothing along the
+floor, gravity's M g dt for pucks that meet in the air. The pucks that did
+not collide have the same arrow in both.
 """
 
 from __future__ import annotations
@@ -104,7 +106,7 @@ def _seen(table: AirTable) -> tuple | None:
     collisions = table.last_collisions_later()  # joined only if the diagram is drawn
     if collisions is None:
         return None
-    began = table.last_step_began_vel_mps  # (None after a restore: a step has run since, so not here)
+    began = table.last_step_began_vel_mps  # (set by the step whose collisions these are)
     return float(table.time_s), collisions, began, table.vel_mps.copy(), table.mass_kg.copy(), table.color_rgb.copy()
 
 
