@@ -113,6 +113,13 @@ def wall_rooms(x, y, radius, size_m) -> tuple:
     return (x - radius, y - radius, width - x - radius, height - y - radius)
 
 
+def wedged(radius, size):
+    """Whether a puck of `radius` is wedged between two walls `size` apart (2 r >= size: a demo's puck too
+    big for the table along an axis, which add_puck centres on it): it cannot move across them, and never
+    hits them (numbers, or arrays that broadcast)."""
+    return radius + radius >= size
+
+
 def each_wall(pos: np.ndarray, vel: np.ndarray, radius: np.ndarray, size_m) -> tuple:
     """For the left, bottom, right and top walls, in that order (WALL_NORMALS'): each puck's
     room between its edge and the wall (m; negative: past it) and its speed away from it (m/s)."""

@@ -155,8 +155,9 @@ def _pair_contacts(pos, vel, ci, cj, reach, rest, held, margin, kept=None) -> _C
 def _wall_contacts(pos, vel, radius, size_m, rest, margin) -> _Contacts:
     """The pucks within margin of a wall, moving into it slower than their rest speed (rest: (N, 2), per axis)."""
     rows, which, gap, vn = [], [], [], []
+    fits = ~collision.wedged(radius[:, None], size_m)  # (N, 2): wedged between two walls, neither holds it
     for w, (room, away) in enumerate(collision.each_wall(pos, vel, radius, size_m)):
-        k = np.flatnonzero((room < margin) & (away >= -rest[:, w % 2]))
+        k = np.flatnonzero((room < margin) & (away >= -rest[:, w % 2]) & fits[:, w % 2])
         rows.append(k)
         which.append(np.full(len(k), w))
         gap.append(room.take(k))

@@ -469,6 +469,8 @@ class _Step:
         """Queue puck k's next wall hit on its present path, if it comes within the step."""
         x, v, r = self.at(k, self.t_now), self.zvel.item(k), self.radius.item(k)
         for axis, (xa, va, size) in enumerate(((x.real, v.real, self.width), (x.imag, v.imag, self.height))):
+            if collision.wedged(r, size):
+                continue  # no hit, ever (walls.stop_wedged)
             t = collision.wall_time(xa, va, r, size - r)
             if t is None or self.t_now + t > self.dt or not abs(va) > self._wall_rest(k, axis):
                 continue

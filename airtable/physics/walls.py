@@ -25,7 +25,8 @@ def still_past(table: Storage, ctx: StepContext) -> None:
 def again(table: Storage, ctx: StepContext, contacts_held: bool) -> None:
     """Stage 6: walls again, since parting pairs can push a puck into a wall: every puck, put on the wall
     without a bounce where it rests, if the contacts held some (`contacts_held`); else only the pucks
-    the pair stage moved."""
+    the pair stage moved. A puck wedged between two walls ends the step stopped between them."""
+    stop_wedged(table.pos_m, table.vel_mps, table.radius_m, table.size_m)
     if contacts_held:
         rest = table.contact_solver.wall_rest(ctx.rest.walls)
         bounced, _ = resolve_walls(*_table_walls(table), rest=rest, hold_slow=True)
@@ -38,6 +39,17 @@ def again(table: Storage, ctx: StepContext, contacts_held: bool) -> None:
     else:
         return
     table.wall_collision_count += bounced
+
+
+def stop_wedged(pos, vel, radius, size_m) -> None:
+    """Put each puck wedged between two walls (collision.wedged) in the middle between them, stopped across
+    them, in place. No hit does it: the hit stage never predicts one there (it would come at once, again
+    and again: 100000 hits a step, the app frozen), nor do the contacts hold it (one wall against the other)."""
+    if len(radius) == 0 or not collision.wedged(float(radius.max()), float(size_m.min())):
+        return  # (the usual case)
+    rows, axes = collision.wedged(radius[:, None], size_m).nonzero()
+    vel[rows, axes] = 0.0
+    pos[rows, axes] = 0.5 * size_m.take(axes)
 
 
 def off_the_wall(pos, vel, radius, size_m, cr_wall: float, rows: np.ndarray) -> list[int]:
@@ -146,6 +158,7 @@ def _bounce_rows(pos, vel, radius, size_m, cr_wall: float, correction: bool, out
     hi = size_m - lo
     below, above = p < lo, p > hi
     into = (below & (v < 0.0)) | (above & (v > 0.0))
+    into &= ~collision.wedged(lo, size_m)  # (no hit: stop_wedged stops it there)
     vectors.put(vel, out, np.where(into, collision.bounce(v, cr_wall), v))
     # Mirrored by the penetration; where it moved into the wall, as two-step backs up a pair: back along its
     # path to the surface and on from there at the bounce's speed, cr_wall times the penetration (on the
