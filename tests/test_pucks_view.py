@@ -5,6 +5,8 @@ from __future__ import annotations
 import numpy as np
 import pygame
 import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
 
 from airtable.app.pucks_view import PuckSprites, core_color, draw_pucks
 
@@ -109,3 +111,133 @@ def test_thousands_of_big_pucks_draw_only_what_shows_and_look_the_same() -> None
         pygame.draw.circle = real_circle
     assert np.array_equal(image, drawn_big_one_by_one((320, 240), centers, r_px, colors))
     assert len(calls) <= 2 * 9  # at most the nine discs left (two circles each), where 3000 pucks were drawn
+
+
+# Stamping against plain blitting on random scenes: small surfaces of odd and even widths, padded pitches
+# and other pixel formats, groups of a few pucks (STAMP_MIN_PUCKS lowered) stamped a few at a time
+# (STAMP_CHUNK_PIXELS lowered), pucks piled on each other, at the same corner, and cut by the clip.
+
+PALETTE = (WHITE, ORANGE, (0, 200, 255), (250, 10, 10))
+FORMATS = ("plain", "plain", "bgr", "padded pitch", "padded pitch", "display", "24 bit", "alpha")  # mostly stamped
+
+
+def new_target(kind: str, w: int, h: int, pad: int) -> pygame.Surface:
+    if kind == "bgr":
+        return pygame.Surface((w, h), 0, 32, (0xFF, 0xFF00, 0xFF0000, 0))
+    if kind == "padded pitch":  # rows `pad` pixels longer than the surface is wide
+        pitch = 4 * (w + pad)
+        return pygame.image.frombuffer(bytearray(pitch * h), (w, h), "RGBX", pitch)
+    if kind == "display":
+        return pygame.display.set_mode((w, h))
+    if kind == "24 bit":
+        return pygame.Surface((w, h), 0, 24)
+    if kind == "alpha":
+        return pygame.Surface((w, h), pygame.SRCALPHA, 32)
+    return pygame.Surface((w, h))
+
+
+def blitted_as_specified(target: pygame.Surface, centers, r_px, colors) -> None:
+    """What draw_pucks draws, done with plain blits: each group (radius, colour) big enough and of a small
+    enough sprite, in the order of (radius, colour), its pucks wholly inside the clip in their order; then
+    all other pucks in their order. On a target whose pixels can't be written straight, all blitted in order."""
+    from airtable.app import pucks_view
+
+    sprites, clip = PuckSprites(), target.get_clip()
+    w, h = target.get_size()
+    pucks = [
+        (round(x) - r, round(y) - r, r, tuple(c))
+        for (x, y), r, c in zip(centers.tolist(), r_px.tolist(), colors.tolist())
+        if x + r >= 0 and x - r <= w and y + r >= 0 and y - r <= h
+    ]
+    counts: dict[tuple, int] = {}
+    for _, _, r, c in pucks:
+        counts[r, c] = counts.get((r, c), 0) + 1
+    direct = target.get_bytesize() == 4 and not target.get_flags() & pygame.SRCALPHA
+    stamped = {
+        key
+        for key, n in counts.items()
+        if direct
+        and n >= pucks_view.STAMP_MIN_PUCKS
+        and (key[0] + 1) ** 2 <= pucks_view.STAMP_MAX_PIXELS
+        and np.any(pygame.surfarray.array3d(sprites.get(*key)) != pucks_view.COLORKEY, axis=2).sum()
+        <= pucks_view.STAMP_MAX_PIXELS
+    }
+
+    def inside(x, y, r):
+        return clip.contains(pygame.Rect(x, y, 2 * r + 1, 2 * r + 1))
+
+    for key in sorted(stamped):
+        for x, y, r, c in pucks:
+            if (r, c) == key and inside(x, y, r):
+                target.blit(sprites.get(r, c), (x, y))
+    for x, y, r, c in pucks:
+        if (r, c) not in stamped or not inside(x, y, r):
+            target.blit(sprites.get(r, c), (x, y))
+
+
+@st.composite
+def scenes(draw):
+    """A target and pucks on it, each at a random place, or near the one before (piles), or at the very
+    place of one a few before (the same corner again, after others)."""
+    w, h = draw(st.integers(16, 80)), draw(st.integers(16, 60))
+    kind, pad = draw(st.sampled_from(FORMATS)), draw(st.integers(1, 3))
+    radius = st.integers(2, 6) | st.integers(7, 9)  # 9: too big a sprite to stamp
+    kinds = draw(st.lists(st.tuples(radius, st.sampled_from(PALETTE)), min_size=1, max_size=4))
+    half = st.sampled_from([0.0, 0.25, 0.5, 0.75, 0.4999])  # rounding both ways, and half to even
+    place = st.tuples(st.integers(-6, w + 6), half, st.integers(-6, h + 6), half)
+    step = st.tuples(st.integers(0, len(kinds) - 1), st.sampled_from(["place", "near", "again"]), place)
+    centers: list[tuple[float, float]] = []
+    which = []
+    for k, how, (x, fx, y, fy) in draw(st.lists(step, min_size=8, max_size=80)):
+        if how == "place" or not centers:
+            centers.append((x + fx, y + fy))
+        elif how == "near":  # x, y as a small step from the one before
+            centers.append((centers[-1][0] + x % 5 - 2 + fx, centers[-1][1] + y % 5 - 2 + fy))
+        else:
+            centers.append(centers[-1 - x % min(len(centers), 4)])
+        which.append(kinds[k])
+    inset = draw(st.tuples(*[st.integers(0, 5)] * 4))  # the clip: left, top, right and bottom margins
+    clip = (inset[0], inset[1], max(1, w - inset[0] - inset[2]), max(1, h - inset[1] - inset[3]))
+    return {
+        "target": (kind, w, h, pad),
+        "clip": clip,
+        "centers": np.array(centers, dtype=float).reshape(-1, 2),
+        "r_px": np.array([r for r, _ in which], dtype=np.int64),
+        "colors": np.array([c for _, c in which], dtype=np.uint8).reshape(-1, 3),
+        "min_pucks": draw(st.integers(1, 4)),
+        "chunk_pixels": draw(st.sampled_from([1, 50, 200, 1000, 65536])),
+    }
+
+
+@settings(max_examples=300, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(scenes())
+def test_stamped_pucks_look_exactly_as_blitted_on_any_scene_and_target(scene) -> None:
+    from airtable.app import pucks_view
+
+    images = []
+    with pytest.MonkeyPatch.context() as patch:
+        patch.setattr(pucks_view, "STAMP_MIN_PUCKS", scene["min_pucks"])
+        patch.setattr(pucks_view, "STAMP_CHUNK_PIXELS", scene["chunk_pixels"])
+        for draw in (
+            lambda t: draw_pucks(t, PuckSprites(), scene["centers"], scene["r_px"], scene["colors"]),
+            lambda t: blitted_as_specified(t, scene["centers"], scene["r_px"], scene["colors"]),
+        ):
+            target = new_target(*scene["target"])
+            target.fill(TABLE_BLUE)
+            if scene["clip"] is not None:
+                target.set_clip(pygame.Rect(scene["clip"]))
+            draw(target)
+            assert not target.get_locked()
+            images.append(pygame.surfarray.array3d(target))
+    assert np.array_equal(images[0], images[1])
+
+
+@settings(max_examples=200, deadline=None)
+@given(st.lists(st.integers(0, 12) | st.integers(0, 1 << 40), min_size=1, max_size=300))
+def test_groups_are_those_of_unique_with_few_keys_or_many(keys) -> None:
+    from airtable.app.pucks_view import _groups
+
+    keys = np.array(keys, dtype=np.int64)
+    expected = np.unique(keys, return_inverse=True, return_counts=True)
+    for got, want in zip(_groups(keys), expected):
+        assert np.array_equal(got, want.ravel())
