@@ -49,6 +49,20 @@ def total_texts(total, scale: float) -> tuple[tuple[str, ...], tuple[str, ...]]:
     )
 
 
+def momenta_titles(m: MomentaView) -> tuple[str, ...]:
+    """The diagram's title, longest first. When the totals differ (a wall acted between two collisions of
+    a puck, or through a puck resting on it: one dropped on a puck on the floor bounces off the floor
+    through it), what came from outside, so a class does not read it as momentum lost or made."""
+    t = f"t = {m.t_s:.2f} s"
+    plain = (f"momenta, collision at {t}", f"collision at {t}", t)
+    scale = momenta_scale(m)
+    x, y = (readable(a - b, scale) for a, b in zip(m.total_after_Ns, m.total_before_Ns, strict=True))
+    if not (x or y):
+        return plain
+    outside = f"from outside ({figures(x)}, {figures(y)}) N s"
+    return (f"momenta at {t}; {outside}", f"{t}; {outside}", *plain)
+
+
 def fitting(font: pygame.font.Font, texts: Sequence[str], width: int) -> str:
     """The first of `texts` (longest first) that fits `width` pixels; else the last, cut to fit."""
     for text in texts:
@@ -162,8 +176,7 @@ class LessonsPainter:
             return rect
         rect = self.corner_rect(self.momenta_size(), corner)
         self._panel(rect)
-        title = (f"momenta, collision at t = {m.t_s:.2f} s", f"collision at t = {m.t_s:.2f} s", f"t = {m.t_s:.2f} s")
-        self._text(fitting(font, title, rect.width - 2 * pad), (rect.x + pad, rect.y + pad), TEXT_COLOR)
+        self._text(fitting(font, momenta_titles(m), rect.width - 2 * pad), (rect.x + pad, rect.y + pad), TEXT_COLOR)
         half = pygame.Rect(0, 0, (rect.width - 3 * pad) // 2, rect.height - 2 * pad - 3 * line_h)
         chains = []
         for momenta, total in ((m.before_Ns, m.total_before_Ns), (m.after_Ns, m.total_after_Ns)):

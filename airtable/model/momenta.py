@@ -4,14 +4,17 @@ The momenta diagram, as PhET's Collision Lab draws it: every puck's momentum
 m v as an arrow, tip to tail, so the arrow from the first tail to the last
 tip is the total; once just before the latest collision and once just after
 it, at one shared scale, so a student sees the total come out the same.
-"Before" is each colliding puck's velocity when the step began, before its
-forces; "after" is the velocity at the end of the step. (The velocity a
-collision found had the step's forces in it: a puck sliding on the floor
-met its partner moving down by gravity's g dt, which the floor takes back
-later in the step, and its arrow pointed down before, flat after.) So the
-totals differ by what acted from outside over the step: nothing along the
-floor, gravity's M g dt for pucks that meet in the air. The pucks that did
-not collide have the same arrow in both.
+"Before" and "after" are the velocities the step's collisions found and left
+(a puck's first collision and its last): each collision conserves momentum,
+so the totals come out the same whatever else acts in the step. What the
+step does outside its collisions, gravity's pull, the floor's push, a spring,
+is in neither (but for a wall hit between two collisions of one puck in the
+step: a puck dropped onto one on the floor, which hits the floor and the
+falling one again). (The velocities at the step's start and end have it: a puck
+sliding on the floor into another drew its arrows pointing down before and
+flat after, the floor having taken back gravity's g dt; two pucks meeting in
+the air showed gravity's M g dt as momentum the collision had gained.)
+The pucks that did not collide have their velocity at the step's end in both.
 """
 
 from __future__ import annotations
@@ -106,24 +109,23 @@ def _seen(table: AirTable) -> tuple | None:
     collisions = table.last_collisions_later()  # joined only if the diagram is drawn
     if collisions is None:
         return None
-    began = table.last_step_began_vel_mps  # (set by the step whose collisions these are)
-    return float(table.time_s), collisions, began, table.vel_mps.copy(), table.mass_kg.copy(), table.color_rgb.copy()
+    return float(table.time_s), collisions, table.vel_mps.copy(), table.mass_kg.copy(), table.color_rgb.copy()
 
 
 def _momenta_around(
-    t_s: float,
-    collisions: Callable[[], Collisions],
-    vel_began: np.ndarray,
-    vel_after: np.ndarray,
-    mass_kg: np.ndarray,
-    colors: np.ndarray,
+    t_s: float, collisions: Callable[[], Collisions], vel_end: np.ndarray, mass_kg: np.ndarray, colors: np.ndarray
 ) -> MomentaAround:
-    """The momenta around the collisions() of a step that began with velocities `vel_began` and ended at
-    t_s with `vel_after`."""
+    """The momenta around the collisions() of a step that ended at t_s with velocities `vel_end`."""
     c = collisions()
-    vel_before = vel_after.copy()
-    rows = np.stack([c.i, c.j], axis=1).ravel()
-    vel_before[rows] = vel_began[rows]
+    rows = np.stack([c.i, c.j], axis=1).ravel()  # the collisions' pucks, in the order they collided
+    found = np.stack([c.vel_i_before, c.vel_j_before], axis=1).reshape(-1, 2)
+    left = np.stack([c.vel_i_after, c.vel_j_after], axis=1).reshape(-1, 2)
+    _, first = np.unique(rows, return_index=True)
+    _, last_from_end = np.unique(rows[::-1], return_index=True)
+    last = len(rows) - 1 - last_from_end
+    vel_before, vel_after = vel_end.copy(), vel_end.copy()
+    vel_before[rows[first]] = found[first]
+    vel_after[rows[last]] = left[last]
     collided = np.zeros(len(vel_after), dtype=bool)
     collided[rows] = True
     mass = mass_kg[:, None]

@@ -22,7 +22,6 @@ class StepContext:
     dt: float  # the step's length (s)
     pulls: Sequence[Pull]  # the cursor strings acting in this step
     began: np.ndarray | None = None  # the positions when the step began (the contacts start there)
-    began_vel: np.ndarray | None = None  # the velocities when the whole step began, before its forces
     sleepers: np.ndarray | None = None  # the rows that sleep through this step (None: none)
     kick: np.ndarray | None = None  # the velocity the forces gave each puck ((N, 2), or (2,): all; None: nothing)
     rest: RestSpeeds | None = None  # which contacts rest instead of bouncing (None: every contact collides)

@@ -30,7 +30,6 @@ def step(table: Storage, dt: float, pulls: Sequence[Pull] = ()) -> StepContext:
     is the last piece's, with every piece's collisions.
     """
     table.run_due_events()  # 0. a demo's timed events whose time has come (storage.py)
-    began_vel = table.vel_mps.copy()  # (for the momenta diagram: table.last_step_began_vel_mps)
     mode = table.puck_correction if table.puck_collisions else "none"  # (no pair hits: nothing to cut for)
     n = max(substeps.pieces(table.vel_mps, table.radius_m, dt, mode), substeps.for_contacts(table, dt))
     outside = table.force_N.copy() if n > 1 and table.force_N.any() else None  # forces set from outside
@@ -40,7 +39,7 @@ def step(table: Storage, dt: float, pulls: Sequence[Pull] = ()) -> StepContext:
             table.force_N[:] = outside  # act in every piece, as they would through the whole step
         ctx = _piece(table, dt / n, pulls)
         records += ctx.records
-    ctx.records, ctx.began_vel = records, began_vel
+    ctx.records = records
     table.time_s += dt
     table.steps += 1
     return ctx

@@ -37,9 +37,8 @@ class AirTable(Storage):
 
     # The handles are parts too: a restored table gives the same handles their rows back (state.py).
     PARTS = (*Storage.PARTS, "puck_handles", "spring_handles")
-    # What the last step's collisions did, and its velocities at the start: not state (a restored table reports
-    # none until it steps).
-    NOT_SAVED = ("_last_records", "_last_collisions", "_began_vel")
+    # What the last step's collisions did: not state (a restored table reports none until it steps).
+    NOT_SAVED = ("_last_records", "_last_collisions")
 
     def __init__(self, width_m: float = TABLE_WIDTH_M, height_m: float = TABLE_HEIGHT_M) -> None:
         super().__init__(width_m, height_m)
@@ -152,7 +151,6 @@ class AirTable(Storage):
         self.clear_storage()
         self._last_records: list[PairRecords] = []  # what the last step's collisions did (its context's records)
         self._last_collisions: Collisions | None = None  # ... joined, once asked for
-        self._began_vel: np.ndarray | None = None  # the velocities when the last step began (None: not known)
 
     def schedule(self, t_s: float, fn: Callable[[AirTable], None]) -> None:
         """Run fn(table) at the start of the first step at or after simulation time t_s."""
@@ -232,17 +230,10 @@ class AirTable(Storage):
         records = self._last_records
         return functools.cache(lambda: Collisions.of_records(records))
 
-    @property
-    def last_step_began_vel_mps(self) -> np.ndarray | None:
-        """The pucks' velocities (N, 2) when the last step began, before its forces (None: no step since
-        the table was made, cleared or restored). The momenta diagram's "before": a puck sliding on the
-        floor meets the hit stage moving down by gravity's g dt, which the floor takes back later in the step."""
-        return self._began_vel
-
     def restore_settings(self, names: tuple[str, ...], values: tuple) -> None:
         """Storage.restore_settings; a restored table reports no collisions until it steps."""
         super().restore_settings(names, values)
-        self._last_records, self._last_collisions, self._began_vel = [], None, None
+        self._last_records, self._last_collisions = [], None
 
     # ------------------------------------------------------------ the step
 
@@ -254,8 +245,7 @@ class AirTable(Storage):
         dt = float(dt_s)
         if not (math.isfinite(dt) and dt >= 0.0):
             raise ValueError(f"dt_s must be zero or a positive number of seconds, not {dt_s!r}")
-        ctx = stepping.step(self, dt, pulls)
-        self._last_records, self._last_collisions, self._began_vel = ctx.records, None, ctx.began_vel
+        self._last_records, self._last_collisions = stepping.step(self, dt, pulls).records, None
 
     def forces_on(self, puck: Puck, dt_s: float = 1 / 240, pulls: Sequence[Pull] = ()) -> dict[str, np.ndarray]:
         """The forces (N) the next step will apply to `puck`, by source, if `pulls` act on it.
