@@ -114,6 +114,26 @@ def test_a_demo_whose_first_build_fails_leaves_none_of_its_settings(tmp_path):
     assert not t.gravity_on and t.cr_puck == 1.0
 
 
+def test_page_down_goes_past_a_demo_that_fails_to_build(tmp_path):
+    """A user test: from a running demo, PageDown (a presentation clicker) tried the next demo, whose build
+    raised, and every further PageDown tried the same one again: the demos after it were out of reach."""
+    (tmp_path / "s1.py").write_text(demo_source("s1", pucks=1))
+    (tmp_path / "s2.py").write_text(demo_source("s2", pucks=2, build_line=RAISES))
+    (tmp_path / "s3.py").write_text(demo_source("s3", pucks=3))
+    app = make_app(tmp_path, key="s1")
+    keys = list(app.demos)
+    assert keys.index("s2") == keys.index("s1") + 1 and keys.index("s3") == keys.index("s2") + 1
+    press(app, pygame.K_PAGEDOWN)
+    assert app.build_error is not None and app.error_key == "s2" and len(app.table.pucks) == 1
+    press(app, pygame.K_ESCAPE)
+    press(app, pygame.K_PAGEDOWN)
+    assert app.build_error is None and app.demo_key == "s3" and len(app.table.pucks) == 3
+    press(app, pygame.K_PAGEUP)  # back: s2 fails again, and PageUp from there goes on to s1
+    press(app, pygame.K_ESCAPE)
+    press(app, pygame.K_PAGEUP)
+    assert app.demo_key == "s1" and len(app.table.pucks) == 1
+
+
 def test_a_demo_file_broken_while_it_runs_stays_in_the_menu_and_the_heading_says_what_failed(tmp_path):
     """A user test: a syntax error in the running demo s1, then Tab: s1 left the menu, the error was on the
     terminal only, and the heading said "Demo 1: Five pucks" over s1's table. After a failed start and

@@ -303,9 +303,12 @@ class App:
             self.start_demo(self.demo_key, self.variation + step)
 
     def next_demo(self, step: int) -> None:
+        """PageUp/PageDown: the demo before or after this one; after a demo that failed to start, the one
+        before or after that (a user test: PageDown tried the same broken demo again and again)."""
         self.shelf.refresh()
         keys = list(self.demos)
-        here = keys.index(self.demo_key) if self.demo_key in keys else -step
+        at = self.error_key if self.failed_start is not None and self.error_key in keys else self.demo_key
+        here = keys.index(at) if at in keys else -step
         self.start_demo(keys[(here + step) % len(keys)])
 
     # ------------------------------------------------------------ what the app's own keys do
