@@ -12,9 +12,10 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from airtable.app.app import App
-from airtable.app.lessons_paint import TOTAL_COLOR, fitting, momenta_scale, momenta_titles, total_texts
+from airtable.app.lessons_paint import TOTAL_COLOR, fitting, momenta_scale, momenta_titles, total_texts, values_hint
 from airtable.app.panel_view import ACCENT
 from airtable.model.momenta import (
+    FEW_PUCKS,
     MomentaLog,
     MomentaView,
     every_puck_values,
@@ -257,3 +258,9 @@ def test_the_panels_stand_clear_of_paused_and_the_timeline(demos, size):
         assert app.window.surface.get_rect().contains(rect)
         assert rect.collidelist(others) < 0, (rect, others)
     assert not drawn["momenta_diagram"].colliderect(drawn["values_panel"])
+
+
+def test_the_values_hint_says_when_the_table_is_empty():
+    """A user test: on the empty table a failed build left, t said "values: more than 6 pucks, so point at one"."""
+    assert values_hint(0) == "values: no pucks on the table"
+    assert values_hint(FEW_PUCKS + 1).startswith(f"values: more than {FEW_PUCKS} pucks")

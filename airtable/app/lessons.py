@@ -15,7 +15,7 @@ import pygame
 
 from airtable.app.demo_loader import BUILTIN_DIR
 from airtable.app.feature import Binding, Feature
-from airtable.app.lessons_paint import VALUES_HINT, LessonsPainter
+from airtable.app.lessons_paint import LessonsPainter, values_hint
 from airtable.app.overlays import OverlayFlag
 from airtable.app.pucks_view import draw_numbers
 from airtable.app.recorder import Recorder, csv_pair, free_csv_pair
@@ -272,7 +272,7 @@ class Lessons(Feature):
             puck = t.puck_at(env.to_world(self.host.mouse_px)) if len(t.pos_m) > FEW_PUCKS else None
             rows = values_for(t, None if puck is None else puck.index, self.aids.chart.scale)
             colors = [t.color_rgb[r.row] if r.row is not None else None for r in rows]
-            paint.values_panel(rows, colors, VALUES_HINT, paint.choose_corner("values", points, taken))
+            paint.values_panel(rows, colors, values_hint(len(t.pos_m)), paint.choose_corner("values", points, taken))
 
     bindings = (
         Binding(

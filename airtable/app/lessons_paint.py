@@ -20,7 +20,11 @@ from airtable.app.panel_view import ACCENT, DIM_TEXT, TEXT_COLOR, panel_surface,
 from airtable.model.momenta import FEW_PUCKS, VALUE_HEADINGS, MomentaView, PuckValues, fit_chains, tip_to_tail
 from airtable.model.readout import figures, readable
 
-VALUES_HINT = f"values: more than {FEW_PUCKS} pucks, so point at one"
+
+def values_hint(pucks: int) -> str:
+    """What the values panel says when it lists no puck (a user test: an empty table said "more than 6")."""
+    return f"values: more than {FEW_PUCKS} pucks, so point at one" if pucks else "values: no pucks on the table"
+
 
 TOTAL_COLOR = CHART_COLORS["momentum_Ns"]  # the chart's |momentum| colour
 PANEL_FILL = (0, 0, 0, 255)  # opaque: nothing shows through the numbers

@@ -11,7 +11,7 @@ import numpy as np
 
 from airtable.app.aids_paint import AidsPainter, draw_annotations
 from airtable.app.aids_view import COM_COLOR
-from airtable.app.lessons_paint import VALUES_HINT
+from airtable.app.lessons_paint import values_hint
 from airtable.model import aids
 from airtable.model import shared_aids as aids_wire
 from airtable.model.momenta import FEW_PUCKS, puck_number
@@ -73,7 +73,7 @@ def draw_student_lessons(paint, timeline_paint, scene: Scene, state: StudentAids
         corner, rows = values
         n = len(scene.color_rgb)
         colors = [scene.color_rgb[r.row] if r.row is not None and r.row < n else None for r in rows]
-        paint.values_panel(rows, colors, VALUES_HINT, corner)
+        paint.values_panel(rows, colors, values_hint(n), corner)
 
 
 def puck_under(scene: Scene, point_m) -> int | None:
