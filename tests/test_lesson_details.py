@@ -74,6 +74,24 @@ def test_the_momenta_diagram_shows_a_collision_from_before_it_was_opened(demos):
     assert changed.any() and not (changed & ~latest.collided).any()
 
 
+def test_rewound_to_before_the_latest_collision_the_diagram_shows_none_yet(demos):
+    """A user test: rewound to t = 0.45 s ("0 collisions"), the diagram showed the collision at t = 0.67 s,
+    still to come on screen; back at it, the diagram shows it again."""
+    app = App(demos, demo_key="8", headless=True)
+    pygame.event.clear()
+    run(app, 120)
+    press(app, pygame.K_d, frames=0)
+    latest = app.lessons.momenta.latest
+    assert latest is not None and app.lessons.momenta_shown(app.table) is latest.view
+    press(app, pygame.K_SPACE)  # pause, then back a second and more
+    for _ in range(3):
+        press(app, pygame.K_COMMA, mod=pygame.KMOD_LSHIFT)
+    assert app.table.time_s < latest.t_s and app.lessons.momenta_shown(app.table) is None
+    for _ in range(4):
+        press(app, pygame.K_PERIOD, mod=pygame.KMOD_LSHIFT)
+    assert app.table.time_s >= latest.t_s and app.lessons.momenta_shown(app.table) is latest.view
+
+
 def test_a_restart_takes_away_the_old_demos_messages_but_not_where_a_file_went(app, tmp_path, monkeypatch):
     monkeypatch.chdir(tmp_path)
     run(app, 60)

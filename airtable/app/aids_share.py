@@ -77,7 +77,6 @@ def shared_lessons(
     if not (lessons.show_momenta or lessons.show_values or timeline is not None):
         return None
     corners = lessons.painter.corners if lessons.painter is not None else {}
-    latest = lessons.momenta.latest
     rows: list[int] = []
     every = len(t.pos_m) <= FEW_PUCKS
     if lessons.show_values:
@@ -85,7 +84,7 @@ def shared_lessons(
     return SharedLessons(
         momenta_on=lessons.show_momenta,
         momenta_corner=corners.get("momenta") or 0,
-        momenta=None if latest is None else latest.view,
+        momenta=lessons.momenta_shown(t),
         values_on=lessons.show_values,
         values_corner=corners.get("values") or 0,
         values_every=every,

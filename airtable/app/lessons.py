@@ -20,7 +20,7 @@ from airtable.app.overlays import OverlayFlag
 from airtable.app.pucks_view import draw_numbers
 from airtable.app.recorder import Recorder, csv_pair, free_csv_pair
 from airtable.app.saved_demo import demo_source, free_key, save_folder, write_demo
-from airtable.model.momenta import FEW_PUCKS, MomentaLog, values_for
+from airtable.model.momenta import FEW_PUCKS, MomentaLog, MomentaView, values_for
 from airtable.physics.table import AirTable
 
 if TYPE_CHECKING:
@@ -119,6 +119,12 @@ class Lessons(Feature):
         if self.recorder is not None:
             self.recorder.close()
         return list(self.recorded)
+
+    def momenta_shown(self, table: AirTable) -> MomentaView | None:
+        """The latest collision's momenta, unless the table is rewound to before it (a user test: rewound to
+        t = 0.45 s, the diagram showed the collision at t = 0.67 s, still to come on screen)."""
+        latest = self.momenta.latest
+        return None if latest is None or latest.t_s > table.time_s else latest.view
 
     def forget_after(self, t_s: float) -> None:
         """The table was rewound to `t_s` and runs on: what the recording and the diagram saw later did not happen."""
@@ -266,8 +272,7 @@ class Lessons(Feature):
         if self.show_momenta:
             corner = paint.choose_corner("momenta", points, taken)
             taken.append(corner)
-            latest = self.momenta.latest
-            paint.momenta_diagram(None if latest is None else latest.view, corner)
+            paint.momenta_diagram(self.momenta_shown(t), corner)
         if self.show_values:
             puck = t.puck_at(env.to_world(self.host.mouse_px)) if len(t.pos_m) > FEW_PUCKS else None
             rows = values_for(t, None if puck is None else puck.index, self.aids.chart.scale)
