@@ -174,6 +174,29 @@ def test_a_file_that_failed_at_start_loads_once_fixed(tmp_path):
     assert app.demo_key == "t1" and len(app.table.pucks) == 2
 
 
+def test_the_table_waits_under_a_notice_or_an_error_until_the_teacher_has_read_it(tmp_path):
+    """A user test: started with a broken file beside the demos, demo 1's first collision happened under
+    the "could not be loaded" notice, out of sight; a demo picked while another ran failed, and the one
+    that ran went on under the error."""
+    (tmp_path / "late.py").write_text("KEY = 't1'\nTITLE = 'x'\ndef build(table, variation=0)\n")
+    (tmp_path / "s2.py").write_text(demo_source("s2", pucks=2, build_line=RAISES))
+    app = make_app(tmp_path)
+    assert app.panels.panel() == "notice"
+    for _ in range(30):
+        app.frame(FRAME_S)
+    assert app.table.time_s == 0.0
+    press(app, pygame.K_SPACE, frames=30)
+    running = app.table.time_s
+    assert running > 0.0
+    app.start_demo("s2")  # (as Tab and its key pick it) its build raises
+    assert app.panels.panel() == "error" and app.demo_key == "1"
+    for _ in range(30):
+        app.frame(FRAME_S)
+    assert app.table.time_s == pytest.approx(running, abs=FRAME_S)  # (the frame that opened it may step)
+    press(app, pygame.K_ESCAPE, frames=30)
+    assert app.table.time_s > running + 0.25
+
+
 def test_the_first_key_after_a_load_notice_also_does_its_work(tmp_path):
     """A user test: the teacher's first key (3, for demo 3) only closed the "could not load" notice."""
     (tmp_path / "late.py").write_text("KEY = 't1'\nTITLE = 'x'\ndef build(table, variation=0)\n")

@@ -502,7 +502,9 @@ class App:
             self.server.update_clients(self.clients, self.table)  # joins, leaves and inputs, even while paused
         for feature in self.features:
             feature.before_physics()
-        if not self.paused:
+        # A notice or a demo's error, which the teacher did not ask for, covers the table: it waits for them
+        # (a user test: a demo's first collision happened under the "could not be loaded" notice).
+        if not self.paused and self.panels.panel() not in ("notice", "error"):
             self.stepper.run(frame_dt_s, self.speed, self.physics_step)
             self._pause_if_stalled()
         self._say_new_notices()
