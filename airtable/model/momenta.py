@@ -5,16 +5,16 @@ m v as an arrow, tip to tail, so the arrow from the first tail to the last
 tip is the total; once just before the latest collision and once just after
 it, at one shared scale, so a student sees the total come out the same.
 "Before" and "after" are the velocities the step's collisions found and left
-(a puck's first collision and its last): each collision conserves momentum,
-so the totals come out the same whatever else acts in the step. What the
-step does outside its collisions, gravity's pull, the floor's push, a spring,
-is in neither (but for a wall hit between two collisions of one puck in the
-step: a puck dropped onto one on the floor, which hits the floor and the
-falling one again). (The velocities at the step's start and end have it: a puck
-sliding on the floor into another drew its arrows pointing down before and
-flat after, the floor having taken back gravity's g dt; two pucks meeting in
-the air showed gravity's M g dt as momentum the collision had gained.)
-The pucks that did not collide have their velocity at the step's end in both.
+(a puck's first collision and its last). A collision conserves momentum, so
+the totals come out the same whatever else acts in the step: gravity's pull,
+a spring, the floor holding a puck up are in neither. (The step's start and
+end have them: a puck sliding on the floor into another drew its arrows
+pointing down before and flat after; pucks meeting in the air showed
+gravity's M g dt as momentum gained.) Only a wall can come between: one hit
+by a puck between two of its collisions, or behind a puck resting on it that
+a heavier one lands on (it bounces off the wall through it); the diagram
+then says what came from outside (lessons_paint.momenta_titles). The pucks
+that did not collide have their velocity at the step's end in both.
 """
 
 from __future__ import annotations
