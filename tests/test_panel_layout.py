@@ -13,6 +13,8 @@ from airtable.app.panel_view import ACCENT
 WORDS = st.text(alphabet="abcdefghij", min_size=1, max_size=12)
 TEXT = st.lists(WORDS, min_size=1, max_size=14).map(" ".join)
 ROW = st.one_of(TEXT, st.tuples(WORDS, TEXT))
+SIDE_KEYS = st.text(alphabet="klmnop", min_size=1, max_size=12)  # (the side sections' keys: told apart)
+SIDE_ROW = st.one_of(TEXT, st.tuples(SIDE_KEYS, TEXT))
 HEADINGS = ("Demos", "More")
 
 
@@ -25,7 +27,7 @@ def font():
 @settings(max_examples=60, deadline=None)
 @given(
     first=st.lists(ROW, min_size=1, max_size=25),
-    side=st.lists(st.lists(ROW, min_size=1, max_size=12), min_size=1, max_size=2),
+    side=st.lists(st.lists(SIDE_ROW, min_size=1, max_size=12), min_size=1, max_size=2),
     width=st.integers(200, 1400),
     lines=st.integers(4, 40),
 )
@@ -42,3 +44,8 @@ def test_a_heading_never_ends_a_column_and_a_key_sits_beside_its_text(font, firs
             elif p.color == ACCENT and p.text:  # a key: its description beside it, or under it if it is long
                 assert after.x > p.x and after.y in (p.y, p.y + line_h, 0)
         assert not (pieces and pieces[-1].color == ACCENT and pieces[-1].text in HEADINGS)
+    for pieces in pages[1:]:  # a page going on with a side section begins with its heading (the title is "Keys")
+        side_keys = [k for k, p in enumerate(pieces) if p.color == ACCENT and p.text and set(p.text) <= set("klmnop")]
+        if side_keys:
+            before = pieces[: side_keys[0]]
+            assert any(p.text in HEADINGS for p in before), "a page goes on with a section under the wrong heading"

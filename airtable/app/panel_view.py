@@ -79,9 +79,10 @@ class Piece:
     color: tuple[int, int, int]
 
 
-def _blocks(font, sections: Sequence[tuple[str, Sequence[Row]]], col_w: int) -> list[list[tuple[int, str, tuple]]]:
-    """Each row as a block of (x offset, text, colour) lines that must stay together."""
-    blocks = []
+def _blocks(font, sections: Sequence[tuple[str, Sequence[Row]]], col_w: int) -> tuple[list[list[tuple]], list[str]]:
+    """Each row as a block of (x offset, text, colour) lines that must stay together; and for each block
+    the heading of its section ("" for none), to begin a page with when the section goes on there."""
+    blocks, headings = [], []
     for heading, rows in sections:
         first = len(blocks)
         keys = [r[0] for r in rows if isinstance(r, tuple)]
@@ -101,7 +102,8 @@ def _blocks(font, sections: Sequence[tuple[str, Sequence[Row]]], col_w: int) -> 
             # its first row: alone at the foot of a column it headed nothing (help page 2 at 1280x720)
             head = [(0, "", ACCENT), (0, heading, ACCENT)] if first else [(0, heading, ACCENT)]
             blocks[first:first] = [head + (blocks.pop(first) if len(blocks) > first else [])]
-    return blocks
+        headings += [heading] * (len(blocks) - first)
+    return blocks, headings
 
 
 def layout(
@@ -116,30 +118,35 @@ def layout(
     col_w = (width - gap * (n_cols - 1)) // n_cols
     line_h = font.get_linesize()
     rows_per_col = max(1, height // line_h)
-    blocks = _blocks(font, sections, col_w)
+    blocks, headings = _blocks(font, sections, col_w)
     pages: list[list[Piece]] = [[]]
     col, used = 0, 0
-    for block in blocks:
+
+    def next_column(heading: str) -> None:
+        """On to the next column; on a new page, the section's heading first (the page's title is the first's)."""
+        nonlocal col, used
+        col, used = col + 1, 0
+        if col == n_cols:
+            pages.append([])
+            col = 0
+            if heading:
+                pages[-1].append(Piece(0, 0, heading, ACCENT))
+                used = 1
+
+    for block, heading in zip(blocks, headings, strict=True):
         lines = sum(1 for x, _, _ in block if x >= 0)
         if used and used + lines > rows_per_col:  # the block goes whole to the next column
-            col, used = col + 1, 0
-            if col == n_cols:
-                pages.append([])
-                col = 0
+            next_column("" if any(text == heading for _, text, _ in block[:2]) else heading)
         if used == 0 and block[0][1] == "":  # no blank line at the top of a column
             block = block[1:]
-        x0 = col * (col_w + gap)
         beside = None  # a key that goes beside the next line (its description's first)
         for x, text, color in block:
             if x < 0:
                 beside = (text, color)
                 continue
             if used >= rows_per_col:  # a block taller than a column goes on in the next one
-                col, used = col + 1, 0
-                if col == n_cols:
-                    pages.append([])
-                    col = 0
-                x0 = col * (col_w + gap)
+                next_column(heading)
+            x0 = col * (col_w + gap)
             if beside is not None:
                 pages[-1].append(Piece(x0, used * line_h, *beside))
                 beside = None
