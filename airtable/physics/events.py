@@ -70,6 +70,17 @@ CAPPED_NOTICE = (
 # pushing a light one into a wall of restitution 0 made 100000 events, 2 to 3 s, in one step.
 REPEAT_MIN = 3
 REPEAT_DECAY = 1e-3
+# A puck that bounces this many times in a row between the two walls across one axis within a step, with
+# nothing else changing its path, stops across them (RATTLE_NOTICE): it has less room across than
+# 1/RATTLE_MAX of its path in a step. That is a puck that fits its table but for round-off (its radius
+# half the height less 1e-16 m bounced 2 million times a step: a second a step), or one at some
+# kilometres a second; its rattle is far too small to see. A light puck squeezed between a heavy one
+# and a wall (the pi demo) hits the heavy one between its wall hits, and is never stopped.
+RATTLE_MAX = 256
+RATTLE_NOTICE = (
+    "A puck with almost no room between two walls (it crossed that room hundreds of times in a step) was"
+    " stopped across them; it still moves along them."
+)
 
 
 def repeat_max(cr: float) -> int:
@@ -126,6 +137,7 @@ class Hits:
     walls: int = 0
     bounced: list = field(default_factory=list)  # the rows of the wall hits, one a hit
     capped: bool = False
+    rattled: bool = False  # a puck was stopped between two walls (RATTLE_MAX)
     maybe_past: np.ndarray | None = None  # the rows that may still be past a wall (None: any)
 
     def records(self) -> PairRecords:
@@ -156,6 +168,8 @@ def hits_in_order(table: Storage, ctx: StepContext) -> None:
         table.collision_count += len(hits.rows)
     if hits.capped:
         table.notices.say("capped", CAPPED_NOTICE)
+    if hits.rattled:
+        table.notices.say("rattled", RATTLE_NOTICE)
     ctx.maybe_past = hits.maybe_past
 
 
@@ -202,6 +216,9 @@ class _Step:
         self.solves: dict[tuple[int, int], int] = {}  # how many times each stuck pair (i < j) was solved
         self.first_speed: dict[tuple[int, int], float] = {}  # each pair's approach speed at its first hit
         self.hit_walls: dict[tuple[int, int], int] = {}  # how many times each puck hit a wall across each axis
+        # Per (puck, axis): (its path's version after its last wall hit across that axis, the wall's side,
+        # how many hits in a row between the two walls there, nothing else in between) (RATTLE_MAX)
+        self.rattles: dict[tuple[int, int], tuple[int, bool, int]] = {}
         self.pinned: dict[int, complex] = {}  # pucks resting on a wall for the rest of the step: its normal
         self.hits = Hits()
         self.partners = None  # the pairs that may meet, per puck (see find_partners)
@@ -551,6 +568,9 @@ class _Step:
         if e < 1.0 and hits >= repeat_max(e):  # its last hit here: it rests on the wall (off_a_pinned)
             self.pinned[k] = self.wall_normal(x, axis)
             e = 0.0
+        if self.rattle(k, axis, x) >= RATTLE_MAX:  # it stops across them, where it is
+            self.hits.rattled = True
+            e = 0.0
         if axis == 0:
             self.set_path(k, x, complex(collision.bounce(v.real, e), v.imag))
         elif a == 0.0:
@@ -559,6 +579,15 @@ class _Step:
             vy, offset = self.bounce_under_gravity(v.imag, a, e)
             self.set_path(k, x, complex(v.real, vy))
             self.offset[k] = complex(0.0, offset)
+
+    def rattle(self, k: int, axis: int, x: complex) -> int:
+        """How many times in a row puck k, at x, has hit the two walls across `axis` by turns, this hit
+        included, with no other change of its path in between (RATTLE_MAX)."""
+        high = (x.real > 0.5 * self.width) if axis == 0 else (x.imag > 0.5 * self.height)
+        version, side, count = self.rattles.get((k, axis), (-1, high, 0))
+        count = count + 1 if version == self.version.get(k, 0) and side != high else 1
+        self.rattles[k, axis] = (self.version.get(k, 0) + 1, high, count)  # (set_path comes next: + 1)
+        return count
 
     def wall_normal(self, x: complex, axis: int) -> complex:
         """The normal into the table of the wall across `axis` nearer to x (collision.WALL_NORMALS)."""
