@@ -108,4 +108,3 @@ def test_a_puck_that_fits_the_table_but_for_a_hair_stops_rattling_across_it(axis
     assert abs(t.vel_mps[0, free]) == pytest.approx(abs(v), rel=1e-12)
     # (A light puck squeezed between a heavy one and a wall hits the heavy one between its wall hits: no
     # rattle. The pi counts of test_engine.py and test_event_oracle.py, 31415 hits at 10^8:1, say so.)
-
