@@ -65,6 +65,8 @@ def test_pressing_a_demo_key_reads_its_file_again_after_an_edit(tmp_path, capsys
     press(app, pygame.K_5)  # from another demo, too: the error, not the built-in 5, over the table that ran
     assert app.panels.panel() == "error" and np.array_equal(app.table.pos_m, triangle)
     assert app.demo_key == "6" and app.caption() == f"Demo 5: mine.py (does not load: {app.demo.label(0)} goes on)"
+    # The panel says it too: at 640x480 the heading was cut before "goes on" (a user test).
+    assert app.panels._error_text()[1][-1] == f"On the table: {app.demo.label(0)} goes on."
     mine.write_text(demo_source("5", pucks=4, build_line=RAISES))
     press(app, pygame.K_5)
     assert app.build_error is not None and app.build_error.stage == "build"
@@ -300,7 +302,13 @@ def test_headless_run_of_a_demo_that_cannot_be_built_exits_1_and_shows_its_error
     (folder / "throws.py").write_text(demo_source("t9", build_line=RAISES))
     (folder / "syntax.py").write_text("KEY = 't8'\nTITLE = 'x'\ndef build(table, variation=0)\n")
     panels: list[str] = []
-    monkeypatch.setattr(GameWindow, "draw_panel", lambda self, title, *a, **k: panels.append(title))
+    lines_shown: list[list[str]] = []
+
+    def draw_panel(self, title, lines=(), *a, **k):
+        panels.append(title)
+        lines_shown.append(list(lines))
+
+    monkeypatch.setattr(GameWindow, "draw_panel", draw_panel)
     shot = tmp_path / "shot"
     argv = ["--headless", "--no-server", "--seconds", "0.5", "--demos", str(folder), "--demo", "t9"]
     assert main([*argv, "--screenshot", str(shot)]) == 1
@@ -313,6 +321,7 @@ def test_headless_run_of_a_demo_that_cannot_be_built_exits_1_and_shows_its_error
     # Every frame, the last one (the screenshot) included, shows this demo's error,
     # not the list of files that failed to load.
     assert set(panels) == {"Demo t9 could not be built"}
+    assert lines_shown[-1][-1] == "The table is empty."  # (the first demo: nothing ran before it)
 
 
 def test_a_headless_run_that_works_exits_0_in_simulated_time(capsys):

@@ -162,6 +162,7 @@ class App:
         self.running_demo: Demo | None = None  # the demo whose run is on the table (its file may be broken since)
         self.error_key = ""  # the demo whose start failed last (the error panel's), while build_error is set
         self.failed_start: str | None = None  # the heading while the demo last started failed (caption)
+        self.goes_on: str | None = None  # then, the run that goes on on the table (None: the table is empty)
         self.demo_path: Path | None = None
         self.variation = 0
 
@@ -281,14 +282,15 @@ class App:
 
     def _failed_caption(self, demo: Demo | None, ran: tuple | None) -> str:
         """The heading after a failed start; `ran`: (key, path, variation) of the demo whose run goes on."""
-        on = ""
-        if ran is not None:
-            on = (
-                ": its last run goes on" if ran[0] == self.error_key else f": {self.running_demo.label(ran[2])} goes on"
-            )
+        self.goes_on = None if ran is None else self._goes_on(ran)
+        on = "" if ran is None else f": {self.goes_on} goes on"
         if self.build_error.stage == "load" or demo is None:
             return f"Demo {key_label(self.error_key)}: {self.build_error.path.name} (does not load{on})"
         return f"{demo.label(self.variation)} (not built{on})"
+
+    def _goes_on(self, ran: tuple) -> str:
+        """What stays on the table after a failed start: `ran` (key, path, variation), the run that goes on."""
+        return "its last run" if ran[0] == self.error_key else self.running_demo.label(ran[2])
 
     def next_variation(self, step: int) -> None:
         """Left/Right: the demo's previous or next variation; at either end it stays (a step round the end

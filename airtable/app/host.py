@@ -34,6 +34,7 @@ class Host(Protocol):
     error_key: str  # the demo whose start failed last
     variation: int
     build_error: DemoError | None
+    goes_on: str | None  # after a failed start, the run that goes on on the table (None: it is empty)
     paused: bool
     clock_s: float  # time the app has run
     mouse_px: Sequence[float]

@@ -196,7 +196,12 @@ class Panels(Feature):
         key = self.host.error_key if self.host.build_error.stage != "event" else self.host.demo_key
         title = ERROR_TITLES[self.host.build_error.stage].format(key=key_label(key))
         again = f"press {key_label(key)} again" if has_own_key(key) else "pick it in Tab's menu"
-        return title, [str(self.host.build_error), f"Fix the file, then {again}. Esc hides this."]
+        lines = [str(self.host.build_error), f"Fix the file, then {again}. Esc hides this."]
+        if self.host.build_error.stage != "event":  # (a timed event's demo is the one on the table)
+            # The heading says it too, but a narrow window cuts it (a user test at 640x480).
+            goes_on = self.host.goes_on
+            lines.append(f"On the table: {goes_on} goes on." if goes_on else "The table is empty.")
+        return title, lines
 
     bindings = (
         Binding("Tab", "demo menu: every demo; arrows and Enter, or type its key", {pygame.K_TAB: open_menu}),
