@@ -71,8 +71,6 @@ ITERATIONS = 10
 # pile settling has 1000 to 2000 awake ones: more iterations there cost more than they show).
 ITERATION_WORK = 8_000
 MAX_ITERATIONS = 200
-SOLVER = "gs"
-OMEGA = 1.0
 CONVERGED_MPS = 1e-7
 # The first iteration's rounds go bottom-up by horizontal bands this many
 # radii high (a contact after its pucks' contacts of lower bands): support from
