@@ -167,6 +167,17 @@ def _wall_contacts(pos, vel, radius, size_m, rest, margin) -> _Contacts:
     return _Contacts(a, b, WALL_NORMALS.take(w), np.concatenate(gap), np.concatenate(vn), keys)
 
 
+def _may_rest(i: np.ndarray, j: np.ndarray, asleep: np.ndarray | None, pressed: np.ndarray | None):
+    """Which of the pairs (i, j) may be contacts (indices; None: all of them): not both asleep (to the
+    awake a sleeper is immovable, and sleepers rest as they are), and one pressed by the forces
+    (RestSpeeds.pressed: of two pucks nothing presses, a touch is a collision). A puck and a wall: i = j."""
+    keep = None if asleep is None else ~(asleep.take(i) & asleep.take(j))
+    if pressed is not None:
+        some = pressed.take(i) | pressed.take(j)
+        keep = some if keep is None else keep & some
+    return None if keep is None else np.flatnonzero(keep)
+
+
 class _Round(NamedTuple):
     """One round's contacts: views into its _Layout's buffers; targets and impulses as (m, 2) [velocity, position].
     (A tuple: quicker to make and to unpack in each sweep than an object's fields to look up.)"""
@@ -273,10 +284,10 @@ class ContactSolver:
             self.forget()
             self._rows = len(pos)
         ci, cj, reach = candidates
+        kept = _may_rest(ci, cj, asleep, rest.pressed)
+        if kept is not None:
+            ci, cj, reach = ci.take(kept), cj.take(kept), reach.take(kept)
         margin = margin_m(vel, dt) if margin is None else margin
-        if asleep is not None:
-            awake = np.flatnonzero(~(asleep.take(ci) & asleep.take(cj)))
-            ci, cj, reach = ci.take(awake), cj.take(awake), reach.take(awake)
         # The contacts where the step began, for the pucks still on the path they began it on
         # (see "Where the contacts are" above); `moved` is what the others' positions hold already.
         moved = vel.copy()
@@ -287,8 +298,9 @@ class ContactSolver:
         start = pos - (vel - moved) * dt
         pc = _pair_contacts(start, vel, ci, cj, reach, rest, self.held, margin, self.kept)
         wc = _wall_contacts(start, vel, radius, size_m, self.wall_rest(rest.walls), margin)
-        if asleep is not None:
-            wc = _Contacts(*(getattr(wc, f).take(np.flatnonzero(~asleep.take(wc.a))) for f in _FIELDS))
+        kept = _may_rest(wc.a, wc.a, asleep, rest.pressed)
+        if kept is not None:
+            wc = _Contacts(*(getattr(wc, f).take(kept) for f in _FIELDS))
         c = _Contacts(*(np.concatenate([getattr(pc, f), getattr(wc, f)]) for f in _FIELDS))
         if began is None or not plain.all():  # where they were at the start if they approached
             zm = np.append(vectors.as_complex(np.ascontiguousarray(moved)), 0.0)

@@ -91,6 +91,16 @@ class RestSpeeds:
         return np.abs(self.press)
 
     @cached_property
+    def pressed(self) -> np.ndarray | None:
+        """(N,) which pucks this step's forces press (None: every one; the floor presses all). A contact
+        needs one: of two pucks nothing presses, a touch is a collision and a gap no stage closes (a
+        puck dragged through a gas of 10000 made every near pair of the gas a contact, 40-130 ms a step)."""
+        if self.floor > 0.0:
+            return None
+        pressed = self.size > 0.0
+        return None if pressed.all() else pressed
+
+    @cached_property
     def walls(self) -> np.ndarray:
         """(N, 2) rest speeds towards the walls across x and across y (one array a step: the contacts
         keep their answer by it, ContactSolver.wall_rest)."""
