@@ -47,6 +47,21 @@ def temporary_files_under_pytests_folder(tmp_path_factory):
         os.environ["TMPDIR"] = old_env
 
 
+@pytest.fixture(scope="session", autouse=True)
+def config_folder_under_pytests_folder(tmp_path_factory):
+    """The config folder (the teacher's seat key, the students' seat tokens: identity.config_dir) is one
+    under pytest's temporary folder, in this process and in the processes it starts."""
+    folder = str(tmp_path_factory.mktemp("config"))
+    saved = {name: os.environ.get(name) for name in ("XDG_CONFIG_HOME", "APPDATA")}
+    os.environ["XDG_CONFIG_HOME"] = os.environ["APPDATA"] = folder
+    yield
+    for name, value in saved.items():
+        if value is None:
+            os.environ.pop(name, None)
+        else:
+            os.environ[name] = value
+
+
 @pytest.fixture(scope="session")
 def demos():
     """The built-in demos by key, loaded once."""

@@ -85,6 +85,18 @@ def test_a_bad_argument_is_one_line_naming_the_command_and_exit_status_2(main, n
     assert "--help" in err  # where the options are listed
 
 
+@pytest.mark.parametrize(
+    ("argv", "problem"),
+    [
+        (["10.0.0.5:9000", "--port", "9001"], "two ports: 9000 in '10.0.0.5:9000' and --port 9001; give one of them"),
+        (["10.0.0.5", "--port", "70000"], "--port 70000 is not a port number (1-65535)"),
+    ],
+)
+def test_the_students_port_is_given_once_in_either_form(argv, problem, capsys) -> None:
+    assert client_cli.main([*argv, "--headless"]) == 2
+    assert capsys.readouterr().err == f"airtable-client: {problem}\n"
+
+
 @pytest.mark.parametrize(("main", "usage"), [(cli.main, "python -m airtable"), (client_cli.main, "airtable-client")])
 def test_help_prints_the_usage_and_every_option_and_exits_0(main, usage, capsys) -> None:
     with pytest.raises(SystemExit) as exited:

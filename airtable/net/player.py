@@ -28,6 +28,7 @@ from airtable.net.outbox import Outbox
 from airtable.net.pacing import link_is_slow
 from airtable.net.playout import SnapshotFeed
 from airtable.net.predictions import RoundInfo, clamp_speed, encode_predict, parse_round
+from airtable.net.seat_memory import SeatMemory
 from airtable.net.udp_inputs import UdpInputs
 
 CONNECT_TIMEOUT_S = 5.0
@@ -149,6 +150,7 @@ class NetPlayer:
         max_backoff_s: float = MAX_BACKOFF_S,
         first_backoff_s: float = FIRST_BACKOFF_S,
         full_backoff_s: float = FIRST_FULL_BACKOFF_S,
+        seat_memory: SeatMemory | None = None,
     ) -> None:
         self.host = host
         self.port = int(port)
@@ -169,6 +171,9 @@ class NetPlayer:
         self._said_bye = False  # the server said BYE on the connection that just ended
         self.next_try: float = 0.0  # time.monotonic() of the next attempt while RETRYING or WAITING
         self.welcome: proto.Welcome | None = None
+        # The tokens kept on this computer (seat_memory.py): a client started again asks for its seat back.
+        self._seat_memory = seat_memory
+        self._remembered = None if seat_memory is None else seat_memory.recall(self.address, self.name)
         self.reconnects = 0
         self.snapshots = 0
         self._scene: Scene | None = None
@@ -303,7 +308,7 @@ class NetPlayer:
         try:
             # After a first WELCOME, its token asks for the same seat (number, name, colour) again:
             # HELLO names the seat, and the token is proven in answer to a CHALLENGE, never sent.
-            token = self.welcome.token if self.welcome is not None else None
+            token = self.welcome.token if self.welcome is not None else self._remembered
             seat = token_seat(token)
             sock.sendall(proto.encode_hello(self.name, self.password, self.protocol_version, seat=seat))
             while True:
@@ -363,6 +368,8 @@ class NetPlayer:
             self._throttle.reset()
             self.round = None  # a round under way comes again after the WELCOME
             self.state = PlayerState.CONNECTED
+        if self._seat_memory is not None and welcome.token:
+            self._seat_memory.keep(self.address, self.name, welcome.token)
             self.waiting_because = None
             self.heard_s, self.lost_s = time.monotonic(), None
 

@@ -13,6 +13,7 @@ from collections.abc import Sequence
 from airtable.arguments import OneLineParser
 from airtable.net import protocol as proto
 from airtable.net.player import NetPlayer, PlayerError
+from airtable.net.seat_memory import SeatMemory, default_path
 from airtable.student.window import PlayerApp, joined_sentence
 
 # A join that takes longer than this (s) says so on the terminal: the window opens only once the first
@@ -27,6 +28,9 @@ def _parse_args(argv: Sequence[str] | None) -> argparse.Namespace:
         "(buttons 1, 2, 3 are the medium, soft and stiff cursor strings; Esc twice leaves; F11 fullscreen).",
     )
     parser.add_argument("server", metavar="HOST[:PORT]", help="the address from the teacher's 'join with:' line")
+    parser.add_argument(
+        "--port", type=int, help="the table's port, if the address has none (the teacher's --port; default 8888)"
+    )
     parser.add_argument("--name", help=f"a name shown next to your cursor (up to {proto.MAX_NAME_CHARS} characters)")
     parser.add_argument("--password", help="the table's password, if the teacher set one")
     parser.add_argument("--headless", action="store_true", help="run without a window (for tests)")
@@ -35,18 +39,31 @@ def _parse_args(argv: Sequence[str] | None) -> argparse.Namespace:
     return parser.parse_args(argv)
 
 
+def _address(server: str, port: int | None) -> tuple[str, int]:
+    """(host, port) from HOST[:PORT] and --port (a user test: `airtable-client HOST --port P`, as the
+    teacher's command takes it, was refused); both may be given only if they agree."""
+    host, given = proto.parse_host_port(server, default_port=0)
+    if port is None:
+        return host, given or proto.DEFAULT_PORT
+    if not 1 <= port <= 65535:
+        raise ValueError(f"--port {port} is not a port number (1-65535)")
+    if given and given != port:
+        raise ValueError(f"two ports: {given} in {server!r} and --port {port}; give one of them")
+    return host, port
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     """The airtable-client command; returns the exit status."""
     args = _parse_args(argv)
     try:
-        host, port = proto.parse_host_port(args.server)
+        host, port = _address(args.server, args.port)
         name = None if args.name is None else proto.check_name(args.name)
         if args.seconds is not None and not (math.isfinite(args.seconds) and args.seconds >= 0):
             raise ValueError("--seconds must be zero or a positive number")
     except (ValueError, proto.ProtocolError) as e:
         print(f"airtable-client: {e}", file=sys.stderr)
         return 2  # a bad argument, as argparse's own refusals
-    net = NetPlayer(host, port, name=name, password=args.password)
+    net = NetPlayer(host, port, name=name, password=args.password, seat_memory=SeatMemory(default_path()))
     saying = f"airtable-client: joining the table at {net.address}..."
     joining = threading.Timer(JOIN_NOTICE_S, print, [saying], {"flush": True})
     joining.daemon = True
