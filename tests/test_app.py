@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from types import SimpleNamespace
+
 import numpy as np
 import pygame
 import pytest
@@ -349,6 +351,10 @@ def test_a_table_too_heavy_for_real_time_runs_in_slow_motion_and_says_so(app):
     assert "physics at 50% of real time (the computer's most)" in app.hud_lines()
     assert "of real time" not in app.status_line()  # (coming and going there, it pushed the last parts off)
     assert "physics at 50% of real time (the teacher's computer's most)" in app.status_parts(for_students=True)
+    app.loop = SimpleNamespace(idling=True)  # a still window, at a few frames a second: nothing to say
+    app.frame(FRAME_S)
+    assert app.window.idle and not any("real time" in line for line in (*app.hud_lines(), *app.status_parts(True)))
+    app.loop = None
     app.speed = 0.5  # slow motion x1/2 asks 2 steps a frame, and both fit in the budget
     for _ in range(150):  # (more than a second of the stepper's clock)
         app.frame(FRAME_S)
