@@ -212,22 +212,29 @@ class LessonsPainter:
 
     # ------------------------------------------------------------ values panel
 
-    def values_size(self, rows: Sequence[PuckValues], hint: str) -> tuple[tuple[int, ...], tuple[int, int]]:
-        """Column widths and the panel's size for `rows` (or the one-line `hint` if there are none)."""
+    def values_size(
+        self, rows: Sequence[PuckValues], hint: str, spaces: int = 2
+    ) -> tuple[tuple[int, ...], tuple[int, int]]:
+        """Column widths and the panel's size for `rows` (or the one-line `hint` if there are none);
+        `spaces`: as wide a gap between columns (at least the padding: where room is short)."""
         font, pad = self.w.label_font, self.w.line_px(4)
         if not rows:  # the hint wrapped to the panel's room: a margin is narrower than the line
             lines = wrap(font, hint, self.text_width_px())
             return (), (max(font.size(t)[0] for t in lines) + 2 * pad, font.get_linesize() * len(lines) + 2 * pad)
         swatch = font.get_height()
         table = [VALUE_HEADINGS, *(r.cells() for r in rows)]
-        widths = tuple(max(font.size(row[c])[0] for row in table) + 2 * pad for c in range(len(VALUE_HEADINGS)))
+        gap = max(2 * pad, font.size(" " * spaces)[0])  # (the padding alone: "m kg |v| m/s" ran together)
+        widths = tuple(max(font.size(row[c])[0] for row in table) + gap for c in range(len(VALUE_HEADINGS)))
         widths = (widths[0] + swatch, *widths[1:])
         return widths, (sum(widths) + 2 * pad, font.get_linesize() * len(table) + 2 * pad)
 
     def values_panel(self, rows: Sequence[PuckValues], colors: Sequence, hint: str, corner: int) -> pygame.Rect:
         """A small table: each puck's mass, speed, momentum and kinetic energy; its colour beside its number."""
-        widths, size = self.values_size(rows, hint)
-        rect = self.corner_rect(size, corner)
+        for spaces in (2, 1, 0):  # too wide for its room: closer columns before dropping one (mass, first)
+            widths, size = self.values_size(rows, hint, spaces)
+            rect = self.corner_rect(size, corner)
+            if rect.width >= size[0]:
+                break
         self._panel(rect)
         font, pad = self.w.label_font, self.w.line_px(4)
         line_h = font.get_linesize()
