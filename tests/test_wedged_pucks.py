@@ -17,6 +17,7 @@ from hypothesis import strategies as st
 
 from airtable.physics.events import CAPPED_NOTICE, RATTLE_MAX, RATTLE_NOTICE
 from airtable.physics.table import AirTable
+from airtable.physics.walls import WEDGED_NOTICE
 
 
 def unfolded(x0: float, v: float, t: float, lo: float, hi: float) -> float:
@@ -50,6 +51,7 @@ def test_a_wedged_puck_stays_at_the_centre_across_and_bounces_along(axis, oversi
         t.step(dt_s)
         assert CAPPED_NOTICE not in t.notices  # (each step had 100000 hits, 1.5 to 2 s)
     assert t.vel_mps[0, axis] == 0.0 and t.pos_m[0, axis] == 0.5 * size
+    assert list(t.notices).count(WEDGED_NOTICE) == 1  # said once: why it moves along the table only
     lo, hi, v, time_s = r, float(t.size_m[free]) - r, speed[free], steps * dt_s
     assert t.pos_m[0, free] == pytest.approx(unfolded(4.0, v, time_s, lo, hi), abs=1e-9)
     assert abs(t.vel_mps[0, free]) == pytest.approx(abs(v), rel=1e-12)

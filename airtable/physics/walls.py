@@ -26,7 +26,8 @@ def again(table: Storage, ctx: StepContext, contacts_held: bool) -> None:
     """Stage 6: walls again, since parting pairs can push a puck into a wall: every puck, put on the wall
     without a bounce where it rests, if the contacts held some (`contacts_held`); else only the pucks
     the pair stage moved. A puck wedged between two walls ends the step stopped between them."""
-    stop_wedged(table.pos_m, table.vel_mps, table.radius_m, table.size_m)
+    if stop_wedged(table.pos_m, table.vel_mps, table.radius_m, table.size_m):
+        table.notices.say("wedged", WEDGED_NOTICE)
     if contacts_held:
         rest = table.contact_solver.wall_rest(ctx.rest.walls)
         bounced, _ = resolve_walls(*_table_walls(table), rest=rest, hold_slow=True)
@@ -41,15 +42,25 @@ def again(table: Storage, ctx: StepContext, contacts_held: bool) -> None:
     table.wall_collision_count += bounced
 
 
-def stop_wedged(pos, vel, radius, size_m) -> None:
+# Said once when a puck is found wedged (a user test: a puck taller than the table stood through both walls,
+# and nothing said why it moved along the table only).
+WEDGED_NOTICE = (
+    "A puck as wide or as tall as the table fits only at its middle across it: it stays there and moves along"
+    " the table only."
+)
+
+
+def stop_wedged(pos, vel, radius, size_m) -> bool:
     """Put each puck wedged between two walls (collision.wedged) in the middle between them, stopped across
-    them, in place. No hit does it: the hit stage never predicts one there (it would come at once, again
-    and again: 100000 hits a step, the app frozen), nor do the contacts hold it (one wall against the other)."""
+    them, in place; whether there was one. No hit does it: the hit stage never predicts one there (it would
+    come at once, again and again: 100000 hits a step, the app frozen), nor do the contacts hold it (one
+    wall against the other)."""
     if len(radius) == 0 or not collision.wedged(float(radius.max()), float(size_m.min())):
-        return  # (the usual case)
+        return False  # (the usual case)
     rows, axes = collision.wedged(radius[:, None], size_m).nonzero()
     vel[rows, axes] = 0.0
     pos[rows, axes] = 0.5 * size_m.take(axes)
+    return len(rows) > 0
 
 
 def off_the_wall(pos, vel, radius, size_m, cr_wall: float, rows: np.ndarray) -> list[int]:
