@@ -16,6 +16,8 @@ import numpy as np
 import pygame
 import pytest
 from conftest import FRAME_S, press
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from airtable.app.app import App
 from airtable.app.panel_view import wrap
@@ -166,3 +168,30 @@ def test_a_word_wider_than_the_line_is_broken_not_cut():
     assert all(font.size(line)[0] <= 150 for line in lines)
     assert "".join(lines).replace(" ", "") == LONG_PATH.replace(" ", "")
     assert lines[0] == "saved" and len(lines) >= 5
+
+
+@settings(max_examples=60, deadline=None)
+@given(
+    parts=st.lists(st.text(st.characters(categories=["L", "Nd"]), min_size=1, max_size=14), min_size=1, max_size=4),
+    joiner=st.sampled_from(["-", "/", "_"]),
+    width=st.integers(30, 300),
+)
+def test_a_long_word_breaks_after_a_hyphen_or_slash_where_one_fits(parts, joiner, width):
+    """A user test: the student "Александр-Константин" read "Александр-Кон" / "стантин" in a side panel."""
+    font = pygame.font.Font(None, 24)
+    word = joiner.join(parts)
+    lines = wrap(font, word, width)
+    assert "".join(lines) == word
+    assert all(font.size(line)[0] <= width or len(line) == 1 for line in lines)
+    for line, rest in zip(lines, lines[1:]):
+        fits = line + rest[0]
+        cut = fits.rfind(joiner, 0, len(line)) + 1  # the last joiner in what fits on the line
+        if cut > len(line) // 2:
+            assert line.endswith(joiner)  # broken after it, not in the middle of the part after it
+
+
+def test_the_name_of_the_user_test_breaks_at_its_hyphen():
+    font = pygame.font.Font(None, 24)
+    name = "Александр-Константин"
+    width = font.size("Александр-Конст")[0]
+    assert wrap(font, name, width) == ["Александр-", "Константин"]

@@ -57,13 +57,21 @@ def wrap(font: pygame.font.Font, text: str, width: int) -> list[str]:
     return lines
 
 
+# A word broken across lines is broken after the last of these that fits, if any: a name or a path
+# then reads in whole parts ("Александр-" / "Константин", not "Александр-Кон" / "стантин": a user test).
+BREAKS_AFTER = "-/\\_."
+
+
 def _break_word(font: pygame.font.Font, word: str, width: int) -> list[str]:
-    """`word` in pieces no wider than `width` pixels (at least one character each)."""
+    """`word` in pieces no wider than `width` pixels (at least one character each), broken after a
+    hyphen, slash or underscore where one fits (BREAKS_AFTER)."""
     pieces = []
     while font.size(word)[0] > width and len(word) > 1:
         n = 1
         while n < len(word) - 1 and font.size(word[: n + 1])[0] <= width:
             n += 1
+        after = max(word.rfind(c, 0, n) for c in BREAKS_AFTER) + 1  # (0: none in the part that fits)
+        n = after if after > n // 2 else n  # (not one early on: that line would be left nearly empty)
         pieces.append(word[:n])
         word = word[n:]
     return [*pieces, word]
