@@ -345,3 +345,17 @@ def test_a_student_who_dropped_shows_as_away_while_the_seat_is_held(served, monk
     press(app, pygame.K_F2)
     app.frame(FRAME_S)
     assert drawn and [name for name, _ in drawn[-1]] == ["C1 Ann"]
+
+
+@pytest.mark.parametrize("width", [120, 250, 400, 636, 900, 2000])
+def test_the_rosters_keys_wrap_between_keys_never_cut_where_a_key_fits(width):
+    """A user test: in a 636 px window the roster's key lines ended "F2 or Es..." and "F5: hide n..."."""
+    pygame.font.init()
+    font = pygame.font.Font(None, 24)
+    lines = roster_view.hint_lines(font, width)
+    keys = [key for hint in roster_view.HINTS for key in hint.split(roster_view.HINT_GAP)]
+    assert all(font.size(line)[0] <= width for line in lines)
+    if all(font.size(key)[0] <= width for key in keys):  # each key whole, each once, in order
+        assert [key for line in lines for key in line.split(roster_view.HINT_GAP)] == keys
+    if all(font.size(hint)[0] <= width for hint in roster_view.HINTS):
+        assert lines == list(roster_view.HINTS)  # room enough: as written

@@ -22,9 +22,10 @@ if TYPE_CHECKING:
 ALERT_COLOR = (255, 90, 70)
 SELECTED_COLOR = (60, 60, 110)
 WARN_COLOR = (255, 170, 90)
+HINT_GAP = "    "
 HINTS = (
-    "Up / Down or click: select    Delete twice: remove    F2 or Esc: close",
-    "F3: hands off    F4: the floor to the next student    F5: hide names",
+    HINT_GAP.join(("Up / Down or click: select", "Delete twice: remove", "F2 or Esc: close")),
+    HINT_GAP.join(("F3: hands off", "F4: the floor to the next student", "F5: hide names")),
 )
 HEADINGS = ("seat", "", "rate", "lag", "warnings")
 # Columns, in font heights from the left: swatch, seat, name, rate, lag, flags.
@@ -40,6 +41,22 @@ def seat_flags(seat: Seat) -> str:
     if idle:
         return f"idle {seat.idle_s:.0f} s"
     return "cursor far off the table" if seat.far_off else ""
+
+
+def hint_lines(font: pygame.font.Font, width: int) -> list[str]:
+    """HINTS in lines that fit `width` px: each line's keys as they fit, the rest on the next line (a user
+    test: at 636 px the lines ended "F2 or Es..." and "F5: hide n...")."""
+    lines = []
+    for hint in HINTS:
+        line = ""
+        for item in hint.split(HINT_GAP):
+            trial = f"{line}{HINT_GAP}{item}" if line else item
+            if line and font.size(trial)[0] > width:
+                lines.append(line)
+                trial = item
+            line = trial
+        lines.append(line)
+    return [panel_view.shorten(font, line, width) for line in lines]  # (a key's own text wider than the panel)
 
 
 def _row_texts(seat: Seat, label: str) -> list[str]:
@@ -71,8 +88,8 @@ def draw_roster(
         w.big_font.render(panel_view.shorten(w.big_font, title, rect.w - 2 * pad), True, panel_view.ACCENT), (pad, pad)
     )
     y = pad + w.big_font.get_linesize()
-    for hint in HINTS:
-        surf.blit(font.render(panel_view.shorten(font, hint, rect.w - 2 * pad), True, panel_view.DIM_TEXT), (pad, y))
+    for hint in hint_lines(font, rect.w - 2 * pad):
+        surf.blit(font.render(hint, True, panel_view.DIM_TEXT), (pad, y))
         y += font.get_linesize()
     if away:  # dropped, seats held: they come back by themselves
         line = "away (seat kept): " + ", ".join(f"{name} {s:.0f} s" for name, s in away)
