@@ -247,6 +247,7 @@ def test_a_player_cut_off_by_a_restart_waits_when_the_table_is_now_full(cleanup)
     squatter.send(proto.encode_bye())
     wait_until(lambda: net.state == net.CONNECTED, what="the place to be taken")
     assert net.reconnects == 1 and server2.player_names() == ["C1"]
+    assert net.waiting_because is None and net.lost_s is None  # in: nothing to wait for, nothing lost
 
 
 # ---------------------------------------------------------------- one-line errors

@@ -368,10 +368,10 @@ class NetPlayer:
             self._throttle.reset()
             self.round = None  # a round under way comes again after the WELCOME
             self.state = PlayerState.CONNECTED
-        if self._seat_memory is not None and welcome.token:
-            self._seat_memory.keep(self.address, self.name, welcome.token)
             self.waiting_because = None
             self.heard_s, self.lost_s = time.monotonic(), None
+        if self._seat_memory is not None and welcome.token:  # (a file: outside the lock)
+            self._seat_memory.keep(self.address, self.name, welcome.token)
 
     def _slow_link(self, sentence: str) -> None:
         """A handshake timed out on a slow link: wait longer next time, and say so."""
