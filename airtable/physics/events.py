@@ -568,7 +568,7 @@ class _Step:
         if e < 1.0 and hits >= repeat_max(e):  # its last hit here: it rests on the wall (off_a_pinned)
             self.pinned[k] = self.wall_normal(x, axis)
             e = 0.0
-        if self.rattle(k, axis, x) >= RATTLE_MAX:  # it stops across them, where it is
+        if self.rattle(k, axis, v) >= RATTLE_MAX:  # it stops across them, where it is
             self.hits.rattled = True
             e = 0.0
         if axis == 0:
@@ -580,10 +580,10 @@ class _Step:
             self.set_path(k, x, complex(v.real, vy))
             self.offset[k] = complex(0.0, offset)
 
-    def rattle(self, k: int, axis: int, x: complex) -> int:
-        """How many times in a row puck k, at x, has hit the two walls across `axis` by turns, this hit
+    def rattle(self, k: int, axis: int, v: complex) -> int:
+        """How many times in a row puck k, coming at v, has hit the two walls across `axis` by turns, this hit
         included, with no other change of its path in between (RATTLE_MAX)."""
-        high = (x.real > 0.5 * self.width) if axis == 0 else (x.imag > 0.5 * self.height)
+        high = (v.real > 0.0) if axis == 0 else (v.imag > 0.0)  # (which wall: the way it goes, not where it is)
         version, side, count = self.rattles.get((k, axis), (-1, high, 0))
         count = count + 1 if version == self.version.get(k, 0) and side != high else 1
         self.rattles[k, axis] = (self.version.get(k, 0) + 1, high, count)  # (set_path comes next: + 1)
