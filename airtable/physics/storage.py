@@ -29,7 +29,7 @@ from collections.abc import Callable
 
 import numpy as np
 
-from airtable.physics import broadphase, contacts, forces
+from airtable.physics import broadphase, contacts, forces, vectors
 from airtable.physics.collision import CORRECTION_MODES
 from airtable.physics.columns import Columns
 
@@ -243,6 +243,11 @@ class Storage:
     def spring_ends(self) -> tuple[np.ndarray, np.ndarray]:
         """(S,) rows of each spring's p1 and (S,) rows of its p2 (live views)."""
         return self.spring_columns.view("i"), self.spring_columns.view("j")
+
+    def spring_stretch_m(self) -> np.ndarray:
+        """(S,) how far each spring is longer than its relaxed length now (negative: compressed)."""
+        a, b = self.spring_ends
+        return vectors.lengths(vectors.take(self.pos_m, a) - vectors.take(self.pos_m, b)) - self.spring_length_m
 
     @property
     def spring_k_effective_Npm(self) -> np.ndarray:

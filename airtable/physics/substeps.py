@@ -93,7 +93,7 @@ def _may_meet(table, dt_s: float) -> bool:
     if not table.puck_collisions:
         return False
     pos, a, b = table.pos_m, *table.spring_ends
-    pull = table.spring_k_Npm * np.abs(vectors.lengths(pos[a] - pos[b]) - table.spring_length_m)
+    pull = table.spring_k_Npm * np.abs(table.spring_stretch_m())
     n = len(pos)
     travel = (
         vectors.lengths(table.vel_mps) * dt_s

@@ -186,9 +186,7 @@ class AirTable(Storage):
         """Elastic energy stored in the springs, sum of k (d - L)^2 / 2, with the k the step uses."""
         if self.n_springs == 0:
             return 0.0
-        a, b = self.spring_ends
-        d = vectors.take(self.pos_m, a) - vectors.take(self.pos_m, b)
-        stretch = vectors.lengths(d) - self.spring_length_m
+        stretch = self.spring_stretch_m()
         return float(0.5 * np.dot(self.spring_k_effective_Npm, stretch * stretch))
 
     def gravity_energy_J(self) -> float:
