@@ -232,20 +232,24 @@ class ContactSolver:
     def piled(self, n: int) -> np.ndarray | None:
         """(n,) which pucks were in a contact with another puck in the last step (None: none were, or the
         rows changed): pucks in a pile, pressed every way by their neighbours (rest_speeds.py)."""
-        if len(self._keys) == 0 or self._rows != n:
+        if self._rows != n:
             return None
-        row, other = np.divmod(self._keys, self._rows + 4)
-        pairs = np.flatnonzero(other < self._rows)
-        if len(pairs) == 0:
+        i, j = self._puck_pairs()
+        if len(i) == 0:
             return None
         out = np.zeros(n, dtype=bool)
-        out[row.take(pairs)] = True
-        out[other.take(pairs)] = True
+        out[i] = out[j] = True
         return out
 
     def held_pairs(self) -> bool:
         """Whether the last step held two pucks against each other (not only pucks on walls)."""
-        return bool(len(self._keys)) and bool((self._keys % (self._rows + 4) < self._rows).any())
+        return len(self._puck_pairs()[0]) > 0
+
+    def _puck_pairs(self) -> tuple[np.ndarray, np.ndarray]:
+        """The last step's contacts of two pucks, (i, j), from their keys (a wall's has j >= the row count)."""
+        i, j = np.divmod(self._keys, self._rows + 4)
+        pairs = np.flatnonzero(j < self._rows)
+        return i.take(pairs), j.take(pairs)
 
     def wall_rest(self, rest: np.ndarray) -> np.ndarray:
         """The (N, 2) rest speeds `rest` towards the walls across x and y, made infinite where the puck
