@@ -19,6 +19,7 @@ from conftest import wait_until
 
 from airtable.net import pacing
 from airtable.net import protocol as proto
+from airtable.net import server as server_module
 from airtable.net.server import GameServer
 
 needs_link = pytest.mark.skipif(linkshaper.isolation_problem() is not None, reason=str(linkshaper.isolation_problem()))
@@ -259,13 +260,14 @@ def test_a_goodbye_gives_the_seat_up():
         assert RawPlayer(server.port, "Bob").welcome()["client"] == "C1"
 
 
-def test_a_reconnect_with_the_token_takes_over_from_the_stale_connection_at_once():
+def test_a_reconnect_with_the_token_takes_over_from_the_stale_connection_at_once(monkeypatch):
+    # Ann's old connection has been silent for IN_USE_S (here 0: at once) but no timeout has passed.
+    monkeypatch.setattr(server_module, "IN_USE_S", 0.0)
     with GameServer(host="127.0.0.1", port=0) as server:
         ann = RawPlayer(server.port, "Ann")
         first = ann.welcome()
         bob = RawPlayer(server.port, "Bob")
         assert bob.welcome()["client"] == "C2"
-        # Ann's old connection still looks alive to the server (no timeout has passed).
         again = RawPlayer(server.port, "Ann", token=first["token"])
         back = again.welcome()
         assert (back["client"], back["color"]) == ("C1", first["color"])
@@ -280,6 +282,27 @@ def test_a_reconnect_with_the_token_takes_over_from_the_stale_connection_at_once
         else:
             pytest.fail("the stale connection stayed open")
         for client in (ann, bob, again):
+            client.close()
+
+
+def test_a_seat_still_heard_from_is_not_taken_over_the_newcomer_asks_again(monkeypatch):
+    """Two live windows of one student (a token they shared, seat_memory.py) took the seat from each other
+    twice a second, without end (a user test). A connection heard from within IN_USE_S is in use."""
+    monkeypatch.setattr(server_module, "IN_USE_S", 1000.0)  # (Ann's connection is as live as can be)
+    with GameServer(host="127.0.0.1", port=0) as server:
+        ann = RawPlayer(server.port, "Ann")
+        first = ann.welcome()
+        again = RawPlayer(server.port, "Ann", token=first["token"])
+        refusal = None
+        for _ in range(100):  # bounded: frames until the ERROR
+            frames = again.reader.feed(again.sock.recv(65536))
+            refusal = next((json.loads(p) for kind, p in frames if kind == proto.ERROR), None)
+            if refusal is not None:
+                break
+        assert refusal is not None and refusal.get("retry") is True, refusal
+        assert refusal["error"] == "C1 Ann is playing in another window; close one (this one asks again by itself)"
+        assert server.player_names() == ["C1 Ann"]  # hers still, on her connection
+        for client in (ann, again):
             client.close()
 
 

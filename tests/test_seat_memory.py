@@ -92,3 +92,21 @@ def test_a_memory_that_cannot_be_written_is_no_memory(tmp_path):
     memory = SeatMemory(blocked / "seats.json")  # its folder is a file
     memory.keep("127.0.0.1:8921", "Ann", "2-" + "e" * 32)  # no exception
     assert memory.recall("127.0.0.1:8921", "Ann") is None
+
+
+def test_two_live_windows_of_one_student_do_not_take_the_seat_from_each_other(cleanup, tmp_path):  # noqa: F811
+    """A user test: the same command twice (a student opened the client twice) shared the kept token, and the
+    two took C1 from each other twice a second, without end. Now the second waits, saying why, and takes the
+    seat when the first closes."""
+    server, _ = start_table(cleanup)
+    memory = tmp_path / "seats.json"
+    first = player(cleanup, server.port, name="Маша", seat_memory=SeatMemory(memory))
+    assert first.connect().label == "C1 Маша"
+    second = player(cleanup, server.port, name="Маша", seat_memory=SeatMemory(memory))
+    assert second.connect() is None  # not welcomed: waiting
+    assert second.waiting_because == "C1 Маша is playing in another window; close one (this one asks again by itself)"
+    wait_until(lambda: second.next_try > 0.0, what="the second window to plan its next try")
+    assert first.state == first.CONNECTED and first.reconnects == 0 and server.player_names() == ["C1 Маша"]
+    first.close()  # the first window closes (BYE): the seat is free
+    wait_until(lambda: second.state == second.CONNECTED, what="the second window in")
+    assert second.welcome.label == "C1 Маша" and server.player_names() == ["C1 Маша"]

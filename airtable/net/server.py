@@ -80,6 +80,12 @@ RESERVED_FDS = 32  # descriptors kept for the app itself (files, the display, th
 FAR_OFF_TABLES = 1.0  # a cursor this many table sizes beyond the edge is "far off" in the roster
 ACCEPT_PAUSE_S = 0.5  # out of descriptors: stop accepting for this long
 NOTICE_S = 60.0  # the projector shows why students were turned away for this long after the last one
+# A seat's connection heard from this recently is in use: a client proving that seat's token is told so and
+# asks again (a live client sends at least once a second). Older, it is stale (a laptop whose Wi-Fi dropped
+# comes back before the server noticed): the newcomer takes the seat over. Taken over at once, two live
+# windows of one student on one computer (a token they shared: seat_memory.py) took it from each other
+# twice a second, without end (a user test).
+IN_USE_S = 2.5
 
 
 def client_color(number: int) -> tuple[int, int, int]:
@@ -859,7 +865,8 @@ class GameServer:
     def _welcome(self, conn: Connection, hello: proto.Hello, now: float) -> None:
         if not self._password_ok(conn, hello, now):
             return
-        self._take_over(conn, hello)
+        if not self._take_over(conn, hello, now):
+            return
         refusal = self._gate.seat_refusal(conn.host, self.password is not None, hello.name)
         if refusal is not None:  # the student's window waits and asks again: the teacher may let the class in
             self._tell_teacher(self._gate.teacher_notice())
@@ -911,18 +918,24 @@ class GameServer:
         away = [held for _, held, _ in self._held.away(time.monotonic()) if held]
         return distinct_name(name, playing + away)
 
-    def _take_over(self, conn: Connection, hello: proto.Hello) -> None:
+    def _take_over(self, conn: Connection, hello: proto.Hello, now: float) -> bool:
         """A student back with their seat's token, while their old connection still holds it (it has
-        not noticed the drop yet): the old one is closed at once, so the seat is free for the new one."""
+        not noticed the drop yet): the old one is closed at once, so the seat is free for the new one.
+        False (the newcomer told to ask again) while the old one is still heard from (IN_USE_S)."""
         number = self._claimed_seat(conn, hello)
         stale = self._conns.get(self._numbers.get(number, -1)) if number is not None else None
         if stale is None:
-            return
+            return True
+        if now - stale.last_rx < IN_USE_S:
+            sentence = f"{stale.name} is playing in another window; close one (this one asks again by itself)"
+            self._fail(conn, sentence, retry=True)
+            return False
         self._log_seat(stale, "%s is back on a new connection; the old one is closed", stale.who)
         stale.keep_seat = False
         self._release_slot(stale)
         stale.close()
         self._settle(stale)
+        return True
 
     def _seat_for(self, conn: Connection, hello: proto.Hello, now: float) -> int | None:
         """The seat a welcomed HELLO gets: the one its token proves, if free (given back from hold);
