@@ -64,7 +64,7 @@ def test_pressing_a_demo_key_reads_its_file_again_after_an_edit(tmp_path, capsys
     triangle = app.table.pos_m.copy()
     press(app, pygame.K_5)  # from another demo, too: the error, not the built-in 5, over the table that ran
     assert app.panels.panel() == "error" and np.array_equal(app.table.pos_m, triangle)
-    assert app.demo_key == "6" and app.caption() == f"Demo 5: mine.py (does not load: {app.demo.label(0)} goes on)"
+    assert app.demo_key == "6" and app.caption() == f"{app.demo.label(0)}; Demo 5: mine.py does not load"
     # The panel says it too: at 640x480 the heading was cut before "goes on" (a user test).
     assert app.panels._error_text()[1][-1] == f"On the table: {app.demo.label(0)} goes on."
     mine.write_text(demo_source("5", pucks=4, build_line=RAISES))
@@ -87,7 +87,7 @@ def test_a_demo_that_fails_to_build_leaves_the_lesson_s_table_and_ctrl_s_saves_t
     jelly, title, label = len(app.table.pucks), app.demo.title, app.demo.label(app.variation)
     for broken in ("s1", "s2"):
         app.start_demo(broken)
-        assert app.panels.panel() == "error" and len(app.table.pucks) == jelly and f"{label} goes on" in app.caption()
+        assert app.panels.panel() == "error" and len(app.table.pucks) == jelly and app.caption().startswith(f"{label}; Demo {broken}")
         assert f"Demo {broken} could not be" in app.panels._error_text()[0]
         press(app, pygame.K_ESCAPE)
     saved = app.lessons.save_moment(tmp_path / "saved.py")
@@ -159,7 +159,7 @@ def test_a_demo_file_broken_while_it_runs_stays_in_the_menu_and_the_heading_says
     press(app, pygame.K_8)
     press(app, pygame.K_ESCAPE)
     # Not the built-in 8's title; s1's run goes on (its file is still broken: it ran as loaded before).
-    assert app.caption() == "Demo 8: Mine (not built: Demo s1: Mine goes on)" and len(app.table.pucks) == 2
+    assert app.caption() == "Demo s1: Mine; Demo 8: Mine not built" and len(app.table.pucks) == 2
     press(app, pygame.K_1)
     assert app.caption().startswith("Demo 1: ")
 

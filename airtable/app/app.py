@@ -281,12 +281,19 @@ class App:
         return self.failed_start or self.demo.label(self.variation)
 
     def _failed_caption(self, demo: Demo | None, ran: tuple | None) -> str:
-        """The heading after a failed start; `ran`: (key, path, variation) of the demo whose run goes on."""
+        """The heading after a failed start; `ran`: (key, path, variation) of the demo whose run goes on.
+        It names the demo on the table first, then the one that failed: a narrow window cuts the end, and
+        at 640x480 the heading named the failed demo over the one running (a user test)."""
         self.goes_on = None if ran is None else self._goes_on(ran)
-        on = "" if ran is None else f": {self.goes_on} goes on"
         if self.build_error.stage == "load" or demo is None:
-            return f"Demo {key_label(self.error_key)}: {self.build_error.path.name} (does not load{on})"
-        return f"{demo.label(self.variation)} (not built{on})"
+            failed, what = f"Demo {key_label(self.error_key)}: {self.build_error.path.name}", "does not load"
+        else:
+            failed, what = demo.label(self.variation), "not built"
+        if ran is None:
+            return f"{failed} ({what})"
+        if ran[0] == self.error_key:  # its own file broke: the same demo goes on
+            return f"{failed} ({what}: its last run goes on)"
+        return f"{self.goes_on}; {failed} {what}"
 
     def _goes_on(self, ran: tuple) -> str:
         """What stays on the table after a failed start: `ran` (key, path, variation), the run that goes on."""
