@@ -87,7 +87,8 @@ def test_a_demo_that_fails_to_build_leaves_the_lesson_s_table_and_ctrl_s_saves_t
     jelly, title, label = len(app.table.pucks), app.demo.title, app.demo.label(app.variation)
     for broken in ("s1", "s2"):
         app.start_demo(broken)
-        assert app.panels.panel() == "error" and len(app.table.pucks) == jelly and app.caption().startswith(f"{label}; Demo {broken}")
+        assert app.panels.panel() == "error" and len(app.table.pucks) == jelly
+        assert app.caption().startswith(f"{label}; Demo {broken}")  # the table's demo first
         assert f"Demo {broken} could not be" in app.panels._error_text()[0]
         press(app, pygame.K_ESCAPE)
     saved = app.lessons.save_moment(tmp_path / "saved.py")
