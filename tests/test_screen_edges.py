@@ -287,3 +287,22 @@ def test_the_rate_measured_after_idling_counts_no_idle_frame():
         now += 1 / 60
         rate = counter.tick(now)
     assert rate == pytest.approx(60.0)
+
+
+@pytest.mark.parametrize("size", SIZES, ids=lambda s: f"{s[0]}x{s[1]}")
+def test_cursors_at_one_spot_keep_their_names_apart(demos, size):
+    """A user test: two students' cursors at one spot wrote their names over each other."""
+    from dataclasses import replace
+
+    from airtable.model.scene import CursorView, Scene
+
+    app = app_at(size, demos, "3")
+    w, h = size
+    for tip in ((w // 2, h // 2), (w - 4, h - 3), (w // 3, 3), (3, h // 2)):
+        spot = tuple(float(v) for v in app.env.to_world(tip))
+        cursors = tuple(CursorView(f"C{k} Student {k}", (200, 100 + 20 * k, 50), spot) for k in range(1, 4))
+        scene = replace(Scene.from_table(app.table, app.clients, title="t", status="s"), cursors=cursors)
+        app.window.draw(scene)
+        boxes = app.window.cursor_boxes
+        assert len(boxes) == 3 and all(app.window.surface.get_rect().contains(b) for b in boxes), (tip, boxes)
+        assert not any(a.colliderect(b) for k, a in enumerate(boxes) for b in boxes[k + 1 :]), (tip, boxes)

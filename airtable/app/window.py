@@ -468,13 +468,17 @@ class GameWindow:
 
     def _cursor_label_box(self, size: tuple[int, int], x: float, y: float, u: float) -> pygame.Rect:
         """Where a cursor's name goes: beside its arrow (below right; at the right edge left of it; at the
-        bottom above it), on screen and off the window's own text (the heads-up lines, the status line);
-        where no such spot is, between the top band and the status bar."""
+        bottom above it), on screen and off the window's own text (the heads-up lines, the status line)
+        and off the names drawn before it (a user test: two cursors at one spot wrote over each other: the
+        later one goes a line further down or up); where no such spot is, between the top band and the
+        status bar."""
         below, above = y + 14 * u, y - 2 * u - size[1]
         free = self.world_area()
         right_of, left_of = int(x + 12 * u), int(x - 2 * u) - size[0]
-        spots = [pygame.Rect((left, int(top)), size) for top in (below, above) for left in (right_of, left_of)]
-        clear = [b for b in spots if free.contains(b) and b.collidelist(self.hud_boxes) < 0]
+        tops = [top + k * size[1] * way for k in range(8) for top, way in ((below, 1), (above, -1))]
+        spots = [pygame.Rect((left, int(top)), size) for top in tops for left in (right_of, left_of)]
+        taken = self.hud_boxes + self.cursor_boxes
+        clear = [b for b in spots if free.contains(b) and b.collidelist(taken) < 0]
         return clear[0] if clear else spots[0].clamp(free if free.height >= size[1] else self.surface.get_rect())
 
     def _draw_hud(self, scene: Scene, hud: Sequence[HudLine]) -> None:
