@@ -64,7 +64,7 @@ BREAKS_AFTER = "-/\\_."
 
 def _break_word(font: pygame.font.Font, word: str, width: int) -> list[str]:
     """`word` in pieces no wider than `width` pixels (at least one character each), broken after a
-    hyphen, slash or underscore where one fits (BREAKS_AFTER)."""
+    hyphen, slash, backslash, underscore or dot where one fits (BREAKS_AFTER)."""
     pieces = []
     while font.size(word)[0] > width and len(word) > 1:
         n = 1

@@ -288,9 +288,9 @@ class ContactSolver:
             self.forget()
             self._rows = len(pos)
         ci, cj, reach = candidates
-        kept = _may_rest(ci, cj, asleep, rest.pressed)
-        if kept is not None:
-            ci, cj, reach = ci.take(kept), cj.take(kept), reach.take(kept)
+        may = _may_rest(ci, cj, asleep, rest.pressed)  # (not self.kept: that is last step's contacts)
+        if may is not None:
+            ci, cj, reach = ci.take(may), cj.take(may), reach.take(may)
         margin = margin_m(vel, dt) if margin is None else margin
         # The contacts where the step began, for the pucks still on the path they began it on
         # (see "Where the contacts are" above); `moved` is what the others' positions hold already.
@@ -302,9 +302,9 @@ class ContactSolver:
         start = pos - (vel - moved) * dt
         pc = _pair_contacts(start, vel, ci, cj, reach, rest, self.held, margin, self.kept)
         wc = _wall_contacts(start, vel, radius, size_m, self.wall_rest(rest.walls), margin)
-        kept = _may_rest(wc.a, wc.a, asleep, rest.pressed)
-        if kept is not None:
-            wc = _Contacts(*(getattr(wc, f).take(kept) for f in _FIELDS))
+        may = _may_rest(wc.a, wc.a, asleep, rest.pressed)
+        if may is not None:
+            wc = _Contacts(*(getattr(wc, f).take(may) for f in _FIELDS))
         c = _Contacts(*(np.concatenate([getattr(pc, f), getattr(wc, f)]) for f in _FIELDS))
         if began is None or not plain.all():  # where they were at the start if they approached
             zm = np.append(vectors.as_complex(np.ascontiguousarray(moved)), 0.0)
