@@ -162,6 +162,24 @@ def test_the_velocity_legend_keeps_off_the_momenta_panel(demos, server, size):
     assert not overlaps, overlaps
 
 
+@pytest.mark.parametrize("size", SIZES, ids=lambda s: f"{s[0]}x{s[1]}")
+def test_nothing_peeks_out_from_under_a_panel(demos, server, size):
+    # User tests: in fullscreen at 1920x1080 the chart's edge showed beside the roster (F2); at 640x480 the
+    # values panel's and the chart's edges did. The join line in the left margin or the top band stays in view.
+    app = App(demos, demo_key="1", headless=True, server=server, window_size_px=size)
+    pygame.event.clear()
+    for key in (pygame.K_c, pygame.K_t, pygame.K_F2):
+        press(app, key)
+    app.frame(FRAME_S)
+    window, painter = app.window, app.painter
+    panel = window.panel_rect()
+    assert panel.left >= window.layout.side_px and panel.top >= window.layout.top_px
+    boxes = [painter.chart_rect(corner) for corner in range(4)]  # every corner the chart may take (m moves it)
+    boxes += [box for box in window.label_boxes if box != panel and box.w < panel.w]  # the values panel, ...
+    peeking = [box for box in boxes if box.colliderect(panel) and not panel.contains(box)]
+    assert not peeking, (panel, peeking)
+
+
 def test_a_word_wider_than_the_line_is_broken_not_cut():
     font = pygame.font.Font(None, 24)
     lines = wrap(font, LONG_PATH, 150)

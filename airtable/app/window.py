@@ -539,15 +539,17 @@ class GameWindow:
             self.surface.blit(label, label.get_rect(midtop=(w // 2, inner.top + k * step)))
 
     def panel_rect(self) -> pygame.Rect:
-        """Where panels go: under the top band, or between the side margins (the join line stays
-        visible either way) and under the frame rate and PAUSED in the top right corner, above the
-        status bar."""
+        """Where panels go: under the top band, or right of the left margin (the join line stays
+        visible either way), and under the frame rate and PAUSED in the top right corner, above the
+        status bar. Sideways a panel reaches the window's edges: the chart, the values and the momenta
+        in the right margin or at the table's edges are covered whole, none peeks out from under it
+        (a user test saw the chart's edge beside the roster in fullscreen, and the values' at 640x480)."""
         w, h = self.surface.get_size()
         pad = self.font.get_height() // 2
         top = max(pad, self.layout.top_px + pad // 2, self.corner_bottom_px + pad // 2)
-        bottom = min(h - pad, self.status_top_px - pad // 2)
-        left = max(pad, w // 40, self.layout.side_px)  # the left margin's text stays in view
-        right = w - max(pad, w // 40)
+        bottom = self.status_top_px
+        left = self.layout.side_px  # (0: no margins)
+        right = w
         return pygame.Rect(left, top, right - left, max(4 * self.font.get_linesize(), bottom - top))
 
     def draw_question(self, title: str, lines: Sequence[str]) -> pygame.Rect:
