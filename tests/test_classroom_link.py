@@ -20,7 +20,7 @@ from conftest import wait_until
 from airtable.net import pacing
 from airtable.net import protocol as proto
 from airtable.net import server as server_module
-from airtable.net.server import GameServer
+from airtable.net.server import IN_USE, GameServer
 
 needs_link = pytest.mark.skipif(linkshaper.isolation_problem() is not None, reason=str(linkshaper.isolation_problem()))
 
@@ -300,7 +300,7 @@ def test_a_seat_still_heard_from_is_not_taken_over_the_newcomer_asks_again(monke
             if refusal is not None:
                 break
         assert refusal is not None and refusal.get("retry") is True, refusal
-        assert refusal["error"] == "C1 Ann is playing in another window; close one (this one asks again by itself)"
+        assert refusal["error"] == IN_USE.format("C1 Ann")
         assert server.player_names() == ["C1 Ann"]  # hers still, on her connection
         for client in (ann, again):
             client.close()

@@ -17,6 +17,7 @@ from conftest import WAIT_S, wait_until
 from test_player import cleanup, player, start_table  # noqa: F401  (fixtures)
 
 from airtable.net.seat_memory import MAX_TABLES, SeatMemory
+from airtable.net.server import IN_USE
 
 CLIENT = "import sys; from airtable.client_cli import main; sys.exit(main(sys.argv[1:]))"
 
@@ -104,9 +105,43 @@ def test_two_live_windows_of_one_student_do_not_take_the_seat_from_each_other(cl
     assert first.connect().label == "C1 Маша"
     second = player(cleanup, server.port, name="Маша", seat_memory=SeatMemory(memory))
     assert second.connect() is None  # not welcomed: waiting
-    assert second.waiting_because == "C1 Маша is playing in another window; close one (this one asks again by itself)"
+    assert second.waiting_because == IN_USE.format("C1 Маша")
     wait_until(lambda: second.next_try > 0.0, what="the second window to plan its next try")
     assert first.state == first.CONNECTED and first.reconnects == 0 and server.player_names() == ["C1 Маша"]
     first.close()  # the first window closes (BYE): the seat is free
     wait_until(lambda: second.state == second.CONNECTED, what="the second window in")
     assert second.welcome.label == "C1 Маша" and server.player_names() == ["C1 Маша"]
+
+
+def test_a_student_whose_seat_went_to_another_comes_back_in_a_new_one(cleanup, tmp_path):  # noqa: F811
+    """A user test: Zed left (Esc Esc), Quinn joined and got his seat, and Zed started again was told "C1 Quinn
+    is playing in another window" for as long as he waited. A kept token proves a seat only while it is the
+    token's student's: Zed is a newcomer, in the next free seat; Quinn keeps hers."""
+    server, _ = start_table(cleanup)
+    memory = tmp_path / "seats.json"
+    zed = player(cleanup, server.port, name="Zed", seat_memory=SeatMemory(memory))
+    assert zed.connect().label == "C1 Zed"
+    zed.close()  # a goodbye: the seat is given up, not held
+    wait_until(lambda: server.player_names() == [], what="Zed's seat given up")
+    quinn = player(cleanup, server.port, name="Quinn")
+    assert quinn.connect().label == "C1 Quinn"
+    again = player(cleanup, server.port, name="Zed", seat_memory=SeatMemory(memory))
+    welcome = again.connect()
+    assert welcome is not None and welcome.label == "C2 Zed", again.waiting_because
+    assert sorted(server.player_names()) == ["C1 Quinn", "C2 Zed"] and quinn.reconnects == 0
+
+
+def test_a_seat_held_for_one_student_is_not_given_to_another_who_once_had_it(cleanup, tmp_path):  # noqa: F811
+    """The same with Quinn dropped (her seat held for her return): Zed's old token for it does not take it."""
+    server, _ = start_table(cleanup, seat_hold_s=1000.0)
+    memory = tmp_path / "seats.json"
+    zed = player(cleanup, server.port, name="Zed", seat_memory=SeatMemory(memory))
+    assert zed.connect().label == "C1 Zed"
+    zed.close()
+    wait_until(lambda: server.player_names() == [], what="Zed's seat given up")
+    quinn = player(cleanup, server.port, name="Quinn", seat_memory=SeatMemory(tmp_path / "quinn.json"))
+    assert quinn.connect().label == "C1 Quinn"
+    quinn.close(bye=False)  # her Wi-Fi: no goodbye, the seat is held for her
+    wait_until(lambda: server.player_names() == [], what="Quinn's drop noticed")
+    again = player(cleanup, server.port, name="Zed", seat_memory=SeatMemory(memory))
+    assert again.connect().label == "C2 Zed"

@@ -86,6 +86,12 @@ NOTICE_S = 60.0  # the projector shows why students were turned away for this lo
 # windows of one student on one computer (a token they shared: seat_memory.py) took it from each other
 # twice a second, without end (a user test).
 IN_USE_S = 2.5
+# What the newcomer is told meanwhile ({}: the seat's label and name, "C1 Ann"): a second window of the same
+# student, or someone else of that name on the same computer (one seat memory; a user test).
+IN_USE = (
+    "{} is playing in another window; close one, or join with another --name if that is not you"
+    " (this one asks again by itself)"
+)
 
 
 def client_color(number: int) -> tuple[int, int, int]:
@@ -295,6 +301,9 @@ class GameServer:
         """What only the network thread touches, and the sockets it will open in start()."""
         self._conns: dict[int, Connection] = {}
         self._numbers: dict[int, int] = {}  # player number -> cid
+        # Seat number -> the name it was last given to (HELLO's, "" for none): a token proves a seat only
+        # while it is that student's (a student back after their seat went to another was told to wait for ever).
+        self._owners: dict[int, str] = {}
         self._quiet = QuietLog(log)
         self._sent_seq = 0
         self._turns = pacing.RoundRobin()
@@ -841,11 +850,16 @@ class GameServer:
             conn.proven_seat = hello.seat
         self._welcome(conn, hello, now)
 
-    def _claimed_seat(self, conn: Connection, hello: proto.Hello) -> int | None:
-        """The seat this client proved it holds: by a PROOF, or (older clients) by its token in clear."""
-        if conn.proven_seat is not None:
-            return conn.proven_seat
-        return self._tokens.seat(hello.token, hello.name or "")
+    def _claimed_seat(self, conn: Connection, hello: proto.Hello, now: float) -> int | None:
+        """The seat this client proved it holds: by a PROOF, or (older clients) by its token in clear; None
+        if it has none, or if that seat has since been given to someone else who has it now (playing or
+        held for their return): then this client is a newcomer."""
+        number = conn.proven_seat
+        if number is None:
+            number = self._tokens.seat(hello.token, hello.name or "")
+        if number is None or not (number in self._numbers or self._held.is_held(number, now)):
+            return number  # (a free seat: its own again)
+        return number if self._owners.get(number) == (hello.name or "") else None
 
     def _predict(self, conn: Connection, payload: bytes) -> None:
         """A guess in the prediction round: checked, then kept in the book (never the physics).
@@ -888,6 +902,7 @@ class GameServer:
         self._gate.handshake_ended(conn.host, seated=True)
         conn.number, conn.name, conn.state = number, name, State.PLAYING
         self._numbers[number] = conn.cid
+        self._owners[number] = hello.name or ""
         with self._lock:
             self._names[number] = name
         self._events.join(conn.cid, name, color, number)
@@ -922,13 +937,12 @@ class GameServer:
         """A student back with their seat's token, while their old connection still holds it (it has
         not noticed the drop yet): the old one is closed at once, so the seat is free for the new one.
         False (the newcomer told to ask again) while the old one is still heard from (IN_USE_S)."""
-        number = self._claimed_seat(conn, hello)
+        number = self._claimed_seat(conn, hello, now)
         stale = self._conns.get(self._numbers.get(number, -1)) if number is not None else None
         if stale is None:
             return True
         if now - stale.last_rx < IN_USE_S:
-            sentence = f"{stale.name} is playing in another window; close one (this one asks again by itself)"
-            self._fail(conn, sentence, retry=True)
+            self._fail(conn, IN_USE.format(stale.name), retry=True)
             return False
         self._log_seat(stale, "%s is back on a new connection; the old one is closed", stale.who)
         stale.keep_seat = False
@@ -942,7 +956,7 @@ class GameServer:
         else the lowest seat neither taken nor held for someone who dropped. None: the table is full."""
         if len(self._numbers) >= self.max_clients:
             return None
-        number = self._claimed_seat(conn, hello)
+        number = self._claimed_seat(conn, hello, now)
         if number is not None and number <= MAX_PLAYERS and number not in self._numbers:
             self._held.give_back(number)
             return number

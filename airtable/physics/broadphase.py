@@ -256,10 +256,14 @@ class Partners:
         order = _argsort_cells(rows, n)  # rows are cell numbers of a kind: the same radix sort
         self._others = np.concatenate([j, i]).take(order)
         self._starts = [0, *np.cumsum(np.bincount(rows, minlength=n)).tolist()]  # where each row's partners begin
+        self._of: dict[int, list[int]] = {}  # those asked for (the pi demo asks for its two pucks' 30000 times a step)
 
     def of(self, k: int) -> list[int]:
-        """Puck k's partners, in increasing order (however the pairs were found)."""
-        return sorted(self._others[self._starts[k] : self._starts[k + 1]].tolist())
+        """Puck k's partners, in increasing order (however the pairs were found). Not to be changed."""
+        out = self._of.get(k)
+        if out is None:
+            out = self._of[k] = sorted(self._others[self._starts[k] : self._starts[k + 1]].tolist())
+        return out
 
 
 class NeighbourList:
