@@ -262,7 +262,9 @@ def test_demo_5_without_damping_keeps_its_energy(demos):
     expected = omega * app.dt_s / 2
     wiggle = (total.max() - total.min()) / (2 * total.mean())
     assert 0.5 * expected < wiggle < 1.5 * expected
-    assert "does not drift" in app.aids.chart.euler_wiggle_note(app.table)  # explained under the chart
+    assert "does not drift" in app.aids.chart.euler_wiggle_note(
+        app.table.spring_pairs.size > 0, aids.loses_energy(app.table)
+    )  # explained under the chart
 
 
 @pytest.mark.parametrize("key, mode", [("1p", "off"), ("2p", "two-step"), ("3p", "perfect-kiss")])
@@ -478,20 +480,24 @@ def test_demo_5_motion_matches_its_notes(demos):
     assert np.hypot(*(a.pos_m - b.pos_m)) == pytest.approx(1.5, abs=0.02)  # relaxed: no more bouncing
     moved = app.table.center_of_mass_m() - start
     np.testing.assert_allclose(moved / app.table.time_s, (0.2, 0.1), atol=1e-6)  # still drifting
-    assert app.aids.chart.euler_wiggle_note(app.table) is None  # no "swings without drifting" claim here
+    assert (
+        app.aids.chart.euler_wiggle_note(app.table.spring_pairs.size > 0, aids.loses_energy(app.table)) is None
+    )  # no "swings without drifting" claim here
     # No damper (Right): the bouncing goes on and the total swings by about 3 % (omega dt / 2).
     press(app, pygame.K_RIGHT)
     assert "no damper" in app.window.caption
     for _ in range(3 * 60):
         app.frame(FRAME_S)
     assert 0.03 < app.aids.chart.total_wiggle(2.0) < 0.04
-    assert "does not drift" in app.aids.chart.euler_wiggle_note(app.table)
+    assert "does not drift" in app.aids.chart.euler_wiggle_note(
+        app.table.spring_pairs.size > 0, aids.loses_energy(app.table)
+    )
     # The same swing where something loses energy is not explained away as the integrator's.
     app.table.cr_wall = 0.7  # a landing jelly: its total falls at each bounce
-    assert app.aids.chart.euler_wiggle_note(app.table) is None
+    assert app.aids.chart.euler_wiggle_note(app.table.spring_pairs.size > 0, aids.loses_energy(app.table)) is None
     app.table.cr_wall = 1.0
     app.table.spring_damper_Nspm[:] = 0.1
-    assert app.aids.chart.euler_wiggle_note(app.table) is None
+    assert app.aids.chart.euler_wiggle_note(app.table.spring_pairs.size > 0, aids.loses_energy(app.table)) is None
 
 
 @pytest.mark.parametrize("key", ["4", "7", "8"])

@@ -19,7 +19,7 @@ from airtable.app.aids_paint import CHART_COLORS
 from airtable.app.app import App
 from airtable.app.demo_loader import Demo
 from airtable.app.window import TEXT_COLOR
-from airtable.model.aids import CHART_WINDOW_S
+from airtable.model.aids import CHART_WINDOW_S, loses_energy
 from airtable.model.client import LOCAL_COLOR
 from airtable.net.server import GameServer
 
@@ -131,7 +131,7 @@ def test_the_charts_note_keeps_off_its_key(demos, size):
     app = App(demos, demo_key="5", variation=1, headless=True, window_size_px=size)
     pygame.event.clear()
     press(app, pygame.K_c, frames=150)
-    assert app.aids.chart.euler_wiggle_note(app.table) is not None
+    assert app.aids.chart.euler_wiggle_note(app.table.spring_pairs.size > 0, loses_energy(app.table)) is not None
     box, texts = app.painter.chart_rect(), app.painter.chart_text
     assert len(texts) > 5 + 3  # the key, the axes and at least a line of the note
     assert all(box.contains(rect) for rect in texts), (box, texts)

@@ -13,6 +13,7 @@ from conftest import FRAME_S, press
 
 from airtable.app import panel_view
 from airtable.app.app import App
+from airtable.model.aids import loses_energy
 
 # Keys that open, close or change what is drawn over the table (the key table's rows: F1 help,
 # F2-F5 roster pages, Tab menu, l notes, F6 prediction, d/t/k lessons, e/a/v/c/m/b aids, s stats).
@@ -63,7 +64,7 @@ def test_the_energy_chart_with_its_note_draws_in_a_strip(demos, size):
     app = App(demos, demo_key="5", variation=1, headless=True)
     pygame.event.clear()
     press(app, pygame.K_c, frames=150)
-    assert app.aids.chart.euler_wiggle_note(app.table) is not None
+    assert app.aids.chart.euler_wiggle_note(app.table.spring_pairs.size > 0, loses_energy(app.table)) is not None
     resize(app, size)
     for _ in range(3):
         app.frame(FRAME_S)

@@ -145,6 +145,22 @@ def test_chart_samples_append_and_notes_come_once():
     assert series["total_J"][-1] == pytest.approx(1.5)
 
 
+def test_a_students_chart_explains_a_springs_swinging_total():
+    """A user test: on the spring demo every student's window failed each frame ("'Scene' object has no
+    attribute 'spring_damper_Nspm'"): the chart's note asked the snapshot for the table's dampers."""
+    enc, viewer, student = AidsEncoder(), AidsViewer(), _Student()
+    for seq in range(1, 301):  # 10 s of a total swinging by 1 % about 1.5 J, no drift (at 30 samples a second)
+        t = seq / 30
+        total = 1.5 * (1.0 + 0.01 * np.sin(2.0 * np.pi * 7.5 * t))  # (the wiggle: twice the spring's frequency)
+        enc.publish(enc.prepare(SharedAids(chart=(t, total - 0.5, 0.5, 0.0, total, 0.25)), seq))
+        student.state.take(student.aids.feed(_payload(enc, viewer), seq, 3, t), 0.0)
+    springs = _scene()
+    springs.spring_pairs = np.array([[0, 1]])
+    _, _, note = student.state.chart_view(springs)
+    assert note is not None and "does not drift" in note
+    assert student.state.chart_view(_scene())[2] is None  # no springs: nothing to explain
+
+
 def test_a_student_gets_the_charts_last_seconds_once_and_again_after_it_was_off():
     enc, viewer, student = AidsEncoder(), AidsViewer(), _Student()
     past = np.array([[t, 1.0, 0.5, 0.0, 1.5, 0.25] for t in (0.1, 0.2, 0.3)])

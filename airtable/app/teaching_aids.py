@@ -70,7 +70,8 @@ class Aids(Feature):
         paint.note_pucks(t.pos_m, t.radius_m)  # the legend and the annotations keep clear of them
         if self.show_chart:  # first: the labels below then find their places around it
             paint.choose_chart_corner(host.env.to_screen(t.pos_m))
-            paint.energy_chart(self.chart.series(), self.chart.latest(), self.chart.euler_wiggle_note(t))
+            note = self.chart.euler_wiggle_note(t.spring_pairs.size > 0, aids.loses_energy(t))
+            paint.energy_chart(self.chart.series(), self.chart.latest(), note)
         if self.vectors and len(t.pos_m):  # before the annotations: its legend has a fixed place
             held = host.local.held
             held = held if held is not None and held.alive else None

@@ -96,7 +96,8 @@ class StudentAids:
     def chart_view(self, scene) -> tuple[dict, dict, str | None]:
         """(series, latest, note) of the chart, read while the network thread is not appending."""
         with self._lock:
-            return self.chart.series(), self.chart.latest(), self.chart.euler_wiggle_note(scene)
+            springs = len(scene.spring_pairs) > 0
+            return self.chart.series(), self.chart.latest(), self.chart.euler_wiggle_note(springs, lossy=False)
 
     def momenta_view(self, colors: np.ndarray) -> tuple[int, MomentaView | None] | None:
         """(corner, diagram) while the teacher shows the momenta diagram, else None; the rows drawn in
