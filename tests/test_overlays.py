@@ -206,6 +206,25 @@ def test_mashing_esc_clears_the_screen_and_asks_but_never_quits(demos):
     assert not app.running
 
 
+def test_esc_pressed_at_a_steady_half_second_beat_never_quits(demos):
+    """A user test: five overlays open, Esc pressed six times half a second apart: the fifth asked, the
+    sixth quit the lesson (one of the five closed something the teacher did not see go). Closing things
+    one by one at any beat up to a second's never answers the question it ends on."""
+    app = App(demos, demo_key="1", headless=True, window_size_px=(1280, 720))
+    pygame.event.clear()
+    for key in (pygame.K_c, pygame.K_d, pygame.K_t, pygame.K_l, pygame.K_F1):
+        press(app, key)
+    for beat_s in (0.5, 0.9):
+        for _ in range(10):
+            press(app, pygame.K_ESCAPE)
+            for _ in range(round(beat_s / FRAME_S)):
+                app.frame(FRAME_S)
+            assert app.running
+        assert app.panels.panel() == "quit"
+    escape_again(app)  # a person who read the question answers it
+    assert not app.running
+
+
 def test_esc_ends_a_prediction_round_before_it_asks_to_quit(demos):
     """A round is under way over the table (F6): Esc ends it, as it closes an overlay (asking first while the
     students guess: Esc again); the next Esc asks to quit."""

@@ -113,7 +113,9 @@ class OverlayValue:
         owner.overlays.set(self.name, bool(value))
 
 
-ESC_PAUSE_S = 0.3  # an Esc this soon after the last one is part of a burst (a double tap is slower)
+# An Esc this soon after the last one is part of a run of them, each closing the next thing: at 0.3 s, Escs half
+# a second apart closed five overlays, asked, and quit the lesson (a user test). Reading the question takes longer.
+ESC_PAUSE_S = 1.0
 
 
 class EscapeBurst:
