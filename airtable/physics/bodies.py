@@ -89,6 +89,12 @@ class Puck:
     def mass_kg(self) -> float:
         return float(self._table.mass_kg[self.index])
 
+    @mass_kg.setter
+    def mass_kg(self, value: float) -> None:
+        """A new mass (kg), the radius and the velocity kept (a user test expected it to be settable)."""
+        self._table.mass_kg[self.index] = positive(value, "mass_kg")
+        self._table.touch(self.index)
+
     @property
     def color(self) -> tuple[int, int, int]:
         return tuple(int(c) for c in self._table.color_rgb[self.index])

@@ -53,19 +53,35 @@ def non_negative(value, what: str) -> float:
     return v
 
 
+def restitution(value, what: str) -> float:
+    v = float(value)
+    if not 0.0 <= v <= 1.0:  # (False for NaN: it failed deep in the first hit, a user test)
+        raise ValueError(f"{what} must be a number from 0 (no bounce) to 1 (elastic), not {value!r}")
+    return v
+
+
+def finite(value, what: str) -> float:
+    v = float(value)
+    if not math.isfinite(v):
+        raise ValueError(f"{what} must be a finite number, not {value!r}")
+    return v
+
+
 def _correction_mode(mode: str) -> str:
     if mode not in CORRECTION_MODES:
         raise ValueError(f"puck_correction must be one of {', '.join(CORRECTION_MODES)}, not {mode!r}")
     return mode
 
 
-def _marking(name: str, check: Callable | None = None) -> property:
-    """A setting whose setter marks the table `changed` (sleepers depend on it: sleep.py); kept in `_name`."""
+def _marking(name: str, check: Callable | None = None, marks: bool = True) -> property:
+    """A setting whose setter checks it and marks the table `changed` (sleepers depend on it: sleep.py;
+    `marks` False: nothing sleeping does); kept in `_name`."""
     private = "_" + name
 
     def set_(self, value) -> None:
         setattr(self, private, value if check is None else check(value))
-        self.changed = True
+        if marks:
+            self.changed = True
 
     return property(operator.attrgetter(private), set_)  # (attrgetter: the step reads these often)
 
@@ -207,11 +223,15 @@ class Storage:
     # ------------------------------------------------------------ settings that wake every sleeper
 
     gravity_on = _marking("gravity_on")
-    gravity_mps2 = _marking("gravity_mps2")
+    gravity_mps2 = _marking("gravity_mps2", lambda v: finite(v, "gravity_mps2"))  # (below 0: falls upward)
     width_m = _marking("width_m", lambda v: positive(v, "width_m"))
     height_m = _marking("height_m", lambda v: positive(v, "height_m"))
     puck_correction = _marking("puck_correction", _correction_mode)
     puck_collisions = _marking("puck_collisions")
+    # Checked, not marking: a bounce's restitution or the rest speed changes nothing for a sleeper.
+    cr_puck = _marking("cr_puck", lambda v: restitution(v, "cr_puck"), marks=False)
+    cr_wall = _marking("cr_wall", lambda v: restitution(v, "cr_wall"), marks=False)
+    rest_speed_mps = _marking("rest_speed_mps", lambda v: non_negative(v, "rest_speed_mps"), marks=False)
 
     @property
     def size_m(self) -> np.ndarray:
