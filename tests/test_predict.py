@@ -505,3 +505,15 @@ def test_a_reveal_over_a_still_table_settles_at_once_and_a_drop_from_rest_still_
     press(app, pygame.K_F6)
     frames_until(app, lambda: app.predict.round.settled, "the reveal to settle", max_frames=int(9.0 / FRAME_S))
     assert (app.table.time_s < 0.1) is (not gravity)  # at once when still; played out when they fall
+
+
+@pytest.mark.parametrize("demo", ["7", "9"])
+def test_a_reveal_opened_before_the_demos_throw_plays_the_throw(demos, demo):
+    """A user test: 9 F6 ... F6 froze again at t = 0.18 s with no collision ("puck 14: comes to rest"): the
+    table was still because the demo's throw (a timed event at 1 s) had not come yet."""
+    app = App(demos, demo_key=demo, headless=True)
+    press(app, pygame.K_F6)
+    assert app.table.time_s < 1.0 and app.table.timed.next_s() == pytest.approx(1.0)
+    press(app, pygame.K_F6)
+    frames_until(app, lambda: app.predict.round.settled, "the reveal to settle", max_frames=int(10.0 / FRAME_S))
+    assert app.table.time_s > 1.0 and app.table.collision_count > 0

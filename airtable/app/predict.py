@@ -103,6 +103,7 @@ class PredictRound:
         self._hits = 0
         self._last_hit_s = 0.0
         self._started_s = 0.0
+        self._quiet_until_s = 0.0
         self._seen_collision = False
 
     @property
@@ -127,6 +128,8 @@ class PredictRound:
         self.state, self.dragging = "revealed", None
         self._hits, self._started_s = table.collision_count, table.time_s
         self._last_hit_s, self._seen_collision = table.time_s, False
+        throw = table.timed.next_s()  # a demo's throw to come (see collision_over); inf: none
+        self._quiet_until_s = throw if math.isfinite(throw) else table.time_s
 
     def close(self) -> None:
         self.state, self.dragging = "closed", None
@@ -136,9 +139,11 @@ class PredictRound:
         if table.collision_count != self._hits:
             self._hits, self._last_hit_s, self._seen_collision = table.collision_count, table.time_s, True
         quiet = table.time_s - self._last_hit_s >= SETTLE_S
-        # A table still a step after the reveal has no collision to come (a user test: "playing until the
-        # collision is over" for 8 s over pucks at rest).
-        still = table.time_s > self._started_s and not np.any(np.abs(table.vel_mps) >= STILL_MPS)
+        # A table still a step after the reveal, and after the demo's next timed event (its throw), has no
+        # collision to come (user tests: "playing until the collision is over" for 8 s over pucks at rest;
+        # opened before demo 9's throw, the reveal froze before it, at t = 0.18 s).
+        started = table.time_s > max(self._started_s, self._quiet_until_s)
+        still = started and not np.any(np.abs(table.vel_mps) >= STILL_MPS)
         return (self._seen_collision and quiet) or still or table.time_s - self._started_s >= TIMEOUT_S
 
     def settle(self, table) -> None:

@@ -138,6 +138,10 @@ class Schedule:
             return heapq.heappop(self._heap)[2]
         return None
 
+    def next_s(self) -> float:
+        """When the earliest event is due (inf: none is)."""
+        return self._heap[0][0] if self._heap else math.inf
+
     def clear(self) -> None:
         self._heap = []
 
