@@ -110,7 +110,7 @@ def test_a_puck_resting_on_the_floor_converges_at_once() -> None:
     solver = contacts.ContactSolver()
     rest = everywhere(1, 2 * 9.8 / 240)
     assert solver.solve(pos, vel, radius, mass, np.array([1.0, 1.0]), (none, none, np.empty(0)), rest, 1 / 240)
-    assert solver.count == 1 and solver.iterations == 2 < contacts.ITERATIONS
+    assert solver.count == 1 and solver.iterations <= 2 < contacts.ITERATIONS
     assert vel[0, 1] == 0.0 and vel[0, 0] == 0.0
     assert pos[0, 1] == pytest.approx(0.1, abs=1e-15)  # back where it rests, and no overlap to push out
 

@@ -120,7 +120,7 @@ def test_every_table_attribute_is_captured():
         assert part or name in table.NOT_SAVED or isinstance(value, PLAIN_TYPES), name
     state = capture(table)
     values = dict(zip(state.names, state.values, strict=True))
-    for name in ("_gravity_on", "_gravity_mps2", "cr_puck", "cr_wall", "wall_correction", "_puck_correction"):
+    for name in ("_gravity_on", "_gravity_mps2", "_cr_puck", "_cr_wall", "wall_correction", "_puck_correction"):
         assert name in values
     for name in ("time_s", "steps", "collision_count", "spring_dt_s", "_puck_collisions", "_width_m", "changed"):
         assert name in values

@@ -59,7 +59,7 @@ from typing import NamedTuple
 
 import numpy as np
 
-from airtable.physics import collision, colouring, vectors
+from airtable.physics import collapse, collision, colouring, vectors
 
 # Iterations over all contacts per step (Box2D and pymunk use about ten);
 # the loop stops early once an iteration changes no velocity by CONVERGED_MPS.
@@ -71,6 +71,11 @@ ITERATIONS = 10
 # pile settling has 1000 to 2000 awake ones: more iterations there cost more than they show).
 ITERATION_WORK = 8_000
 MAX_ITERATIONS = 200
+# Up to this many contacts (a stack, a slab, a few pucks landing) are solved exactly, at once
+# (collapse.impulses: the complementarity problem by active sets), not by sequential impulses, whose
+# chains converge as slowly as the masses along them differ: a stack with masses 1 to 1e5 upward,
+# dropped at restitution 0, crushed its bottom pucks into each other and jumped up (a user test).
+EXACT_MAX = 24
 CONVERGED_MPS = 1e-7
 # The first iteration's rounds go bottom-up by horizontal bands this many
 # radii high (a contact after its pucks' contacts of lower bands): support from
@@ -318,27 +323,48 @@ class ContactSolver:
         inv = np.append(1.0 / mass, 0.0)  # the walls never move, nor do sleepers
         if asleep is not None:
             inv[:-1][asleep] = 0.0
-        first, later = self._gather(c, inv, dt, asleep)
         w = np.zeros((len(pos) + 1, 2), dtype=complex)  # velocities and pseudo-velocities; the last row: walls
         w[:-1, 0] = vectors.as_complex(np.ascontiguousarray(vel))
         v0 = w[:-1, 0].copy()
-        w[:-1, 0] += _warm_push(c, mass, self._warm, asleep)  # warm start: last step's velocity impulses first
-        self.iterations, layout = _iterate(w, first, later)
-        self._keep(c, layout)
+        if self.count <= EXACT_MAX:
+            impulses = self._solve_exactly(c, inv, w, dt)
+        else:
+            first, later = self._gather(c, inv, dt, asleep)
+            w[:-1, 0] += _warm_push(c, mass, self._warm, asleep)  # warm start: last step's velocity impulses first
+            self.iterations, layout = _iterate(w, first, later)
+            impulses = layout.impulses()
+        self._keep(c, impulses)
         moved = (w[:-1, 0] - v0 + w[:-1, 1]) * dt
         pos += np.column_stack([moved.real, moved.imag])
         vel[:, 0], vel[:, 1] = w[:-1, 0].real, w[:-1, 0].imag
         return True
 
+    def _solve_exactly(self, c: _Contacts, inv: np.ndarray, w: np.ndarray, dt: float) -> np.ndarray:
+        """A few contacts (EXACT_MAX) solved at once, exactly (collapse.impulses), velocities and
+        pseudo-velocities in `w` in place; returns their impulses (m, 2), contact by contact."""
+        m, rows = len(c.a), self._rows
+        bodies, local = np.unique(np.concatenate([c.a, c.b]), return_inverse=True)  # (the bodies these touch)
+        a, b = local[:m], np.where(c.b == rows, -1, local[m:])  # (collapse's wall: -1)
+        target = _targets(c, dt)
+        vn = (c.n.conjugate() * (w.take(c.a, axis=0)[:, 0] - w.take(c.b, axis=0)[:, 0])).real
+        impulses = columns(
+            collapse.impulses(c.n, vn - target[:, 0], a, b, inv.take(bodies)),  # vn after: at least the bound
+            collapse.impulses(c.n, -target[:, 1], a, b, inv.take(bodies)),  # the pseudo-velocity: from 0
+        )
+        for col in (0, 1):
+            push = impulses[:, col] * c.n
+            np.add.at(w[:, col], c.a, push * inv.take(c.a))
+            np.add.at(w[:, col], c.b, -push * inv.take(c.b))  # (the walls' row: inv 0)
+        self._key_order = np.argsort(c.keys)
+        self._layouts = None  # (the rounds start afresh when the contacts are many again)
+        self._band_rounds = self._free_rounds = np.empty(0, dtype=np.intp)
+        self.iterations = 1
+        return impulses
+
     def _gather(self, c: _Contacts, inv, dt: float, asleep=None) -> tuple[_Layout, _Layout]:
         """This step's targets, inverse masses (inv, with the walls' 0 last) and warm-start impulses,
         filled into the layouts of the rounds of the first iteration and of the later ones."""
-        # The gaps where the step began: the velocity bound keeps a pair from closing more
-        # than its gap, and the pseudo-velocity pushes out a share of its overlap.
-        target = columns(
-            -np.maximum(c.gap, 0.0) / dt,
-            np.minimum(POSITION_FRACTION * np.maximum(-c.gap - SLOP_M, 0.0) / dt, MAX_PUSH_MPS),
-        )
+        target = _targets(c, dt)
         impulse = np.zeros((len(c.keys), 2))  # pseudo-velocities start from nothing each step
         self._warm = impulse[:, 0]
         cached = self._layouts
@@ -430,9 +456,8 @@ class ContactSolver:
         y = self._y.take(c.a.take(korder))
         return np.minimum((y - y.min()) / (BAND_RADII * self._r_mean), 30_000).astype(np.int16)
 
-    def _keep(self, c: _Contacts, layout: _Layout) -> None:
-        """Keep this step's impulses by contact key, for the next step's warm start."""
-        impulses = layout.impulses()
+    def _keep(self, c: _Contacts, impulses: np.ndarray) -> None:
+        """Keep this step's impulses ((m, 2), contact by contact) by contact key, for the next step's warm start."""
         order = self._key_order
         self._keys, self._impulses = c.keys.take(order), impulses.take(order, axis=0)
         # The pucks pressed on a wall, and the wall's axis (normal 1 or -1: x; 1j or -1j: y), for wall_rest.
@@ -613,6 +638,16 @@ class _Layout:
         self.w_min = float(w_round.min())
         np.take(impulse, order, axis=0, out=self.impulse, mode="clip")
         return self
+
+
+def _targets(c: _Contacts, dt: float) -> np.ndarray:
+    """(m, 2) each contact's least relative normal velocity after the stage, and its pseudo-velocity:
+    from the gaps where the step began, the velocity bound keeps a pair from closing more than its gap,
+    and the pseudo-velocity pushes out a share of its overlap."""
+    return columns(
+        -np.maximum(c.gap, 0.0) / dt,
+        np.minimum(POSITION_FRACTION * np.maximum(-c.gap - SLOP_M, 0.0) / dt, MAX_PUSH_MPS),
+    )
 
 
 def columns(first: np.ndarray, second: np.ndarray) -> np.ndarray:
