@@ -329,15 +329,19 @@ class ContactSolver:
         if self.count <= EXACT_MAX:
             impulses = self._solve_exactly(c, inv, w, dt)
         else:
-            first, later = self._gather(c, inv, dt, asleep)
-            w[:-1, 0] += _warm_push(c, mass, self._warm, asleep)  # warm start: last step's velocity impulses first
-            self.iterations, layout = _iterate(w, first, later)
-            impulses = layout.impulses()
+            impulses = self._solve_iteratively(c, inv, w, dt, mass, asleep)
         self._keep(c, impulses)
         moved = (w[:-1, 0] - v0 + w[:-1, 1]) * dt
         pos += np.column_stack([moved.real, moved.imag])
         vel[:, 0], vel[:, 1] = w[:-1, 0].real, w[:-1, 0].imag
         return True
+
+    def _solve_iteratively(self, c: _Contacts, inv, w: np.ndarray, dt: float, mass, asleep) -> np.ndarray:
+        """Sequential impulses in coloured rounds, warm-started, on `w` in place; returns the impulses (m, 2)."""
+        first, later = self._gather(c, inv, dt, asleep)
+        w[:-1, 0] += _warm_push(c, mass, self._warm, asleep)  # warm start: last step's velocity impulses first
+        self.iterations, layout = _iterate(w, first, later)
+        return layout.impulses()
 
     def _solve_exactly(self, c: _Contacts, inv: np.ndarray, w: np.ndarray, dt: float) -> np.ndarray:
         """A few contacts (EXACT_MAX) solved at once, exactly (collapse.impulses), velocities and
