@@ -107,6 +107,9 @@ CHAIN_FRACTION = 1.0
 # this ratio: its correction moves each puck its mass share of it, and a puck much lighter than its partner
 # moves nearly all of it, into its next neighbour (a light puck between heavy ones was pushed through one).
 LIKE_MASSES = 2.0
+# A push along n counts as into a wall (off_a_pinned) only where n leans into it by more than this (the cosine):
+# two pucks side by side on the floor, one 1e-17 m lower by round-off, made a level hit a bounce off the floor.
+INTO_WALL = 1e-9
 # A puck whose path changed has its hits with up to this many partners predicted one by one in
 # Python numbers (a few microseconds each), with more at once in numpy (some sixty calls whatever
 # their number): the same lines either way (either.py), the same bits.
@@ -756,7 +759,7 @@ class _Step:
         if wall is None:
             wall, held = self.held_on_wall(a, b, n), True
         towards = vectors.dot(vb, n)
-        if wall is None or vectors.dot(n, wall) >= 0.0 or not towards > 0.0:
+        if wall is None or vectors.dot(n, wall) >= -INTO_WALL or not towards > 0.0:
             return ()  # (b does not push a into the wall: a, sliding along it into b, hits it as any puck)
         e = self.rules.cr_wall
         if held:
@@ -783,7 +786,7 @@ class _Step:
             return None
         x = self.at(a, self.t_now)
         for axis in (0, 1):
-            if rest.item(a, axis) == math.inf and vectors.dot(n, normal := self.wall_normal(x, axis)) < 0.0:
+            if rest.item(a, axis) == math.inf and vectors.dot(n, normal := self.wall_normal(x, axis)) < -INTO_WALL:
                 return normal
         return None
 
