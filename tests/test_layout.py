@@ -40,6 +40,16 @@ def puck_rects(app) -> list[pygame.Rect]:
     return [pygame.Rect(int(x - q), int(y - q), int(2 * q), int(2 * q)) for (x, y), q in zip(centers, r)]
 
 
+def drawn_after_keys(demos, server, size, demo: str, keys) -> App:
+    """The teacher's app on `demo` in a window of `size`, `keys` pressed in turn, one frame drawn."""
+    app = App(demos, demo_key=demo, headless=True, server=server, window_size_px=size)
+    pygame.event.clear()
+    for key in keys:
+        press(app, key)
+    app.frame(FRAME_S)
+    return app
+
+
 def crossings(app, boxes) -> list[tuple]:
     """Each text box that crosses a wall line or a puck, with what it crosses."""
     keep_clear = [("wall", r) for r in app.window.wall_rects()] + [("puck", r) for r in puck_rects(app)]
@@ -147,11 +157,7 @@ def test_the_reveal_summary_stays_off_the_table(demos, server, size):
 @pytest.mark.parametrize("size", SIZES, ids=lambda s: f"{s[0]}x{s[1]}")
 def test_the_velocity_legend_keeps_off_the_momenta_panel(demos, server, size):
     # User test at 640x480, demo 8 paused with the momenta diagram (d) on: the legend lay over its title.
-    app = App(demos, demo_key="8", headless=True, server=server, window_size_px=size)
-    pygame.event.clear()
-    for key in (pygame.K_SPACE, pygame.K_v, pygame.K_d):
-        press(app, key)
-    app.frame(FRAME_S)
+    app = drawn_after_keys(demos, server, size, "8", (pygame.K_SPACE, pygame.K_v, pygame.K_d))
     boxes = app.window.label_boxes
     overlaps = [
         (a, b)
@@ -166,11 +172,7 @@ def test_the_velocity_legend_keeps_off_the_momenta_panel(demos, server, size):
 def test_nothing_peeks_out_from_under_a_panel(demos, server, size):
     # User tests: in fullscreen at 1920x1080 the chart's edge showed beside the roster (F2); at 640x480 the
     # values panel's and the chart's edges did. The join line in the left margin or the top band stays in view.
-    app = App(demos, demo_key="1", headless=True, server=server, window_size_px=size)
-    pygame.event.clear()
-    for key in (pygame.K_c, pygame.K_t, pygame.K_F2):
-        press(app, key)
-    app.frame(FRAME_S)
+    app = drawn_after_keys(demos, server, size, "1", (pygame.K_c, pygame.K_t, pygame.K_F2))
     window, painter = app.window, app.painter
     panel = window.panel_rect()
     assert panel.left >= window.layout.side_px and panel.top >= window.layout.top_px
