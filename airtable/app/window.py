@@ -544,13 +544,11 @@ class GameWindow:
         status bar. Sideways a panel reaches the window's edges: the chart, the values and the momenta
         in the right margin or at the table's edges are covered whole, none peeks out from under it
         (a user test saw the chart's edge beside the roster in fullscreen, and the values' at 640x480)."""
-        w, h = self.surface.get_size()
         pad = self.font.get_height() // 2
         top = max(pad, self.layout.top_px + pad // 2, self.corner_bottom_px + pad // 2)
-        bottom = self.status_top_px
         left = self.layout.side_px  # (0: no margins)
-        right = w
-        return pygame.Rect(left, top, right - left, max(4 * self.font.get_linesize(), bottom - top))
+        height = max(4 * self.font.get_linesize(), self.status_top_px - top)
+        return pygame.Rect(left, top, self.surface.get_width() - left, height)
 
     def draw_question(self, title: str, lines: Sequence[str]) -> pygame.Rect:
         """A short question in an opaque box just big enough for it, in the middle of the window."""

@@ -36,7 +36,12 @@ def impulses(n: np.ndarray, vn: np.ndarray, a: np.ndarray, b: np.ndarray, inv_ma
 
     inv_mass: 1 / mass of each body (kg^-1), indexed by a and b.
     """
-    m = len(vn)
+    return solve(response(n, a, b, inv_mass), vn)
+
+
+def response(n: np.ndarray, a: np.ndarray, b: np.ndarray, inv_mass: np.ndarray) -> np.ndarray:
+    """(m, m) how each contact's relative normal velocity changes per unit impulse of each (see impulses)."""
+    m = len(n)
     jac = np.zeros((m, 2 * len(inv_mass)))  # each contact's normal on body a, minus it on body b
     rows = np.arange(m)
     jac[rows, 2 * a], jac[rows, 2 * a + 1] = n.real, n.imag
@@ -44,7 +49,12 @@ def impulses(n: np.ndarray, vn: np.ndarray, a: np.ndarray, b: np.ndarray, inv_ma
     on_b = np.where(wall, 0, b)
     jac[rows, 2 * on_b] -= np.where(wall, 0.0, n.real)
     jac[rows, 2 * on_b + 1] -= np.where(wall, 0.0, n.imag)
-    a_mat = (jac * np.repeat(inv_mass, 2)) @ jac.T  # relative normal velocity change per unit impulse
+    return (jac * np.repeat(inv_mass, 2)) @ jac.T
+
+
+def solve(a_mat: np.ndarray, vn: np.ndarray) -> np.ndarray:
+    """The impulses p >= 0 with vn + a_mat p >= 0 and p (vn + a_mat p) = 0 (see impulses; a_mat: response)."""
+    m = len(vn)
     tol = 1e-12 * (float(np.abs(vn).max()) + 1e-300)
     active, p = vn < 0.0, np.zeros(m)
     for _ in range(TRIES):  # block pivoting: every contact that pulls lets go, every one that closes pushes

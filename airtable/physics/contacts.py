@@ -72,7 +72,7 @@ ITERATIONS = 10
 ITERATION_WORK = 8_000
 MAX_ITERATIONS = 200
 # Up to this many contacts (a stack, a slab, a few pucks landing) are solved exactly, at once
-# (collapse.impulses: the complementarity problem by active sets), not by sequential impulses, whose
+# (collapse.solve: the complementarity problem by active sets), not by sequential impulses, whose
 # chains converge as slowly as the masses along them differ: a stack with masses 1 to 1e5 upward,
 # dropped at restitution 0, crushed its bottom pucks into each other and jumped up (a user test).
 EXACT_MAX = 24
@@ -344,16 +344,17 @@ class ContactSolver:
         return layout.impulses()
 
     def _solve_exactly(self, c: _Contacts, inv: np.ndarray, w: np.ndarray, dt: float) -> np.ndarray:
-        """A few contacts (EXACT_MAX) solved at once, exactly (collapse.impulses), velocities and
+        """A few contacts (EXACT_MAX) solved at once, exactly (collapse.solve), velocities and
         pseudo-velocities in `w` in place; returns their impulses (m, 2), contact by contact."""
         m, rows = len(c.a), self._rows
         bodies, local = np.unique(np.concatenate([c.a, c.b]), return_inverse=True)  # (the bodies these touch)
         a, b = local[:m], np.where(c.b == rows, -1, local[m:])  # (collapse's wall: -1)
         target = _targets(c, dt)
         vn = (c.n.conjugate() * (w.take(c.a, axis=0)[:, 0] - w.take(c.b, axis=0)[:, 0])).real
+        response = collapse.response(c.n, a, b, inv.take(bodies))  # (one matrix for both problems)
         impulses = columns(
-            collapse.impulses(c.n, vn - target[:, 0], a, b, inv.take(bodies)),  # vn after: at least the bound
-            collapse.impulses(c.n, -target[:, 1], a, b, inv.take(bodies)),  # the pseudo-velocity: from 0
+            collapse.solve(response, vn - target[:, 0]),  # vn after: at least the bound
+            collapse.solve(response, -target[:, 1]),  # the pseudo-velocity: from 0
         )
         for col in (0, 1):
             push = impulses[:, col] * c.n
