@@ -187,3 +187,19 @@ def test_the_view_note_says_the_zoom_and_when_the_table_is_out_of_sight() -> Non
     env.reset()
     env.pan((10, 0))  # panned a little, zoom 1: still a moved view
     assert env.view_note() == "zoom x1"
+
+
+def test_the_view_note_says_when_no_puck_is_in_sight() -> None:
+    """A user test: zoomed x200 between the pucks the window was black, and the note said only the zoom."""
+    env = Environment(width_m=10.0, height_m=8.7556)
+    pos, radius = np.array([[2.0, 2.0], [7.0, 6.0]]), np.array([0.3, 0.5])
+    env.zoom_about(env.to_screen((4.5, 4.0)), 200.0)  # 2 m from the nearest edge of a puck
+    assert env.view_note(pos, radius) == "zoom x200, no puck in sight"
+    env.reset()
+    env.zoom_about(env.to_screen((2.35, 2.0)), 200.0)  # 5 cm right of a puck's edge: the window is 4.5 cm wide
+    half_width_m = 0.5 * env.size_px[0] / env.px_per_m
+    assert half_width_m < 0.05
+    assert env.view_note(pos, radius) == "zoom x200, no puck in sight"
+    env.zoom_about(env.to_screen((2.35, 2.0)), 0.1)  # x20: the window is 45 cm wide, the edge 5 cm away
+    assert env.view_note(pos, radius) == "zoom x20"
+    assert env.view_note(np.empty((0, 2)), np.empty(0)) == "zoom x20, no puck in sight"

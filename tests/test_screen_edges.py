@@ -306,3 +306,25 @@ def test_cursors_at_one_spot_keep_their_names_apart(demos, size):
         boxes = app.window.cursor_boxes
         assert len(boxes) == 3 and all(app.window.surface.get_rect().contains(b) for b in boxes), (tip, boxes)
         assert not any(a.colliderect(b) for k, a in enumerate(boxes) for b in boxes[k + 1 :]), (tip, boxes)
+
+
+@pytest.mark.parametrize("size", SIZES, ids=lambda s: f"{s[0]}x{s[1]}")
+def test_zoomed_in_on_nothing_the_status_line_says_how_to_get_back(demos, size):
+    """A user test: wheeled x200 in between the pucks of demo 4 the window was black, and the status line
+    said "zoom x200" only: the way back, a hint in brackets, was the first thing a narrow bar left out."""
+    app = app_at(size, demos, "4")
+    app.paused = True
+    pos = app.table.pos_m
+    # Between the two pucks nearest the table's middle: the wheel zooms about the mouse.
+    middle = np.array([0.5 * app.table.width_m, 0.5 * app.table.height_m])
+    a, b = np.argsort(np.hypot(*(pos - middle).T))[:2]
+    mouse = tuple(int(v) for v in app.env.to_screen(0.5 * (pos[a] + pos[b])))
+    pygame.event.post(pygame.event.Event(pygame.MOUSEMOTION, pos=mouse, rel=(0, 0), buttons=(0, 0, 0)))
+    for _ in range(60):  # 1.1^60 = 304: the zoom stops at its most, x200
+        pygame.event.post(pygame.event.Event(pygame.MOUSEWHEEL, x=0, y=1, flipped=False, precise_x=0.0, precise_y=1.0))
+    app.frame(FRAME_S)
+    assert app.env.zoom == 200.0
+    texts = [text for text, _ in app.window.status_boxes]
+    assert texts[0] == "zoom x200, no puck in sight: q shows the whole table"
+    press(app, pygame.K_q)
+    assert app.env.zoom == 1.0 and app.env.view_note(pos, app.table.radius_m) == ""

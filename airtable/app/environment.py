@@ -114,9 +114,10 @@ class Environment:
         width, height = self.width_m * self.fit_px_per_m, self.height_m * self.fit_px_per_m
         return (self.offset_px[0], self.size_px[1] - self.offset_px[1] - height, width, height)
 
-    def view_note(self) -> str:
+    def view_note(self, pos_m: np.ndarray | None = None, radius_m: np.ndarray | None = None) -> str:
         """What the status line says of the view: "" for the whole table; else how far it is zoomed, and
-        whether the table is out of sight (zoomed in on empty space the window is plain black)."""
+        whether the table, or (given the pucks) every puck, is out of sight: zoomed in on empty space the
+        window is plain black, and a teacher at x200 saw nothing to tell where the pucks had gone."""
         if self.zoom == 1.0 and not self.origin_m.any():
             return ""
         corners = self.to_screen(np.array([[0.0, 0.0], [self.width_m, self.height_m]]))
@@ -124,7 +125,16 @@ class Environment:
         w, h = self.size_px
         if x1 < 0 or x0 > w or y1 < 0 or y0 > h:
             return f"zoom x{self.zoom:.3g}, the table is out of sight"
+        if pos_m is not None and radius_m is not None and not self.any_in_sight(pos_m, radius_m):
+            return f"zoom x{self.zoom:.3g}, no puck in sight"
         return f"zoom x{self.zoom:.3g}"
+
+    def any_in_sight(self, pos_m: np.ndarray, radius_m: np.ndarray) -> bool:
+        """Whether any puck (centres pos_m, radii radius_m) shows in the window, at least in part."""
+        (left, top), (right, bottom) = self.to_world(np.array([[0.0, 0.0], [*self.size_px]], dtype=float))
+        x, y = pos_m[:, 0], pos_m[:, 1]
+        near = (x + radius_m >= left) & (x - radius_m <= right) & (y + radius_m >= bottom) & (y - radius_m <= top)
+        return bool(near.any())
 
     # ------------------------------------------------------------ transform
 
