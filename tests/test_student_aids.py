@@ -376,3 +376,45 @@ def test_numbers_off_the_wire_that_are_no_physics_are_refused_without_a_warning(
         warnings.simplefilter("error")
         with pytest.raises(ProtocolError, match="chart history samples that are not finite numbers"):
             aids_wire._numbers(Reader(data, "aids"), (1, 6), "chart history samples")
+
+
+def test_a_student_pages_through_the_help_and_the_notes_in_a_small_window(classroom):
+    """A user test: in a small student window the help and the teacher's notes ended "a larger window shows
+    the rest", F1 again closed the help, and nothing hid the notes but the teacher. Now F1 and L turn the
+    pages, L after the last page (or Esc) hides the notes on this window alone, and L shows them again."""
+    teacher, net = classroom
+    teacher.aids.trails, teacher.panels.show_notes = False, True
+    student = PlayerApp(net, headless=True)
+    L, ESC, F1 = pygame.K_l, pygame.K_ESCAPE, pygame.K_F1
+    keys: list[int] = []
+    seen = []  # after each key, once drawn: (key, help shown, its page, notes shown, their page)
+    last = []  # the key last pressed and the frame it was pressed in
+
+    def step():
+        teacher.frame(FRAME_S)
+        if student.frames == 3:
+            pygame.event.post(pygame.event.Event(pygame.VIDEORESIZE, size=(320, 240), w=320, h=240))
+        if last and student.frames > last[1] + 1:  # a frame has drawn what the key did
+            key = last[0]
+            last.clear()
+            seen.append((key, student.show_help, student.help_page, student._notes_shown(), student.notes_page))
+            if key == F1 and not student.show_help:
+                return True  # the help closed after its last page
+        if not keys and not seen and student.frames > 10 and student.notes_pages > 1:
+            keys.extend([L] * student.notes_pages + [L, ESC] + [F1] * 20)
+        if keys and not last:
+            key = keys.pop(0)
+            post_key(key)
+            post_key(key, down=False)
+            last.extend([key, student.frames])
+        return False
+
+    assert student.run(seconds=30, until=step) == 0
+    help_pages, notes_pages = student.help_pages, student.notes_pages
+    assert student.window.surface.get_size() == (320, 240) and help_pages > 1 and notes_pages > 1
+    assert teacher.panels.show_notes, "the student's keys are the student's window's alone"
+    expected = [(L, False, 0, True, k) for k in range(1, notes_pages)] + [(L, False, 0, False, 0)]
+    expected += [(L, False, 0, True, 0), (ESC, False, 0, False, 0)]
+    expected += [(F1, True, k, False, 0) for k in range(help_pages)] + [(F1, False, 0, False, 0)]
+    assert seen == expected
+    assert student.leave_asked_until < 0, "Esc hid the notes: it did not ask to leave"

@@ -170,6 +170,15 @@ def body_rect(size_px: tuple[int, int], font, title_font, small_font) -> pygame.
     return pygame.Rect(pad, top, size_px[0] - 2 * pad, size_px[1] - top - small_font.get_linesize() - pad // 2)
 
 
+def next_page(shown: bool, page: int, pages: int) -> tuple[bool, int]:
+    """(shown, page) after the key that turns a text's pages: a text not shown opens at its first page,
+    one shown goes to its next page, and after its last it closes (back at the first)."""
+    if not shown:
+        return True, 0
+    following = page + 1
+    return (True, following) if following < pages else (False, 0)
+
+
 def page_note(page: int, pages: int, page_key: str | None) -> str:
     """The note under page `page` (from 0) of `pages`: which key turns them (None: none does, as in the menu,
     which scrolls, or an error, which Esc hides)."""

@@ -16,6 +16,7 @@ from typing import TYPE_CHECKING
 
 import pygame
 
+from airtable.app import panel_view
 from airtable.app.controls import MODIFIER_KEYS
 from airtable.app.demo_loader import has_own_key, key_label, key_order
 from airtable.app.feature import Binding, Feature
@@ -154,14 +155,9 @@ class Panels(Feature):
     def _turn_page(self, panel: str) -> None:
         """Open `panel` ("help" or "notes") at its first page, or show its next page, or close it after its last."""
         page = f"{panel}_page"
-        if not getattr(self, f"show_{panel}"):
-            setattr(self, f"show_{panel}", True)
-            setattr(self, page, 0)
-            return
-        following = getattr(self, page) + 1
-        more = following < getattr(self, f"{panel}_pages")
-        setattr(self, f"show_{panel}", more)
-        setattr(self, page, following if more else 0)
+        shown, at = panel_view.next_page(getattr(self, f"show_{panel}"), getattr(self, page), getattr(self, f"{page}s"))
+        setattr(self, f"show_{panel}", shown)
+        setattr(self, page, at)
 
     # ------------------------------------------------------------ drawing
 

@@ -28,9 +28,10 @@ STUDENT_KEYS = (
     ("i", "inspect the puck under your cursor, on or off"),
     ("e", "trails on your window, on or off"),
     ("k", "puck numbers on your window (as the teacher's summaries count them), on or off"),
-    ("F1", "this help (again: close it)"),
+    ("L", "the teacher's notes, while shown: their next page; after the last, hidden here (L shows them again)"),
+    ("F1", "this help (again: its next page, then close it)"),
     ("F11", "fullscreen on / off"),
-    ("Esc", "close this help; else leave the table (Esc twice)"),
+    ("Esc", "close this help or the notes; else leave the table (Esc twice)"),
 )
 
 

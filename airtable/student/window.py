@@ -19,6 +19,7 @@ import numpy as np
 from airtable.app.controls import by_position
 from airtable.app.loop import IdlingLoop, signals_end_the_run
 from airtable.app.overlays import EscapeBurst
+from airtable.app.panel_view import next_page
 from airtable.app.predict import StudentGuesses
 from airtable.app.predict_view import paint_round
 from airtable.app.pucks_view import draw_numbers
@@ -61,7 +62,12 @@ class PlayerApp:
         self.draw_error: str | None = None  # the first drawing error, reported once
         self.button = 0
         self.keys: set[str] = set()
-        self.show_help = False  # F1: the keys of this window
+        self.show_help = False  # F1: the keys of this window, on pages in a small one
+        self.help_page, self.help_pages = 0, 1
+        # The teacher's notes, while the teacher shows them: on pages in a small window (L turns them), and
+        # hidden on this window after the last page, till L again or the teacher's next notes.
+        self.show_notes, self.notes_page, self.notes_pages = True, 0, 1
+        self._notes: str | None = None  # the notes last shown, to start new ones at their first page
         self.leave_asked_until = -math.inf  # time.monotonic() until which a second Esc leaves
         self._escapes = EscapeBurst()
         self.ended: str | None = None  # why the session ended for good, shown until a key is pressed
@@ -212,7 +218,7 @@ class PlayerApp:
     def _answer_leave(self, escape: bool) -> bool:
         """A key while the window may be asking whether to leave; False to leave now.
 
-        Esc closes the help if it is open, else asks; Esc again while asked leaves.
+        Esc closes the help or the teacher's notes if open, else asks; Esc again while asked leaves.
         Any other key while asked: stay."""
         asked, now = self.leave_asked_until > time.monotonic(), time.monotonic()
         self.leave_asked_until = -math.inf
@@ -220,7 +226,9 @@ class PlayerApp:
             return True
         deliberate = self._escapes.deliberate(now)  # a burst of Escs does not answer (overlays.py)
         if self.show_help:
-            self.show_help = False
+            self.show_help, self.help_page = False, 0
+        elif self._notes_shown():
+            self.show_notes, self.notes_page = False, 0
         elif asked and deliberate:
             return False
         else:
@@ -233,7 +241,9 @@ class PlayerApp:
 
         name = pygame.key.name(key)
         if name == "f1":
-            self.show_help = not self.show_help
+            self.show_help, self.help_page = next_page(self.show_help, self.help_page, self.help_pages)
+        elif name == "l" and self._notes is not None:
+            self.show_notes, self.notes_page = next_page(self._notes_shown(), self.notes_page, self.notes_pages)
         elif name in LOCAL_KEYS:
             self.net.aids.toggle(name)
             if name == "e":
@@ -332,10 +342,21 @@ class PlayerApp:
         elif self.leave_asked_until > time.monotonic():
             win.draw_question("Leave the table?", [LEAVE_QUESTION])
         elif self.show_help:
-            win.draw_panel("Keys", list(STUDENT_KEYS))
-        elif net.aids.teacher & NOTES and net.aids.notes is not None:
-            win.draw_panel(scene.title, [net.aids.notes], large=True)
+            self.help_pages = win.draw_panel("Keys", list(STUDENT_KEYS), page=self.help_page, page_key="F1")
+        elif self._notes_shown():
+            self.notes_pages = win.draw_panel(
+                scene.title, [net.aids.notes], large=True, page=self.notes_page, page_key="L"
+            )
         win.present()
+
+    def _notes_shown(self) -> bool:
+        """Whether this window shows the teacher's notes: while the teacher shows them, unless the student
+        hid them (L after their last page, or Esc); new notes show again, at their first page."""
+        aids = self.net.aids
+        notes = aids.notes if aids.teacher & NOTES else None
+        if notes != self._notes:
+            self._notes, self.show_notes, self.notes_page = notes, True, 0
+        return notes is not None and self.show_notes
 
     def _view_hint(self, scene: Scene) -> tuple[str, ...]:
         """A line when the teacher's view shows none of the table (zoomed or panned away)."""
