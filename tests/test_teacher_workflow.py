@@ -280,6 +280,18 @@ def test_the_demo_menu_lists_every_demo_and_starts_the_one_picked(tmp_path):
     assert app.panels.panel() is None
 
 
+def test_f1_in_the_demo_menu_shows_the_help_over_it(tmp_path):
+    """A user test: F1 did nothing while the menu was open (the menu took every key)."""
+    (tmp_path / "demo_t1.py").write_text(demo_source("t1", pucks=1))
+    app = make_app(tmp_path)
+    press(app, pygame.K_TAB)
+    press(app, pygame.K_t, unicode="t")
+    press(app, pygame.K_F1)
+    assert app.panels.panel() == "help" and app.panels.menu.typed == "t"
+    press(app, pygame.K_ESCAPE)  # the help goes; the menu is as it was
+    assert app.panels.panel() == "menu" and app.panels.menu.typed == "t" and app.running
+
+
 # ---------------------------------------------------------------- errors reach the terminal
 
 

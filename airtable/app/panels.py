@@ -88,6 +88,8 @@ class Panels(Feature):
             return False  # the question says "x exports it": x stays, and exports
         if panel == "quit" and getattr(event, "mod", 0) & pygame.KMOD_CTRL and event.key in (pygame.K_q, pygame.K_w):
             return False  # Ctrl+Q again, as Esc again: it quits
+        if panel == "menu" and event.key == pygame.K_F1:
+            return False  # help over the menu (Esc closes it, and the menu is still there)
         if panel == "menu" and event.key == pygame.K_TAB:
             self.menu = None
         elif panel == "menu":
