@@ -97,6 +97,14 @@ def test_the_students_port_is_given_once_in_either_form(argv, problem, capsys) -
     assert capsys.readouterr().err == f"airtable-client: {problem}\n"
 
 
+@pytest.mark.parametrize("name", ["", " "])
+def test_an_empty_name_says_to_give_one_or_leave_it_out(name, capsys) -> None:
+    """A user test: --name "" was refused as "the name is empty" where leaving --name out joins by seat."""
+    assert client_cli.main(["10.0.0.5", "--name", name, "--headless"]) == 2
+    said = "--name is empty: give a name, like --name Ann, or leave --name out to join by seat"
+    assert capsys.readouterr().err == f"airtable-client: {said}\n"
+
+
 @pytest.mark.parametrize(("main", "usage"), [(cli.main, "python -m airtable"), (client_cli.main, "airtable-client")])
 def test_help_prints_the_usage_and_every_option_and_exits_0(main, usage, capsys) -> None:
     with pytest.raises(SystemExit) as exited:

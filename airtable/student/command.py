@@ -57,6 +57,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     args = _parse_args(argv)
     try:
         host, port = _address(args.server, args.port)
+        if args.name is not None and not args.name.strip():  # (a script's unset $NAME, most likely)
+            raise ValueError("--name is empty: give a name, like --name Ann, or leave --name out to join by seat")
         name = None if args.name is None else proto.check_name(args.name)
         if args.seconds is not None and not (math.isfinite(args.seconds) and args.seconds >= 0):
             raise ValueError("--seconds must be zero or a positive number")
