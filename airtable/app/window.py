@@ -27,7 +27,7 @@ from airtable.app.aids_paint import AidsPainter  # noqa: F401  (imported from he
 from airtable.app.environment import Environment, fitting_size_px
 from airtable.app.hud_view import HudLine, HudStyle, TextLayout, draw_hud, fit_parts, fitting_parts, text_layout
 from airtable.app.lessons_paint import LessonsPainter  # noqa: F401  (imported from here by the student's window)
-from airtable.app.pucks_view import COLORKEY, MIN_PUCK_RADIUS_PX, PuckSprites, draw_pucks
+from airtable.app.pucks_view import COLORKEY, PuckSprites, draw_pucks, radii_px
 from airtable.app.timeline_paint import TimelinePainter  # noqa: F401  (imported from here by the student's window)
 from airtable.assets import ASSETS_DIR
 from airtable.model.scene import STATUS_SEPARATOR, Scene
@@ -406,8 +406,7 @@ class GameWindow:
         if len(scene.pos_m) == 0:
             return
         centers = self.env.to_screen(scene.pos_m)
-        # Clipped before the cast, so a zoom of any size stays a sane integer.
-        r_px = np.clip(np.rint(self.env.length_to_px(scene.radius_m)), MIN_PUCK_RADIUS_PX, 1 << 20).astype(np.int64)
+        r_px = radii_px(self.env.length_to_px(scene.radius_m), scene.color_rgb, target.get_size())
         draw_pucks(target, self.sprites, centers, r_px, scene.color_rgb)
 
     def _draw_springs(self, scene: Scene) -> None:
