@@ -23,8 +23,9 @@ if TYPE_CHECKING:
 # Said once (in `notices`) when springs are first solved implicitly (beyond what substeps.py takes).
 IMPLICIT_NOTICE = (
     f"Some springs vibrate faster than even {substeps.MAX_SUBSTEPS} substeps of a step can follow: the step"
-    " solves them implicitly, so they hold and sag as their k says, but their vibrations are damped away,"
-    " the fastest at once and the slow ones too, a little each period."
+    " solves them implicitly, so they hold and sag as their k says, but their vibrations die away, the fastest"
+    " within a step or two and the slowest by a fifth or more of their swing each period. A shorter step,"
+    " softer springs or heavier pucks keep them ringing."
 )
 # Passes that add walls to the implicit solve (see _brace_walls).
 BRACE_PASSES = 4

@@ -54,8 +54,10 @@ from airtable.physics.events import FAST_FRACTION
 # pucks then has omega h = sqrt(2 k h^2 / m) <= 0.5, and semi-implicit Euler's
 # period, 2 pi / omega times (omega h / 2) / asin(omega h / 2), is within 1.1 %.
 SUBSTEP_STIFFNESS = 0.125
-# At most this many substeps a step (a 5 x 5 lattice 100 times beyond the explicit limit needs 20).
-MAX_SUBSTEPS = 32
+# At most this many substeps a step: a 5 x 5 lattice 100 times beyond the explicit limit needs 20, a chain
+# 1000 times beyond it 64 (at 32 its slowest mode, 1.3 steps a period at dt 1/30, kept an eighth of its
+# swing a period in the implicit step). A substep costs 50-80 us on a small table: 64 of them 3-5 ms.
+MAX_SUBSTEPS = 64
 
 
 def count(mass: np.ndarray, a: np.ndarray, b: np.ndarray, k: np.ndarray, dt_s: float) -> int:
