@@ -225,12 +225,12 @@ class PlayerApp:
         if not escape:
             return True
         deliberate = self._escapes.deliberate(now)  # a burst of Escs does not answer (overlays.py)
+        if asked and deliberate:  # (first: the question covers the notes the teacher may have shown since)
+            return False
         if self.show_help:
             self.show_help, self.help_page = False, 0
         elif self._notes_shown():
             self.show_notes, self.notes_page = False, 0
-        elif asked and deliberate:
-            return False
         else:
             self.leave_asked_until = now + LEAVE_CONFIRM_S
         return True
