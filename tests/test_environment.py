@@ -179,14 +179,14 @@ def test_window_size_from_the_command_line() -> None:
 def test_the_view_note_says_the_zoom_and_when_the_table_is_out_of_sight() -> None:
     """A user test: zoomed in on empty space the window was plain black, with no hint of the zoom."""
     env = Environment(width_m=10.0, height_m=8.7556)
-    assert env.view_note() == ""
+    assert env.view_note()[0] == ""
     env.zoom_about((450, 394), 4.0)  # about the window's middle: the table fills it
-    assert env.view_note() == "zoom x4"
+    assert env.view_note()[0] == "zoom x4"
     env.pan((5000, 0))  # 5000 px to the right: the table's left edge is past the window's right
-    assert env.view_note() == "zoom x4, the table is out of sight"
+    assert env.view_note()[0] == "zoom x4, the table is out of sight"
     env.reset()
     env.pan((10, 0))  # panned a little, zoom 1: still a moved view
-    assert env.view_note() == "zoom x1"
+    assert env.view_note()[0] == "zoom x1"
 
 
 def test_the_view_note_says_when_no_puck_is_in_sight() -> None:
@@ -194,12 +194,12 @@ def test_the_view_note_says_when_no_puck_is_in_sight() -> None:
     env = Environment(width_m=10.0, height_m=8.7556)
     pos, radius = np.array([[2.0, 2.0], [7.0, 6.0]]), np.array([0.3, 0.5])
     env.zoom_about(env.to_screen((4.5, 4.0)), 200.0)  # 2 m from the nearest edge of a puck
-    assert env.view_note(pos, radius) == "zoom x200, no puck in sight"
+    assert env.view_note(pos, radius)[0] == "zoom x200, no puck in sight"
     env.reset()
     env.zoom_about(env.to_screen((2.35, 2.0)), 200.0)  # 5 cm right of a puck's edge: the window is 4.5 cm wide
     half_width_m = 0.5 * env.size_px[0] / env.px_per_m
     assert half_width_m < 0.05
-    assert env.view_note(pos, radius) == "zoom x200, no puck in sight"
+    assert env.view_note(pos, radius)[0] == "zoom x200, no puck in sight"
     env.zoom_about(env.to_screen((2.35, 2.0)), 0.1)  # x20: the window is 45 cm wide, the edge 5 cm away
-    assert env.view_note(pos, radius) == "zoom x20"
-    assert env.view_note(np.empty((0, 2)), np.empty(0)) == "zoom x20, no puck in sight"
+    assert env.view_note(pos, radius)[0] == "zoom x20"
+    assert env.view_note(np.empty((0, 2)), np.empty(0))[0] == "zoom x20, no puck in sight"

@@ -327,4 +327,4 @@ def test_zoomed_in_on_nothing_the_status_line_says_how_to_get_back(demos, size):
     texts = [text for text, _ in app.window.status_boxes]
     assert texts[0] == "zoom x200, no puck in sight: q shows the whole table"
     press(app, pygame.K_q)
-    assert app.env.zoom == 1.0 and app.env.view_note(pos, app.table.radius_m) == ""
+    assert app.env.zoom == 1.0 and app.env.view_note(pos, app.table.radius_m)[0] == ""

@@ -575,9 +575,9 @@ class App:
         parts = ["PAUSED"] if self.paused else []
         for feature in self.features:
             parts.extend(feature.status_parts(for_students))  # hands off, the floor, the round, rewound
-        view = self.env.view_note(t.pos_m, t.radius_m)
-        if view.endswith("sight"):  # (zoomed far in, the window is black: say so, and how to get back,
-            parts.append(view if for_students else f"{view}: q shows the whole table")  # never cut as a hint)
+        view, blank = self.env.view_note(t.pos_m, t.radius_m)
+        if blank:  # (zoomed far in, the window is black: say so, and how to get back, never cut as a hint)
+            parts.append(view if for_students else f"{view}: q shows the whole table")
         elif view:
             parts.append(view if for_students else f"{view} (q: the whole table)")
         if self.speed != 1.0:

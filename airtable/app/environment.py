@@ -114,20 +114,22 @@ class Environment:
         width, height = self.width_m * self.fit_px_per_m, self.height_m * self.fit_px_per_m
         return (self.offset_px[0], self.size_px[1] - self.offset_px[1] - height, width, height)
 
-    def view_note(self, pos_m: np.ndarray | None = None, radius_m: np.ndarray | None = None) -> str:
-        """What the status line says of the view: "" for the whole table; else how far it is zoomed, and
-        whether the table, or (given the pucks) every puck, is out of sight: zoomed in on empty space the
-        window is plain black, and a teacher at x200 saw nothing to tell where the pucks had gone."""
+    def view_note(self, pos_m: np.ndarray | None = None, radius_m: np.ndarray | None = None) -> tuple[str, bool]:
+        """(What the status line says of the view, whether the window shows nothing): "" for the whole table;
+        else how far it is zoomed, and whether the table, or (given the pucks) every puck, is out of sight:
+        zoomed in on empty space the window is plain black, and a teacher at x200 saw nothing to tell where
+        the pucks had gone."""
         if self.zoom == 1.0 and not self.origin_m.any():
-            return ""
+            return "", False
+        zoom = f"zoom x{self.zoom:.3g}"
         corners = self.to_screen(np.array([[0.0, 0.0], [self.width_m, self.height_m]]))
         (x0, y1), (x1, y0) = corners
         w, h = self.size_px
         if x1 < 0 or x0 > w or y1 < 0 or y0 > h:
-            return f"zoom x{self.zoom:.3g}, the table is out of sight"
+            return f"{zoom}, the table is out of sight", True
         if pos_m is not None and radius_m is not None and not self.any_in_sight(pos_m, radius_m):
-            return f"zoom x{self.zoom:.3g}, no puck in sight"
-        return f"zoom x{self.zoom:.3g}"
+            return f"{zoom}, no puck in sight", True
+        return zoom, False
 
     def any_in_sight(self, pos_m: np.ndarray, radius_m: np.ndarray) -> bool:
         """Whether any puck (centres pos_m, radii radius_m) shows in the window, at least in part."""
