@@ -684,7 +684,7 @@ def test_a_handshake_that_says_nothing_is_dropped_after_its_deadline(make_server
     kind, payload = c.next_frame()
     sentence, retry = proto.parse_error_message(payload)
     # A HELLO lost on the way looks the same: an airtable client tries again, never ends its session.
-    assert kind == proto.ERROR and "no HELLO came within 0.1 s" in sentence and retry
+    assert kind == proto.ERROR and "your hello did not reach the table within 0.1 s" in sentence and retry
     c.close()
     wait_until(lambda: server.connection_count == 0, what="the silent handshake to be gone")
 

@@ -123,8 +123,10 @@ class NetPlayer:
     """The network side of a player: handshake, newest snapshot, input, reconnect.
 
     `connect()` makes the first connection (raising PlayerError with a sentence
-    when it fails for good) and starts a reader thread. When the table is full
-    it returns None and the thread keeps asking, with backoff (state WAITING).
+    when it fails for good: a wrong password, another version) and starts a reader
+    thread. When the first try fails in a way trying again can mend (refused, no
+    answer, the table full) it returns None and the thread keeps asking, with
+    backoff (state RETRYING, or WAITING when the server asked to wait).
     From then on `state` (a PlayerState) is CONNECTED, RETRYING (the server went
     away; it reconnects with backoff), WAITING or FAILED (`error` says why);
     `close()` ends it. `on_snapshot(scene, t)` is called from the reader thread
@@ -244,13 +246,12 @@ class NetPlayer:
         try:
             opened = self._open()
         except _ConnectError as e:
-            if not (e.full or e.slow):
+            if not e.retry:
                 self.state, self.error = PlayerState.FAILED, str(e)
                 raise PlayerError(str(e)) from None
-            if e.full:
-                self._wait_for_place(str(e), self.full_backoff_s)
-            else:
-                self._slow_link(str(e))
+            # Refused, unanswered, hung up: the window opens, says why and asks again (a user test: a
+            # student who started before the teacher's table got no window, only a line and exit 1).
+            self._not_joined_yet(e, self.first_backoff_s)
             opened = None
         if opened is not None:
             self._adopt(opened[0], opened[1])
@@ -514,13 +515,19 @@ class NetPlayer:
                     self.state, self.error = PlayerState.FAILED, str(e)
                     return None
                 backoff = min(backoff * 2, self.max_backoff_s)
-                if e.full:
-                    self._wait_for_place(str(e), max(backoff, self.full_backoff_s))
-                else:
-                    if e.slow:
-                        self._slow_link(str(e))
-                    self.next_try = time.monotonic() + backoff
+                self._not_joined_yet(e, backoff)
         return None
+
+    def _not_joined_yet(self, e: _ConnectError, backoff_s: float) -> None:
+        """An attempt failed in a way trying again can mend: wait, and say why where the window shows it."""
+        if e.full:
+            self._wait_for_place(str(e), max(backoff_s, self.full_backoff_s))
+            return
+        if e.slow:
+            self._slow_link(str(e))
+        elif self.welcome is None:  # never at the table: say why (once there, "reconnecting" says it)
+            self.waiting_because, self.state = f"{e}; trying again", PlayerState.RETRYING
+        self.next_try = time.monotonic() + backoff_s
 
     # ---------------------------------------------------------------- the game side
 

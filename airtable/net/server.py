@@ -1070,8 +1070,8 @@ class GameServer:
             )
         else:
             sentence = (
-                f"no HELLO came within {self.hello_timeout_s:g} s of connecting (lost on the way?); "
-                "airtable-client tries again by itself, other programs cannot join"
+                f"your hello did not reach the table within {self.hello_timeout_s:g} s of connecting (lost on "
+                "the way? a slow network?); airtable-client asks again by itself"
             )
         self._fail(conn, sentence, retry=True, quiet=True)
 

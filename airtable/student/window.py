@@ -28,7 +28,7 @@ from airtable.model.scene import CursorView, Scene
 from airtable.model.shared_aids import NOTES
 from airtable.model.student_aids import LOCAL_KEYS
 from airtable.net import protocol as proto
-from airtable.net.player import NetPlayer, PlayerState, empty_scene
+from airtable.net.player import TABLE_CLOSED, NetPlayer, PlayerState, empty_scene
 
 # Once nothing has moved on the table (pucks, cursors) and this window had no input for
 # IDLE_AFTER_S, it draws IDLE_FPS frames a second instead of its full rate, waking at once on
@@ -43,9 +43,18 @@ MAX_PUCK_LOOKS = 1024
 MAX_SPRING_SPAN_PX = 20_000_000
 
 
-def joined_sentence(address: str, welcome: proto.Welcome) -> str:
-    """What the terminal says once a student is at the table (at the start, after a wait, or back)."""
+def joined_sentence(address: str, welcome: proto.Welcome, back: bool = False) -> str:
+    """What the terminal says once a student is at the table (at the start, after a wait, or `back`)."""
+    if back:
+        return f"airtable-client: back at the table at {address}; you are {welcome.label}"
     return f"airtable-client: connected to {address}; you are {welcome.label}"
+
+
+def lost_sentence(address: str, closed: bool) -> str:
+    """What the terminal says when a student's connection ends and the client tries again."""
+    if closed:
+        return f"airtable-client: the teacher closed the table at {address}; waiting for it to open again"
+    return f"airtable-client: lost the connection to {address}; reconnecting (your seat is kept)"
 
 
 class PlayerApp:
@@ -77,6 +86,7 @@ class PlayerApp:
         self.timeline_painter = None  # the TimelinePainter, likewise
         self._drawn_from: tuple = ()  # the restarts and view the trails were drawn in
         self._welcome: proto.Welcome | None = None
+        self._last_state: PlayerState | None = None  # the connection's state at the last frame
         self.predicting = StudentGuesses()  # our arrows in a prediction round
         self._motion: tuple = ()  # what moves, as the last frame showed it (see note_motion)
         self._moved_s = -math.inf  # when it last changed
@@ -279,15 +289,23 @@ class PlayerApp:
             self.net.send_predict(*guessed)
         return guessed is not None
 
+    def _say_when_lost(self) -> None:
+        """A connection that ended is said on the terminal too (a user test: it said only "connected" again
+        on the way back), once each time."""
+        state = self.net.state
+        if state is PlayerState.RETRYING and self._last_state is PlayerState.CONNECTED:
+            print(lost_sentence(self.net.address, self.net.waiting_because == TABLE_CLOSED), flush=True)
+        self._last_state = state
+
     def _follow_welcome(self) -> None:
         """After a (re)connect: the new name in the caption, the new table size in the view."""
         welcome = self.net.welcome
         if welcome is None or welcome is self._welcome:
             return
         old_width = self._table_size()[0]
-        self._welcome = welcome
+        back, self._welcome = self._welcome is not None, welcome
         # The terminal's last word was a wait or a retry (a user test: joined, and it never said so).
-        print(joined_sentence(self.net.address, welcome), flush=True)
+        print(joined_sentence(self.net.address, welcome, back), flush=True)
         self.window.set_caption(self._caption())
         if welcome.width_m != old_width:  # the teacher restarted with another table
             self.window.set_env(self._new_env())
@@ -298,6 +316,7 @@ class PlayerApp:
         from airtable.app.environment import MAX_ZOOM, MIN_ZOOM
 
         net, env = self.net, self.env
+        self._say_when_lost()
         self._follow_welcome()
         scene = net.smooth() or empty_scene(*self._table_size())
         # The teacher's view: the student sees what the projector shows.
