@@ -182,6 +182,24 @@ def test_nothing_peeks_out_from_under_a_panel(demos, server, size):
     assert not peeking, (panel, peeking)
 
 
+@pytest.mark.parametrize("size", SIZES, ids=lambda s: f"{s[0]}x{s[1]}")
+def test_the_chart_and_the_momenta_stay_in_sight_below_the_lecture_notes(demos, server, size):
+    """A user test: `2 l c` showed no chart till the notes closed; the notes leave the table below them in
+    sight, and the chart and the momenta diagram move to the corners there."""
+    app = drawn_after_keys(demos, server, size, "2", (pygame.K_l, pygame.K_c, pygame.K_d))
+    app.frame(FRAME_S)  # (the chart keeps clear of the panel the last frame drew)
+    window, painter = app.window, app.painter
+    notes = window.panel_area
+    assert app.panels.panel() == "notes" and notes is not None and notes.bottom < window.status_top_px // 2
+    (chart,) = [box for box in window.label_boxes if box.contains(painter.chart_plot)]
+    assert not chart.colliderect(notes), (chart, notes)
+    under = [box for box in window.label_boxes if box.colliderect(notes)]  # the momenta box, the HUD, ...
+    assert not under, (notes, under)
+    press(app, pygame.K_l)  # the notes closed: the chart goes back to its corner
+    app.frame(FRAME_S)
+    assert window.panel_area is None and app.painter.corner_in_sight() == app.painter.chart_corner
+
+
 def test_a_word_wider_than_the_line_is_broken_not_cut():
     font = pygame.font.Font(None, 24)
     lines = wrap(font, LONG_PATH, 150)

@@ -103,7 +103,12 @@ class LessonsPainter:
     # ------------------------------------------------------------ corners
 
     def choose_corner(self, panel: str, points_px: np.ndarray, avoid: Sequence[int]) -> int:
-        """The corner of `panel`: kept once chosen, unless in `avoid`; else the free corner over the fewest points."""
+        """The corner of `panel`: kept once chosen, unless in `avoid`; else the free corner over the fewest points.
+        Corners under the last frame's panel (the lecture notes leave room below them) are avoided too, while
+        others are free."""
+        under = [k for k in range(len(CHART_CORNERS)) if k not in avoid and self._under_panel(k)]
+        if len(avoid) + len(under) < len(CHART_CORNERS):
+            avoid = [*avoid, *under]
         if self.corners.get(panel) is None or self.corners[panel] in avoid:
             free = [k for k in range(len(CHART_CORNERS)) if k not in avoid] or [0]
             w, h = self.w.surface.get_size()
@@ -117,6 +122,14 @@ class LessonsPainter:
                 counts.append(int(np.count_nonzero(dx & dy)))
             self.corners[panel] = free[counts.index(min(counts))]
         return self.corners[panel]
+
+    def _under_panel(self, corner: int) -> bool:
+        """Whether the last frame's panel covers the corner's first few lines."""
+        panel = self.w.panel_area
+        if panel is None:
+            return False
+        line = self.w.label_font.get_linesize()
+        return place_in_corner(self.w, pygame.Rect(0, 0, 8 * line, 3 * line), corner).colliderect(panel)
 
     def corner_rect(self, size: tuple[int, int], corner: int) -> pygame.Rect:
         """A box of `size` in `corner`: under the HUD or above the status bar, at most half the window,

@@ -62,7 +62,7 @@ class Aids(Feature):
         if not self.show_chart:
             return None
         self.host.painter.choose_chart_corner(points_px)
-        return self.host.painter.chart_corner
+        return self.host.painter.corner_in_sight()
 
     def draw(self) -> None:
         host = self.host

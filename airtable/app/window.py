@@ -126,6 +126,10 @@ class GameWindow:
         self._trail_layer: pygame.Surface | None = None
         self._labels: dict[tuple, pygame.Surface] = {}
         self._panels: dict[tuple, tuple[pygame.Surface, int]] = {}
+        # Where the last frame's panel lay (None: no panel), so what is drawn before the panels can keep clear of
+        # one that leaves room (the lecture notes, only as tall as their text): the chart does.
+        self.panel_area: pygame.Rect | None = None
+        self._panel_drawn: pygame.Rect | None = None
         self._status_bar: pygame.Surface | None = None
         self.hud_bottom_px = 0  # below the title and HUD lines: panels start under it
         self.corner_bottom_px = 0  # below the frame rate and PAUSED in the top right corner (margins layout)
@@ -325,6 +329,7 @@ class GameWindow:
         """
         self.follow_display()
         self.label_boxes = []
+        self.panel_area, self._panel_drawn = self._panel_drawn, None
         surf = self.surface
         table = self._table_rect(scene)
         for margin in margins_around(surf.get_rect(), table):  # not the whole screen: each fill costs its pixels
@@ -617,5 +622,5 @@ class GameWindow:
             if len(self._panels) >= 8:
                 self._panels.clear()
             self._panels[key] = cached
-        self.surface.blit(cached[0], rect)
+        self._panel_drawn = self.surface.blit(cached[0], rect)
         return cached[1]
