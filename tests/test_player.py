@@ -900,7 +900,8 @@ def test_a_hello_lost_on_a_quick_link_is_tried_again_not_the_end(cleanup):
     assert net.connect() is None and net.state == net.WAITING  # told to try again, not ended
     assert "your hello did not reach the table within 0.2 s" in net.waiting_because
     assert net.banner_text.startswith(
-        "your hello did not reach the table within 0.2 s of connecting (lost on the way? a slow network?): asking again in"
+        "your hello did not reach the table within 0.2 s of connecting (lost on the way? a slow network?): "
+        "asking again in"
     )
     wait_until(lambda: net.state == net.CONNECTED, what="the second try to join")
     assert net.welcome.client == "C1"
