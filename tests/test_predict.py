@@ -365,8 +365,11 @@ def test_space_cannot_resume_the_table_while_students_predict(tmp_path):
 def test_space_pauses_a_playing_reveal_and_after_the_freeze_closes_the_round(tmp_path):
     app = head_on_app(tmp_path)
     press(app, pygame.K_F6)
+    assert app.message.startswith("prediction round open")
     app.predict.round.local[1] = (1.0, 0.0)
     press(app, pygame.K_F6)
+    # (a user test: "prediction round open" stayed in the header over the bar's REVEALED)
+    assert app.message.startswith("revealed") and "open" not in app.message
     press(app, pygame.K_SPACE)  # the teacher stops the reveal to point at something
     t0 = app.table.time_s
     for _ in range(5):

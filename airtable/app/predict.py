@@ -244,9 +244,12 @@ class Predict(Feature):
             book = self._book()
             r.reveal(book.arrows() if book is not None else (), host.table)
             host.paused = False  # after_physics keeps everyone's strings off until the collision is over
+            # (a user test: "prediction round open" stayed over a bar saying REVEALED)
+            host.say("revealed: the table plays the collision; F6 again closes the round")
         else:
             r.close()
             host.paused = True
+            host.say("prediction round closed")
         self.publish()
 
     def on_escape(self) -> bool:
