@@ -280,6 +280,20 @@ def test_the_demo_menu_lists_every_demo_and_starts_the_one_picked(tmp_path):
     assert app.panels.panel() is None
 
 
+def test_shift_and_a_digit_in_the_demo_menu_picks_the_shifted_demo(tmp_path):
+    """A user test: Shift+1 in the menu typed "!" (no demo key starts so), where on the table it starts 1p."""
+    (tmp_path / "demo_1p.py").write_text(demo_source("1p", pucks=2))
+    (tmp_path / "demo_1.py").write_text(demo_source("1", pucks=1))
+    app = make_app(tmp_path, key="1")
+    press(app, pygame.K_TAB)
+    press(app, pygame.K_1, mod=pygame.KMOD_LSHIFT, unicode="!")
+    assert app.panels.panel() is None and app.demo_key == "1p" and len(app.table.pucks) == 2
+    press(app, pygame.K_TAB)
+    press(app, pygame.K_1, unicode="1")  # "1" alone: "1p" starts so too, so Enter picks it
+    press(app, pygame.K_RETURN)
+    assert app.demo_key == "1" and len(app.table.pucks) == 1
+
+
 def test_f1_in_the_demo_menu_shows_the_help_over_it(tmp_path):
     """A user test: F1 did nothing while the menu was open (the menu took every key)."""
     (tmp_path / "demo_t1.py").write_text(demo_source("t1", pucks=1))

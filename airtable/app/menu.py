@@ -22,8 +22,8 @@ class DemoMenu:
         self.selected = keys.index(current) if current in keys else 0
         self.typed = ""
 
-    def press(self, name: str, text: str = "") -> str | None:
-        """A key press: `name` as pygame.key.name gives it, `text` the character typed.
+    def press(self, name: str, text: str = "", shift: bool = False) -> str | None:
+        """A key press: `name` as pygame.key.name gives it, `text` the character typed, `shift` held.
 
         Returns the demo key to start, or None while the choice goes on.
         """
@@ -38,6 +38,8 @@ class DemoMenu:
             return self.items[self.selected][0]
         if text and not text.isascii() and len(name) == 1 and name.isascii():
             text = name  # a letter of another layout ("е"): demo keys are Latin, taken by where the key sits
+        if shift and len(name) == 1 and name.isdigit():
+            text = f"{name}p"  # Shift+1 is demo "1p", as on the table (a user test: the menu typed "!")
         if name == "backspace":
             self.typed = self.typed[:-1]
         elif text and text.isprintable() and not text.isspace():

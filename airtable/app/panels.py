@@ -93,7 +93,8 @@ class Panels(Feature):
         if panel == "menu" and event.key == pygame.K_TAB:
             self.menu = None
         elif panel == "menu":
-            picked = self.menu.press(pygame.key.name(event.key), getattr(event, "unicode", ""))
+            shift = bool(getattr(event, "mod", 0) & pygame.KMOD_SHIFT)
+            picked = self.menu.press(pygame.key.name(event.key), getattr(event, "unicode", ""), shift)
             if picked is not None:
                 self.menu = None
                 self.host.start_demo(picked)
