@@ -309,6 +309,27 @@ def test_cursors_at_one_spot_keep_their_names_apart(demos, size):
 
 
 @pytest.mark.parametrize("size", SIZES, ids=lambda s: f"{s[0]}x{s[1]}")
+@pytest.mark.parametrize("zoom", [4.0, 40.0])
+def test_zoomed_in_the_names_of_cursors_out_of_view_line_up_along_the_edge(demos, size, zoom):
+    """A user test: after the teacher zoomed in, the names of idle students (their cursors at a corner of the
+    table, out of the view) piled up over the title in the top left corner."""
+    from dataclasses import replace
+
+    from airtable.model.scene import CursorView, Scene
+
+    app = app_at(size, demos, "3")
+    app.env.zoom_about(app.env.to_screen(np.array([0.6 * app.table.width_m, 0.5 * app.table.height_m])), zoom)
+    corners = [(0.0, 0.0), (0.0, app.table.height_m), (app.table.width_m, 0.0)]
+    cursors = tuple(CursorView(f"C{k} Kid {k}", (200, 100 + 5 * k, 50), corners[k % 3]) for k in range(12))
+    scene = replace(Scene.from_table(app.table, app.clients, title="t", status="s"), cursors=cursors)
+    app.window.draw(scene)
+    boxes, hud = app.window.cursor_boxes, app.window.hud_boxes
+    assert all(app.window.surface.get_rect().contains(b) for b in boxes), boxes
+    piled = [(a, b) for k, a in enumerate(boxes) for b in boxes[k + 1 :] if a.colliderect(b)]
+    assert not piled and not [b for b in boxes if b.collidelist(hud) >= 0], (piled, hud)
+
+
+@pytest.mark.parametrize("size", SIZES, ids=lambda s: f"{s[0]}x{s[1]}")
 def test_zoomed_in_on_nothing_the_status_line_says_how_to_get_back(demos, size):
     """A user test: wheeled x200 in between the pucks of demo 4 the window was black, and the status line
     said "zoom x200" only: the way back, a hint in brackets, was the first thing a narrow bar left out."""
