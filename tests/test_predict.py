@@ -11,7 +11,7 @@ from pathlib import Path
 import numpy as np
 import pygame
 import pytest
-from conftest import FRAME_S, WAIT_S, frames_until, press, wait_until
+from conftest import FRAME_S, WAIT_S, frames_until, press, teacher_and_student, wait_until
 from test_server import RawClient, frame
 
 from airtable.app.app import App
@@ -486,6 +486,29 @@ def test_the_students_predict_lines_are_on_an_opaque_box_clear_of_the_walls(serv
         assert win.surface.get_at((block.right - 2, block.bottom - 2))[:3] == (0, 0, 0)
     finally:
         net.close()
+
+
+@pytest.mark.parametrize("size", [(480, 360), (640, 480)], ids=lambda s: f"{s[0]}x{s[1]}")
+@pytest.mark.parametrize("demo", ["2", "4", "8"])
+@pytest.mark.parametrize("aids", ["", "c", "ct", "cd"])
+def test_a_small_students_window_shows_the_predict_instruction_over_a_crowded_table(demos, demo, size, aids):
+    """A user test: a student's 640x480 window showed no PREDICT lines."""
+    with teacher_and_student(demos, demo) as (teacher, net):
+        frames_until(teacher, lambda: teacher.student_count() == 1 and net.latest() is not None, "the join")
+        for key in aids:
+            press(teacher, pygame.key.key_code(key))
+        press(teacher, pygame.K_F6)
+        wait_until(lambda: net.round is not None and net.round.state == "open", what="the ROUND at the student")
+        player = PlayerApp(net, headless=True)
+        player.run(seconds=WAIT_S, until=lambda: player.frames >= 2)
+        win = player.window
+        win.resize(size)
+        wait_until(lambda: net.aids.shows("c") == ("c" in aids), what="the teacher's aids at the student")
+        player._frame()
+        placed = player._draw_round((200, 200, 200))
+        assert placed and placed[0][0].startswith("PREDICT"), placed
+        seen = pygame.Rect(0, 0, size[0], win.status_top_px)
+        assert all(seen.contains(rect) for _, rect in placed), (placed, seen)
 
 
 def test_esc_while_students_guess_asks_before_it_throws_the_guesses_away(tmp_path):

@@ -58,7 +58,9 @@ def fit_lines(font, lines, width_px: int) -> list[tuple[str, tuple[int, int, int
 def _legend(painter, lines) -> list[tuple[str, pygame.Rect]]:
     """The round's lines on an opaque panel at the top left, each line wrapped to fit: in the left
     margin where the window has one, else inside the table's walls (a wall must stay seen), below
-    whatever text is there and past the pucks; returns each line and where it went."""
+    whatever text is there and past the pucks, or over the pucks where there is no room past them (a user
+    test: under the chart and past the pucks, a student's 640x480 window drew them below its bottom);
+    returns each line and where it went."""
     w = painter.w
     font, pad = w.font, w.line_px(4)
     line_h = font.get_linesize()
@@ -73,12 +75,9 @@ def _legend(painter, lines) -> list[tuple[str, pygame.Rect]]:
         avoid = painter._taken + [r for r in painter.puck_boxes if r not in walls]
     lines = fit_lines(font, lines, max(room.width, 1))
     width = max(font.size(t)[0] for t, _ in lines)
-    block = pygame.Rect(room.left, room.top, width, line_h * len(lines)).inflate(pad, pad // 2)
-    for _ in range(len(avoid)):  # slide down past whatever is in the way
-        hit = block.collidelist(avoid)
-        if hit < 0:
-            break
-        block.top = avoid[hit].bottom + pad
+    first = pygame.Rect(room.left, room.top, width, line_h * len(lines)).inflate(pad, pad // 2)
+    room_px = (w.status_top_px, pad)
+    block = _slid_past(first, avoid, *room_px) or _slid_past(first, painter._taken, *room_px) or first
     pygame.draw.rect(w.surface, LEGEND_FILL, block)
     placed = []
     for k, (text, color) in enumerate(lines):
@@ -117,6 +116,17 @@ def paint_round(
     if info.truth:
         return _legend(painter, [("the truth in bold white", TRUTH_COLOR), *((s, PROMPT_COLOR) for s in info.summary)])
     return _legend(painter, [("revealed: playing until the collision is over", PROMPT_COLOR)])
+
+
+def _slid_past(block: pygame.Rect, avoid: Sequence[pygame.Rect], bottom_px: int, pad: int) -> pygame.Rect | None:
+    """`block` moved down past whatever of `avoid` is in its way, or None where it then ends below `bottom_px`."""
+    block = block.copy()
+    for _ in range(len(avoid)):
+        hit = block.collidelist(avoid)
+        if hit < 0:
+            break
+        block.top = avoid[hit].bottom + pad
+    return block if block.bottom <= bottom_px and block.collidelist(avoid) < 0 else None
 
 
 def _tip(start: Sequence[float], vel: Sequence[float]) -> tuple[float, float]:
