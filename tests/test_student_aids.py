@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pygame
 import pytest
-from conftest import FRAME_S, post_key, server_frames, teacher_and_student
+from conftest import FRAME_S, frames_until, post_key, press, server_frames, teacher_and_student
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
@@ -269,6 +269,26 @@ def _run_student(teacher, net, until, keys=()):
     assert student.run(seconds=20, until=step) == 0
     assert until(student), "the condition came true before the time ran out"
     return student
+
+
+def test_after_a_rewind_the_students_chart_keeps_what_came_before_it_as_the_teachers_does(classroom):
+    """A user test: the student's chart was empty after the teacher rewound and ran on (time went back, so it
+    started afresh) while the teacher's kept the samples before that moment."""
+    teacher, net = classroom
+    teacher.aids.show_chart = True
+    series = lambda: net.aids.chart.series(100.0)["time_s"]  # noqa: E731
+    frames_until(teacher, lambda: len(series()) > 20 and series()[-1] > 1.0, "a second of chart at the student")
+    press(teacher, pygame.K_SPACE)
+    for _ in range(8):
+        press(teacher, pygame.K_COMMA)
+    t = teacher.table.time_s
+    assert t > 0.5
+    press(teacher, pygame.K_SPACE)  # runs on from t: the later samples go
+    frames_until(teacher, lambda: len(series()) and series()[-1] > t + 0.1, "samples after the rewind")
+    times = series()
+    assert times[0] < t - 0.5 and np.all(np.diff(times) > 0), (t, times)
+    teachers = teacher.aids.chart.series(100.0)["time_s"]
+    assert set(np.round(times[times <= t], 5)) <= set(np.round(teachers, 5))  # (float32 on the wire)
 
 
 def test_a_student_sees_the_teachers_vectors_annotations_and_chart(classroom):

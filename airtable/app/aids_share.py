@@ -65,6 +65,7 @@ def shared_aids(
         chart=chart,
         chart_corner=corner,
         chart_history=history,
+        chart_version=shown.chart.version,
         notes=notes,
         lessons=lessons,
     )

@@ -180,10 +180,12 @@ class EnergyChart:
         self._next = 0
         self._count = 0
         self.scale = SceneScale()  # the scene's round-off scale: readouts show less than it as 0
+        self.version = 0  # counts the times samples were taken back (clear, drop_after), for the students' copies
 
     def clear(self) -> None:
         self._next = self._count = 0
         self.scale.clear()
+        self.version += 1
 
     def sample(self, table: AirTable) -> None:
         ke, se, ge = table.kinetic_energy_J(), table.spring_energy_J(), table.gravity_energy_J()
@@ -195,9 +197,13 @@ class EnergyChart:
         self.scale.observe((ke, se, ge), size, float(table.mass_kg.sum()))
 
     def append(self, row) -> None:
-        """One sample made elsewhere (a student's window gets the teacher's): the values of FIELDS."""
-        if self._count and row[0] < self._data[(self._next - 1) % len(self._data), 0]:
-            self.clear()  # time went back: a restart or a rewind
+        """One sample made elsewhere (a student's window gets the teacher's): the values of FIELDS. The same
+        sample again (two frames between steps) is taken once."""
+        last = self._data[(self._next - 1) % len(self._data), 0]
+        if self._count and row[0] == last:
+            return
+        if self._count and row[0] < last:
+            self.clear()  # time went back (a restart or a rewind) and no history came with it
         self.scale.observe(row[1:4], row[5])
         self._data[self._next] = row
         self._next = (self._next + 1) % len(self._data)
@@ -205,9 +211,11 @@ class EnergyChart:
 
     def drop_after(self, t_s: float) -> None:
         """Forget the samples later than `t_s` (the table was rewound to it and runs on)."""
+        count = self._count
         while self._count and self._data[(self._next - 1) % len(self._data), 0] > t_s:
             self._next = (self._next - 1) % len(self._data)
             self._count -= 1
+        self.version += self._count != count
 
     def series(self, window_s: float = CHART_WINDOW_S) -> dict[str, np.ndarray]:
         """The samples of the last `window_s` seconds of simulation, oldest first."""

@@ -89,6 +89,7 @@ class SharedAids:
     chart: tuple[float, ...] | None = None  # the newest sample: time, kinetic, spring, gravity, total, |p|
     chart_corner: int = 0  # where the teacher's chart is (aids_paint.CHART_CORNERS), + 4 if small
     chart_history: np.ndarray | None = None  # (H, 6) the samples before `chart`, oldest first
+    chart_version: int = 0  # changes when samples are taken back (a rewind, a restart): the history goes again
     notes: str | None = None  # the lecture notes, while their panel is open
 
     annotations_on: bool = False
