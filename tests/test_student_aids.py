@@ -291,6 +291,21 @@ def test_after_a_rewind_the_students_chart_keeps_what_came_before_it_as_the_teac
     assert set(np.round(times[times <= t], 5)) <= set(np.round(teachers, 5))  # (float32 on the wire)
 
 
+def test_the_students_own_cursor_and_name_are_drawn_over_the_chart(classroom):
+    """A user test: the student's own name lay under the teacher's chart when the mouse was over it."""
+    teacher, net = classroom
+    teacher.aids.show_chart = True
+    student = _run_student(teacher, net, lambda s: len(net.aids.chart.series()["time_s"]) > 5)
+    chart = student.painter.chart_plot
+    point = student.env.to_world(np.array(chart.center, dtype=float))
+    student._draw(net.latest(), point, True)
+    label = student.window.cursor_boxes[-1]
+    assert chart.colliderect(label), (chart, label)
+    surface, color = student.window.surface, tuple(net.welcome.color)
+    drawn = [surface.get_at((x, y))[:3] for x in range(label.left, label.right) for y in range(label.top, label.bottom)]
+    assert drawn.count(color) > 10, "our name in our colour, over the chart"
+
+
 def test_a_student_sees_the_teachers_vectors_annotations_and_chart(classroom):
     teacher, net = classroom
     teacher.aids.show_annotations, teacher.aids.vectors, teacher.aids.show_chart = True, 1, True

@@ -30,7 +30,7 @@ from airtable.app.lessons_paint import LessonsPainter  # noqa: F401  (imported f
 from airtable.app.pucks_view import COLORKEY, PuckSprites, draw_pucks, radii_px
 from airtable.app.timeline_paint import TimelinePainter  # noqa: F401  (imported from here by the student's window)
 from airtable.assets import ASSETS_DIR
-from airtable.model.scene import STATUS_SEPARATOR, Scene
+from airtable.model.scene import STATUS_SEPARATOR, CursorView, Scene
 
 BANNER_LINES = 3  # a banner's sentence wraps over at most this many lines; the last is cut to fit
 
@@ -442,11 +442,15 @@ class GameWindow:
     def _draw_cursors(self, scene: Scene) -> None:
         self.cursor_boxes = []
         for cur in scene.cursors:
-            if 0 <= cur.held < len(scene.pos_m):
-                start = self.env.to_screen(np.asarray(cur.cursor_m))
-                end = self.env.to_screen(scene.pos_m[cur.held])
-                pygame.draw.line(self.surface, cur.color, start, end, self.line_px(2))
-            self.cursor_boxes.append(self.draw_cursor(cur.name, cur.color, cur.cursor_m))
+            self.draw_cursor_view(scene, cur)
+
+    def draw_cursor_view(self, scene: Scene, cur: CursorView) -> None:
+        """One cursor of `scene`: its string to the puck it holds, its arrow, its name (kept in `cursor_boxes`)."""
+        if 0 <= cur.held < len(scene.pos_m):
+            start = self.env.to_screen(np.asarray(cur.cursor_m))
+            end = self.env.to_screen(scene.pos_m[cur.held])
+            pygame.draw.line(self.surface, cur.color, start, end, self.line_px(2))
+        self.cursor_boxes.append(self.draw_cursor(cur.name, cur.color, cur.cursor_m))
 
     def draw_cursor(self, name: str, color: Sequence[int], cursor_m: Sequence[float]) -> pygame.Rect:
         """A coloured arrow with the client's name on dark ground, its tip at the cursor; returns the name's box."""

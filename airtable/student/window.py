@@ -340,10 +340,10 @@ class PlayerApp:
         net, win, welcome = self.net, self.window, self._welcome
         me = welcome.label if welcome else ""
         color = welcome.color if welcome else (200, 200, 200)
-        cursors, extra = own_cursor_live(scene.cursors, me, cursor_m, self.button, focused)
+        others, mine = own_cursor_live(scene.cursors, me, color, cursor_m, self.button, focused)
         self._follow_restarts(scene)
         win.draw(
-            dataclasses.replace(scene, cursors=cursors),
+            dataclasses.replace(scene, cursors=others),
             trails=net.aids.shows("e"),
             hud=(f"You are {me}" if me else "Not at the table yet", net.status_text, *self._view_hint(scene)),
             banner=net.banner_text or student_banner(scene, me),
@@ -353,9 +353,9 @@ class PlayerApp:
         draw_student_aids(self.painter, scene, net.aids, time.monotonic(), cursor_m)
         if net.aids.shows("k") and len(scene.pos_m):  # "puck 3" of a reveal's summary, found on the table
             draw_numbers(win.surface, win.label_font, win.env.to_screen(scene.pos_m))
-        if extra and me:  # not in the snapshots yet: the arrow alone
-            win.draw_cursor(me, color, cursor_m)
         self._draw_round(color)
+        if mine is not None:  # over the aids (a user test: our name lay under the chart)
+            win.draw_cursor_view(scene, mine)
         if self.ended is not None:
             win.draw_panel("The session has ended", [self.ended, "Press any key to close this window."])
         elif self.leave_asked_until > time.monotonic():
@@ -471,20 +471,19 @@ def _fit_cursor_strings(scene: Scene, env) -> dict:
 
 
 def own_cursor_live(
-    cursors: Sequence[CursorView], me: str, cursor_m: Sequence[float], button: int, focused: bool
-) -> tuple[tuple[CursorView, ...], bool]:
-    """The snapshot's cursors with ours moved to where the mouse is now.
+    cursors: Sequence[CursorView], me: str, color, cursor_m: Sequence[float], button: int, focused: bool
+) -> tuple[tuple[CursorView, ...], CursorView | None]:
+    """The snapshot's other cursors, and ours (None: we have no seat) moved to where the mouse is now.
 
     Our cursor in a snapshot is a round trip old; drawing it at the live mouse
-    position (and last, on top) makes the arrow and its string follow the hand
-    without delay. Returns the cursors and whether ours still needs drawing
-    on its own (it is not in the snapshots yet).
+    position (and last, over the aids) makes the arrow and its string follow the hand
+    without delay. Before the snapshots have it, it is the arrow alone, in our `color`.
     """
     others = tuple(c for c in cursors if c.name != me)
     mine = next((c for c in cursors if c.name == me), None)
-    if not focused:  # the mouse is in another window: show what the server has
-        return others + ((mine,) if mine else ()), False
+    if not focused or not me:  # the mouse is in another window: show what the server has
+        return others, mine
+    live = (float(cursor_m[0]), float(cursor_m[1]))
     if mine is None:
-        return others, True
-    live = dataclasses.replace(mine, cursor_m=(float(cursor_m[0]), float(cursor_m[1])), button=button)
-    return others + (live,), False
+        return others, CursorView(me, tuple(color), live, button)
+    return others, dataclasses.replace(mine, cursor_m=live, button=button)
