@@ -498,12 +498,16 @@ def test_a_small_students_window_shows_the_predict_instruction_over_a_crowded_ta
         for key in aids:
             press(teacher, pygame.key.key_code(key))
         press(teacher, pygame.K_F6)
-        wait_until(lambda: net.round is not None and net.round.state == "open", what="the ROUND at the student")
+
+        def arrived() -> bool:
+            values = net.aids.values_rows(None) is not None
+            return net.round.state == "open" and net.aids.shows("c") == ("c" in aids) and values == ("t" in aids)
+
+        frames_until(teacher, lambda: net.round is not None and arrived(), "the round and the aids at the student")
         player = PlayerApp(net, headless=True)
-        player.run(seconds=WAIT_S, until=lambda: player.frames >= 2)
+        player.run(seconds=WAIT_S, until=lambda: player.frames >= 2)  # (the connection then closes)
         win = player.window
         win.resize(size)
-        wait_until(lambda: net.aids.shows("c") == ("c" in aids), what="the teacher's aids at the student")
         player._frame()
         placed = player._draw_round((200, 200, 200))
         assert placed and placed[0][0].startswith("PREDICT"), placed

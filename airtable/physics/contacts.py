@@ -246,6 +246,10 @@ class ContactSolver:
         out[i] = out[j] = True
         return out
 
+    def pressing(self) -> bool:
+        """Whether any contact of the last step pressed (a non-zero impulse, which the next step starts from)."""
+        return bool(self._impulses.any())
+
     def held_pairs(self) -> bool:
         """Whether the last step held two pucks against each other (not only pucks on walls)."""
         return len(self._puck_pairs()[0]) > 0

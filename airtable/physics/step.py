@@ -12,7 +12,7 @@ from __future__ import annotations
 from collections.abc import Sequence
 from typing import TYPE_CHECKING
 
-from airtable.physics import events, integrate, pairs, resting, sleep, substeps, walls
+from airtable.physics import events, integrate, pairs, quiet, resting, sleep, substeps, walls
 from airtable.physics.context import StepContext
 from airtable.physics.forces import Pull
 
@@ -24,12 +24,18 @@ def step(table: Storage, dt: float, pulls: Sequence[Pull] = ()) -> StepContext:
     """Advance `table` by dt seconds with the cursor strings `pulls`; return the step's context.
 
     Sleeping pucks are not moved: the step first wakes those something
-    disturbed; when every puck sleeps, it only advances time. Where springs are
+    disturbed; when every puck sleeps, or the table is quiet (quiet.py), it only
+    advances time. Where springs are
     too stiff for dt or many pucks are fast (a gas stirred hot), the step is
     taken in pieces, each the whole loop (substeps.py); the context returned
     is the last piece's, with every piece's collisions.
     """
     table.run_due_events()  # 0. a demo's timed events whose time has come (storage.py)
+    if table.quiet is not None and table.quiet.holds(table, pulls):  # nothing moves, nothing acts (quiet.py)
+        table.time_s += dt
+        table.steps += 1
+        return StepContext(dt, pulls)
+    at_rest = quiet.before_step(table, pulls)
     mode = table.puck_correction if table.puck_collisions else "none"  # (no pair hits: nothing to cut for)
     n = max(substeps.pieces(table.vel_mps, table.radius_m, dt, mode), substeps.for_contacts(table, dt))
     outside = table.force_N.copy() if n > 1 and table.force_N.any() else None  # forces set from outside
@@ -40,6 +46,7 @@ def step(table: Storage, dt: float, pulls: Sequence[Pull] = ()) -> StepContext:
         ctx = _piece(table, dt / n, pulls)
         records += ctx.records
     ctx.records = records
+    table.quiet = quiet.after_step(table, at_rest, len(records) + len(ctx.bounced))
     table.time_s += dt
     table.steps += 1
     return ctx

@@ -223,6 +223,7 @@ class Storage:
         self.wall_collision_count = 0  # bounces off a wall since the start
         self.changed = True  # a setting, the pucks or the springs changed since the last step (sleep.wake)
         self.any_touched = False  # some puck was set through its handle since the last step (touch)
+        self.quiet = None  # the table as a step that changed nothing left it (quiet.py), None
 
     # ------------------------------------------------------------ settings that wake every sleeper
 
@@ -308,8 +309,9 @@ class Storage:
 
     # The parts that save and restore their own state (`save(like)`, `restore(saved)`; state.py).
     PARTS = ("puck_columns", "spring_columns", "neighbour_list", "contact_solver", "timed", "notices")
-    # Attributes that are neither parts nor settings (AirTable's: what the last step did, not kept).
-    NOT_SAVED: tuple[str, ...] = ()
+    # Attributes that are neither parts nor settings (AirTable's: what the last step did, not kept; `quiet`, a
+    # memo the step checks against the table before it trusts it).
+    NOT_SAVED: tuple[str, ...] = ("quiet",)
 
     def save_settings(self) -> tuple[tuple[str, ...], tuple]:
         """The names and values of the plain attributes: settings, counters and marks (taken by type, so a

@@ -38,7 +38,7 @@ class AirTable(Storage):
     # The handles are parts too: a restored table gives the same handles their rows back (state.py).
     PARTS = (*Storage.PARTS, "puck_handles", "spring_handles")
     # What the last step's collisions did: not state (a restored table reports none until it steps).
-    NOT_SAVED = ("_last_records", "_last_collisions")
+    NOT_SAVED = (*Storage.NOT_SAVED, "_last_records", "_last_collisions")
 
     def __init__(self, width_m: float = TABLE_WIDTH_M, height_m: float = TABLE_HEIGHT_M) -> None:
         super().__init__(width_m, height_m)
