@@ -268,7 +268,7 @@ def test_a_student_who_starts_before_the_teacher_waits_in_the_window_and_joins(c
     assert main([f"127.0.0.1:{port}", "--headless", "--seconds", "0.1"]) == 0
     out = capsys.readouterr().out
     assert f"connection refused by 127.0.0.1:{port}: is the server running?" in out
-    assert "trying again (Ctrl+C quits)" in out
+    assert "firewall? (trying again; Ctrl+C quits)" in out
     net = player(cleanup, port, name="Ann")
     assert net.connect() is None and net.state is PlayerState.RETRYING
     assert net.banner_text.startswith(f"connection refused by 127.0.0.1:{port}") and "trying again" in net.banner_text

@@ -526,7 +526,7 @@ class NetPlayer:
         if e.slow:
             self._slow_link(str(e))
         elif self.welcome is None:  # never at the table: say why (once there, "reconnecting" says it)
-            self.waiting_because, self.state = f"{e}; trying again", PlayerState.RETRYING
+            self.waiting_because, self.state = f"{e} (trying again)", PlayerState.RETRYING
         self.next_try = time.monotonic() + backoff_s
 
     # ---------------------------------------------------------------- the game side

@@ -31,7 +31,7 @@ def step(table: Storage, dt: float, pulls: Sequence[Pull] = ()) -> StepContext:
     is the last piece's, with every piece's collisions.
     """
     table.run_due_events()  # 0. a demo's timed events whose time has come (storage.py)
-    if table.quiet is not None and table.quiet.holds(table, pulls):  # nothing moves, nothing acts (quiet.py)
+    if table.quiet is not None and table.quiet.holds(table, pulls):  # 0a. nothing moves, nothing acts (quiet.py)
         table.time_s += dt
         table.steps += 1
         return StepContext(dt, pulls)

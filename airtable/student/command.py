@@ -81,7 +81,8 @@ def main(argv: Sequence[str] | None = None) -> int:
         joining.cancel()
     if welcome is None:
         leave = "Ctrl+C quits" if args.headless else "Esc quits"  # no window: no Esc to press
-        print(f"airtable-client: {net.waiting_because} ({leave})")
+        why = net.waiting_because or "waiting"
+        print(f"airtable-client: {why[:-1]}; {leave})" if why.endswith(")") else f"airtable-client: {why} ({leave})")
     else:
         print(joined_sentence(net.address, welcome))
     if args.headless:
