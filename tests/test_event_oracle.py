@@ -224,6 +224,9 @@ restitutions = st.sampled_from([1.0, 1.0, 0.9, 0.5])
 @example(seed=4044363540, n=17, dt=1 / 240, cr_puck=1.0, cr_wall=0.9)  # ... past 1e-9 m (round_off_spread)
 @example(seed=3250422163, n=11, dt=0.013400020908274319, cr_puck=1.0, cr_wall=0.5)  # 1.2e-7 m
 @example(seed=2016456835, n=27, dt=1 / 1000, cr_puck=1.0, cr_wall=0.5)  # 203 steps, each rounding every position
+@example(seed=30, n=29, dt=1 / 30, cr_puck=0.5, cr_wall=1.0)  # a pair's 10 hits in a step, all real (repeat_max)
+@example(seed=2023680856, n=27, dt=1 / 30, cr_puck=0.9, cr_wall=0.5)  # a puck's 11 hits on a wall, all real
+@example(seed=1680487804, n=13, dt=1 / 120, cr_puck=0.5, cr_wall=1.0)
 def test_perfect_kiss_follows_the_exact_hard_disc_motion(seed: int, n: int, dt: float, cr_puck, cr_wall) -> None:
     pucks = random_scene(seed, n)
     oracle = Oracle(pucks, WIDTH_M, HEIGHT_M, cr_puck, cr_wall)
