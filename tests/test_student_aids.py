@@ -283,6 +283,9 @@ def test_after_a_rewind_the_students_chart_keeps_what_came_before_it_as_the_teac
         press(teacher, pygame.K_COMMA)
     t = teacher.table.time_s
     assert t > 0.5
+    frames_until(teacher, lambda: net.latest().time_s <= t + 1e-9, "the student to see the moment looked back at")
+    charted = len(series())
+    assert charted > 20 and series()[-1] > t + 0.3  # looking back: the chart as it was (a user test: it went blank)
     press(teacher, pygame.K_SPACE)  # runs on from t: the later samples go
     frames_until(teacher, lambda: len(series()) and series()[-1] > t + 0.1, "samples after the rewind")
     times = series()

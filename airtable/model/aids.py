@@ -197,13 +197,13 @@ class EnergyChart:
         self.scale.observe((ke, se, ge), size, float(table.mass_kg.sum()))
 
     def append(self, row) -> None:
-        """One sample made elsewhere (a student's window gets the teacher's): the values of FIELDS. The same
-        sample again (two frames between steps) is taken once."""
-        last = self._data[(self._next - 1) % len(self._data), 0]
-        if self._count and row[0] == last:
+        """One sample made elsewhere (a student's window gets the teacher's, at the time of the snapshot it came
+        with): the values of FIELDS. The same sample again (two frames between steps) is taken once, and one
+        from before the last is left out: the teacher looks back at a moment it has charted, its chart as it
+        was (a user test: the students' went blank). Running on from there, or a restart, takes samples back
+        from the teacher's chart, and its history comes again (`version`)."""
+        if self._count and row[0] <= self._data[(self._next - 1) % len(self._data), 0]:
             return
-        if self._count and row[0] < last:
-            self.clear()  # time went back (a restart or a rewind) and no history came with it
         self.scale.observe(row[1:4], row[5])
         self._data[self._next] = row
         self._next = (self._next + 1) % len(self._data)
