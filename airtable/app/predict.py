@@ -239,13 +239,16 @@ class Predict(Feature):
                 return
             r.open(host.table.pos_m)
             host.paused = True
-            host.say("prediction round open: F6 again reveals")
+            # The class predicts from the pucks: the notes, over the table, close (a user test: with them open
+            # neither the teacher's window nor the students' showed the pucks or the PREDICT lines).
+            notes = " (the notes closed: L shows them)" if host.overlays.close("notes") else ""
+            host.say(f"prediction round open: F6 again reveals{notes}")
         elif r.state == "open":
             book = self._book()
             r.reveal(book.arrows() if book is not None else (), host.table)
             host.paused = False  # after_physics keeps everyone's strings off until the collision is over
             # (a user test: "prediction round open" stayed over a bar saying REVEALED)
-            host.say("revealed: the table plays the collision; F6 again closes the round")
+            host.say("revealed (F6 again closes the round)")  # (it plays, then stands still: no verb that lapses)
         else:
             r.close()
             host.paused = True

@@ -346,7 +346,6 @@ class PlayerApp:
             dataclasses.replace(scene, cursors=others),
             trails=net.aids.shows("e"),
             hud=(f"You are {me}" if me else "Not at the table yet", net.status_text, *self._view_hint(scene)),
-            banner=net.banner_text or student_banner(scene, me),
             hud_color=color,
         )
         draw_student_lessons(self.lessons_painter, self.timeline_painter, scene, net.aids, cursor_m)
@@ -356,6 +355,9 @@ class PlayerApp:
         self._draw_round(color)
         if mine is not None:  # over the aids (a user test: our name lay under the chart)
             win.draw_cursor_view(scene, mine)
+        banner = net.banner_text or student_banner(scene, me)
+        if banner:  # over our cursor too: "reconnecting ..." must read whole
+            win.draw_banner(banner)
         if self.ended is not None:
             win.draw_panel("The session has ended", [self.ended, "Press any key to close this window."])
         elif self.leave_asked_until > time.monotonic():
