@@ -232,7 +232,7 @@ class NetPlayer:
         if self.state == PlayerState.WAITING:  # the server's reason, up to its advice
             reason = (self.waiting_because or "the table cannot take you yet").split(";")[0]
             reason = "the table is full" if reason.startswith("server full") else reason
-            return f"{reason}: asking again in {wait} s (Esc quits)"
+            return f"{reason}: asking again in {wait} s (Esc to leave)"
         if self.state == PlayerState.FAILED:
             return self.error
         return None

@@ -80,7 +80,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     finally:
         joining.cancel()
     if welcome is None:
-        leave = "Ctrl+C quits" if args.headless else "Esc quits"  # no window: no Esc to press
+        leave = "Ctrl+C quits" if args.headless else "Esc to leave"  # no window: no Esc to press
         why = net.waiting_because or "waiting"
         print(f"airtable-client: {why[:-1]}; {leave})" if why.endswith(")") else f"airtable-client: {why} ({leave})")
     else:
