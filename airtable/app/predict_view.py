@@ -76,8 +76,8 @@ def _legend(painter, lines) -> list[tuple[str, pygame.Rect]]:
     lines = fit_lines(font, lines, max(room.width, 1))
     width = max(font.size(t)[0] for t, _ in lines)
     first = pygame.Rect(room.left, room.top, width, line_h * len(lines)).inflate(pad, pad // 2)
-    room_px = (w.status_top_px, pad)
-    block = _slid_past(first, avoid, *room_px) or _slid_past(first, painter._taken, *room_px) or first
+    bottom = w.status_top_px
+    block = _slid_past(first, avoid, bottom, pad) or _slid_past(first, painter._taken, bottom, pad) or first
     pygame.draw.rect(w.surface, LEGEND_FILL, block)
     placed = []
     for k, (text, color) in enumerate(lines):

@@ -106,8 +106,9 @@ class AidsViewer:
     vector_seq: int = 0
     annotation_serial: int = 0
     notes_version: int = -1
-    chart_synced: bool = False  # has the chart's history (and every sample since)
-    chart_version: int = -1  # of the teacher's chart it has (a rewind takes samples back: the history goes again)
+    # The version of the teacher's chart whose history (and every sample since) it has; None: none (a rewind or
+    # a restart takes samples back and changes the version: the history goes again).
+    chart_version: int | None = None
     momenta_serial: int = 0  # the collision whose momenta it holds
 
 
@@ -197,20 +198,20 @@ class AidsEncoder:
         Updates `viewer`."""
         p, history, cache, notes = self.state() if state is None else state
         if p is None:
-            viewer.chart_synced = False
+            viewer.chart_version = None
             return b""
         held = history.get(viewer.vector_seq) if p.values is not None else None
         base = held[2] if held is not None and held[:2] == p.base_key[:2] and held[2].shape == p.values.shape else None
         fresh = [s for s in p.serials if s > viewer.annotation_serial]
         send_notes = bool(p.flags & NOTES) and viewer.notes_version != p.notes_version
-        synced = viewer.chart_synced and viewer.chart_version == p.aids.chart_version
-        sync = bool(p.flags & CHART) and not synced and p.aids.chart_history is not None
+        behind = viewer.chart_version != p.aids.chart_version
+        sync = bool(p.flags & CHART) and behind and p.aids.chart_history is not None
         rows = p.momenta_serial != 0 and viewer.momenta_serial != p.momenta_serial
         key = (p.seq, viewer.vector_seq if base is not None else 0, len(fresh), send_notes, sync, rows)
         data = cache.get(key)
         if data is None:
             data = cache[key] = encode_frame(AIDS, encode_aids(p, base, len(fresh), send_notes, notes, sync, rows))
-        viewer.chart_synced, viewer.chart_version = bool(p.flags & CHART), p.aids.chart_version
+        viewer.chart_version = p.aids.chart_version if p.flags & CHART else None
         if p.aids.lesson_flags & MOMENTA:
             viewer.momenta_serial = p.momenta_serial
         if p.values is not None:

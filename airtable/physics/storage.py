@@ -223,7 +223,7 @@ class Storage:
         self.wall_collision_count = 0  # bounces off a wall since the start
         self.changed = True  # a setting, the pucks or the springs changed since the last step (sleep.wake)
         self.any_touched = False  # some puck was set through its handle since the last step (touch)
-        self.quiet = None  # the table as a step that changed nothing left it (quiet.py), None
+        self.quiet = None  # the table as a step that changed nothing left it (quiet.py), or None
 
     # ------------------------------------------------------------ settings that wake every sleeper
 
