@@ -82,3 +82,71 @@ def test_the_cluster_impulses_stop_every_approach_and_only_push() -> None:
     np.testing.assert_allclose(p, [3.0, 3.0, 3.0], rtol=1e-9)
     # Parting contacts get nothing: the cue moving away.
     assert collapse.impulses(n[:1], np.array([2.0]), a[:1], b[:1], inv).tolist() == [0.0]
+
+
+def touching_cluster(data, count: int) -> tuple[np.ndarray, np.ndarray]:
+    """Discs of radius 0.05-0.5 m in the bottom left corner of a box, each touching two placed earlier or
+    one and the floor (the first: both walls), none overlapping another: (centres as complex, radii).
+    Touching two closes a triangle: a wedged, rigid cluster, with more contacts than ways to move."""
+    radii = np.array(data.draw(st.lists(st.floats(0.05, 0.5), min_size=count, max_size=count)))
+    centres = [complex(radii[0], radii[0])]
+    for r in radii[1:]:
+        k = data.draw(st.integers(0, len(centres) - 1))
+        c, reach = centres[k], radii[k] + r
+        if len(centres) > 1 and data.draw(st.booleans()):  # on two discs: where the circles of reach meet
+            other = data.draw(st.integers(0, len(centres) - 2))
+            other += other >= k
+            d, far = centres[other] - c, radii[other] + r
+            along = (abs(d) ** 2 + reach**2 - far**2) / (2 * abs(d))
+            if reach**2 - along**2 <= 0.0:
+                continue
+            at = c + d / abs(d) * complex(along, math.sqrt(reach**2 - along**2) * data.draw(st.sampled_from([1, -1])))
+        elif abs(c.imag - r) < reach:  # on one disc and the floor
+            at = c + complex(math.sqrt(reach**2 - (c.imag - r) ** 2) * data.draw(st.sampled_from([1, -1])), r - c.imag)
+        else:
+            continue
+        if (
+            at.real >= r - 1e-12
+            and at.imag >= r - 1e-12
+            and all(abs(at - e) >= radii[q] + r - 1e-9 for q, e in enumerate(centres))
+        ):
+            centres.append(at)
+    return np.array(centres), radii[: len(centres)]
+
+
+@settings(max_examples=300, deadline=None, derandomize=True)
+@given(count=st.integers(1, 9), data=st.data())
+def test_the_cluster_impulses_meet_the_contact_conditions_in_a_wedged_cluster(count: int, data) -> None:
+    # The conditions themselves are the oracle: p >= 0, no contact approaches after, and a contact that
+    # pushes is closed (p (vn + A p) = 0). A cluster of touching discs in a corner, masses six decades
+    # apart, has dependent contacts (a puck wedged under two more: more contacts than ways to move),
+    # where an active set's equations may have no exact answer; a random pile met one (test_piles).
+    # vn = J v plus a slack >= 0 (a bound that lets a gap close), so an answer exists.
+    centres, radii = touching_cluster(data, count)
+    i, j = np.triu_indices(len(centres), 1)
+    touch = np.abs(centres[i] - centres[j]) <= radii[i] + radii[j] + 1e-9
+    a = np.concatenate(
+        [i[touch], np.flatnonzero(centres.real <= radii + 1e-9), np.flatnonzero(centres.imag <= radii + 1e-9)]
+    )
+    b = np.concatenate([j[touch], -np.ones(len(a) - touch.sum(), dtype=int)])
+    d = centres[a] - np.where(b < 0, 0.0, centres[np.maximum(b, 0)])
+    n = np.concatenate(
+        [
+            d[: touch.sum()] / np.abs(d[: touch.sum()]),
+            np.ones((centres.real <= radii + 1e-9).sum()),
+            1j * np.ones((centres.imag <= radii + 1e-9).sum()),
+        ]
+    )
+    kg = 10.0 ** np.array(data.draw(st.lists(st.floats(-3.0, 3.0), min_size=len(centres), max_size=len(centres))))
+    v = np.array(
+        data.draw(st.lists(st.complex_numbers(max_magnitude=10.0), min_size=len(centres), max_size=len(centres)))
+    )
+    slack = np.array(data.draw(st.lists(st.sampled_from([0.0, 0.0, 0.1, 1.0]), min_size=len(a), max_size=len(a))))
+    vn = (n.conjugate() * (v[a] - np.where(b < 0, 0.0, v[np.maximum(b, 0)]))).real + slack
+    a_mat = collapse.response(n, a, b, 1.0 / kg)
+    p = collapse.solve(a_mat, vn)
+    after = vn + a_mat @ p
+    round_off = 1e-9 * (np.abs(vn).max() + np.abs(a_mat) @ p)  # (the sum's terms)
+    assert p.min() >= 0.0
+    assert (after >= -round_off).all()
+    assert (np.abs(after) <= round_off)[p > 0.0].all()

@@ -34,7 +34,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from hypothesis import given, settings
+from hypothesis import example, given, settings
 from hypothesis import strategies as st
 
 from airtable.physics.table import AirTable
@@ -123,6 +123,9 @@ def pushes(began: np.ndarray, vel: np.ndarray) -> np.ndarray:
     dt=st.sampled_from([1 / 240, 1 / 60]),
     throw_mps=st.sampled_from([0.0, 2.0]),
 )
+# A random sweep's: a 3 g puck at 6 m/s along the floor under a 0.17 kg one on the floor, beside a third:
+# 21 contacts with 19 ways to move, whose exact solve missed (collapse.solve) and sank them 15 mm.
+@example(n=11, seed=837, dt=1 / 60, throw_mps=0.0)
 def test_a_random_pile_thrown_down_at_restitution_0_loses_energy_and_lands_dead(
     n: int, seed: int, dt: float, throw_mps: float
 ) -> None:

@@ -16,17 +16,25 @@ Baraff's): find impulses p >= 0 with vn + A p >= 0 and p (vn + A p) = 0. A
 cluster holds a few contacts, so it is solved exactly by trying active sets
 (the contacts that push) with a least-squares solve each (block pivoting),
 not by iterating: for a light puck between heavy ones, sequential impulses
-converge as slowly as the hits themselves (they are only the fallback).
+converge as slowly as the hits themselves. Where block pivoting goes round
+in circles (dependent contacts: a puck wedged under two others and on the
+floor), Murty's method, one contact at a time, settles it.
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-# Active sets tried (a bound: block pivoting settles in a few on these clusters), then Gauss-Seidel sweeps
-# from the best one if it has not.
+# Active sets tried by block pivoting, which settles in a few on most clusters; then Murty's
+# single pivots (MURTY_TRIES per contact at most), which settle on any.
 TRIES = 12
-SWEEPS = 50
+MURTY_TRIES = 20
+# Where contacts are dependent (a puck wedged in a corner under another: more contacts than ways to
+# move), the active set's equations may have no exact solution; a compliance this small beside each
+# contact's own response (ODE's constraint force mixing) makes the problem strictly convex, with
+# one answer, which block pivoting can miss and Murty's method finds.
+COMPLIANCE = 1e-10
+ROUND_OFF = 1e-12  # of a sum, relative to its largest terms: what an active set may miss by
 
 
 def impulses(n: np.ndarray, vn: np.ndarray, a: np.ndarray, b: np.ndarray, inv_mass: np.ndarray) -> np.ndarray:
@@ -54,21 +62,45 @@ def response(n: np.ndarray, a: np.ndarray, b: np.ndarray, inv_mass: np.ndarray) 
 
 def solve(a_mat: np.ndarray, vn: np.ndarray) -> np.ndarray:
     """The impulses p >= 0 with vn + a_mat p >= 0 and p (vn + a_mat p) = 0 (see impulses; a_mat: response)."""
-    m = len(vn)
-    tol = 1e-12 * (float(np.abs(vn).max()) + 1e-300)
-    active, p = vn < 0.0, np.zeros(m)
+    active = vn < 0.0
     for _ in range(TRIES):  # block pivoting: every contact that pulls lets go, every one that closes pushes
-        p = np.zeros(m)
-        if active.any():
-            sub = np.ix_(active, active)
-            p[active] = np.linalg.lstsq(a_mat[sub], -vn[active], rcond=None)[0]
-        pulls, closing = p < -tol, ~active & (vn + a_mat @ p < -tol)
-        if not pulls.any() and not closing.any():
+        p = _pushes(a_mat, vn, active, _least_squares)
+        wrong = _wrong(a_mat, vn, active, p)
+        if not wrong.any():
             return np.maximum(p, 0.0)
-        active = (active & ~pulls) | closing
-    p = np.maximum(p, 0.0)
-    for _ in range(SWEEPS):  # (rare) projected Gauss-Seidel from there: every step pushes, none pulls
-        for k in range(m):
-            if a_mat[k, k] > 0.0:
-                p[k] = max(0.0, p[k] - (vn[k] + a_mat[k] @ p) / a_mat[k, k])
+        active ^= wrong
+    return _murty(a_mat + COMPLIANCE * np.diag(np.diag(a_mat)), vn, active)
+
+
+def _pushes(a_mat: np.ndarray, vn: np.ndarray, active: np.ndarray, solver) -> np.ndarray:
+    """The impulses with which the `active` contacts stop approaching (the others: 0), by solver(A, b)."""
+    p = np.zeros(len(vn))
+    if active.any():
+        p[active] = solver(a_mat[np.ix_(active, active)], -vn[active])
     return p
+
+
+def _least_squares(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    return np.linalg.lstsq(a, b, rcond=None)[0]
+
+
+def _wrong(a_mat: np.ndarray, vn: np.ndarray, active: np.ndarray, p: np.ndarray) -> np.ndarray:
+    """Which contacts the active set has wrong: an active one that pulls or still approaches (its equations
+    had no exact answer), an idle one that approaches; each beyond its round-off."""
+    after = vn + a_mat @ p
+    off = ROUND_OFF * (np.abs(vn).max() + np.abs(a_mat) @ np.abs(p))  # (the sum's terms: its round-off)
+    pulls = p < -ROUND_OFF * np.abs(p).max()
+    return np.where(active, pulls | (after < -off), after < -off)
+
+
+def _murty(a_mat: np.ndarray, vn: np.ndarray, active: np.ndarray) -> np.ndarray:
+    """Murty's least-index principal pivoting from `active`: flip the first contact the set has wrong,
+    until none is. a_mat is positive definite here, so it ends, at the one answer."""
+    p = np.zeros(len(vn))
+    for _ in range(MURTY_TRIES * len(vn)):
+        p = _pushes(a_mat, vn, active, np.linalg.solve)
+        wrong = np.flatnonzero(_wrong(a_mat, vn, active, p))
+        if len(wrong) == 0:
+            break
+        active[wrong[0]] = not active[wrong[0]]
+    return np.maximum(p, 0.0)
