@@ -289,9 +289,28 @@ def test_shift_and_a_digit_in_the_demo_menu_picks_the_shifted_demo(tmp_path):
     press(app, pygame.K_1, mod=pygame.KMOD_LSHIFT, unicode="!")
     assert app.panels.panel() is None and app.demo_key == "1p" and len(app.table.pucks) == 2
     press(app, pygame.K_TAB)
-    press(app, pygame.K_1, unicode="1")  # "1" alone: "1p" starts so too, so Enter picks it
-    press(app, pygame.K_RETURN)
-    assert app.demo_key == "1" and len(app.table.pucks) == 1
+    press(app, pygame.K_1, unicode="1")  # "1" alone is demo 1: "1p" is Shift+1, not "1" and more
+    assert app.panels.panel() is None and app.demo_key == "1" and len(app.table.pucks) == 1
+
+
+def test_a_digit_in_the_demo_menu_starts_that_demo_at_once_unless_a_longer_key_is_typed_so(tmp_path):
+    """A user test: "2" in the Tab menu waited for Enter, because a demo "2p" exists; but the menu lists
+    2p as Shift+2, so nothing more is typed after "2". A two-digit key ("12") still makes "1" wait."""
+    (tmp_path / "demo_12.py").write_text(demo_source("12", pucks=12))
+    app = make_app(tmp_path, key="1")
+    assert "2p" in app.demos
+    press(app, pygame.K_TAB)
+    press(app, pygame.K_2, unicode="2")
+    assert app.panels.panel() is None and app.demo_key == "2"
+    press(app, pygame.K_TAB)
+    press(app, pygame.K_1, unicode="1")  # "1" or "12": wait
+    assert app.panels.panel() == "menu" and app.demo_key == "2"
+    press(app, pygame.K_2, unicode="2")
+    assert app.panels.panel() is None and app.demo_key == "12" and len(app.table.pucks) == 12
+    press(app, pygame.K_TAB)
+    press(app, pygame.K_1, unicode="1")
+    press(app, pygame.K_RETURN)  # Enter on "1" picks demo 1, as before
+    assert app.panels.panel() is None and app.demo_key == "1"
 
 
 def test_f1_in_the_demo_menu_shows_the_help_over_it(tmp_path):

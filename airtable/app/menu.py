@@ -3,13 +3,16 @@
 Keys like "t1" have no key of their own on the keyboard; the menu reaches them.
 Typing narrows the choice: the first demo whose key starts with what was typed
 is selected, and a key that nothing else extends (say "t2" beside "t10")
-starts at once. No pygame here: the app passes key names ("up", "return",
-"backspace") and typed characters.
+starts at once; so does "2" beside "2p", which the menu lists as Shift+2. No
+pygame here: the app passes key names ("up", "return", "backspace") and typed
+characters.
 """
 
 from __future__ import annotations
 
 from collections.abc import Sequence
+
+from airtable.app.demo_loader import key_label
 
 VISIBLE_ROWS = 14  # rows shown around the selection in a long list, unless the panel says how many fit
 
@@ -58,8 +61,12 @@ class DemoMenu:
         if not self.typed or not starting:
             return None
         self.selected = starting[0]
-        if len(starting) == 1 and keys[starting[0]].lower() == self.typed.lower():
-            return keys[starting[0]]
+        typed = self.typed.lower()
+        exact = [i for i in starting if keys[i].lower() == typed]
+        # A key listed as Shift+N ("2p") is not reached by typing on after "2": it does not make "2" wait.
+        longer = [i for i in starting if keys[i].lower() != typed and key_label(keys[i]) == keys[i]]
+        if exact and not longer:
+            return keys[exact[0]]
         return None
 
     def rows(self, visible: int = VISIBLE_ROWS, label=str) -> list[tuple[str, str]]:
