@@ -207,9 +207,9 @@ def test_three_students_predict_over_real_sockets_then_the_reveal_sums_them_up(s
         info = next_round(students[1], lambda i: bool(i.arrows and i.arrows[0].label))
         assert sorted(a.label for a in info.arrows) == ["C1 Ann", "C2 Ben", "C3 Cat"]
 
-        press(app, pygame.K_F6)  # closes the round
+        press(app, pygame.K_F6)  # closes the round; the table ran when it opened, so it runs on
         assert next_round(students[2], lambda i: i.state == "closed").arrows == ()
-        assert not app.predict.round.active and app.paused
+        assert not app.predict.round.active and not app.paused
     finally:
         for s in students:
             s.close()
@@ -399,6 +399,52 @@ def test_space_pauses_a_playing_reveal_and_after_the_freeze_closes_the_round(tmp
     assert app.table.time_s > t1
     press(app, pygame.K_SPACE)
     assert app.paused  # Space is pause / resume again
+
+
+# ---------------------------------------------------------------- the table after the round
+
+
+def shows_paused(app) -> bool:
+    """Whether the table is paused, checked against what the status line and the header's message say."""
+    said_paused = "PAUSED" in app.status_parts() and "paused" in app.message
+    said_running = "PAUSED" not in app.status_parts() and "runs on" in app.message
+    assert said_paused != said_running, (app.status_line(), app.message)
+    t0 = app.table.time_s
+    for _ in range(3):
+        app.frame(FRAME_S)
+    assert (app.table.time_s == t0) is app.paused is said_paused
+    return app.paused
+
+
+@pytest.mark.parametrize("paused_before", [False, True])
+def test_a_round_closed_with_f6_leaves_the_table_running_or_paused_as_it_was(tmp_path, paused_before):
+    """A user test: F6, F6, F6 over a running table left it paused; a teacher expects it as it was before."""
+    app = head_on_app(tmp_path)
+    if paused_before:
+        press(app, pygame.K_SPACE)
+    assert app.paused is paused_before
+    press(app, pygame.K_F6)
+    app.predict.round.local[1] = (1.0, 0.0)
+    press(app, pygame.K_F6)
+    frames_until(app, lambda: app.predict.round.settled, "the collision to be over", max_frames=600)
+    press(app, pygame.K_F6)
+    assert app.predict.round.state == "closed" and app.message.startswith("prediction round closed")
+    assert shows_paused(app) is paused_before
+
+
+@pytest.mark.parametrize("paused_before", [False, True])
+def test_a_round_ended_with_esc_or_a_new_demo_leaves_the_table_as_it_was(tmp_path, paused_before):
+    app = head_on_app(tmp_path)
+    if paused_before:
+        press(app, pygame.K_SPACE)
+    press(app, pygame.K_F6)
+    press(app, pygame.K_ESCAPE)
+    press(app, pygame.K_ESCAPE)  # the second Esc ends the round (the first asks)
+    assert app.predict.round.state == "closed" and app.message.startswith("prediction round closed (Esc)")
+    assert shows_paused(app) is paused_before
+    press(app, pygame.K_F6)
+    press(app, pygame.K_3)  # another demo ends the round too
+    assert app.predict.round.state == "closed" and app.demo_key == "3" and app.paused is paused_before
 
 
 # ---------------------------------------------------------------- the summary fits the window

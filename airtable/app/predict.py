@@ -9,7 +9,8 @@ The `Predict` feature owns the round; one key (F6, `predict_key`) steps it along
                       table plays; once the collision is over (no collision for
                       SETTLE_S after at least one, or TIMEOUT_S) it freezes, the
                       true velocities are drawn bold and a summary per puck printed
-    revealed -> none  the round closes; the table stays paused
+    revealed -> none  the round closes; the table runs, or stays paused, as it did
+                      when the round opened
 
 The guesses live in the server's PredictionBook (airtable/net/predictions.py)
 and in the round's `local`; nothing in them reaches the physics. `summarize`
@@ -188,6 +189,7 @@ class Predict(Feature):
         self.room = room  # an anonymous projector hides the names on the arrows
         self.round = PredictRound()
         self._end_asked_until = -math.inf  # (clock_s) until when a second Esc ends an open round
+        self._paused_before = False  # whether the table was paused when the round opened
 
     def _book(self):
         server = self.host.server
@@ -238,7 +240,7 @@ class Predict(Feature):
                 host.say("no pucks on the table to predict")
                 return
             r.open(host.table.pos_m)
-            host.paused = True
+            self._paused_before, host.paused = host.paused, True
             # The class predicts from the pucks: the notes, over the table, close (a user test: with them open
             # neither the teacher's window nor the students' showed the pucks or the PREDICT lines).
             notes = " (the notes closed: L shows them)" if host.overlays.close("notes") else ""
@@ -250,24 +252,30 @@ class Predict(Feature):
             # (a user test: "prediction round open" stayed over a bar saying REVEALED)
             host.say("revealed (F6 again closes the round)")  # (it plays, then stands still: no verb that lapses)
         else:
-            r.close()
-            host.paused = True
-            host.say("prediction round closed")
+            self._end("prediction round closed")  # (it tells the students)
+            return
         self.publish()
 
+    def _end(self, said: str) -> None:
+        """Close the round and leave the table as it was when the round opened (a user test: a running
+        table stayed paused after F6, F6, F6), and say which, as the status line's PAUSED does."""
+        self.round.close()
+        self.publish()
+        self.host.paused = self._paused_before
+        after = "paused, as before the round (Space runs on)" if self._paused_before else "the table runs on"
+        self.host.say(f"{said}: {after}")
+
     def on_escape(self) -> bool:
-        """Esc during a round ends it, as closing an overlay would; the table stays paused. While the
-        students guess, only a second Esc within ESC_AGAIN_S does (one Esc threw every guess away)."""
+        """Esc during a round ends it, as closing an overlay would, leaving the table running or paused as
+        before the round. While the students guess, only a second Esc within ESC_AGAIN_S does (one Esc
+        threw every guess away)."""
         if not self.round.active:
             return False
         if self.round.state == "open" and self.host.clock_s > self._end_asked_until:
             self._end_asked_until = self.host.clock_s + ESC_AGAIN_S
             self.host.say("Esc again ends the prediction round, and the students' guesses go (F6 reveals)")
             return True
-        self.round.close()
-        self.publish()
-        self.host.paused = True
-        self.host.say("prediction round closed (Esc)")
+        self._end("prediction round closed (Esc)")
         return True
 
     def pause_key(self) -> bool:
@@ -315,10 +323,11 @@ class Predict(Feature):
         self.host.say(f"prediction names {'shown' if r.show_names else 'hidden'}")
 
     def on_demo_start(self, table) -> None:
-        """A new demo: a round under way ends with it."""
+        """A new demo: a round under way ends with it, and the table runs or not as before the round."""
         if self.round.active:
             self.round.close()
             self.publish()
+            self.host.paused = self._paused_before
 
     def before_physics(self) -> None:
         """While the reveal plays nobody's string holds a puck, so the truth is what the guesses were about."""
