@@ -105,6 +105,43 @@ def test_an_empty_name_says_to_give_one_or_leave_it_out(name, capsys) -> None:
     assert capsys.readouterr().err == f"airtable-client: {said}\n"
 
 
+NO_TABLE = ["127.0.0.1:1", "--headless", "--seconds", "0"]  # nobody on port 1: a name that passes waits, then ends
+
+
+@pytest.mark.parametrize(
+    ("name", "said"),
+    [
+        (
+            "Nguyễn",
+            "the name has 'ễ' (U+1EC5), which the teacher's screen's font cannot draw; "
+            "write 'e' for it, as in \"Nguyen\"",
+        ),
+        ("Trần Thị Hương", "write 'a' for it, as in \"Tran Thi Huong\""),
+        (
+            "Ann 😀",
+            "the name has '😀' (U+1F600), which the teacher's screen's font cannot draw; leave it out, as in \"Ann\"",
+        ),
+        ("שלום", "pick a name in Latin, Greek or Cyrillic letters"),
+        ("A" * 21, "is over 20 characters; pick a shorter name"),
+        ("😀", "has no visible letter or digit"),
+    ],
+)
+def test_a_name_the_teachers_font_cannot_draw_is_a_bad_argument_said_before_joining(name, said, capsys) -> None:
+    """A user test: --name "Nguyễn" passed, then the teacher's table refused it and the client ended with status 1
+    (and with no table yet, it waited and failed once the table opened). The teacher's table draws names in
+    pygame's default font, as this window does: a name it lacks a letter for is refused here, at once."""
+    assert client_cli.main([*NO_TABLE, "--name", name]) == 2
+    out, err = capsys.readouterr()
+    assert out == "" and err.count("\n") == 1 and err.startswith("airtable-client: ") and said in err, err
+
+
+@pytest.mark.parametrize("name", ["Иван", "Αλέξης", "Zoë", "Nguyên", "Đan", "Chloe\u0308"])
+def test_a_name_the_teachers_font_draws_is_taken(name, capsys) -> None:
+    """Cyrillic, Greek and the Latin letters with accents the font has (Vietnamese "ê", "đ") are accepted."""
+    assert client_cli.main([*NO_TABLE, "--name", name]) == 0
+    assert "connection refused" in capsys.readouterr().out
+
+
 @pytest.mark.parametrize(("main", "usage"), [(cli.main, "python -m airtable"), (client_cli.main, "airtable-client")])
 def test_help_prints_the_usage_and_every_option_and_exits_0(main, usage, capsys) -> None:
     with pytest.raises(SystemExit) as exited:

@@ -6,6 +6,7 @@ import contextlib
 import math
 import os
 import socket
+import string
 import struct
 import subprocess
 import sys
@@ -296,6 +297,35 @@ def test_a_full_table_is_waited_for_on_screen_and_joined_when_a_place_frees(caps
     first.send(proto.encode_bye())
     wait_until(lambda: net.state == net.CONNECTED, what="a place at the table")
     assert net.welcome.client == "C1" and net.reconnects == 0
+
+
+def latin_only_teacher(cleanup, port: int = 0) -> GameServer:
+    """A table whose screen draws plain Latin letters only (its font lacks the "ë" this client's has)."""
+    from airtable.app.glyphs import NameCheck
+
+    return start_table(cleanup, port, name_refusal=NameCheck(frozenset(string.ascii_letters + " ")))[0]
+
+
+def test_a_name_the_teachers_screen_refuses_ends_the_client_with_status_2(capsys, cleanup):
+    """A user test: a name the teacher's table refused ended the client with status 1, as a broken link does;
+    it is a bad --name: one line and status 2, as for any bad argument."""
+    server = latin_only_teacher(cleanup)
+    assert main([f"127.0.0.1:{server.port}", "--name", "Zoë", "--headless", "--seconds", "0"]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "Traceback" not in err, err
+    assert err.startswith("airtable-client: the name has 'ë' (U+00EB), which the teacher's screen's font cannot draw")
+    assert "write 'e' for it, as in \"Zoe\"" in err
+
+
+def test_a_client_started_before_the_table_that_then_refuses_its_name_ends_with_status_2(capsys, cleanup):
+    """Started before the teacher's table, the client waits; the table, once open, refuses the name: status 2."""
+    port = free_port()
+    net = player(cleanup, port, name="Zoë")
+    assert net.connect() is None and net.state == net.RETRYING  # nobody there yet
+    latin_only_teacher(cleanup, port)
+    cleanup(pygame.quit)
+    assert PlayerApp(net, headless=True).run(seconds=WAIT_S) == 2
+    assert net.state == net.FAILED and "cannot draw" in capsys.readouterr().err
 
 
 def test_wrong_and_missing_password(capsys, cleanup):

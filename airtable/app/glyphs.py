@@ -10,6 +10,7 @@ draw with a sentence.
 from __future__ import annotations
 
 import unicodedata
+from collections.abc import Iterable
 
 import pygame
 
@@ -17,9 +18,9 @@ import pygame
 LAST_CHECKED = 0x2FFF
 
 
-def drawable_characters(last: int = LAST_CHECKED) -> frozenset[str]:
-    """Every character up to `last` that pygame's default font has a glyph for: those that
-    do not draw as the box of a missing glyph (the same as a private-use character)."""
+def drawable_characters(last: int = LAST_CHECKED, among: Iterable[str] | None = None) -> frozenset[str]:
+    """Every character up to `last` (of `among`, if given) that pygame's default font has a glyph for:
+    those that do not draw as the box of a missing glyph (the same as a private-use character)."""
     pygame.font.init()
     font = pygame.font.Font(None, 12)
 
@@ -31,7 +32,19 @@ def drawable_characters(last: int = LAST_CHECKED) -> frozenset[str]:
         return s.get_size(), pygame.image.tobytes(s, "RGBA")
 
     missing = pixels(chr(0x10FFFD))
-    return frozenset(ch for ch in map(chr, range(0x20, last + 1)) if ch.isprintable() and pixels(ch) != missing)
+    chars = map(chr, range(0x20, last + 1)) if among is None else (c for c in set(among) if ord(c) <= last)
+    return frozenset(ch for ch in chars if ch.isprintable() and pixels(ch) != missing)
+
+
+def _plain(ch: str) -> str:
+    """The letter without its accents ("e" for "ễ")."""
+    return unicodedata.normalize("NFD", ch)[0]
+
+
+def name_refusal(name: str) -> str | None:
+    """What NameCheck says of `name` on this computer, looking up only its own letters (quick: the
+    student's command asks before it joins, and draws names in the same default font)."""
+    return NameCheck(drawable_characters(among={*name, *map(_plain, name)}))(name)
 
 
 class NameCheck:
@@ -42,9 +55,23 @@ class NameCheck:
 
     def __call__(self, name: str) -> str | None:
         """A sentence refusing `name`, or None if every character of it can be drawn."""
-        ch = next((c for c in name if not c.isspace() and c not in self.drawable), None)
+        ch = next((c for c in name if self._lacks(c)), None)
         if ch is None:
             return None
-        base = unicodedata.normalize("NFD", ch)[0]  # the letter without its accents ("e" for "ễ")
-        instead = f"write {base!r} for it" if base != ch and base in self.drawable else "pick other letters or digits"
+        instead = f"write {self._instead(ch)!r} for it" if self._instead(ch) else "leave it out"
+        # The whole name as it could be written, so the student need not work it out letter by letter.
+        kept = " ".join("".join(self._instead(c) for c in name).split())
+        if any(c.isalnum() for c in kept):
+            instead = f'{instead}, as in "{kept}"'
+        else:
+            instead = "pick a name in Latin, Greek or Cyrillic letters"
         return f"the name has {ch!r} (U+{ord(ch):04X}), which the teacher's screen's font cannot draw; {instead}"
+
+    def _lacks(self, ch: str) -> bool:
+        return not ch.isspace() and ch not in self.drawable
+
+    def _instead(self, ch: str) -> str:
+        """`ch` if it can be drawn, else its letter without accents if that can, else nothing."""
+        if not self._lacks(ch):
+            return ch
+        return _plain(ch) if not self._lacks(_plain(ch)) else ""

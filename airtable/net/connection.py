@@ -177,11 +177,12 @@ class Connection:
         self._encoder, self._tick_due = encoder, True
         self.flush()
 
-    def fail(self, sentence: str, now: float, retry: bool = False) -> None:
-        """Send ERROR `sentence`; close once it is out (the server closes it after LINGER_S)."""
+    def fail(self, sentence: str, now: float, retry: bool = False, about: str | None = None) -> None:
+        """Send ERROR `sentence` (`about`: the HELLO field refused); close once it is out (the server
+        closes it after LINGER_S)."""
         self.state = State.CLOSING
         self._tick_due = False
-        self._out_ctrl.append(proto.encode_error(sentence, retry=retry))
+        self._out_ctrl.append(proto.encode_error(sentence, retry=retry, about=about))
         self.deadline = now + LINGER_S
         self.flush()
 

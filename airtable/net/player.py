@@ -48,18 +48,26 @@ TABLE_CLOSED = "the teacher closed the table: waiting for it to open again..."
 
 
 class PlayerError(Exception):
-    """A problem the player cannot get past; str(error) is one sentence for the user."""
+    """A problem the player cannot get past; str(error) is one sentence for the user, and `about`
+    the HELLO field the server refused ("name"): the user's own input, not the network."""
+
+    def __init__(self, message: str, about: str | None = None) -> None:
+        super().__init__(message)
+        self.about = about
 
 
 class _ConnectError(Exception):
     """One connection attempt failed; `retry` says whether trying again can help,
     `full` that the server asked us to wait for a place."""
 
-    def __init__(self, message: str, retry: bool, full: bool = False, slow: bool = False) -> None:
+    def __init__(
+        self, message: str, retry: bool, full: bool = False, slow: bool = False, about: str | None = None
+    ) -> None:
         super().__init__(message)
         self.retry = retry
         self.full = full
         self.slow = slow  # the link is slow: try again, waiting longer
+        self.about = about  # the HELLO field the server refused ("name"), if it said
 
 
 class _ConnectionEndedError(Exception):
@@ -169,6 +177,7 @@ class NetPlayer:
         self.heard_s = time.monotonic()  # when the server was last heard from (monotonic s)
         self.lost_s: float | None = None  # when the connection was lost, while reconnecting
         self.error: str | None = None
+        self.error_about: str | None = None  # with `error`: the HELLO field the server refused ("name")
         self.waiting_because: str | None = None  # the server's sentence while WAITING
         self._said_bye = False  # the server said BYE on the connection that just ended
         self.next_try: float = 0.0  # time.monotonic() of the next attempt while RETRYING or WAITING
@@ -247,8 +256,8 @@ class NetPlayer:
             opened = self._open()
         except _ConnectError as e:
             if not e.retry:
-                self.state, self.error = PlayerState.FAILED, str(e)
-                raise PlayerError(str(e)) from None
+                self.state, self.error, self.error_about = PlayerState.FAILED, str(e), e.about
+                raise PlayerError(str(e), e.about) from None
             # Refused, unanswered, hung up: the window opens, says why and asks again (a user test: a
             # student who started before the teacher's table got no window, only a line and exit 1).
             self._not_joined_yet(e, self.first_backoff_s)
@@ -350,8 +359,8 @@ class NetPlayer:
     def _first_frame(self, frames: list) -> tuple[proto.Welcome, list]:
         frame_type, payload = frames[0]
         if frame_type == proto.ERROR:
-            sentence, retry = proto.parse_error_message(payload)
-            raise _ConnectError(sentence, retry=retry, full=retry)
+            sentence, retry, about = proto.parse_error_reply(payload)
+            raise _ConnectError(sentence, retry=retry, full=retry, about=about)
         if frame_type != proto.WELCOME:
             raise proto.ProtocolError(f"the first message was {proto.FRAME_NAMES[frame_type]}, not WELCOME")
         # Frames that came with the WELCOME go to the reader thread.
@@ -512,7 +521,7 @@ class NetPlayer:
                 return self._open()
             except _ConnectError as e:
                 if not e.retry:
-                    self.state, self.error = PlayerState.FAILED, str(e)
+                    self.state, self.error, self.error_about = PlayerState.FAILED, str(e), e.about
                     return None
                 backoff = min(backoff * 2, self.max_backoff_s)
                 self._not_joined_yet(e, backoff)

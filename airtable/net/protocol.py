@@ -338,6 +338,7 @@ class Hello:
 
 
 HELLO_EXAMPLE = f'{{"protocol": {PROTOCOL_VERSION}, "name": "Ann"}}'
+HELLO_FIELDS = ("name", "password", "token", "seat")  # besides "protocol"; an ERROR's "about" names one
 
 
 def encode_hello(
@@ -390,7 +391,7 @@ def _validate_hello(message: dict) -> Hello:
         raise ProtocolError(f'HELLO "protocol" must be a whole number like {PROTOCOL_VERSION}, not {_short(protocol)}')
     if protocol != PROTOCOL_VERSION:
         raise ProtocolError(version_mismatch(protocol))
-    _check_fields(message, "HELLO", ("protocol",), ("name", "password", "token", "seat"))
+    _check_fields(message, "HELLO", ("protocol",), HELLO_FIELDS)
     name = message.get("name")
     if name is not None:
         name = check_name(name)
@@ -591,26 +592,35 @@ def parse_welcome(payload: bytes) -> Welcome:
     return Welcome(client, color, w, h, protocol, name, token, udp_key)
 
 
-def encode_error(sentence: str, retry: bool = False) -> bytes:
+def encode_error(sentence: str, retry: bool = False, about: str | None = None) -> bytes:
     """An ERROR frame (the server closes the connection after it). `retry` tells the
-    client that trying again later can work (the table is full or busy)."""
+    client that trying again later can work (the table is full or busy); `about` names
+    the HELLO field refused ("name"), so a command can say its argument was bad."""
     message: dict = {"error": sentence[:MAX_ERROR_CHARS]}
     if retry:
         message["retry"] = True
+    if about is not None:
+        message["about"] = about
     return encode_json(ERROR, message)
 
 
 def parse_error_message(payload: bytes) -> tuple[str, bool]:
     """(sentence, retry) of an ERROR; the sentence is made safe to print on one line."""
+    return parse_error_reply(payload)[:2]
+
+
+def parse_error_reply(payload: bytes) -> tuple[str, bool, str | None]:
+    """(sentence, retry, about) of an ERROR: `about` is the HELLO field it refused ("name"), or None."""
     try:
         message = parse_json(payload, "the server's ERROR", '{"error": "..."}')
     except ProtocolError as e:
-        return f"the server sent an unreadable error ({e})", False
+        return f"the server sent an unreadable error ({e})", False, None
     sentence = message.get("error")
     retry = message.get("retry") is True
+    about = message.get("about") if message.get("about") in HELLO_FIELDS else None
     if not isinstance(sentence, str) or not sentence:
-        return "the server sent an error without a reason", retry
-    return printable(sentence[:MAX_ERROR_CHARS]), retry
+        return "the server sent an error without a reason", retry, about
+    return printable(sentence[:MAX_ERROR_CHARS]), retry, about
 
 
 def parse_error(payload: bytes) -> str:

@@ -889,7 +889,7 @@ class GameServer:
         if hello.name and self._name_refusal is not None:
             refusal = self._name_refusal(hello.name)
         if refusal is not None:
-            self._fail(conn, refusal)
+            self._fail(conn, refusal, about="name")  # (the student's command: a bad --name, status 2)
             return
         number = self._seat_for(conn, hello, now)
         if number is None:
@@ -992,8 +992,10 @@ class GameServer:
         self._gate.right_password(conn.host)
         return True
 
-    def _fail(self, conn: Connection, sentence: str, retry: bool = False, quiet: bool = False) -> None:
-        """Send ERROR `sentence`, then close once it is out (or after LINGER_S).
+    def _fail(
+        self, conn: Connection, sentence: str, retry: bool = False, quiet: bool = False, about: str | None = None
+    ) -> None:
+        """Send ERROR `sentence`, then close once it is out (or after LINGER_S); `about`: the HELLO field refused.
 
         Logged once per address and summarised after that (`quiet`: not at all)."""
         if not quiet:
@@ -1001,7 +1003,7 @@ class GameServer:
                 f"connections dropped from {conn.host}", "dropped %s: %s", conn.who, sentence, level=logging.INFO
             )
         self._release_slot(conn)
-        conn.fail(sentence, time.monotonic(), retry=retry)
+        conn.fail(sentence, time.monotonic(), retry=retry, about=about)
 
     def _remove(self, number: int, sentence: str) -> None:
         cid = self._numbers.get(number)

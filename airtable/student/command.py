@@ -10,6 +10,7 @@ import sys
 import threading
 from collections.abc import Sequence
 
+from airtable.app.glyphs import name_refusal
 from airtable.arguments import OneLineParser
 from airtable.net import protocol as proto
 from airtable.net.player import NetPlayer, PlayerError
@@ -60,6 +61,9 @@ def main(argv: Sequence[str] | None = None) -> int:
         if args.name is not None and not args.name.strip():  # (a script's unset $NAME, most likely)
             raise ValueError("--name is empty: give a name, like --name Ann, or leave --name out to join by seat")
         name = None if args.name is None else proto.check_name(args.name)
+        refusal = None if name is None else name_refusal(name)
+        if refusal is not None:  # the teacher's table would refuse it (it draws in the same default font)
+            raise ValueError(refusal)
         if args.seconds is not None and not (math.isfinite(args.seconds) and args.seconds >= 0):
             raise ValueError("--seconds must be zero or a positive number")
     except (ValueError, proto.ProtocolError) as e:
@@ -74,7 +78,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         welcome = net.connect()
     except PlayerError as e:
         print(f"airtable-client: {e}", file=sys.stderr)
-        return 1
+        return 2 if e.about else 1  # the table refused one of our arguments (its font lacks a letter of --name)
     except KeyboardInterrupt:
         return 1
     finally:

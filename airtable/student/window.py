@@ -95,7 +95,8 @@ class PlayerApp:
     def run(
         self, seconds: float | None = None, screenshot: str | None = None, until: Callable[[], bool] | None = None
     ) -> int:
-        """The UI loop; returns the process exit status (1 when the connection failed for good).
+        """The UI loop; returns the process exit status (1 when the connection failed for good, 2 when
+        the table refused our --name).
 
         Ends after `seconds`, or after the frame in which `until()` is true, or
         when the user quits. Closes the connection when it ends, but leaves
@@ -122,7 +123,9 @@ class PlayerApp:
             return False
         if self.net.state == PlayerState.FAILED and self.ended is None:
             print(f"airtable-client: {self.net.error}", file=sys.stderr)
-            self.status, self.ended = 1, self.net.error or "the session ended"
+            # A refused argument (a name the teacher's font lacks a letter of) is status 2, as a bad argument is.
+            self.status = 2 if self.net.error_about else 1
+            self.ended = self.net.error or "the session ended"
             if self.headless:
                 return False  # nobody to read it: the line above says it
         self._frame()
