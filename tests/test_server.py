@@ -24,6 +24,7 @@ from airtable.model.scene import Scene
 from airtable.net import protocol as proto
 from airtable.net.codec import SnapshotDecoder
 from airtable.net.events import MAX_QUEUED_INPUTS, EventQueue, PlayerInput, PlayerJoined, PlayerLeft
+from airtable.net.gate import SUMMARY_EVERY_S, QuietLog
 from airtable.net.server import (
     COURSE_COLORS,
     RESERVED_FDS,
@@ -649,6 +650,60 @@ def test_wrong_passwords_earn_a_growing_wait_then_a_lockout_and_few_log_lines(ma
     lines = [r.getMessage() for r in caplog.records if "password" in r.getMessage()]
     assert len(lines) <= 3, lines
     assert any("locked out" in line for line in lines)
+
+
+def joined_lines(caplog) -> list[str]:
+    return [r.getMessage() for r in caplog.records if " joined from " in r.getMessage()]
+
+
+def join_and_leave(server: GameServer, clients, name: str) -> None:
+    """A student joins, says BYE, and is gone (so the next join may take the same seat)."""
+    c = clients(server.port)
+    c.hello(name)
+    c.send(proto.encode_bye())
+    wait_until(lambda: server.player_count == 0, what=f"{name} to leave")
+
+
+def test_every_student_joining_from_one_address_is_named_in_the_teachers_log(make_server, clients, caplog):
+    """A user test: a class on 127.0.0.1 (or behind one router) joined, and the log named the first only: joins
+    were summarised per address, every 30 s. They are summarised per student now (below)."""
+    caplog.set_level(logging.INFO, logger="airtable.net")
+    server = make_server()
+    names = ("Ann", "Ben", "Cat", "Dan", "Eve")
+    for name in names:
+        clients(server.port).hello(name)
+    expected = [f"C{i} {name} joined from 127.0.0.1:" for i, name in enumerate(names, 1)]
+    wait_until(lambda: len(joined_lines(caplog)) == len(names), what="a line for every join")
+    assert [line[: len(e)] for line, e in zip(joined_lines(caplog), expected)] == expected
+
+
+def test_a_student_joining_again_and_again_is_named_once_and_a_flood_of_names_a_roomful(make_server, clients, caplog):
+    """The flood protection the per-address summary gave: a laptop rejoining in a loop, or a script joining
+    under ever new names, fills no log: a student's repeats, and names beyond a roomful (--max-clients)
+    from one address, are counted into the summary every SUMMARY_EVERY_S."""
+    caplog.set_level(logging.INFO, logger="airtable.net")
+    server = make_server(max_clients=3)
+    for _ in range(4):
+        join_and_leave(server, clients, "Ann")
+    assert joined_lines(caplog) == [joined_lines(caplog)[0]] and joined_lines(caplog)[0].startswith("C1 Ann joined")
+    for i in range(6):
+        join_and_leave(server, clients, f"Bot{i}")
+    assert [line.split(" joined")[0] for line in joined_lines(caplog)] == ["C1 Ann", "C1 Bot0", "C1 Bot1"]
+
+
+def test_the_quiet_log_sums_up_what_it_held_back_per_kind_and_per_budget(caplog):
+    caplog.set_level(logging.INFO, logger="test.quiet")
+    quiet = QuietLog(logging.getLogger("test.quiet"))
+    for name in ("Ann", "Ann", "Ann", "Ben", "Cat", "Dan"):
+        quiet.note(f"joins of {name}", "%s joined", name, level=logging.INFO, budget=("other joins", 2))
+    assert [r.getMessage() for r in caplog.records] == ["Ann joined", "Ben joined"]
+    quiet.flush(time.monotonic() + SUMMARY_EVERY_S)
+    summary = [r.getMessage() for r in caplog.records][2:]
+    assert sorted(line.split(": ")[1] for line in summary) == ["joins of Ann", "other joins"]
+    assert any(line.startswith("2 more in ") and line.endswith("joins of Ann") for line in summary)
+    assert any(line.startswith("2 more in ") and line.endswith("other joins") for line in summary)
+    quiet.note("joins of Cat", "%s joined", "Cat", level=logging.INFO, budget=("other joins", 2))
+    assert caplog.records[-1].getMessage() == "Cat joined"  # a new period: named again
 
 
 def test_server_full_then_a_freed_name_is_reused(make_server, clients):

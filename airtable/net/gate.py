@@ -186,22 +186,38 @@ class QuietLog:
 
     def __init__(self, log: logging.Logger) -> None:
         self.log = log
-        self._counts: Counter[str] = Counter()
+        self._seen: set[str] = set()  # the kinds logged this period
+        self._held: Counter[str] = Counter()  # lines held back this period, by kind
+        self._named: Counter[str] = Counter()  # kinds logged this period, by budget
         self._levels: dict[str, int] = {}
         self._since = time.monotonic()
 
-    def note(self, kind: str, line: str, *args, level: int = logging.WARNING) -> None:
-        if self._counts[kind] == 0:
+    def note(
+        self, kind: str, line: str, *args, level: int = logging.WARNING, budget: tuple[str, int] = ("", 0)
+    ) -> None:
+        """Log `line` if it is the first of `kind` this period, else count it for the summary.
+
+        `budget` (group, most): kinds that share a group (the joins from one address, each student a
+        kind) log at most `most` first lines a period; more kinds count toward the group's summary."""
+        group, most = budget
+        if kind not in self._seen and group and self._named[group] >= most:
+            kind = group  # a flood of kinds (a script joining under ever new names): counted, never named
+        elif kind not in self._seen:
             self.log.log(level, line, *args)
+            self._seen.add(kind)
+            self._named[group] += 1
             self._levels[kind] = level
-        self._counts[kind] += 1
+            return
+        self._levels.setdefault(kind, level)
+        self._held[kind] += 1
 
     def flush(self, now: float) -> None:
         if now - self._since < SUMMARY_EVERY_S:
             return
-        for kind, count in self._counts.items():
-            if count > 1:
-                self.log.log(self._levels[kind], "%d more in %.0f s: %s", count - 1, now - self._since, kind)
-        self._counts.clear()
+        for kind, count in self._held.items():
+            self.log.log(self._levels[kind], "%d more in %.0f s: %s", count, now - self._since, kind)
+        self._seen.clear()
+        self._held.clear()
+        self._named.clear()
         self._levels.clear()
         self._since = now

@@ -798,7 +798,7 @@ class GameServer:
             frames = conn.receive(now)
             if frames is None:
                 if conn.state != State.CLOSING:
-                    self._log_seat(conn, "%s left", conn.who)
+                    self._log_seat(conn, "leaves", "%s left", conn.who)
                 conn.close()
                 return
             for frame_type, payload in frames:
@@ -810,7 +810,7 @@ class GameServer:
 
     def _handle(self, conn: Connection, frame_type: int, payload: bytes, now: float) -> None:
         if frame_type == proto.BYE:
-            self._log_seat(conn, "%s said goodbye", conn.who)
+            self._log_seat(conn, "leaves", "%s said goodbye", conn.who)
             conn.keep_seat = False
             conn.close()
         elif frame_type == proto.HELLO:
@@ -915,7 +915,7 @@ class GameServer:
             round_frame = self._round_frame
         if round_frame is not None:  # a prediction round is under way
             conn.send_control(round_frame)
-        self._log_seat(conn, "%s joined from %s", name, conn.peer)
+        self._log_seat(conn, "joins", "%s joined from %s", name, conn.peer)
 
     def _tell_teacher(self, notice: str | None) -> None:
         """A line for the log (once, then summaries) and for the projector, under the join lines, for a while."""
@@ -944,7 +944,7 @@ class GameServer:
         if now - stale.last_rx < IN_USE_S:
             self._fail(conn, IN_USE.format(stale.name), retry=True)
             return False
-        self._log_seat(stale, "%s is back on a new connection; the old one is closed", stale.who)
+        self._log_seat(stale, "joins", "%s is back on a new connection; the old one is closed", stale.who)
         stale.keep_seat = False
         self._release_slot(stale)
         stale.close()
@@ -962,9 +962,16 @@ class GameServer:
             return number
         return self._held.free_number(self._numbers, now)
 
-    def _log_seat(self, conn: Connection, line: str, *args) -> None:
-        """Joins and leaves, one line each, but summarised when one computer churns."""
-        self._quiet.note(f"joins and leaves from {conn.host}", line, *args, level=logging.INFO)
+    def _log_seat(self, conn: Connection, what: str, line: str, *args) -> None:
+        """Joins and leaves (`what`), one line each, but summarised when one student churns (a laptop
+        rejoining in a loop). Per student, not per address: a class behind one router, or on 127.0.0.1,
+        shares an address, and only its first join was named. A flood of new names from one address
+        (a script) is named up to a roomful (max_clients) a period, then counted."""
+        if not conn.name:  # (a connection that never got a seat)
+            self._quiet.note(f"{what} from {conn.host}", line, *args, level=logging.INFO)
+            return
+        budget = (f"{what} of other students from {conn.host}", self.max_clients)
+        self._quiet.note(f"{what} of {conn.name} from {conn.host}", line, *args, level=logging.INFO, budget=budget)
 
     def _password_ok(self, conn: Connection, hello: proto.Hello, now: float) -> bool:
         if self.password is None:
