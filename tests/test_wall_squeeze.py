@@ -24,6 +24,7 @@ from airtable.physics.table import AirTable
 R_LIGHT, R_HEAVY = 0.1, 0.15
 SIZE = (4.0, 3.0)
 # Into the table from the left, bottom, right and top walls, and where each wall is along it.
+ROUND_OFF = 2.2e-16  # a double's relative spacing
 WALLS = (((1.0, 0.0), 0.0), ((0.0, 1.0), 0.0), ((-1.0, 0.0), SIZE[0]), ((0.0, -1.0), SIZE[1]))
 
 
@@ -88,13 +89,20 @@ def test_the_heavy_puck_never_passes_the_squeezed_one_nor_gains_energy(wall, rat
     mode=st.sampled_from(("two-step", "perfect-kiss")),
     dt=st.sampled_from((1 / 240, 1 / 60, 1 / 30)),
 )
+# A random search's (16 of 4209 scenes, every one 3e5 times heavier or more, at 10 m/s or more): the light puck
+# ended 2.7e-9 m off the wall, its velocity known to round-off of the heavy one's momentum (ROUND_OFF).
+@example(wall=1, ratio=832604.0060047667, speed=16.094387741061105, mode="two-step", dt=1 / 60)
 def test_at_wall_restitution_0_the_heavy_puck_stops_against_the_light_one_on_the_wall(wall, ratio, speed, mode, dt):
     table = squeeze(wall, ratio, speed, 0.2, 0.0, mode)
     reach = 0.2 + 0.3 + 2 * R_LIGHT + R_HEAVY  # the heavy puck's way to the squeeze
     for _ in range(math.ceil((reach / speed + 0.5) / dt)):  # there, and half a second more
         table.step(dt)
     light, heavy = off_the_wall(table, wall)
-    assert light == np.float64(R_LIGHT) or abs(light - R_LIGHT) < 1e-9
+    # By hand, the light puck ends on the wall. What it exchanges with the heavy one is a share of the
+    # heavy one's momentum M v, known to round-off eps M v: its velocity to eps (M / m) v, which over the
+    # last half second may carry it that times 0.5 s off (at 1e6 times heavier and 20 m/s, 2e-9 m).
+    slack = 1e-9 + 4 * ROUND_OFF * ratio * speed * 0.5
+    assert light == np.float64(R_LIGHT) or abs(light - R_LIGHT) < slack
     assert abs(heavy - (2 * R_LIGHT + R_HEAVY)) < 1e-6
     assert np.abs(table.vel_mps).max() < 1e-6 * speed
 
