@@ -121,6 +121,7 @@ def test_bad_hello(payload, hints):
         ("Ann\u200b", ["U+200B", "not printable"]),
         ("line\nbreak", ["U+000A", "not printable"]),
         ("x" * 21, ["over 20 characters", "shorter"]),
+        ("ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmn", ["'ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefgh...' is over 20 characters"]),
         ("  ", ["empty"]),
     ],
 )

@@ -211,8 +211,13 @@ def _reject_constant(name: str):
 
 
 def _short(value: object, limit: int = 40) -> str:
+    """`value` as Python writes it, cut to about `limit` characters; a string keeps its closing quote."""
     text = repr(value)
-    return text if len(text) <= limit else text[: limit - 3] + "..."
+    if len(text) <= limit:
+        return text
+    if isinstance(value, str):
+        return repr(value[: limit - 6] + "...")  # (a user test: the cut name's quote was left open)
+    return text[: limit - 3] + "..."
 
 
 def encode_json(frame_type: int, message: dict) -> bytes:
