@@ -166,3 +166,16 @@ def test_students_see_the_moment_on_view(demos):
             assert "rewound 1.00 s" in seen["scene"].status
         finally:
             student.close()
+
+
+def test_a_demo_started_while_paused_starts_paused_at_its_beginning_and_space_runs_it(app):
+    # docs/teacher.md: the teacher can talk the class through the set-up first.
+    run_frames(app, 30)
+    press(app, pygame.K_SPACE)
+    press(app, pygame.K_2)
+    assert app.paused and app.table.time_s == 0.0
+    run_frames(app, 5)
+    assert app.table.time_s == 0.0
+    press(app, pygame.K_SPACE)
+    run_frames(app, 5)
+    assert not app.paused and app.table.time_s > 0.0
