@@ -37,7 +37,7 @@ def test_a_class_behind_one_router_is_turned_away_with_how_to_let_it_in(make_ser
     assert server.player_count == 3
     # The student reads why and what the teacher can do; the window waits and asks again (a user test: it
     # quit within a second, and "your computer already plays with 3 windows" was not true behind a router).
-    sentence, retry = refused[0]
+    sentence, retry, _ = refused[0]
     assert retry and "3 windows from your address (127.0.0.9) play already" in sentence
     assert "--per-address" in sentence and "--password" in sentence and "one router" in sentence
     # The projector says it under the join lines, the fix first (a narrow band cut it); the log says it once.

@@ -612,7 +612,7 @@ def test_password(make_server, clients):
     c = clients(server.port)
     c.send(proto.encode_hello("Ann", "sesame"))
     got = c.next_frame()
-    sentence, retry = proto.parse_error_message(got[1])
+    sentence, retry, _ = proto.parse_error_message(got[1])
     assert "waiting 1 s" in sentence and retry
 
     def joined():
@@ -737,7 +737,7 @@ def test_a_handshake_that_says_nothing_is_dropped_after_its_deadline(make_server
     server = make_server(hello_timeout_s=0.1, timeout_s=30)
     c = clients(server.port)
     kind, payload = c.next_frame()
-    sentence, retry = proto.parse_error_message(payload)
+    sentence, retry, _ = proto.parse_error_message(payload)
     # A HELLO lost on the way looks the same: an airtable client tries again, never ends its session.
     assert kind == proto.ERROR and "your hello did not reach the table within 0.1 s" in sentence and retry
     c.close()

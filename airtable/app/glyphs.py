@@ -58,7 +58,8 @@ class NameCheck:
         ch = next((c for c in name if self._lacks(c)), None)
         if ch is None:
             return None
-        instead = f"write {self._instead(ch)!r} for it" if self._instead(ch) else "leave it out"
+        sub = self._instead(ch)
+        instead = f"write {sub!r} for it" if sub else "leave it out"
         # The whole name as it could be written, so the student need not work it out letter by letter.
         kept = " ".join("".join(self._instead(c) for c in name).split())
         if any(c.isalnum() for c in kept):
@@ -74,4 +75,5 @@ class NameCheck:
         """`ch` if it can be drawn, else its letter without accents if that can, else nothing."""
         if not self._lacks(ch):
             return ch
-        return _plain(ch) if not self._lacks(_plain(ch)) else ""
+        plain = _plain(ch)
+        return plain if not self._lacks(plain) else ""

@@ -257,13 +257,17 @@ class Predict(Feature):
         self.publish()
 
     def _end(self, said: str) -> None:
-        """Close the round and leave the table as it was when the round opened (a user test: a running
-        table stayed paused after F6, F6, F6), and say which, as the status line's PAUSED does."""
+        """Close the round (_close) and say so, and whether the table runs, as the status line's PAUSED does."""
+        self._close()
+        after = "paused, as before the round (Space runs on)" if self._paused_before else "the table runs on"
+        self.host.say(f"{said}: {after}")
+
+    def _close(self) -> None:
+        """Close the round, tell the students, and leave the table as it was when the round opened (a user
+        test: a running table stayed paused after F6, F6, F6)."""
         self.round.close()
         self.publish()
         self.host.paused = self._paused_before
-        after = "paused, as before the round (Space runs on)" if self._paused_before else "the table runs on"
-        self.host.say(f"{said}: {after}")
 
     def on_escape(self) -> bool:
         """Esc during a round ends it, as closing an overlay would, leaving the table running or paused as
@@ -325,9 +329,7 @@ class Predict(Feature):
     def on_demo_start(self, table) -> None:
         """A new demo: a round under way ends with it, and the table runs or not as before the round."""
         if self.round.active:
-            self.round.close()
-            self.publish()
-            self.host.paused = self._paused_before
+            self._close()
 
     def before_physics(self) -> None:
         """While the reveal plays nobody's string holds a puck, so the truth is what the guesses were about."""

@@ -359,7 +359,7 @@ class NetPlayer:
     def _first_frame(self, frames: list) -> tuple[proto.Welcome, list]:
         frame_type, payload = frames[0]
         if frame_type == proto.ERROR:
-            sentence, retry, about = proto.parse_error_reply(payload)
+            sentence, retry, about = proto.parse_error_message(payload)
             raise _ConnectError(sentence, retry=retry, full=retry, about=about)
         if frame_type != proto.WELCOME:
             raise proto.ProtocolError(f"the first message was {proto.FRAME_NAMES[frame_type]}, not WELCOME")
@@ -472,7 +472,7 @@ class NetPlayer:
                 except proto.ProtocolError as e:
                     self.skipped(f"left out a prediction round this client cannot use ({e})")
             elif frame_type == proto.ERROR:
-                sentence, retry = proto.parse_error_message(payload)
+                sentence, retry, _ = proto.parse_error_message(payload)
                 raise _ConnectionEndedError(None if retry else sentence)
             elif frame_type == proto.BYE:
                 self._said_bye = True

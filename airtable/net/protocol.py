@@ -609,13 +609,9 @@ def encode_error(sentence: str, retry: bool = False, about: str | None = None) -
     return encode_json(ERROR, message)
 
 
-def parse_error_message(payload: bytes) -> tuple[str, bool]:
-    """(sentence, retry) of an ERROR; the sentence is made safe to print on one line."""
-    return parse_error_reply(payload)[:2]
-
-
-def parse_error_reply(payload: bytes) -> tuple[str, bool, str | None]:
-    """(sentence, retry, about) of an ERROR: `about` is the HELLO field it refused ("name"), or None."""
+def parse_error_message(payload: bytes) -> tuple[str, bool, str | None]:
+    """(sentence, retry, about) of an ERROR: the sentence made safe to print on one line; `about` the
+    HELLO field it refused ("name"), or None."""
     try:
         message = parse_json(payload, "the server's ERROR", '{"error": "..."}')
     except ProtocolError as e:
