@@ -125,18 +125,11 @@ def test_the_cluster_impulses_meet_the_contact_conditions_in_a_wedged_cluster(co
     centres, radii = touching_cluster(data, count)
     i, j = np.triu_indices(len(centres), 1)
     touch = np.abs(centres[i] - centres[j]) <= radii[i] + radii[j] + 1e-9
-    a = np.concatenate(
-        [i[touch], np.flatnonzero(centres.real <= radii + 1e-9), np.flatnonzero(centres.imag <= radii + 1e-9)]
-    )
-    b = np.concatenate([j[touch], -np.ones(len(a) - touch.sum(), dtype=int)])
-    d = centres[a] - np.where(b < 0, 0.0, centres[np.maximum(b, 0)])
-    n = np.concatenate(
-        [
-            d[: touch.sum()] / np.abs(d[: touch.sum()]),
-            np.ones((centres.real <= radii + 1e-9).sum()),
-            1j * np.ones((centres.imag <= radii + 1e-9).sum()),
-        ]
-    )
+    left, floor = np.flatnonzero(centres.real <= radii + 1e-9), np.flatnonzero(centres.imag <= radii + 1e-9)
+    a = np.concatenate([i[touch], left, floor])
+    b = np.concatenate([j[touch], -np.ones(len(left) + len(floor), dtype=int)])
+    d = centres[i[touch]] - centres[j[touch]]
+    n = np.concatenate([d / np.abs(d), np.ones(len(left)), 1j * np.ones(len(floor))])
     kg = 10.0 ** np.array(data.draw(st.lists(st.floats(-3.0, 3.0), min_size=len(centres), max_size=len(centres))))
     v = np.array(
         data.draw(st.lists(st.complex_numbers(max_magnitude=10.0), min_size=len(centres), max_size=len(centres)))
