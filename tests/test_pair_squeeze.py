@@ -137,9 +137,34 @@ def test_the_cluster_impulses_meet_the_contact_conditions_in_a_wedged_cluster(co
     slack = np.array(data.draw(st.lists(st.sampled_from([0.0, 0.0, 0.1, 1.0]), min_size=len(a), max_size=len(a))))
     vn = (n.conjugate() * (v[a] - np.where(b < 0, 0.0, v[np.maximum(b, 0)]))).real + slack
     a_mat = collapse.response(n, a, b, 1.0 / kg)
-    p = collapse.solve(a_mat, vn)
+    # Where it starts (the contacts that pushed in the last step, in the engine) changes nothing.
+    pushed = np.array(data.draw(st.lists(st.booleans(), min_size=len(a), max_size=len(a))), dtype=bool)
+    p = collapse.solve(a_mat, vn, pushed if data.draw(st.booleans()) else None)
     after = vn + a_mat @ p
     round_off = 1e-9 * (np.abs(vn).max() + np.abs(a_mat) @ p)  # (the sum's terms)
     assert p.min() >= 0.0
     assert (after >= -round_off).all()
     assert (np.abs(after) <= round_off)[p > 0.0].all()
+
+
+def jacobian_response(n: np.ndarray, a: np.ndarray, b: np.ndarray, inv_mass: np.ndarray) -> np.ndarray:
+    """By hand: J W J^T, J's row k holding n_k on body a[k]'s x and y and -n_k on body b[k]'s (none for a wall)."""
+    jac = np.zeros((len(n), 2 * len(inv_mass)))
+    for k, (nk, ak, bk) in enumerate(zip(n, a, b, strict=True)):
+        jac[k, 2 * ak : 2 * ak + 2] += (nk.real, nk.imag)
+        if bk >= 0:
+            jac[k, 2 * bk : 2 * bk + 2] -= (nk.real, nk.imag)
+    return jac @ np.diag(np.repeat(inv_mass, 2)) @ jac.T
+
+
+@settings(max_examples=100, deadline=None, derandomize=True)
+@given(bodies=st.integers(1, 12), contacts=st.integers(1, 40), data=st.data())
+def test_the_response_matrix_is_the_jacobian_times_the_inverse_masses_times_its_transpose(bodies, contacts, data):
+    # Built from the pairs of contacts that share a body (collapse.response); any contacts, any masses.
+    a = np.array(data.draw(st.lists(st.integers(0, bodies - 1), min_size=contacts, max_size=contacts)))
+    b = np.array([data.draw(st.integers(-1, bodies - 1).filter(lambda x, ak=ak: x != ak)) for ak in a])
+    n = np.exp(1j * np.array(data.draw(st.lists(st.floats(-4.0, 4.0), min_size=contacts, max_size=contacts))))
+    inv = 10.0 ** np.array(data.draw(st.lists(st.floats(-3.0, 3.0), min_size=bodies, max_size=bodies)))
+    expected = jacobian_response(n, a, b, inv)
+    got = collapse.response(n, a, b, inv)
+    np.testing.assert_allclose(got, expected, rtol=1e-12, atol=1e-12 * np.abs(expected).max())

@@ -14,11 +14,12 @@ pass through (a 0.1 kg puck between two 1 kg ones at 100 m/s, restitution 0).
 This is a small linear complementarity problem (Catto's contact impulses, or
 Baraff's): find impulses p >= 0 with vn + A p >= 0 and p (vn + A p) = 0. A
 cluster holds a few contacts, so it is solved exactly by trying active sets
-(the contacts that push) with a least-squares solve each (block pivoting),
-not by iterating: for a light puck between heavy ones, sequential impulses
-converge as slowly as the hits themselves. Where block pivoting goes round
-in circles (dependent contacts: a puck wedged under two others and on the
-floor), Murty's method, one contact at a time, settles it.
+(the contacts that push) with a linear solve each (block pivoting, starting
+from the contacts that pushed in the last step, if known), not by iterating:
+for a light puck between heavy ones, sequential impulses converge as slowly
+as the hits themselves. Where block pivoting goes round in circles
+(dependent contacts: a puck wedged under two others and on the floor),
+Murty's method, one contact at a time, settles it.
 """
 
 from __future__ import annotations
@@ -35,6 +36,9 @@ MURTY_TRIES = 20
 # one answer, which block pivoting can miss and Murty's method finds.
 COMPLIANCE = 1e-10
 ROUND_OFF = 1e-12  # of a sum, relative to its largest terms: what an active set may miss by
+# Impulses this many times those that would stop each contact on its own are round-off along a
+# dependence of contacts (see _pushes), not an answer.
+OUT_OF_SCALE = 1e6
 
 
 def impulses(n: np.ndarray, vn: np.ndarray, a: np.ndarray, b: np.ndarray, inv_mass: np.ndarray) -> np.ndarray:
@@ -48,40 +52,76 @@ def impulses(n: np.ndarray, vn: np.ndarray, a: np.ndarray, b: np.ndarray, inv_ma
 
 
 def response(n: np.ndarray, a: np.ndarray, b: np.ndarray, inv_mass: np.ndarray) -> np.ndarray:
-    """(m, m) how each contact's relative normal velocity changes per unit impulse of each (see impulses)."""
+    """(m, m) how each contact's relative normal velocity changes per unit impulse of each (see impulses).
+
+    Two contacts act on each other only through a body they share: entry (k, l) sums, over the bodies
+    k and l share, the body's 1 / mass times n_k . n_l, signed by the sides (a or b) they touch it on.
+    Built from those pairs alone: a pile's contacts share a body with a handful of others each.
+    """
     m = len(n)
-    jac = np.zeros((m, 2 * len(inv_mass)))  # each contact's normal on body a, minus it on body b
-    rows = np.arange(m)
-    jac[rows, 2 * a], jac[rows, 2 * a + 1] = n.real, n.imag
-    wall = b < 0
-    on_b = np.where(wall, 0, b)
-    jac[rows, 2 * on_b] -= np.where(wall, 0.0, n.real)
-    jac[rows, 2 * on_b + 1] -= np.where(wall, 0.0, n.imag)
-    return (jac * np.repeat(inv_mass, 2)) @ jac.T
+    out = np.zeros((m, m))
+    flat = out.reshape(-1)
+    on_wall = b < 0
+    out[np.arange(m), np.arange(m)] = inv_mass.take(a) + np.where(on_wall, 0.0, inv_mass.take(np.maximum(b, 0)))
+    pucks = np.flatnonzero(~on_wall)
+    body = np.concatenate([a, b.take(pucks)])  # each contact's ends on a puck: a always, b unless a wall
+    contact = np.concatenate([np.arange(m), pucks])
+    side = np.concatenate([n, -n.take(pucks)])  # the normal as it pushes that body
+    order = np.argsort(body, kind="stable")
+    body, contact, side = body.take(order), contact.take(order), side.take(order)
+    for gap in range(1, len(body)):  # ends `gap` apart in body order that share a body (a handful of gaps)
+        same = np.flatnonzero(body[gap:] == body[:-gap])
+        if len(same) == 0:
+            break
+        first, second = contact.take(same), contact.take(same + gap)
+        value = inv_mass.take(body.take(same)) * (side.take(same) * side.take(same + gap).conjugate()).real
+        np.add.at(flat, np.concatenate([first * m + second, second * m + first]), np.concatenate([value, value]))
+    return out
 
 
-def solve(a_mat: np.ndarray, vn: np.ndarray) -> np.ndarray:
-    """The impulses p >= 0 with vn + a_mat p >= 0 and p (vn + a_mat p) = 0 (see impulses; a_mat: response)."""
-    active = vn < 0.0
+def solve(a_mat: np.ndarray, vn: np.ndarray, pushed: np.ndarray | None = None) -> np.ndarray:
+    """The impulses p >= 0 with vn + a_mat p >= 0 and p (vn + a_mat p) = 0 (see impulses; a_mat: response).
+
+    pushed: the contacts likely to push (those that pushed in the last step), to start from: a pile's
+    active set changes little from step to step, and block pivoting then settles in a try or two.
+    """
+    active = vn < 0.0 if pushed is None else (vn < 0.0) | pushed
+    tried = set()
     for _ in range(TRIES):  # block pivoting: every contact that pulls lets go, every one that closes pushes
-        p = _pushes(a_mat, vn, active, _least_squares)
+        p = _pushes(a_mat, vn, active)
         wrong = _wrong(a_mat, vn, active, p)
         if not wrong.any():
             return np.maximum(p, 0.0)
+        tried.add(active.tobytes())
         active ^= wrong
+        if active.tobytes() in tried:
+            break  # round in circles: Murty's method ends
     return _murty(a_mat + COMPLIANCE * np.diag(np.diag(a_mat)), vn, active)
 
 
-def _pushes(a_mat: np.ndarray, vn: np.ndarray, active: np.ndarray, solver) -> np.ndarray:
-    """The impulses with which the `active` contacts stop approaching (the others: 0), by solver(A, b)."""
+def _pushes(a_mat: np.ndarray, vn: np.ndarray, active: np.ndarray, definite: bool = False) -> np.ndarray:
+    """The impulses with which the `active` contacts stop approaching (the others: 0).
+
+    By LU, quick. Unless a_mat is `definite` (and LU's answer finite), where LU's answer pulls somewhere
+    or is out of all scale, again by least squares: on dependent contacts (more than the ways their pucks can move) LU's
+    equations are singular but for round-off, and its impulses push and pull against each other
+    along the dependence, where least squares gives the smallest that stop the contacts."""
     p = np.zeros(len(vn))
-    if active.any():
-        p[active] = solver(a_mat[np.ix_(active, active)], -vn[active])
+    if not active.any():
+        return p
+    sub, rhs = a_mat[np.ix_(active, active)], -vn[active]
+    try:
+        p[active] = np.linalg.solve(sub, rhs)
+    except np.linalg.LinAlgError:  # (singular to the last bit)
+        p[active] = np.nan
+    if definite and np.isfinite(p).all():
+        return p
+    # Stopping each contact on its own takes |vn| / A_kk; a pile passes support along (N pucks: N times
+    # that) and a shallow wedge magnifies it (1 / tan of its angle), but not by OUT_OF_SCALE.
+    scale = OUT_OF_SCALE * float(np.abs(rhs).sum()) / max(float(np.diag(sub).min()), 1e-300)
+    if not (p >= -ROUND_OFF * np.abs(p).max()).all() or np.abs(p).max() > scale:  # (NaN too)
+        p[active] = np.linalg.lstsq(sub, rhs, rcond=None)[0]
     return p
-
-
-def _least_squares(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    return np.linalg.lstsq(a, b, rcond=None)[0]
 
 
 def _wrong(a_mat: np.ndarray, vn: np.ndarray, active: np.ndarray, p: np.ndarray) -> np.ndarray:
@@ -98,7 +138,7 @@ def _murty(a_mat: np.ndarray, vn: np.ndarray, active: np.ndarray) -> np.ndarray:
     until none is. a_mat is positive definite here, so it ends, at the one answer."""
     p = np.zeros(len(vn))
     for _ in range(MURTY_TRIES * len(vn)):
-        p = _pushes(a_mat, vn, active, np.linalg.solve)
+        p = _pushes(a_mat, vn, active, definite=True)
         wrong = np.flatnonzero(_wrong(a_mat, vn, active, p))
         if len(wrong) == 0:
             break

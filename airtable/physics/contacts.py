@@ -232,9 +232,12 @@ class ContactSolver:
 
     def _last_step(self, i: np.ndarray, j: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """(where each pair (i, j) is or would be among the last step's contacts, whether it is one)."""
-        if len(self._keys) == 0 or len(i) == 0:
-            return np.zeros(len(i), dtype=np.intp), np.zeros(len(i), dtype=bool)
-        keys = i.astype(np.int64) * (self._rows + 4) + j
+        return self._find(i.astype(np.int64) * (self._rows + 4) + j)
+
+    def _find(self, keys: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """(where each contact of `keys` is or would be among the last step's contacts, whether it is one)."""
+        if len(self._keys) == 0 or len(keys) == 0:
+            return np.zeros(len(keys), dtype=np.intp), np.zeros(len(keys), dtype=bool)
         found = np.searchsorted(self._keys, keys).clip(0, len(self._keys) - 1)
         return found, self._keys.take(found) == keys
 
@@ -360,9 +363,10 @@ class ContactSolver:
         target = _targets(c, dt)
         vn = (c.n.conjugate() * (w.take(c.a, axis=0)[:, 0] - w.take(c.b, axis=0)[:, 0])).real
         response = collapse.response(c.n, a, b, inv.take(bodies))  # (one matrix for both problems)
+        pushed = self._pushed(c.keys)  # (where to start: the set that pushed changes little from step to step)
         impulses = columns(
-            collapse.solve(response, vn - target[:, 0]),  # vn after: at least the bound
-            collapse.solve(response, -target[:, 1]),  # the pseudo-velocity: from 0
+            collapse.solve(response, vn - target[:, 0], pushed[:, 0]),  # vn after: at least the bound
+            collapse.solve(response, -target[:, 1], pushed[:, 1]),  # the pseudo-velocity: from 0
         )
         for col in (0, 1):
             push = impulses[:, col] * c.n
@@ -373,6 +377,13 @@ class ContactSolver:
         self._band_rounds = self._free_rounds = np.empty(0, dtype=np.intp)
         self.iterations = 1
         return impulses
+
+    def _pushed(self, keys: np.ndarray) -> np.ndarray:
+        """(m, 2) which of the contacts `keys` pushed in the last step, in velocity and in position."""
+        found, kept = self._find(keys)
+        if not kept.any():
+            return np.zeros((len(keys), 2), dtype=bool)
+        return kept[:, None] & (self._impulses.take(found, axis=0) > 0.0)
 
     def _gather(self, c: _Contacts, inv, dt: float, asleep=None) -> tuple[_Layout, _Layout]:
         """This step's targets, inverse masses (inv, with the walls' 0 last) and warm-start impulses,
