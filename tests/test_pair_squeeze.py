@@ -139,7 +139,11 @@ def test_the_cluster_impulses_meet_the_contact_conditions_in_a_wedged_cluster(co
     a_mat = collapse.response(n, a, b, 1.0 / kg)
     # Where it starts (the contacts that pushed in the last step, in the engine) changes nothing.
     pushed = np.array(data.draw(st.lists(st.booleans(), min_size=len(a), max_size=len(a))), dtype=bool)
-    p = collapse.solve(a_mat, vn, pushed if data.draw(st.booleans()) else None)
+    with pytest.MonkeyPatch.context() as patch:
+        if data.draw(st.booleans()):  # none of plain block pivoting's tries: the safe pivoting (_settle) alone
+            patch.setattr(collapse, "TRIES", 0)
+        p = collapse.solve(a_mat, vn, pushed if data.draw(st.booleans()) else None)
+    assert p is not None
     after = vn + a_mat @ p
     round_off = 1e-9 * (np.abs(vn).max() + np.abs(a_mat) @ p)  # (the sum's terms)
     assert p.min() >= 0.0

@@ -65,21 +65,25 @@ from airtable.physics import collapse, collision, colouring, vectors
 # the loop stops early once an iteration changes no velocity by CONVERGED_MPS.
 ITERATIONS = 10
 # A step may spend about this many contact-iterations before it stops unconverged,
-# and at most MAX_ITERATIONS: a small group of contacts (a stack, a slab) gets as
-# many iterations as its chains need (a column of 7 with masses 8 times apart,
-# dropped: about 100), and a pile of 800 contacts or more its ITERATIONS (an 800-puck
-# pile settling has 1000 to 2000 awake ones: more iterations there cost more than they show).
-ITERATION_WORK = 8_000
+# and at most MAX_ITERATIONS: a group of contacts too many to solve exactly (a heap of a hundred
+# pucks) gets as many iterations as its chains need (a 101-puck heap's 310 contacts, dropped at dt
+# 1/60: at 25 iterations its pucks sank 4.5 mm into each other, at 70 1.3 mm), and a pile of 2200
+# contacts or more its ITERATIONS (an 800-puck pile settling has 1000 to 2300 awake ones: more
+# iterations there cost more than they show).
+ITERATION_WORK = 22_000
 MAX_ITERATIONS = 200
-# Up to this many contacts (a stack, a slab, a heap of a few dozen pucks) are solved exactly, at once
+# Up to this many contacts (a stack, a slab, a heap of fifty pucks) are solved exactly, at once
 # (collapse.solve: the complementarity problem by active sets), not by sequential impulses, whose
 # chains converge as slowly as the masses along them differ: a stack with masses 1 to 1e5 upward,
 # dropped at restitution 0, crushed its bottom pucks into each other and jumped up (a user test);
 # a 29-puck heap's small puck, wedged on the floor between two bigger ones at 2 m/s, still sank 4 mm
-# into them after 135 iterations over its 59 contacts. Up to here the exact solve also costs less than
-# the iterations do (a 90-puck heap dropped: 1.6 s, against 3.2 s at 24); beyond it, its pivoting costs
-# more (at 120, a 40-puck heap took 15 s, against 2.7 s).
-EXACT_MAX = 64
+# into them after 135 iterations over its 59 contacts, and an 80-puck heap 5.6 mm after 50 over its
+# 160. Up to here the exact solve costs what the iterations do, or less (heaps of 68 to 80 pucks
+# dropped: 0.6 ms a step for up to 50 contacts, 3 ms up to 150, against 17 to 25 ms for
+# ITERATION_WORK's iterations); beyond, its LU solves grow as the cube of the contacts and its
+# pivots in number (175 to 200 contacts: 8 ms a step, 40 to 60 ms on an 80-puck heap; 200 to 300:
+# 34 to 47 ms). If its pivoting does not settle (collapse.PIVOTS), the step takes the iterations.
+EXACT_MAX = 160
 CONVERGED_MPS = 1e-7
 # The first iteration's rounds go bottom-up by horizontal bands this many
 # radii high (a contact after its pucks' contacts of lower bands): support from
@@ -337,9 +341,8 @@ class ContactSolver:
         w = np.zeros((len(pos) + 1, 2), dtype=complex)  # velocities and pseudo-velocities; the last row: walls
         w[:-1, 0] = vectors.as_complex(np.ascontiguousarray(vel))
         v0 = w[:-1, 0].copy()
-        if self.count <= EXACT_MAX:
-            impulses = self._solve_exactly(c, inv, w, dt)
-        else:
+        impulses = self._solve_exactly(c, inv, w, dt) if self.count <= EXACT_MAX else None
+        if impulses is None:  # (many contacts, or a few hundred the exact solve did not settle)
             impulses = self._solve_iteratively(c, inv, w, dt, mass, asleep)
         self._keep(c, impulses)
         moved = (w[:-1, 0] - v0 + w[:-1, 1]) * dt
@@ -354,9 +357,10 @@ class ContactSolver:
         self.iterations, layout = _iterate(w, first, later)
         return layout.impulses()
 
-    def _solve_exactly(self, c: _Contacts, inv: np.ndarray, w: np.ndarray, dt: float) -> np.ndarray:
+    def _solve_exactly(self, c: _Contacts, inv: np.ndarray, w: np.ndarray, dt: float) -> np.ndarray | None:
         """A few contacts (EXACT_MAX) solved at once, exactly (collapse.solve), velocities and
-        pseudo-velocities in `w` in place; returns their impulses (m, 2), contact by contact."""
+        pseudo-velocities in `w` in place; returns their impulses (m, 2), contact by contact, or
+        None (`w` untouched) if the solve did not settle."""
         m, rows = len(c.a), self._rows
         bodies, local = np.unique(np.concatenate([c.a, c.b]), return_inverse=True)  # (the bodies these touch)
         a, b = local[:m], np.where(c.b == rows, -1, local[m:])  # (collapse's wall: -1)
@@ -364,10 +368,11 @@ class ContactSolver:
         vn = (c.n.conjugate() * (w.take(c.a, axis=0)[:, 0] - w.take(c.b, axis=0)[:, 0])).real
         response = collapse.response(c.n, a, b, inv.take(bodies))  # (one matrix for both problems)
         pushed = self._pushed(c.keys)  # (where to start: the set that pushed changes little from step to step)
-        impulses = columns(
-            collapse.solve(response, vn - target[:, 0], pushed[:, 0]),  # vn after: at least the bound
-            collapse.solve(response, -target[:, 1], pushed[:, 1]),  # the pseudo-velocity: from 0
-        )
+        velocity = collapse.solve(response, vn - target[:, 0], pushed[:, 0])  # vn after: at least the bound
+        position = None if velocity is None else collapse.solve(response, -target[:, 1], pushed[:, 1])  # from 0
+        if position is None:
+            return None
+        impulses = columns(velocity, position)
         for col in (0, 1):
             push = impulses[:, col] * c.n
             np.add.at(w[:, col], c.a, push * inv.take(c.a))
