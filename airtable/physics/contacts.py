@@ -342,7 +342,7 @@ class ContactSolver:
         w[:-1, 0] = vectors.as_complex(np.ascontiguousarray(vel))
         v0 = w[:-1, 0].copy()
         impulses = self._solve_exactly(c, inv, w, dt) if self.count <= EXACT_MAX else None
-        if impulses is None:  # (many contacts, or a few hundred the exact solve did not settle)
+        if impulses is None:  # (many contacts, or those the exact solve did not settle)
             impulses = self._solve_iteratively(c, inv, w, dt, mass, asleep)
         self._keep(c, impulses)
         moved = (w[:-1, 0] - v0 + w[:-1, 1]) * dt
