@@ -70,7 +70,7 @@ def response(n: np.ndarray, a: np.ndarray, b: np.ndarray, inv_mass: np.ndarray) 
     out = np.zeros((m, m))
     flat = out.reshape(-1)
     on_wall = b < 0
-    out[np.arange(m), np.arange(m)] = inv_mass.take(a) + np.where(on_wall, 0.0, inv_mass.take(np.maximum(b, 0)))
+    np.fill_diagonal(out, inv_mass.take(a) + np.where(on_wall, 0.0, inv_mass.take(np.maximum(b, 0))))
     pucks = np.flatnonzero(~on_wall)
     body = np.concatenate([a, b.take(pucks)])  # each contact's ends on a puck: a always, b unless a wall
     contact = np.concatenate([np.arange(m), pucks])
