@@ -139,12 +139,10 @@ def _near_each(pos: np.ndarray, radius: np.ndarray, rows: np.ndarray, margin_m: 
     """(a, b): each of `rows` (a) with every puck b closer than r_a + r_b + margin_m, itself too
     (the arithmetic of _closer_than, without gathering a copy of each puck for each row)."""
     z = vectors.as_complex(np.ascontiguousarray(pos, dtype=np.float64))
-    a, b = [], []
-    for r in rows.tolist():
-        near = rows_near(z, radius, z.item(r), radius.item(r), margin_m)
-        a.append(np.full(len(near), r))
-        b.append(near)
-    return np.concatenate(a), np.concatenate(b)
+    reach = (radius.take(rows)[:, None] + radius[None, :]) + margin_m  # (rows, pucks): at most NEAR_BRUTE_FORCE_LOOKS
+    d = z.take(rows)[:, None] - z[None, :]
+    k, b = (d.real * d.real + d.imag * d.imag < reach * reach).nonzero()  # (rows_near's arithmetic, all rows at once)
+    return rows.take(k), b
 
 
 def rows_near(z: np.ndarray, radius: np.ndarray, centre: complex, radius_m: float, margin_m: float) -> np.ndarray:

@@ -158,6 +158,8 @@ def _pair_contacts(pos, vel, ci, cj, reach, rest, held, margin, kept=None) -> _C
         maybe = np.flatnonzero((squared < hold * hold) & ~near)
         near[maybe] = kept(ci.take(maybe), cj.take(maybe))
     near = np.flatnonzero(near)
+    if len(near) == 0:  # (most steps of a few pucks: none of the work below)
+        return _no_contacts()
     i, j = ci.take(near), cj.take(near)
     n, dist = vectors.unit_vectors(vectors.take(d, near), i + j)
     vn = vectors.dot_rows(vectors.take(vel, i) - vectors.take(vel, j), n)
@@ -173,20 +175,26 @@ def _pair_contacts(pos, vel, ci, cj, reach, rest, held, margin, kept=None) -> _C
 
 
 def _wall_contacts(pos, vel, radius, size_m, rest, margin) -> _Contacts:
-    """The pucks within margin of a wall, moving into it slower than their rest speed (rest: (N, 2), per axis)."""
-    rows, which, gap, vn = [], [], [], []
-    fits = ~collision.wedged(radius[:, None], size_m)  # (N, 2): wedged between two walls, neither holds it
-    for w, (room, away) in enumerate(collision.each_wall(pos, vel, radius, size_m)):
-        k = np.flatnonzero((room < margin) & (away >= -rest[:, w % 2]) & fits[:, w % 2])
-        rows.append(k)
-        which.append(np.full(len(k), w))
-        gap.append(room.take(k))
-        vn.append(away.take(k))
-    a, w = np.concatenate(rows), np.concatenate(which)
+    """The pucks within margin of a wall, moving into it slower than their rest speed (rest: (N, 2), per axis).
+    Wall by wall (left, bottom, right, top: WALL_NORMALS'), each wall's pucks in row order."""
+    room = np.stack(collision.wall_rooms(pos[:, 0], pos[:, 1], radius, size_m))  # (4, N)
+    near = room < margin
+    if not near.any():  # (most steps of a few pucks: none of the work below)
+        return _no_contacts()
+    vx, vy = vel[:, 0], vel[:, 1]
+    away = np.stack((vx, vy, -vx, -vy))
+    across = np.tile(rest.T, (2, 1))  # (4, N): each wall's axis, x, y, x, y
+    fits = np.tile(~collision.wedged(radius, np.asarray(size_m)[:, None]), (2, 1))  # (wedged: neither wall holds it)
+    w, a = np.nonzero(near & (away >= -across) & fits)
     count = len(pos)
     keys = a.astype(np.int64) * (count + 4) + count + w
     b = np.full(len(a), count)
-    return _Contacts(a, b, WALL_NORMALS.take(w), np.concatenate(gap), np.concatenate(vn), keys)
+    return _Contacts(a, b, WALL_NORMALS.take(w), room[w, a], away[w, a], keys)
+
+
+def _no_contacts() -> _Contacts:
+    none = np.empty(0, dtype=np.intp)
+    return _Contacts(none, none, np.empty(0, dtype=complex), np.empty(0), np.empty(0), np.empty(0, dtype=np.int64))
 
 
 def _may_rest(i: np.ndarray, j: np.ndarray, asleep: np.ndarray | None, pressed: np.ndarray | None):
@@ -334,15 +342,15 @@ class ContactSolver:
         may = _may_rest(wc.a, wc.a, asleep, rest.pressed)
         if may is not None:
             wc = _Contacts(*(getattr(wc, f).take(may) for f in _FIELDS))
-        c = _Contacts(*(np.concatenate([getattr(pc, f), getattr(wc, f)]) for f in _FIELDS))
-        if began is None or not plain.all():  # where they were at the start if they approached
-            zm = np.append(vectors.as_complex(np.ascontiguousarray(moved)), 0.0)
-            c.gap = c.gap - np.minimum((c.n.conjugate() * (zm.take(c.a) - zm.take(c.b))).real, 0.0) * dt
-        self.count = len(c.a)
+        self.count = len(pc.a) + len(wc.a)
         if self.count == 0:
             self._keys, self._impulses = np.empty(0, dtype=np.int64), np.empty((0, 2))
             self._band_rounds = self._free_rounds = np.empty(0, dtype=np.intp)
             return False
+        c = _Contacts(*(np.concatenate([getattr(pc, f), getattr(wc, f)]) for f in _FIELDS))
+        if began is None or not plain.all():  # where they were at the start if they approached
+            zm = np.append(vectors.as_complex(np.ascontiguousarray(moved)), 0.0)
+            c.gap = c.gap - np.minimum((c.n.conjugate() * (zm.take(c.a) - zm.take(c.b))).real, 0.0) * dt
         self._y, self._r_mean = start[:, 1], float(radius.mean())  # for the bands
         inv = np.append(1.0 / mass, 0.0)  # the walls never move, nor do sleepers
         if asleep is not None:

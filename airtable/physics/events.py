@@ -414,8 +414,9 @@ class _Step:
         s = np.minimum(np.maximum(dw / np.where(ww > 0.0, ww, 1.0), 0.0), self.dt)  # time back from the end
         reach = self.radius.take(i) + self.radius.take(j)
         close = (dw - ww * self.dt < 0.0) & (vectors.squared_abs(d - w * s) < reach * reach)
-        if self.rules.rest is not None:  # (ww: at least the approach along the line of centres, squared)
-            close &= ww > self.rules.rest.pairs(i, j, d - w * self.dt) ** 2  # (their line at t = 0, as predict_pairs)
+        if self.rules.rest is not None and close.any():  # (ww: at least the approach along their line, squared)
+            k = close.nonzero()[0]  # (few: the rest speeds of these only; their line at t = 0, as predict_pairs)
+            close[k] = ww.take(k) > self.rules.rest.pairs(i.take(k), j.take(k), d.take(k) - w.take(k) * self.dt) ** 2
         if self.rules.pairs != "perfect-kiss":  # only fast pairs: the others are seen overlapping
             speed_sq = np.maximum(self.speed_sq.take(i), self.speed_sq.take(j))
             fast = _moves(speed_sq, np.minimum(self.radius.take(i), self.radius.take(j)), self.dt, FAST_FRACTION)
@@ -435,6 +436,8 @@ class _Step:
         step, in the pairs' order: numpy arrays of rows (a step's first pairs, or a puck's many partners,
         at once), or one pair (a and b ints) in Python numbers, by the same lines (either.py)."""
         rules, ours = self.rules, False
+        if isinstance(a, np.ndarray) and len(a) == 0:
+            return
         if rules.pairs != "perfect-kiss":  # the pair stage sees the others overlapping, if they hit
             fast = self.fast(a, b)
             if rules.pairs == "two-step":
