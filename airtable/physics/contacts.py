@@ -193,6 +193,7 @@ def _wall_contacts(pos, vel, radius, size_m, rest, margin) -> _Contacts:
 
 
 def _no_contacts() -> _Contacts:
+    """No contact: each field empty, of its type."""
     none = np.empty(0, dtype=np.intp)
     return _Contacts(none, none, np.empty(0, dtype=complex), np.empty(0), np.empty(0), np.empty(0, dtype=np.int64))
 
