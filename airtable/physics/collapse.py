@@ -87,16 +87,17 @@ def response(n: np.ndarray, a: np.ndarray, b: np.ndarray, inv_mass: np.ndarray) 
     return out
 
 
-def solve(a_mat: np.ndarray, vn: np.ndarray, pushed: np.ndarray | None = None) -> np.ndarray | None:
+def solve(a_mat: np.ndarray, vn: np.ndarray, pushed: np.ndarray | None = None, safe: bool = True) -> np.ndarray | None:
     """The impulses p >= 0 with vn + a_mat p >= 0 and p (vn + a_mat p) = 0 (see impulses; a_mat: response);
     None if the pivoting did not settle within its tries (a few hundred contacts, some dependent).
 
     pushed: the contacts likely to push (those that pushed in the last step), to start from: a pile's
     active set changes little from step to step, and block pivoting then settles in a try or two.
+    safe: where block pivoting does not settle in TRIES, the safe pivoting (_settle) goes on; else None.
     """
     active = vn < 0.0 if pushed is None else (vn < 0.0) | pushed
     p = _block_pivoting(a_mat, vn, active, TRIES)
-    return p if p is not None else _settle(a_mat, vn, active)
+    return p if p is not None or not safe else _settle(a_mat, vn, active)
 
 
 def _block_pivoting(a_mat: np.ndarray, vn: np.ndarray, active: np.ndarray, tries: int) -> np.ndarray | None:

@@ -87,12 +87,20 @@ DEEP_CHECKS = 5
 # dropped at restitution 0, crushed its bottom pucks into each other and jumped up (a user test);
 # a 29-puck heap's small puck, wedged on the floor between two bigger ones at 2 m/s, still sank 4 mm
 # into them after 135 iterations over its 59 contacts, and an 80-puck heap 5.6 mm after 50 over its
-# 160. Up to here the exact solve costs what the iterations do, or less (heaps of 68 to 80 pucks
-# dropped: 0.6 ms a step for up to 50 contacts, 3 ms up to 150, against 17 to 25 ms for
-# ITERATION_WORK's iterations); beyond, its LU solves grow as the cube of the contacts and its
-# pivots in number (175 to 200 contacts: 8 ms a step, 40 to 60 ms on an 80-puck heap; 200 to 300:
-# 34 to 47 ms). If its pivoting does not settle (collapse.PIVOTS), the step takes the iterations.
-EXACT_MAX = 160
+# 160; a 10 x 10 slab of masses three decades apart, thrown down (190 contacts), sank 23 mm and its
+# pucks leapt up at 1.8 m/s, in 54 ms a step. Up to here the exact solve costs what the iterations
+# do, or less (that slab: 3 ms a step, landing dead; heaps of 75 to 100 pucks, 180 to 330 contacts:
+# 4 to 18 ms a step against 7 to 24). Beyond 160 contacts it takes only block pivoting's TRIES
+# (collapse.solve, safe=False: its LU solves grow as the cube of the contacts, and the safe pivoting's
+# hundred of them cost 0.3 to 0.7 s on a few hundred dependent contacts, as where a pile falls asleep
+# around its last awake pucks); heaps settle so in 98 to 100 % of their steps. If the pivoting does
+# not settle, the step takes the iterations.
+EXACT_MAX = 400
+SAFE_MAX = 160
+# After the exact solve did not settle, this many steps go straight to the iterations: the same
+# contacts do not settle the next step either (where an 800-puck pile falls asleep around its last
+# awake pucks, 41 of 43 exact solves in a second did not, at 50 to 180 ms each).
+EXACT_PAUSE = 60
 CONVERGED_MPS = 1e-7
 # The first iteration's rounds go bottom-up by horizontal bands this many
 # radii high (a contact after its pucks' contacts of lower bands): support from
@@ -238,6 +246,7 @@ class ContactSolver:
         self._held_walls: tuple | None = None  # (_impulses, rows, axes) of the pucks pressed on a wall
         self.count = 0  # contacts in the last step
         self.iterations = 0  # iterations the last step needed
+        self._paused = 0  # steps left that skip the exact solve (EXACT_PAUSE)
 
     def held(self, i: np.ndarray, j: np.ndarray) -> np.ndarray:
         """Which pairs (i, j) pressed on each other in the last step (a non-zero impulse).
@@ -359,7 +368,12 @@ class ContactSolver:
         w = np.zeros((len(pos) + 1, 2), dtype=complex)  # velocities and pseudo-velocities; the last row: walls
         w[:-1, 0] = vectors.as_complex(np.ascontiguousarray(vel))
         v0 = w[:-1, 0].copy()
-        impulses = self._solve_exactly(c, inv, w, dt) if self.count <= EXACT_MAX else None
+        impulses = None
+        if self._paused:
+            self._paused -= 1
+        elif self.count <= EXACT_MAX:
+            impulses = self._solve_exactly(c, inv, w, dt)
+            self._paused = 0 if impulses is not None else EXACT_PAUSE
         if impulses is None:  # (many contacts, or those the exact solve did not settle)
             impulses = self._solve_iteratively(c, inv, w, dt, mass, asleep)
         self._keep(c, impulses)
@@ -386,8 +400,9 @@ class ContactSolver:
         vn = (c.n.conjugate() * (w.take(c.a, axis=0)[:, 0] - w.take(c.b, axis=0)[:, 0])).real
         response = collapse.response(c.n, a, b, inv.take(bodies))  # (one matrix for both problems)
         pushed = self._pushed(c.keys)  # (where to start: the set that pushed changes little from step to step)
-        velocity = collapse.solve(response, vn - target[:, 0], pushed[:, 0])  # vn after: at least the bound
-        position = None if velocity is None else collapse.solve(response, -target[:, 1], pushed[:, 1])  # from 0
+        safe = m <= SAFE_MAX
+        velocity = collapse.solve(response, vn - target[:, 0], pushed[:, 0], safe)  # vn after: at least the bound
+        position = None if velocity is None else collapse.solve(response, -target[:, 1], pushed[:, 1], safe)
         if position is None:
             return None
         impulses = columns(velocity, position)
@@ -515,7 +530,7 @@ class ContactSolver:
     # What the solver keeps from step to step: its impulses by contact (the warm start), and each
     # contact's rounds (they depend on the contacts it had before, so they change results). The
     # solver replaces these arrays each step and never changes them in place, so a save keeps references.
-    KEPT = ("_keys", "_impulses", "_rows", "_band_rounds", "_free_rounds", "count", "iterations")
+    KEPT = ("_keys", "_impulses", "_rows", "_band_rounds", "_free_rounds", "count", "iterations", "_paused")
     # Worked out afresh in each solve (the layouts from the kept rounds, the same in the same order):
     # they change no result, so a save need not keep them.
     NOT_KEPT = frozenset({"_y", "_r_mean", "_warm", "_key_order", "_layouts", "_wall_rest", "_held_walls"})
