@@ -39,7 +39,7 @@ def build(table, variation=0):
         # Done once both go right and the heavy one is faster: no more hits can come, and the count
         # is said at once. Both stop before the far wall sends the heavy one back.
         v_light, v_heavy = light.vel_mps[0], heavy.vel_mps[0]
-        if 0.0 <= v_light <= v_heavy:
+        if -1e-12 * abs(v_heavy) <= v_light <= v_heavy:  # (the light one may end at rest but for round-off)
             pairs, walls = table.collision_count, table.wall_collision_count
             table.notices.say(
                 "pi",

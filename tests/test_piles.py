@@ -200,8 +200,8 @@ def slab(table: AirTable, across: int, rows: int, r: float, hexagonal: bool, thr
 def test_a_slab_too_big_to_solve_exactly_lands_without_sinking_into_itself(
     across: int, rows: int, r: float, hexagonal: bool, throw_mps: float, dt: float
 ) -> None:
-    """A slab of 96 to 300 pucks thrown down at restitution 0 (186 to 1600 contacts: the most of them beyond
-    contacts.EXACT_MAX, solved by iterations). Through its landing, until a quarter of a second after it
+    """A slab of 96 to 300 pucks thrown down at restitution 0 (186 to 1600 contacts: those beyond
+    contacts.EXACT_MAX solved by iterations). Through its landing, until a quarter of a second after it
     reaches the floor, no puck sinks OVERLAP_M into another or into the floor. (Later a frictionless slab
     spreads: its edge pucks slide off, and a square one's columns tip over, as hard discs do.)"""
     r = min(r, 4.0 / across)  # (it fits the 10 m table with room on each side)

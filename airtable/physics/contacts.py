@@ -92,7 +92,7 @@ DEEP_CHECKS = 5
 # do, or less (that slab: 3 ms a step, landing dead; heaps of 75 to 100 pucks, 180 to 330 contacts:
 # 4 to 18 ms a step against 7 to 24). Beyond 160 contacts it takes only block pivoting's TRIES
 # (collapse.solve, safe=False: its LU solves grow as the cube of the contacts, and the safe pivoting's
-# hundred of them cost 0.3 to 0.7 s on a few hundred dependent contacts, as where a pile falls asleep
+# hundred of them cost 0.2 to 0.7 s on a few hundred dependent contacts, as where a pile falls asleep
 # around its last awake pucks); heaps settle so in 98 to 100 % of their steps. If the pivoting does
 # not settle, the step takes the iterations.
 EXACT_MAX = 400
@@ -368,12 +368,7 @@ class ContactSolver:
         w = np.zeros((len(pos) + 1, 2), dtype=complex)  # velocities and pseudo-velocities; the last row: walls
         w[:-1, 0] = vectors.as_complex(np.ascontiguousarray(vel))
         v0 = w[:-1, 0].copy()
-        impulses = None
-        if self._paused:
-            self._paused -= 1
-        elif self.count <= EXACT_MAX:
-            impulses = self._solve_exactly(c, inv, w, dt)
-            self._paused = 0 if impulses is not None else EXACT_PAUSE
+        impulses = self._try_exactly(c, inv, w, dt)
         if impulses is None:  # (many contacts, or those the exact solve did not settle)
             impulses = self._solve_iteratively(c, inv, w, dt, mass, asleep)
         self._keep(c, impulses)
@@ -388,6 +383,17 @@ class ContactSolver:
         w[:-1, 0] += _warm_push(c, mass, self._warm, asleep)  # warm start: last step's velocity impulses first
         self.iterations, layout = _iterate(w, first, later, lambda: _sinks(c, w, dt) > DEEPEST_M)
         return layout.impulses()
+
+    def _try_exactly(self, c: _Contacts, inv: np.ndarray, w: np.ndarray, dt: float) -> np.ndarray | None:
+        """_solve_exactly, unless the contacts are too many (EXACT_MAX) or one did not settle lately (EXACT_PAUSE)."""
+        if self._paused:
+            self._paused -= 1
+            return None
+        if self.count > EXACT_MAX:
+            return None
+        impulses = self._solve_exactly(c, inv, w, dt)
+        self._paused = 0 if impulses is not None else EXACT_PAUSE
+        return impulses
 
     def _solve_exactly(self, c: _Contacts, inv: np.ndarray, w: np.ndarray, dt: float) -> np.ndarray | None:
         """A few contacts (EXACT_MAX) solved at once, exactly (collapse.solve), velocities and

@@ -24,7 +24,8 @@ if TYPE_CHECKING:
 IMPLICIT_NOTICE = (
     f"Some springs vibrate faster than even {substeps.MAX_SUBSTEPS} substeps of a step can follow: the step"
     " solves them implicitly, so they hold and sag as their k says, but their vibrations die away, the fastest"
-    " within a step or two and the slowest by a fifth or more of their swing each period. A shorter step,"
+    " within a step or two, and even the slowest lose a fifth to nine tenths of their swing each period, the"
+    " more the stiffer the springs. A shorter step,"
     " softer springs or heavier pucks keep them ringing."
 )
 # Passes that add walls to the implicit solve (see _brace_walls).
