@@ -101,6 +101,12 @@ SAFE_MAX = 160
 # contacts do not settle the next step either (where an 800-puck pile falls asleep around its last
 # awake pucks, 41 of 43 exact solves in a second did not, at 50 to 180 ms each).
 EXACT_PAUSE = 60
+# Up to this many contacts, the iterations' answer is polished by the exact solve, from the contacts it has
+# pushing (block pivoting alone), where it would still sink a contact past DEEPEST_M or the last step was
+# solved exactly: a 10 x 20 slab thrown down has 700 contacts in the step it lands (each puck's diagonal
+# neighbours within the margin), and the iterations' answer left a puck leaping up at 1.8 m/s; polished,
+# it lands dead, 80 ms for that step, and sleeps. (An 800-puck pile: a few ms a step more while it drops.)
+POLISH_MAX = 1000
 CONVERGED_MPS = 1e-7
 # The first iteration's rounds go bottom-up by horizontal bands this many
 # radii high (a contact after its pucks' contacts of lower bands): support from
@@ -247,6 +253,7 @@ class ContactSolver:
         self.count = 0  # contacts in the last step
         self.iterations = 0  # iterations the last step needed
         self._paused = 0  # steps left that skip the exact solve (EXACT_PAUSE)
+        self._exact = False  # whether the last step's contacts were solved exactly
 
     def held(self, i: np.ndarray, j: np.ndarray) -> np.ndarray:
         """Which pairs (i, j) pressed on each other in the last step (a non-zero impulse).
@@ -368,14 +375,29 @@ class ContactSolver:
         w = np.zeros((len(pos) + 1, 2), dtype=complex)  # velocities and pseudo-velocities; the last row: walls
         w[:-1, 0] = vectors.as_complex(np.ascontiguousarray(vel))
         v0 = w[:-1, 0].copy()
+        was_exact, self._exact = self._exact, False
         impulses = self._try_exactly(c, inv, w, dt)
         if impulses is None:  # (many contacts, or those the exact solve did not settle)
-            impulses = self._solve_iteratively(c, inv, w, dt, mass, asleep)
+            impulses = self._iterate_then_polish(c, inv, w, dt, mass, asleep, was_exact)
         self._keep(c, impulses)
         moved = (w[:-1, 0] - v0 + w[:-1, 1]) * dt
         pos += np.column_stack([moved.real, moved.imag])
         vel[:, 0], vel[:, 1] = w[:-1, 0].real, w[:-1, 0].imag
         return True
+
+    def _iterate_then_polish(self, c: _Contacts, inv, w: np.ndarray, dt: float, mass, asleep, was_exact: bool):
+        """_solve_iteratively; then, up to POLISH_MAX contacts, the exact solve from the contacts the iterations
+        have pushing, where they would still sink one past DEEPEST_M or the last step was solved exactly."""
+        start = w.copy() if EXACT_MAX < self.count <= POLISH_MAX and not self._paused else None
+        impulses = self._solve_iteratively(c, inv, w, dt, mass, asleep)
+        if start is None or not (was_exact or _sinks(c, w, dt) > DEEPEST_M):
+            return impulses
+        exact = self._solve_exactly(c, inv, start, dt, impulses > 0.0)
+        self._paused = 0 if exact is not None else EXACT_PAUSE
+        if exact is None:
+            return impulses
+        w[:] = start
+        return exact
 
     def _solve_iteratively(self, c: _Contacts, inv, w: np.ndarray, dt: float, mass, asleep) -> np.ndarray:
         """Sequential impulses in coloured rounds, warm-started, on `w` in place; returns the impulses (m, 2)."""
@@ -395,17 +417,18 @@ class ContactSolver:
         self._paused = 0 if impulses is not None else EXACT_PAUSE
         return impulses
 
-    def _solve_exactly(self, c: _Contacts, inv: np.ndarray, w: np.ndarray, dt: float) -> np.ndarray | None:
+    def _solve_exactly(self, c: _Contacts, inv: np.ndarray, w: np.ndarray, dt: float, pushed=None) -> np.ndarray | None:
         """A few contacts (EXACT_MAX) solved at once, exactly (collapse.solve), velocities and
         pseudo-velocities in `w` in place; returns their impulses (m, 2), contact by contact, or
-        None (`w` untouched) if the solve did not settle."""
+        None (`w` untouched) if the solve did not settle. pushed: (m, 2) where to start (None: the
+        contacts that pushed in the last step)."""
         m, rows = len(c.a), self._rows
         bodies, local = np.unique(np.concatenate([c.a, c.b]), return_inverse=True)  # (the bodies these touch)
         a, b = local[:m], np.where(c.b == rows, -1, local[m:])  # (collapse's wall: -1)
         target = _targets(c, dt)
         vn = (c.n.conjugate() * (w.take(c.a, axis=0)[:, 0] - w.take(c.b, axis=0)[:, 0])).real
         response = collapse.response(c.n, a, b, inv.take(bodies))  # (one matrix for both problems)
-        pushed = self._pushed(c.keys)  # (where to start: the set that pushed changes little from step to step)
+        pushed = self._pushed(c.keys) if pushed is None else pushed  # (a pile's pushing set changes little)
         safe = m <= SAFE_MAX
         velocity = collapse.solve(response, vn - target[:, 0], pushed[:, 0], safe)  # vn after: at least the bound
         position = None if velocity is None else collapse.solve(response, -target[:, 1], pushed[:, 1], safe)
@@ -419,7 +442,7 @@ class ContactSolver:
         self._key_order = np.argsort(c.keys)
         self._layouts = None  # (the rounds start afresh when the contacts are many again)
         self._band_rounds = self._free_rounds = np.empty(0, dtype=np.intp)
-        self.iterations = 1
+        self.iterations, self._exact = 1, True
         return impulses
 
     def _pushed(self, keys: np.ndarray) -> np.ndarray:
@@ -536,7 +559,7 @@ class ContactSolver:
     # What the solver keeps from step to step: its impulses by contact (the warm start), and each
     # contact's rounds (they depend on the contacts it had before, so they change results). The
     # solver replaces these arrays each step and never changes them in place, so a save keeps references.
-    KEPT = ("_keys", "_impulses", "_rows", "_band_rounds", "_free_rounds", "count", "iterations", "_paused")
+    KEPT = ("_keys", "_impulses", "_rows", "_band_rounds", "_free_rounds", "count", "iterations", "_paused", "_exact")
     # Worked out afresh in each solve (the layouts from the kept rounds, the same in the same order):
     # they change no result, so a save need not keep them.
     NOT_KEPT = frozenset({"_y", "_r_mean", "_warm", "_key_order", "_layouts", "_wall_rest", "_held_walls"})
