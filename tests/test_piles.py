@@ -68,12 +68,18 @@ def heap(table: AirTable, rng: np.random.Generator, n: int, throw_mps: float, wi
         table.add_puck(pos_m=(x, y), radius_m=r, density_kgpm2=0.3, vel_mps=(0.0, -throw_mps))
 
 
-def drop(n: int, seed: int, dt: float, throw_mps: float = 0.0, wide_m: float = 4.0):
-    """Drop a heap at restitution 0 for SECONDS; return (largest energy rise of a step as a share of the
-    start energy, fastest rise out of rest (m/s), deepest overlap (m))."""
+def dead_table() -> AirTable:
+    """An empty table with gravity on and every restitution 0."""
     table = AirTable()
     table.gravity_on = True
     table.cr_puck = table.cr_wall = 0.0
+    return table
+
+
+def drop(n: int, seed: int, dt: float, throw_mps: float = 0.0, wide_m: float = 4.0):
+    """Drop a heap at restitution 0 for SECONDS; return (largest energy rise of a step as a share of the
+    start energy, fastest rise out of rest (m/s), deepest overlap (m))."""
+    table = dead_table()
     heap(table, np.random.default_rng(seed), n, throw_mps, wide_m)
     mass, radius, g = table.mass_kg, table.radius_m, table.gravity_mps2
 
@@ -173,16 +179,28 @@ def test_a_wide_heap_of_up_to_60_pucks_thrown_down_at_restitution_0_loses_energy
     lands_dead(*drop(n, seed, dt, throw_mps, wide_m=9.0))  # (the table is 10 m wide)
 
 
-def slab(table: AirTable, across: int, rows: int, r: float, hexagonal: bool, throw_mps: float) -> None:
+def slab(table: AirTable, across: int, rows: int, r: float, hexagonal: bool, throw_mps: float, densities=None) -> None:
     """across x rows touching pucks of radius r mid-table, DROP_M above the floor, thrown down: each row on
-    the one below (square), or in its hollows (hexagonal, every other row shifted by r)."""
+    the one below (square), or in its hollows (hexagonal, every other row shifted by r). densities: one per
+    puck, row by row (kg/m^2; None: 0.3 each)."""
     rise = 2.0 * r * (math.sqrt(3.0) / 2.0 if hexagonal else 1.0)
     left = 0.5 * table.width_m - across * r
+    densities = np.full(across * rows, 0.3) if densities is None else densities
     for row in range(rows):
         shift = r if hexagonal and row % 2 else 0.0
         for k in range(across):
             pos = (left + r + 2.0 * r * k + shift, DROP_M + r + rise * row)
-            table.add_puck(pos_m=pos, radius_m=r, density_kgpm2=0.3, vel_mps=(0.0, -throw_mps))
+            density = float(densities[row * across + k])
+            table.add_puck(pos_m=pos, radius_m=r, density_kgpm2=density, vel_mps=(0.0, -throw_mps))
+
+
+def watch(table: AirTable, steps: int, dt: float = 1 / 60) -> tuple[float, float]:
+    """Run `steps` steps of dt; return (the deepest overlap (m), the fastest any puck moved up (m/s)) after any."""
+    overlap = up = 0.0
+    for _ in range(steps):
+        table.step(dt)
+        overlap, up = max(overlap, deepest(table, gaps(table))), max(up, float(table.vel_mps[:, 1].max()))
+    return overlap, up
 
 
 @settings(max_examples=4, deadline=None, derandomize=True)
@@ -206,9 +224,7 @@ def test_a_slab_too_big_to_solve_exactly_lands_without_sinking_into_itself(
     reaches the floor, no puck sinks OVERLAP_M into another or into the floor. (Later a frictionless slab
     spreads: its edge pucks slide off, and a square one's columns tip over, as hard discs do.)"""
     r = min(r, 4.0 / across)  # (it fits the 10 m table with room on each side)
-    table = AirTable()
-    table.gravity_on = True
-    table.cr_puck = table.cr_wall = 0.0
+    table = dead_table()
     slab(table, across, rows, r, hexagonal, throw_mps)
     overlap, landed = 0.0, None
     for step in range(round(2.0 / dt)):
@@ -231,20 +247,10 @@ def test_a_square_slab_of_masses_three_decades_apart_thrown_down_lands_dead(side
     column lands as one body, and nothing pushes a puck sideways). No puck moves up (UP_MPS) and none
     sinks OVERLAP_M into another, from the throw to a second after it lands (up to 190 contacts: solved
     exactly; sequential impulses converged as slowly as the masses along the columns differ)."""
-    table = AirTable()
-    table.gravity_on = True
-    table.cr_puck = table.cr_wall = 0.0
-    rng = np.random.default_rng(seed)
-    left = 0.5 * table.width_m - side * 0.1
-    for row in range(side):
-        for k in range(side):
-            density = 0.3 * 10.0 ** rng.uniform(-1.5, 1.5)
-            table.add_puck(pos_m=(left + 0.1 + 0.2 * k, DROP_M + 0.1 + 0.2 * row), radius_m=0.1, density_kgpm2=density,
-                           vel_mps=(0.0, -throw_mps))  # fmt: skip
-    overlap = up = 0.0
-    for _ in range(round(1.5 / (1 / 60))):
-        table.step(1 / 60)
-        overlap, up = max(overlap, deepest(table, gaps(table))), max(up, float(table.vel_mps[:, 1].max()))
+    table = dead_table()
+    densities = 0.3 * 10.0 ** np.random.default_rng(seed).uniform(-1.5, 1.5, side * side)
+    slab(table, side, side, 0.1, hexagonal=False, throw_mps=throw_mps, densities=densities)
+    overlap, up = watch(table, 90)
     assert overlap < OVERLAP_M
     assert up < UP_MPS
 
@@ -257,14 +263,9 @@ def test_a_tall_square_slab_thrown_down_lands_dead(across: int, rows: int, throw
     threw a top puck up at 1.8 m/s (10 x 20 at 3 m/s). Polished by the exact solve (contacts.POLISH_MAX),
     nothing moves up (UP_MPS) and nothing sinks OVERLAP_M, for half a second. (Not yet so where the polish
     does not settle: 20 x 10 at 3 m/s still throws a puck up at 36 mm/s, 12 x 16 at 4 m/s at 0.27 m/s.)"""
-    table = AirTable()
-    table.gravity_on = True
-    table.cr_puck = table.cr_wall = 0.0
+    table = dead_table()
     slab(table, across, rows, 0.08, hexagonal=False, throw_mps=throw_mps)
-    overlap = up = 0.0
-    for _ in range(30):
-        table.step(1 / 60)
-        overlap, up = max(overlap, deepest(table, gaps(table))), max(up, float(table.vel_mps[:, 1].max()))
+    overlap, up = watch(table, 30)
     assert overlap < OVERLAP_M
     assert up < UP_MPS
 

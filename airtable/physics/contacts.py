@@ -393,7 +393,6 @@ class ContactSolver:
         if start is None or not (was_exact or _sinks(c, w, dt) > DEEPEST_M):
             return impulses
         exact = self._solve_exactly(c, inv, start, dt, impulses > 0.0)
-        self._paused = 0 if exact is not None else EXACT_PAUSE
         if exact is None:
             return impulses
         w[:] = start
@@ -413,26 +412,25 @@ class ContactSolver:
             return None
         if self.count > EXACT_MAX:
             return None
-        impulses = self._solve_exactly(c, inv, w, dt)
-        self._paused = 0 if impulses is not None else EXACT_PAUSE
-        return impulses
+        return self._solve_exactly(c, inv, w, dt)
 
     def _solve_exactly(self, c: _Contacts, inv: np.ndarray, w: np.ndarray, dt: float, pushed=None) -> np.ndarray | None:
         """A few contacts (EXACT_MAX) solved at once, exactly (collapse.solve), velocities and
         pseudo-velocities in `w` in place; returns their impulses (m, 2), contact by contact, or
-        None (`w` untouched) if the solve did not settle. pushed: (m, 2) where to start (None: the
-        contacts that pushed in the last step)."""
+        None (`w` untouched, and the next EXACT_PAUSE steps iterate) if the solve did not settle.
+        pushed: (m, 2) where to start (None: the contacts that pushed in the last step)."""
         m, rows = len(c.a), self._rows
         bodies, local = np.unique(np.concatenate([c.a, c.b]), return_inverse=True)  # (the bodies these touch)
         a, b = local[:m], np.where(c.b == rows, -1, local[m:])  # (collapse's wall: -1)
         target = _targets(c, dt)
-        vn = (c.n.conjugate() * (w.take(c.a, axis=0)[:, 0] - w.take(c.b, axis=0)[:, 0])).real
+        vn = _normal_speeds(c, w)
         response = collapse.response(c.n, a, b, inv.take(bodies))  # (one matrix for both problems)
         pushed = self._pushed(c.keys) if pushed is None else pushed  # (a pile's pushing set changes little)
         safe = m <= SAFE_MAX
         velocity = collapse.solve(response, vn - target[:, 0], pushed[:, 0], safe)  # vn after: at least the bound
         position = None if velocity is None else collapse.solve(response, -target[:, 1], pushed[:, 1], safe)
         if position is None:
+            self._paused = EXACT_PAUSE  # (the same contacts would not settle the next step either)
             return None
         impulses = columns(velocity, position)
         for col in (0, 1):
@@ -763,17 +761,21 @@ def _warm_push(c: _Contacts, mass: np.ndarray, impulse: np.ndarray, asleep=None)
     return out + 1j * (np.bincount(c.a, a.imag, rows) - np.bincount(c.b, b.imag, rows + 1)[:rows])
 
 
+def _normal_speeds(c: _Contacts, w: np.ndarray) -> np.ndarray:
+    """Each contact's relative normal velocity (m/s, negative: approaching) by the velocities `w` (w[:, 0])."""
+    return (c.n.conjugate() * (w.take(c.a, axis=0)[:, 0] - w.take(c.b, axis=0)[:, 0])).real
+
+
 def _sinks(c: _Contacts, w: np.ndarray, dt: float) -> float:
     """How far (m) the velocities `w` would close the worst contact past its bound in dt (past its gap;
     for a pair touching or overlapping, past where it is)."""
-    vn = (c.n.conjugate() * (w.take(c.a, axis=0)[:, 0] - w.take(c.b, axis=0)[:, 0])).real
-    return float((-np.maximum(c.gap, 0.0) - vn * dt).max())
+    return float((-np.maximum(c.gap, 0.0) - _normal_speeds(c, w) * dt).max())
 
 
-def _iterate(w: np.ndarray, first: _Layout, later: _Layout, too_deep=None) -> tuple[int, _Layout]:
+def _iterate(w: np.ndarray, first: _Layout, later: _Layout, too_deep) -> tuple[int, _Layout]:
     """Sequential impulses, round by round, until converged or ITERATIONS; return the iterations used
-    and the layout whose rounds hold the impulses. too_deep(), if given, says whether the velocities
-    so far would still sink a contact too deep: then the iterations go on (DEEPEST_M).
+    and the layout whose rounds hold the impulses. too_deep() says whether the velocities so far
+    would still sink a contact too deep: then the iterations go on (DEEPEST_M).
 
     The first iteration goes bottom-up (`first`), so support from the floor
     travels up a pile; the later ones refine it and take the fewer rounds of
@@ -794,7 +796,7 @@ def _iterate(w: np.ndarray, first: _Layout, later: _Layout, too_deep=None) -> tu
     last_gg = (0.0, 0.0)
     m = len(later.order)
     iterations = max(ITERATIONS, min(MAX_ITERATIONS, ITERATION_WORK // m))
-    most = iterations if too_deep is None else max(iterations, min(MAX_ITERATIONS, DEEP_WORK // m))
+    most = max(iterations, min(MAX_ITERATIONS, DEEP_WORK // m))
     for it in range(2, most + 1):
         before = w.copy()
         _sweep(flat, later)
