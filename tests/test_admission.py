@@ -9,6 +9,7 @@ import socket
 import threading
 import time
 
+import pytest
 from conftest import WAIT_S, wait_until
 from test_server import RawClient, clients, make_server  # noqa: F401  (fixtures)
 
@@ -16,7 +17,7 @@ from airtable.app.hud_view import BAND_LINES, fold_lines
 from airtable.app.roster_view import ALERT_COLOR
 from airtable.cli import build_parser
 from airtable.net import protocol as proto
-from airtable.net.gate import Gate
+from airtable.net.gate import LOCKOUT_AFTER, LOCKOUT_S, Gate
 from airtable.net.player import NetPlayer, PlayerState
 
 NAT = "127.0.0.9"  # the one address a classroom's router shows the server
@@ -230,3 +231,21 @@ def test_the_teachers_notice_counts_students_by_name_and_never_counts_nameless_t
     for _ in range(9):  # a nameless window asking again and again: how many there are cannot be told
         gate.seat_refusal("10.0.0.2")
     assert ": students at 10.0.0.2 could not join" in gate.teacher_notice()
+
+
+def test_wrong_passwords_add_up_however_slowly_they_come() -> None:
+    """A guess a while after the last, with the server's clean-up of old guesses in between, still counts:
+    the first wrong password used to be forgotten at the next clean-up (its wait, none, was 'long over'),
+    so one guess every few seconds was never made to wait nor locked out."""
+    gate, log = Gate(password_wait_s=1.0), logging.getLogger("test")
+    now = 1000.0
+    for _ in range(LOCKOUT_AFTER):
+        now += gate.password_wait("10.0.0.5", now) + 5.0  # each guess 5 s after it may come
+        gate.forget_old_guesses(now, log)
+        assert gate.password_wait("10.0.0.5", now) == 0.0
+        gate.wrong_password("10.0.0.5", now, log)
+    assert gate.password_wait("10.0.0.5", now + 1.0) == pytest.approx(LOCKOUT_S - 1.0)
+    later = now + 2.0 * LOCKOUT_S + 1.0  # long after the lockout ended: forgotten, a clean slate
+    gate.forget_old_guesses(later, log)
+    gate.wrong_password("10.0.0.5", later, log)
+    assert gate.password_wait("10.0.0.5", later) == 0.0  # (a first wrong one again: no wait)

@@ -158,7 +158,8 @@ class Gate:
                 log.warning("%s gave %d wrong passwords: locked out for %g s", host, guesses.wrong, LOCKOUT_S)
         elif guesses.wrong > 1:
             guesses.next_try = now + self.password_wait_s * 2 ** (guesses.wrong - 2)
-        if guesses.wrong == 1:
+        else:  # the first costs no wait, and is remembered for LOCKOUT_S (forget_old_guesses) like the others
+            guesses.next_try = now
             log.info("wrong password from %s", host)
 
     def right_password(self, host: str) -> None:
