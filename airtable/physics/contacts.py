@@ -59,7 +59,7 @@ from typing import NamedTuple
 
 import numpy as np
 
-from airtable.physics import collapse, collision, colouring, vectors
+from airtable.physics import collapse, collision, colouring, proportioning, vectors
 
 # Iterations over all contacts per step (Box2D and pymunk use about ten);
 # the loop stops early once an iteration changes no velocity by CONVERGED_MPS.
@@ -101,12 +101,17 @@ SAFE_MAX = 160
 # contacts do not settle the next step either (where an 800-puck pile falls asleep around its last
 # awake pucks, 41 of 43 exact solves in a second did not, at 50 to 180 ms each).
 EXACT_PAUSE = 60
-# Up to this many contacts, the iterations' answer is polished by the exact solve, from the contacts it has
-# pushing (block pivoting alone), where it would still sink a contact past DEEPEST_M or the last step was
-# solved exactly: a 10 x 20 slab thrown down has 700 contacts in the step it lands (each puck's diagonal
-# neighbours within the margin), and the iterations' answer left a puck leaping up at 1.8 m/s; polished,
-# it lands dead, 80 ms for that step, and sleeps. (An 800-puck pile: a few ms a step more while it drops.)
-POLISH_MAX = 1000
+# Where the iterations (more than EXACT_MAX contacts, or the exact solve paused) leave a contact off
+# its bound by more than POLISH_MPS (m/s), or the last step was solved to the end, their answer is
+# carried to the end by proportioning.solve, to POLISH_TOL_MPS, in at most POLISH_STEPS steps and
+# POLISH_WORK contact-steps. Square slabs of 200 to 300 pucks thrown down (600 to 1100 contacts as they land:
+# each puck's diagonal neighbours are within the margin) threw top pucks up at up to 2.8 m/s from the
+# iterations' answer; polished in 10 to 81 steps, they land dead. An 800-puck pile settling (2300
+# contacts, many dependent) does not settle in its steps: it pauses, as the exact solve does.
+POLISH_MPS = 1e-4
+POLISH_TOL_MPS = 1e-6
+POLISH_STEPS = 300
+POLISH_WORK = 150_000
 CONVERGED_MPS = 1e-7
 # The first iteration's rounds go bottom-up by horizontal bands this many
 # radii high (a contact after its pucks' contacts of lower bands): support from
@@ -253,6 +258,7 @@ class ContactSolver:
         self.count = 0  # contacts in the last step
         self.iterations = 0  # iterations the last step needed
         self._paused = 0  # steps left that skip the exact solve (EXACT_PAUSE)
+        self._polish_paused = 0
         self._exact = False  # whether the last step's contacts were solved exactly
 
     def held(self, i: np.ndarray, j: np.ndarray) -> np.ndarray:
@@ -386,24 +392,46 @@ class ContactSolver:
         return True
 
     def _iterate_then_polish(self, c: _Contacts, inv, w: np.ndarray, dt: float, mass, asleep, was_exact: bool):
-        """_solve_iteratively; then, up to POLISH_MAX contacts, the exact solve from the contacts the iterations
-        have pushing, where they would still sink one past DEEPEST_M or the last step was solved exactly."""
-        start = w.copy() if EXACT_MAX < self.count <= POLISH_MAX and not self._paused else None
-        impulses = self._solve_iteratively(c, inv, w, dt, mass, asleep)
-        if start is None or not (was_exact or _sinks(c, w, dt) > DEEPEST_M):
-            return impulses
-        exact = self._solve_exactly(c, inv, start, dt, impulses > 0.0)
-        if exact is None:
-            return impulses
-        w[:] = start
-        return exact
-
-    def _solve_iteratively(self, c: _Contacts, inv, w: np.ndarray, dt: float, mass, asleep) -> np.ndarray:
-        """Sequential impulses in coloured rounds, warm-started, on `w` in place; returns the impulses (m, 2)."""
+        """Sequential impulses in coloured rounds, warm-started, on `w` in place; then, where their answer
+        leaves a contact off its bound by more than POLISH_MPS or the last step was solved to the end, carried
+        to the answer by _polish. Returns the impulses (m, 2). Without the polish (paused, or it did not
+        settle) they iterate on while a contact would sink too deep (DEEPEST_M)."""
+        if self._polish_paused:
+            self._polish_paused -= 1
+        start = None if self._polish_paused else w.copy()
         first, later = self._gather(c, inv, dt, asleep)
         w[:-1, 0] += _warm_push(c, mass, self._warm, asleep)  # warm start: last step's velocity impulses first
-        self.iterations, layout = _iterate(w, first, later, lambda: _sinks(c, w, dt) > DEEPEST_M)
+        too_deep = lambda: _sinks(c, w, dt) > DEEPEST_M  # noqa: E731
+        self.iterations, layout = _iterate(w, first, later, too_deep if start is None else lambda: False)
+        impulses = layout.impulses()
+        if start is None or not (was_exact or _off_bound(c, w, dt, impulses) > POLISH_MPS):
+            return impulses
+        polished = self._polish(c, inv, w, start, dt, impulses)
+        if polished is not None:
+            return polished
+        more, layout = _iterate(w, layout, layout, too_deep)  # (from where they stopped)
+        self.iterations += more
         return layout.impulses()
+
+    def _polish(self, c: _Contacts, inv, w: np.ndarray, start: np.ndarray, dt: float, impulses: np.ndarray):
+        """The iterations' impulses carried to the answer by proportioning.solve, from `start` (the velocities
+        before them), column by column, in place; if the velocities' does not settle, None (`w` untouched,
+        and the next EXACT_PAUSE steps go without); if the pseudo-velocities' does not, theirs are kept."""
+        response = proportioning.Response(c.n, c.a, c.b, inv)
+        q = np.column_stack([_normal_speeds(c, start, col) for col in (0, 1)]) - _targets(c, dt)
+        most = min(POLISH_STEPS, POLISH_WORK // len(c.a))
+        out = impulses.copy()
+        for col in (0, 1):
+            p, settled = proportioning.solve(response, q[:, col], impulses[:, col], POLISH_TOL_MPS, most)
+            if settled:
+                out[:, col] = p
+            elif col == 0:
+                self._polish_paused = EXACT_PAUSE
+                return None
+        w[:] = start
+        _push(c, inv, w, out)
+        self._exact = True
+        return out
 
     def _try_exactly(self, c: _Contacts, inv: np.ndarray, w: np.ndarray, dt: float) -> np.ndarray | None:
         """_solve_exactly, unless the contacts are too many (EXACT_MAX) or one did not settle lately (EXACT_PAUSE)."""
@@ -414,18 +442,17 @@ class ContactSolver:
             return None
         return self._solve_exactly(c, inv, w, dt)
 
-    def _solve_exactly(self, c: _Contacts, inv: np.ndarray, w: np.ndarray, dt: float, pushed=None) -> np.ndarray | None:
+    def _solve_exactly(self, c: _Contacts, inv: np.ndarray, w: np.ndarray, dt: float) -> np.ndarray | None:
         """A few contacts (EXACT_MAX) solved at once, exactly (collapse.solve), velocities and
         pseudo-velocities in `w` in place; returns their impulses (m, 2), contact by contact, or
-        None (`w` untouched, and the next EXACT_PAUSE steps iterate) if the solve did not settle.
-        pushed: (m, 2) where to start (None: the contacts that pushed in the last step)."""
+        None (`w` untouched, and the next EXACT_PAUSE steps iterate) if the solve did not settle."""
         m, rows = len(c.a), self._rows
         bodies, local = np.unique(np.concatenate([c.a, c.b]), return_inverse=True)  # (the bodies these touch)
         a, b = local[:m], np.where(c.b == rows, -1, local[m:])  # (collapse's wall: -1)
         target = _targets(c, dt)
         vn = _normal_speeds(c, w)
         response = collapse.response(c.n, a, b, inv.take(bodies))  # (one matrix for both problems)
-        pushed = self._pushed(c.keys) if pushed is None else pushed  # (a pile's pushing set changes little)
+        pushed = self._pushed(c.keys)  # where to start: a pile's pushing set changes little
         safe = m <= SAFE_MAX
         velocity = collapse.solve(response, vn - target[:, 0], pushed[:, 0], safe)  # vn after: at least the bound
         position = None if velocity is None else collapse.solve(response, -target[:, 1], pushed[:, 1], safe)
@@ -433,10 +460,7 @@ class ContactSolver:
             self._paused = EXACT_PAUSE  # (the same contacts would not settle the next step either)
             return None
         impulses = columns(velocity, position)
-        for col in (0, 1):
-            push = impulses[:, col] * c.n
-            np.add.at(w[:, col], c.a, push * inv.take(c.a))
-            np.add.at(w[:, col], c.b, -push * inv.take(c.b))  # (the walls' row: inv 0)
+        _push(c, inv, w, impulses)
         self._key_order = np.argsort(c.keys)
         self._layouts = None  # (the rounds start afresh when the contacts are many again)
         self._band_rounds = self._free_rounds = np.empty(0, dtype=np.intp)
@@ -557,7 +581,10 @@ class ContactSolver:
     # What the solver keeps from step to step: its impulses by contact (the warm start), and each
     # contact's rounds (they depend on the contacts it had before, so they change results). The
     # solver replaces these arrays each step and never changes them in place, so a save keeps references.
-    KEPT = ("_keys", "_impulses", "_rows", "_band_rounds", "_free_rounds", "count", "iterations", "_paused", "_exact")
+    KEPT = (
+        *("_keys", "_impulses", "_rows", "_band_rounds", "_free_rounds", "count", "iterations"),
+        *("_paused", "_exact", "_polish_paused"),
+    )
     # Worked out afresh in each solve (the layouts from the kept rounds, the same in the same order):
     # they change no result, so a save need not keep them.
     NOT_KEPT = frozenset({"_y", "_r_mean", "_warm", "_key_order", "_layouts", "_wall_rest", "_held_walls"})
@@ -761,15 +788,31 @@ def _warm_push(c: _Contacts, mass: np.ndarray, impulse: np.ndarray, asleep=None)
     return out + 1j * (np.bincount(c.a, a.imag, rows) - np.bincount(c.b, b.imag, rows + 1)[:rows])
 
 
-def _normal_speeds(c: _Contacts, w: np.ndarray) -> np.ndarray:
-    """Each contact's relative normal velocity (m/s, negative: approaching) by the velocities `w` (w[:, 0])."""
-    return (c.n.conjugate() * (w.take(c.a, axis=0)[:, 0] - w.take(c.b, axis=0)[:, 0])).real
+def _normal_speeds(c: _Contacts, w: np.ndarray, col: int = 0) -> np.ndarray:
+    """Each contact's relative normal velocity (m/s, negative: approaching) by the velocities `w` (w[:, col]:
+    0 the velocities, 1 the pseudo-velocities)."""
+    return (c.n.conjugate() * (w.take(c.a, axis=0)[:, col] - w.take(c.b, axis=0)[:, col])).real
+
+
+def _push(c: _Contacts, inv: np.ndarray, w: np.ndarray, impulses: np.ndarray) -> None:
+    """Apply the contacts' impulses (m, 2) to the velocities and pseudo-velocities `w`, in place."""
+    for col in (0, 1):
+        push = impulses[:, col] * c.n
+        np.add.at(w[:, col], c.a, push * inv.take(c.a))
+        np.add.at(w[:, col], c.b, -push * inv.take(c.b))  # (the walls' row: inv 0)
 
 
 def _sinks(c: _Contacts, w: np.ndarray, dt: float) -> float:
     """How far (m) the velocities `w` would close the worst contact past its bound in dt (past its gap;
     for a pair touching or overlapping, past where it is)."""
     return float((-np.maximum(c.gap, 0.0) - _normal_speeds(c, w) * dt).max())
+
+
+def _off_bound(c: _Contacts, w: np.ndarray, dt: float, impulses: np.ndarray) -> float:
+    """How far (m/s) the velocities `w` leave the worst contact off its bound: approaching past it, or,
+    where the contact pushes (impulses), parting faster than it (an impulse too big: a puck thrown up)."""
+    off = _normal_speeds(c, w) + np.maximum(c.gap, 0.0) / dt
+    return max(float(-off.min()), float(off.max(where=impulses[:, 0] > 0.0, initial=0.0)))
 
 
 def _iterate(w: np.ndarray, first: _Layout, later: _Layout, too_deep) -> tuple[int, _Layout]:
