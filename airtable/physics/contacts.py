@@ -36,6 +36,12 @@ iterations after the first are sped up as conjugate gradients speed up plain
 ones (_iterate), and a small group of contacts gets as many as ITERATION_WORK
 pays for: a stack landing settles within its step.
 
+Up to EXACT_MAX contacts the problem is instead solved exactly (collapse.py);
+beyond, where the iterations leave a contact off its bound, their answer is
+carried to the end by conjugate gradients that keep every impulse a push
+(proportioning.py): a slab of hundreds of pucks landing, whose chains of
+contacts the iterations pass a push along only a link or so at a time.
+
 Order of the step: positions have already moved with the velocities when
 this stage runs, so a velocity change dv also moves the puck by dv dt: the
 stage gives the same result as solving contacts before the position update.
@@ -258,8 +264,8 @@ class ContactSolver:
         self.count = 0  # contacts in the last step
         self.iterations = 0  # iterations the last step needed
         self._paused = 0  # steps left that skip the exact solve (EXACT_PAUSE)
-        self._polish_paused = 0
-        self._exact = False  # whether the last step's contacts were solved exactly
+        self._polish_paused = 0  # steps left that skip the polish (EXACT_PAUSE)
+        self._exact = False  # whether the last step's contacts were solved to the end (exactly, or polished)
 
     def held(self, i: np.ndarray, j: np.ndarray) -> np.ndarray:
         """Which pairs (i, j) pressed on each other in the last step (a non-zero impulse).
