@@ -110,14 +110,14 @@ EXACT_PAUSE = 60
 # Where the iterations (more than EXACT_MAX contacts, or the exact solve paused) leave a contact off
 # its bound by more than POLISH_MPS (m/s), or the last step was solved to the end, their answer is
 # carried to the end by proportioning.solve, to POLISH_TOL_MPS, in at most POLISH_STEPS steps and
-# POLISH_WORK contact-steps. Square slabs of 200 to 300 pucks thrown down (600 to 1100 contacts as they land:
-# each puck's diagonal neighbours are within the margin) threw top pucks up at up to 2.8 m/s from the
-# iterations' answer; polished in 10 to 81 steps, they land dead. An 800-puck pile settling (2300
-# contacts, many dependent) does not settle in its steps: it pauses, as the exact solve does.
+# POLISH_WORK contact-steps. Square slabs of 200 to 400 pucks thrown down (600 to 1500 contacts as they
+# land: each puck's diagonal neighbours are within the margin) threw top pucks up at up to 2.8 m/s from
+# the iterations' answer; polished in 10 to 300 steps, they land dead. An 800-puck pile settling (2300
+# contacts, many dependent) does not settle in its 260 steps (some 75 ms): it pauses, as the exact solve does.
 POLISH_MPS = 1e-4
 POLISH_TOL_MPS = 1e-6
-POLISH_STEPS = 300
-POLISH_WORK = 150_000
+POLISH_STEPS = 1000
+POLISH_WORK = 600_000
 CONVERGED_MPS = 1e-7
 # The first iteration's rounds go bottom-up by horizontal bands this many
 # radii high (a contact after its pucks' contacts of lower bands): support from

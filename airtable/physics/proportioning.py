@@ -30,27 +30,38 @@ STEP_SHARE = 0.95
 
 class Response:
     """The map p -> A p (see the module docstring) for contacts k between body a[k] and body b[k] along
-    the unit normal n[k] (complex, from b to a); inv[body] = 1 / its mass (0: a wall, a sleeper)."""
+    the unit normal n[k] (complex, from b to a); inv[body] = 1 / its mass (0: a wall, a sleeper).
+
+    The problem is solved scaled by the diagonal (each contact's own response, 1 / its pair's reduced mass):
+    impulses y = p / scale with scale = A_kk^(-1/2), so that every contact answers a unit push alike. The
+    bound y >= 0 is p >= 0, and where the masses differ by decades the gradients converge as though alike.
+    """
 
     def __init__(self, n: np.ndarray, a: np.ndarray, b: np.ndarray, inv: np.ndarray) -> None:
         self.n, self.a, self.b, self.inv, self.bodies = n, a, b, inv, len(inv)
-        # |A| is at most the largest row sum of |A_kl| (Gershgorin): a body shared by two contacts adds
-        # its 1 / mass times |n_k . n_l| <= 1, so a contact's row sums at most each body's 1 / mass
-        # times the contacts on it.
-        ends = np.bincount(a, minlength=self.bodies) + np.bincount(b, minlength=self.bodies)
-        load = inv * ends
-        self.norm_bound = float((load.take(a) + load.take(b)).max()) if len(a) else 0.0
+        own = inv.take(a) + inv.take(b)
+        self.scale = 1.0 / np.sqrt(np.where(own > 0.0, own, 1.0))
+        # |scale A scale| is at most its largest row sum of |entries| (Gershgorin): a body shared by
+        # contacts k and l adds scale_k scale_l / its mass times |n_k . n_l| <= 1 to row k.
+        shared = np.bincount(a, self.scale, self.bodies) + np.bincount(b, self.scale, self.bodies)
+        load = inv * shared
+        self.norm_bound = float((self.scale * (load.take(a) + load.take(b))).max()) if len(a) else 0.0
 
     def __call__(self, p: np.ndarray) -> np.ndarray:
+        """A p."""
         push = p * self.n
         a, b, k = self.a, self.b, self.bodies
         dv = (np.bincount(a, push.real, k) - np.bincount(b, push.real, k)) * self.inv
         dv = dv + 1j * ((np.bincount(a, push.imag, k) - np.bincount(b, push.imag, k)) * self.inv)
         return (self.n.conjugate() * (dv.take(a) - dv.take(b))).real
 
+    def scaled(self, y: np.ndarray) -> np.ndarray:
+        """scale A scale y: the scaled problem's map."""
+        return self.scale * self(self.scale * y)
 
-def solve(apply: Response, q: np.ndarray, start: np.ndarray, tol: float, most: int) -> tuple[np.ndarray, bool]:
-    """(p, settled): the impulses p >= 0 of the problem (apply: p -> A p; q as in the module docstring)
+
+def solve(response: Response, q: np.ndarray, start: np.ndarray, tol: float, most: int) -> tuple[np.ndarray, bool]:
+    """(p, settled): the impulses p >= 0 of the problem (response: p -> A p; q as in the module docstring)
     from `start`, after at most `most` steps; settled: every contact within `tol` of its bound (m/s).
 
     A step is one of three. Proportioning, where the contacts that push not but should (beta) are wrong
@@ -58,18 +69,21 @@ def solve(apply: Response, q: np.ndarray, start: np.ndarray, tol: float, most: i
     conjugate gradient step on the pushing contacts, as far as the minimum along it or, where that would
     make an impulse pull, as far as it can go and then a projected gradient step (expansion).
     """
-    if apply.norm_bound <= 0.0:
+    if response.norm_bound <= 0.0:
         return np.zeros_like(q), False
-    alpha = 2.0 * STEP_SHARE / apply.norm_bound
-    p = np.maximum(start, 0.0)
-    g = apply(p) + q
+    scale, apply = response.scale, response.scaled
+    alpha = 2.0 * STEP_SHARE / response.norm_bound
+    tol = tol * scale  # (w_k = g_k / scale_k)
+    p = np.maximum(start, 0.0) / scale
+    g = apply(p) + q * scale
+    q = q * scale
     free = p > 0.0
     phi = np.where(free, g, 0.0)
     direction = phi
     for _ in range(most):
         beta = np.where(free, 0.0, np.minimum(g, 0.0))
-        if max(float(np.abs(phi).max()), float(-beta.min())) <= tol:
-            return p, True
+        if (np.abs(phi) <= tol).all() and (-beta <= tol).all():
+            return p * scale, True
         reduced = np.where(free, np.minimum(p / alpha, phi), 0.0)
         if beta @ beta > reduced @ phi:  # proportioning: release the contacts that should push
             image = apply(beta)
@@ -81,7 +95,7 @@ def solve(apply: Response, q: np.ndarray, start: np.ndarray, tol: float, most: i
         image = apply(direction)
         curvature = direction @ image
         if curvature <= 0.0:  # (round-off: the pushing contacts' problem is solved)
-            return p, False
+            return p * scale, False
         step = (g @ direction) / curvature
         shrinks = direction > 0.0
         room = float((p[shrinks] / direction[shrinks]).min()) if shrinks.any() else np.inf
@@ -97,4 +111,4 @@ def solve(apply: Response, q: np.ndarray, start: np.ndarray, tol: float, most: i
         g = apply(p) + q
         free = p > 0.0
         phi = direction = np.where(free, g, 0.0)
-    return p, False
+    return p * scale, False
