@@ -109,15 +109,22 @@ SAFE_MAX = 160
 EXACT_PAUSE = 60
 # Where the iterations (more than EXACT_MAX contacts, or the exact solve paused) leave a contact off
 # its bound by more than POLISH_MPS (m/s), or the last step was solved to the end, their answer is
-# carried to the end by proportioning.solve, to POLISH_TOL_MPS, in at most POLISH_STEPS steps and
-# POLISH_WORK contact-steps. Square slabs of 200 to 400 pucks thrown down (600 to 1500 contacts as they
-# land: each puck's diagonal neighbours are within the margin) threw top pucks up at up to 2.8 m/s from
-# the iterations' answer; polished in 10 to 300 steps, they land dead. An 800-puck pile settling (2300
-# contacts, many dependent) does not settle in its 260 steps (some 75 ms): it pauses, as the exact solve does.
+# polished, up to POLISH_MAX contacts: first by the exact solve from the contacts they have pushing (block
+# pivoting alone, up to PIVOT_MAX contacts, unless it paused); where that does not settle, by
+# proportioning.solve from their answer, to POLISH_TOL_MPS (or NEAR_MPS), in at most POLISH_STEPS steps and
+# POLISH_WORK contact-steps. Square slabs of 200 to 340 pucks thrown down (600 to 1100 contacts as they land:
+# each puck's diagonal neighbours are within the margin) threw top pucks up at up to 2.8 m/s from the
+# iterations' answer, where block pivoting did not settle; polished in 10 to 300 steps, they land dead.
+# (Proportioning alone, on a slab of rows of 1 g and 1000 kg, stopped near the answer, and the iterations of
+# the next step, warm-started from it, diverged; a pile of 800 pucks, 2300 contacts, many dependent,
+# settles in neither: beyond POLISH_MAX, the iterations alone.) If neither settles, they pause.
 POLISH_MPS = 1e-4
 POLISH_TOL_MPS = 1e-6
+NEAR_MPS = 1e-5
+POLISH_MAX = 1500
+PIVOT_MAX = 1000
 POLISH_STEPS = 1000
-POLISH_WORK = 600_000
+POLISH_WORK = 300_000
 CONVERGED_MPS = 1e-7
 # The first iteration's rounds go bottom-up by horizontal bands this many
 # radii high (a contact after its pucks' contacts of lower bands): support from
@@ -399,12 +406,13 @@ class ContactSolver:
 
     def _iterate_then_polish(self, c: _Contacts, inv, w: np.ndarray, dt: float, mass, asleep, was_exact: bool):
         """Sequential impulses in coloured rounds, warm-started, on `w` in place; then, where their answer
-        leaves a contact off its bound by more than POLISH_MPS or the last step was solved to the end, carried
-        to the answer by _polish. Returns the impulses (m, 2). Without the polish (paused, or it did not
-        settle) they iterate on while a contact would sink too deep (DEEPEST_M)."""
+        leaves a contact off its bound by more than POLISH_MPS or the last step was solved to the end, polished
+        (see POLISH_MPS). Returns the impulses (m, 2). Without a polish (too many contacts, paused, or it did
+        not settle: then the next EXACT_PAUSE steps go without) they iterate on while a contact would sink too
+        deep (DEEPEST_M)."""
         if self._polish_paused:
             self._polish_paused -= 1
-        start = None if self._polish_paused else w.copy()
+        start = None if self._polish_paused or self.count > POLISH_MAX else w.copy()
         first, later = self._gather(c, inv, dt, asleep)
         w[:-1, 0] += _warm_push(c, mass, self._warm, asleep)  # warm start: last step's velocity impulses first
         too_deep = lambda: _sinks(c, w, dt) > DEEPEST_M  # noqa: E731
@@ -412,28 +420,37 @@ class ContactSolver:
         impulses = layout.impulses()
         if start is None or not (was_exact or _off_bound(c, w, dt, impulses) > POLISH_MPS):
             return impulses
-        polished = self._polish(c, inv, w, start, dt, impulses)
+        polished = None
+        if self.count <= PIVOT_MAX and not self._paused:
+            polished = self._solve_exactly(c, inv, start, dt, impulses > 0.0)  # from the contacts pushing
+            if polished is not None:
+                w[:] = start
+        if polished is None:
+            polished = self._polish(c, inv, w, start, dt, impulses)
         if polished is not None:
             return polished
+        self._polish_paused = EXACT_PAUSE
         more, layout = _iterate(w, layout, layout, too_deep)  # (from where they stopped)
         self.iterations += more
         return layout.impulses()
 
     def _polish(self, c: _Contacts, inv, w: np.ndarray, start: np.ndarray, dt: float, impulses: np.ndarray):
         """The iterations' impulses carried to the answer by proportioning.solve, from `start` (the velocities
-        before them), column by column, in place; if the velocities' does not settle, None (`w` untouched,
-        and the next EXACT_PAUSE steps go without); if the pseudo-velocities' does not, theirs are kept."""
+        before them) or the last step's (_nearest), column by column, in place; None (`w` untouched) if the
+        velocities' does not come within NEAR_MPS of it; if the pseudo-velocities' does not, theirs are kept."""
         response = proportioning.Response(c.n, c.a, c.b, inv)
         q = np.column_stack([_normal_speeds(c, start, col) for col in (0, 1)]) - _targets(c, dt)
         most = min(POLISH_STEPS, POLISH_WORK // len(c.a))
         out = impulses.copy()
         for col in (0, 1):
-            p, settled = proportioning.solve(response, q[:, col], impulses[:, col], POLISH_TOL_MPS, most)
-            if settled:
+            begin = _nearest(response, q[:, col], impulses[:, col], self._warm if col == 0 else None)
+            p, settled = proportioning.solve(response, q[:, col], begin, POLISH_TOL_MPS, most)
+            if not settled and col == 0:
+                w_p = response(p) + q[:, 0]
+                if max(float(-w_p.min()), float(w_p.max(where=p > 0.0, initial=0.0))) > NEAR_MPS:
+                    return None
+            if settled or col == 0:
                 out[:, col] = p
-            elif col == 0:
-                self._polish_paused = EXACT_PAUSE
-                return None
         w[:] = start
         _push(c, inv, w, out)
         self._exact = True
@@ -448,17 +465,18 @@ class ContactSolver:
             return None
         return self._solve_exactly(c, inv, w, dt)
 
-    def _solve_exactly(self, c: _Contacts, inv: np.ndarray, w: np.ndarray, dt: float) -> np.ndarray | None:
+    def _solve_exactly(self, c: _Contacts, inv: np.ndarray, w: np.ndarray, dt: float, pushed=None) -> np.ndarray | None:
         """A few contacts (EXACT_MAX) solved at once, exactly (collapse.solve), velocities and
         pseudo-velocities in `w` in place; returns their impulses (m, 2), contact by contact, or
-        None (`w` untouched, and the next EXACT_PAUSE steps iterate) if the solve did not settle."""
+        None (`w` untouched, and the next EXACT_PAUSE steps iterate) if the solve did not settle.
+        pushed: (m, 2) where to start (None: the contacts that pushed in the last step)."""
         m, rows = len(c.a), self._rows
         bodies, local = np.unique(np.concatenate([c.a, c.b]), return_inverse=True)  # (the bodies these touch)
         a, b = local[:m], np.where(c.b == rows, -1, local[m:])  # (collapse's wall: -1)
         target = _targets(c, dt)
         vn = _normal_speeds(c, w)
         response = collapse.response(c.n, a, b, inv.take(bodies))  # (one matrix for both problems)
-        pushed = self._pushed(c.keys)  # where to start: a pile's pushing set changes little
+        pushed = self._pushed(c.keys) if pushed is None else pushed  # (a pile's pushing set changes little)
         safe = m <= SAFE_MAX
         velocity = collapse.solve(response, vn - target[:, 0], pushed[:, 0], safe)  # vn after: at least the bound
         position = None if velocity is None else collapse.solve(response, -target[:, 1], pushed[:, 1], safe)
@@ -812,6 +830,17 @@ def _sinks(c: _Contacts, w: np.ndarray, dt: float) -> float:
     """How far (m) the velocities `w` would close the worst contact past its bound in dt (past its gap;
     for a pair touching or overlapping, past where it is)."""
     return float((-np.maximum(c.gap, 0.0) - _normal_speeds(c, w) * dt).max())
+
+
+def _nearest(response: proportioning.Response, q: np.ndarray, *candidates: np.ndarray | None) -> np.ndarray:
+    """Of the candidate impulses and none at all, the nearest the answer by proportioning.objective, to
+    start from: the iterations' answer mostly, but on masses decades apart, warm-started from a slab's
+    landing, they diverge (a user test: 16 x 16 pucks, rows of 1 g and 1000 kg, leapt at 400 m/s)."""
+    best, least = np.zeros_like(q), 0.0
+    for p in candidates:
+        if p is not None and (f := proportioning.objective(response, q, p)) < least:
+            best, least = p, f
+    return best
 
 
 def _off_bound(c: _Contacts, w: np.ndarray, dt: float, impulses: np.ndarray) -> float:

@@ -60,6 +60,11 @@ class Response:
         return self.scale * self(self.scale * y)
 
 
+def objective(response: Response, q: np.ndarray, p: np.ndarray) -> float:
+    """p.A p / 2 + q.p, which the answer makes least over p >= 0 (the module docstring)."""
+    return 0.5 * float(p @ response(p)) + float(q @ p)
+
+
 def solve(response: Response, q: np.ndarray, start: np.ndarray, tol: float, most: int) -> tuple[np.ndarray, bool]:
     """(p, settled): the impulses p >= 0 of the problem (response: p -> A p; q as in the module docstring)
     from `start`, after at most `most` steps; settled: every contact within `tol` of its bound (m/s).
