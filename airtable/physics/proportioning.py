@@ -76,6 +76,13 @@ def solve(response: Response, q: np.ndarray, start: np.ndarray, tol: float, most
     """
     if response.norm_bound <= 0.0:
         return np.zeros_like(q), False
+    with np.errstate(over="ignore", divide="ignore", invalid="ignore"):  # (a problem with no answer diverges)
+        p, settled = _steps(response, q, start, tol, most)
+    return p, settled and bool(np.isfinite(p).all())
+
+
+def _steps(response: Response, q: np.ndarray, start: np.ndarray, tol: float, most: int) -> tuple[np.ndarray, bool]:
+    """solve's steps."""
     scale, apply = response.scale, response.scaled
     alpha = 2.0 * STEP_SHARE / response.norm_bound
     tol = tol * scale  # (w_k = g_k / scale_k)
