@@ -11,6 +11,8 @@ least value of p.A p / 2 + q.p, the quantity the answer makes least.
 
 from __future__ import annotations
 
+import warnings
+
 import numpy as np
 from hypothesis import given, settings
 from hypothesis import strategies as st
@@ -77,3 +79,15 @@ def test_a_column_of_pucks_landing_on_the_floor_stops_dead():
     p, settled = proportioning.solve(response, q, np.zeros(pucks), 1e-12, 1000)
     assert settled
     np.testing.assert_allclose(p, 3.0 * (pucks - np.arange(pucks)), rtol=1e-10)
+
+
+def test_a_puck_squeezed_between_two_walls_that_both_push_it_out_has_no_answer_and_says_so():
+    """By hand: a puck overlapping both walls of a channel, each contact asking it to move away from its wall
+    at 0.5 m/s, cannot do both: the impulses grow without bound along (1, 1), which changes nothing. The
+    solve must say it did not settle, quietly (no numpy warnings reach the user's console)."""
+    n = np.array([1.0 + 0j, -1.0 + 0j])  # from each wall (body 1) to the puck (body 0)
+    response = proportioning.Response(n, np.array([0, 0]), np.array([1, 1]), np.array([1.0, 0.0]))
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        _, settled = proportioning.solve(response, np.array([-0.5, -0.5]), np.zeros(2), 1e-9, 10_000)
+    assert not settled

@@ -838,8 +838,8 @@ def _sinks(c: _Contacts, w: np.ndarray, dt: float) -> float:
 
 def _nearest(response: proportioning.Response, q: np.ndarray, *candidates: np.ndarray | None) -> np.ndarray:
     """Of the candidate impulses and none at all, the nearest the answer by proportioning.objective, to
-    start from: the iterations' answer mostly, but on masses decades apart, warm-started from a slab's
-    landing, they diverge (a user test: 16 x 16 pucks, rows of 1 g and 1000 kg, leapt at 400 m/s)."""
+    start from: the iterations' answer mostly; where they diverged (masses decades apart, warm-started from a
+    landing solved to the end: a user test's slab of rows of 1 g and 1000 kg), the last step's, or none."""
     best, least = np.zeros_like(q), 0.0
     for p in candidates:
         if p is not None and (f := proportioning.objective(response, q, p)) < least:
