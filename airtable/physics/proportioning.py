@@ -8,12 +8,12 @@ the least of f(p) = p.A p / 2 + q.p over p >= 0: w is f's gradient.
 
 Sequential impulses (contacts._iterate) pass a push along a chain of contacts about one link an
 iteration; a slab of 20 rows landing needs hundreds. Conjugate gradients carry it along the whole chain
-in a few dozen. This is Dostal and Schoberl's MPRGP (modified proportioning with reduced gradient
-projections, 2005): conjugate gradients on the contacts that push, a step that frees a contact that
-should push (proportioning) when those are wrong by more than the free ones, and a projected gradient
-step when a conjugate step would make an impulse pull (expansion). On a positive semidefinite A (as
-here: more contacts than ways to move, in a square slab) it still converges; it stops when every
-contact is within `tol` of its bound (m/s).
+(square slabs of 200 to 340 pucks landing: 10 to 300 steps). This is Dostal and Schoberl's MPRGP
+(modified proportioning with reduced gradient projections, 2005): conjugate gradients on the contacts
+that push, a step that frees a contact that should push (proportioning) when those are wrong by more
+than the free ones, and a projected gradient step when a conjugate step would make an impulse pull
+(expansion). On a positive semidefinite A (as here: more contacts than ways to move, in a square slab)
+it still converges; it stops when every contact is within `tol` of its bound (m/s).
 
 A is never built: A p is "push each contact's bodies by p along its normal, then read the contacts'
 relative normal velocities" (`Response`), a few numpy calls on the contacts' rows, so a step costs
@@ -33,8 +33,8 @@ class Response:
     the unit normal n[k] (complex, from b to a); inv[body] = 1 / its mass (0: a wall, a sleeper).
 
     The problem is solved scaled by the diagonal (each contact's own response, 1 / its pair's reduced mass):
-    impulses y = p / scale with scale = A_kk^(-1/2), so that every contact answers a unit push alike. The
-    bound y >= 0 is p >= 0, and where the masses differ by decades the gradients converge as though alike.
+    impulses y = p / scale with scale = A_kk^(-1/2), so that every contact answers a unit push alike (the bound
+    y >= 0 is p >= 0). Masses decades apart along a chain still slow it: six decades took 3000 to 10000 steps.
     """
 
     def __init__(self, n: np.ndarray, a: np.ndarray, b: np.ndarray, inv: np.ndarray) -> None:
