@@ -16,8 +16,8 @@ than the free ones, and a projected gradient step when a conjugate step would ma
 it still converges; it stops when every contact is within `tol` of its bound (m/s).
 
 A is never built: A p is "push each contact's bodies by p along its normal, then read the contacts'
-relative normal velocities" (`Response`), a few numpy calls on the contacts' rows, so a step costs
-the same on 100 contacts or 10,000 (a pile's matrix is almost all zeros).
+relative normal velocities" (`Response`): a dozen numpy calls on the contacts' rows, however many, where
+the matrix would be m x m and almost all zeros (a pile's contact shares a body with a handful of others).
 """
 
 from __future__ import annotations
