@@ -423,7 +423,7 @@ class ContactSolver:
         too_deep = lambda: _sinks(c, w, dt) > DEEPEST_M  # noqa: E731
         self.iterations, layout = _iterate(w, first, later, too_deep if start is None else lambda: False)
         impulses = layout.impulses()
-        if start is None or not (was_exact or _off_bound(c, w, dt, impulses) > POLISH_MPS):
+        if start is None or not (was_exact or _off_bound(c, w, _targets(c, dt), impulses) > POLISH_MPS):
             return impulses
         polished = None
         if self.count <= PIVOT_MAX and not self._paused:
@@ -445,7 +445,8 @@ class ContactSolver:
         velocities' does not come within NEAR_MPS of their bounds; if the pseudo-velocities' does not settle,
         the iterations' are kept."""
         response = proportioning.Response(c.n, c.a, c.b, inv)
-        q = np.column_stack([_normal_speeds(c, start, col) for col in (0, 1)]) - _targets(c, dt)
+        target = _targets(c, dt)
+        q = np.column_stack([_normal_speeds(c, start, col) for col in (0, 1)]) - target
         most = min(POLISH_STEPS, POLISH_WORK // len(c.a))
         out, taken = impulses.copy(), []
         for col in (0, 1):
@@ -459,7 +460,7 @@ class ContactSolver:
         # Checked as applied, to NEAR_MPS: impulses out of all scale, pushing against each other along dependent
         # contacts (a jam), leave round-off in the velocities (a puck jumped 50 mm in a step of a pile falling
         # asleep, its pseudo-velocities' problem having no answer).
-        if not all(_off_bound(c, polished, dt, out, col) <= NEAR_MPS for col in taken):  # (NaN: not)
+        if not all(_off_bound(c, polished, target, out, col) <= NEAR_MPS for col in taken):  # (NaN: not)
             return None
         w[:] = polished
         self._exact = True
@@ -854,11 +855,11 @@ def _nearest(response: proportioning.Response, q: np.ndarray, *candidates: np.nd
     return best
 
 
-def _off_bound(c: _Contacts, w: np.ndarray, dt: float, impulses: np.ndarray, col: int = 0) -> float:
+def _off_bound(c: _Contacts, w: np.ndarray, target: np.ndarray, impulses: np.ndarray, col: int = 0) -> float:
     """How far (m/s) the velocities `w` (col 0; 1: the pseudo-velocities) leave the worst contact off its
-    bound (_targets): approaching past it, or, where the contact pushes (impulses), parting faster than it
-    (an impulse too big: a puck thrown up). NaN if any is."""
-    off = _normal_speeds(c, w, col) - _targets(c, dt)[:, col]
+    bound (target: _targets): approaching past it, or, where the contact pushes (impulses), parting faster
+    than it (an impulse too big: a puck thrown up). NaN if any is."""
+    off = _normal_speeds(c, w, col) - target[:, col]
     return max(float(-off.min()), float(off.max(where=impulses[:, col] > 0.0, initial=0.0)))
 
 
