@@ -203,6 +203,20 @@ def watch(table: AirTable, steps: int, dt: float = 1 / 60) -> tuple[float, float
     return overlap, up
 
 
+def watch_landing(table: AirTable, dt: float, after_s: float) -> tuple[int | None, float, float]:
+    """Step by dt until `after_s` after a puck first reaches the floor (TOUCH_M), for 2 s at most; return (the
+    step it landed in, None if none did; the deepest overlap (m) and fastest up (m/s) after any step)."""
+    landed, overlap, up = None, 0.0, 0.0
+    for step in range(round(2.0 / dt)):
+        table.step(dt)
+        overlap, up = max(overlap, deepest(table, gaps(table))), max(up, float(table.vel_mps[:, 1].max()))
+        if landed is None and float(np.min(table.pos_m[:, 1] - table.radius_m)) < TOUCH_M:
+            landed = step
+        if landed is not None and (step - landed) * dt >= after_s:
+            break
+    return landed, overlap, up
+
+
 @settings(max_examples=4, deadline=None, derandomize=True)
 @given(
     across=st.integers(16, 30),
@@ -226,14 +240,7 @@ def test_a_slab_too_big_to_solve_exactly_lands_without_sinking_into_itself(
     r = min(r, 4.0 / across)  # (it fits the 10 m table with room on each side)
     table = dead_table()
     slab(table, across, rows, r, hexagonal, throw_mps)
-    overlap, landed = 0.0, None
-    for step in range(round(2.0 / dt)):
-        table.step(dt)
-        overlap = max(overlap, deepest(table, gaps(table)))
-        if landed is None and float(np.min(table.pos_m[:, 1] - table.radius_m)) < TOUCH_M:
-            landed = step
-        if landed is not None and (step - landed) * dt >= 0.25:
-            break
+    landed, overlap, _ = watch_landing(table, dt, 0.25)
     assert landed is not None
     assert overlap < OVERLAP_M
 
@@ -315,14 +322,7 @@ def test_a_square_slab_of_random_masses_thrown_down_lands_dead(across, rows, r, 
     table = dead_table()
     densities = 0.3 * 10.0 ** np.random.default_rng(seed).uniform(-decades / 2, decades / 2, across * rows)
     slab(table, across, rows, r, hexagonal=False, throw_mps=throw_mps, densities=densities)
-    landed, overlap, up = None, 0.0, 0.0
-    for step in range(round(2.0 / dt)):
-        table.step(dt)
-        overlap, up = max(overlap, deepest(table, gaps(table))), max(up, float(table.vel_mps[:, 1].max()))
-        if landed is None and float(np.min(table.pos_m[:, 1] - table.radius_m)) < TOUCH_M:
-            landed = step
-        if landed is not None and (step - landed) * dt >= 0.5:
-            break
+    landed, overlap, up = watch_landing(table, dt, 0.5)
     assert landed is not None
     assert overlap < OVERLAP_M
     assert up < UP_MPS
