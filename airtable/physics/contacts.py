@@ -114,22 +114,32 @@ SAFE_MASS_RATIO = 100.0
 EXACT_PAUSE = 60
 # Where the iterations (more than EXACT_MAX contacts, or the exact solve paused) leave a contact off
 # its bound by more than POLISH_MPS (m/s), or the last step was solved to the end, their answer is
-# polished, up to POLISH_MAX contacts: first by the exact solve from the contacts they have pushing (block
-# pivoting alone, up to PIVOT_MAX contacts, unless it paused); where that does not settle, by
-# proportioning.solve from their answer, to POLISH_TOL_MPS (or NEAR_MPS), in at most POLISH_STEPS steps and
-# POLISH_WORK contact-steps. Square slabs of 200 to 340 pucks thrown down (600 to 1100 contacts as they land:
-# each puck's diagonal neighbours are within the margin) threw top pucks up at up to 2.8 m/s from the
-# iterations' answer, where block pivoting did not settle; polished in 10 to 300 steps, they land dead.
-# (Proportioning alone, on a slab of rows of 1 g and 1000 kg, stopped near the answer, and the iterations of
-# the next step, warm-started from it, diverged; a pile of 800 pucks, 2300 contacts, many dependent,
-# settles in neither: beyond POLISH_MAX, the iterations alone.) If neither settles, they pause.
+# polished, up to POLISH_MAX contacts; up to LEAP_MAX, only where they leave a contact off by LEAP_MPS (a puck
+# leaping or sinking: a slab landing) or one sinking DEEPEST_M (an 800-puck pile settling has 1000 to 2300
+# contacts, which they leave up to 0.16 m/s off, and polishing those doubled its step). A polish is, in turn:
+# QUICK_STEPS of proportioning.solve from their answer or the last step's (a slab at rest settles in one or
+# two: block pivoting first cost 0.1 to 0.6 s a step on a 20 x 20 slab at rest, 780 contacts); block pivoting
+# from the contacts they have pushing, where it costs little (EXACT_MAX) or the masses differ (SAFE_MASS_RATIO,
+# up to PIVOT_MAX: there proportioning converges as slowly as they differ, and on a slab of rows of 1 g and
+# 1000 kg its answers, near but not exact, led the next step's iterations to diverge); then proportioning to
+# POLISH_TOL_MPS in at most POLISH_STEPS steps and POLISH_WORK contact-steps, or LEAP_WORK where they leap or
+# the last step was solved to the end (a square slab of 25 x 25 pucks landing took 500 to 1700 steps, three
+# steps running, then one a step). Where that does not settle, its answer if it leaves the contacts nearer
+# their bounds than theirs; if it does not, the iterations go on, and the polish pauses (EXACT_PAUSE) but for
+# leaps. Square slabs of 200 to 340 pucks thrown down (600 to 1100 contacts as they land: each puck's diagonal
+# neighbours are within the margin) threw top pucks up at up to 2.8 m/s from the iterations' answer; 22 x 22
+# and 25 x 25 ones (1800 to 2400 contacts) at 0.3 to 1.6 m/s, sinking 3 to 8 mm: polished, they land dead.
 POLISH_MPS = 1e-4
 POLISH_TOL_MPS = 1e-6
 NEAR_MPS = 1e-5
 POLISH_MAX = 1500
 PIVOT_MAX = 1000
-POLISH_STEPS = 1000
+POLISH_STEPS = 2000
+QUICK_STEPS = 60
 POLISH_WORK = 300_000
+LEAP_MPS = 0.3
+LEAP_MAX = 4000
+LEAP_WORK = 4_000_000
 CONVERGED_MPS = 1e-7
 # The first iteration's rounds go bottom-up by horizontal bands this many
 # radii high (a contact after its pucks' contacts of lower bands): support from
@@ -410,60 +420,82 @@ class ContactSolver:
         return True
 
     def _iterate_then_polish(self, c: _Contacts, inv, w: np.ndarray, dt: float, mass, asleep, was_exact: bool):
-        """Sequential impulses in coloured rounds, warm-started, on `w` in place; then, where their answer
-        leaves a contact off its bound by more than POLISH_MPS or the last step was solved to the end, polished
-        (see POLISH_MPS). Returns the impulses (m, 2). Without a polish (too many contacts, paused, or it did
-        not settle: then the next EXACT_PAUSE steps go without) they iterate on while a contact would sink too
-        deep (DEEPEST_M)."""
+        """Sequential impulses in coloured rounds, warm-started, on `w` in place; then polished (see POLISH_MPS)
+        where the last step was solved to the end or their answer leaves a contact off its bound by more than
+        POLISH_MPS (up to POLISH_MAX contacts), and wherever it leaves a puck leaping or sinking (LEAP_MPS, up to
+        LEAP_MAX). Returns the impulses (m, 2). Where no polish follows they iterate on while a contact would
+        sink too deep (DEEPEST_M); where one does not settle, the next EXACT_PAUSE steps polish only leaps."""
         if self._polish_paused:
             self._polish_paused -= 1
-        start = None if self._polish_paused or self.count > POLISH_MAX else w.copy()
+        start = w.copy() if self.count <= LEAP_MAX else None
         first, later = self._gather(c, inv, dt, asleep)
         w[:-1, 0] += _warm_push(c, mass, self._warm, asleep)  # warm start: last step's velocity impulses first
         too_deep = lambda: _sinks(c, w, dt) > DEEPEST_M  # noqa: E731
-        self.iterations, layout = _iterate(w, first, later, too_deep if start is None else lambda: False)
+        sure = not self._polish_paused and self.count <= POLISH_MAX  # (a polish follows whatever they leave off)
+        self.iterations, layout = _iterate(w, first, later, (lambda: False) if sure else too_deep)
         impulses = layout.impulses()
-        if start is None or not (was_exact or _off_bound(c, w, _targets(c, dt), impulses) > POLISH_MPS):
+        if start is None:
             return impulses
-        polished = None
-        if self.count <= PIVOT_MAX and not self._paused:
-            polished = self._solve_exactly(c, inv, start, dt, impulses > 0.0)  # from the contacts pushing
-            if polished is not None:
-                w[:] = start
-        if polished is None:
-            polished = self._polish(c, inv, w, start, dt, impulses)
+        off = _off_bound(c, w, _targets(c, dt), impulses)
+        leaping = off > LEAP_MPS or too_deep()
+        if not (leaping or (not self._polish_paused and was_exact) or (sure and off > POLISH_MPS)):
+            return impulses
+        work = POLISH_WORK if sure and not (leaping or was_exact) else LEAP_WORK
+        polished = self._polished(c, inv, w, start, dt, impulses, work, off)
+        if polished is None or not self._exact:
+            self._polish_paused = EXACT_PAUSE
         if polished is not None:
             return polished
-        self._polish_paused = EXACT_PAUSE
         more, layout = _iterate(w, layout, layout, too_deep)  # (from where they stopped)
         self.iterations += more
         return layout.impulses()
 
-    def _polish(self, c: _Contacts, inv, w: np.ndarray, start: np.ndarray, dt: float, impulses: np.ndarray):
+    def _polished(self, c: _Contacts, inv, w: np.ndarray, start: np.ndarray, dt: float, impulses, work: int, off):
+        """The iterations' impulses carried to the answer, in place: by a few steps of proportioning from them or
+        the last step's (a pile at rest barely changes), else by block pivoting from the contacts they have
+        pushing (where it costs little, or the masses differ: see SAFE_MASS_RATIO; unless paused), else by up to
+        `work` contact-steps of proportioning; where that does not settle, its answer if it leaves the contacts
+        nearer their bounds than theirs do (`off`: then self._exact is False). None (`w` untouched) if none is."""
+        apart = _masses_apart(inv.take(np.append(c.a, c.b)))
+        polished = None if apart else self._polish(c, inv, w, start, dt, impulses, QUICK_STEPS)
+        pivots = self.count <= (PIVOT_MAX if apart else EXACT_MAX)
+        if polished is None and pivots and not self._paused:
+            polished = self._solve_exactly(c, inv, start, dt, impulses > 0.0)
+            if polished is not None:
+                w[:] = start
+        if polished is None:
+            polished = self._polish(c, inv, w, start, dt, impulses, POLISH_STEPS, work, better_than=off)
+        return polished
+
+    def _polish(self, c: _Contacts, inv, w, start, dt: float, impulses, most: int, work=POLISH_WORK, better_than=None):
         """The iterations' impulses carried to the answer by proportioning.solve, from `start` (the velocities
-        before them) or the last step's (_nearest), column by column, in place; None (`w` untouched) if the
-        velocities' does not come within NEAR_MPS of their bounds; if the pseudo-velocities' does not settle,
-        the iterations' are kept."""
+        before them) or the last step's (_nearest), column by column, in place: the velocities' in at most
+        `most` steps and `work` contact-steps, the pseudo-velocities' in POLISH_WORK (unsettled, the iterations'
+        are kept). None (`w` untouched) if the velocities' does not settle, unless `better_than` is given: then
+        if it comes within NEAR_MPS of their bounds as applied, or nearer than `better_than` (self._exact False).
+        """
         response = proportioning.Response(c.n, c.a, c.b, inv)
         target = _targets(c, dt)
         q = np.column_stack([_normal_speeds(c, start, col) for col in (0, 1)]) - target
-        most = min(POLISH_STEPS, POLISH_WORK // len(c.a))
-        out, taken = impulses.copy(), []
-        for col in (0, 1):
+        out, polished, exact = impulses.copy(), start.copy(), True
+        for col, budget in ((0, work), (1, POLISH_WORK)):
             begin = _nearest(response, q[:, col], impulses[:, col], self._warm if col == 0 else None)
-            p, settled = proportioning.solve(response, q[:, col], begin, POLISH_TOL_MPS, most)
-            if settled or col == 0:  # (the velocities' may be near enough unsettled: see below)
+            p, settled = proportioning.solve(response, q[:, col], begin, POLISH_TOL_MPS, min(most, budget // len(c.a)))
+            if better_than is None and not settled and col == 0:
+                return None
+            if settled or col == 0:  # (the velocities' may be near enough unsettled: checked below)
                 out[:, col] = p
-                taken.append(col)
-        polished = start.copy()
-        _push(c, inv, polished, out)
-        # Checked as applied, to NEAR_MPS: impulses out of all scale, pushing against each other along dependent
-        # contacts (a jam), leave round-off in the velocities (a puck jumped 50 mm in a step of a pile falling
-        # asleep, its pseudo-velocities' problem having no answer).
-        if not all(_off_bound(c, polished, target, out, col) <= NEAR_MPS for col in taken):  # (NaN: not)
-            return None
+            _push_column(c, inv, polished, out[:, col], col)
+            # Checked as applied, to NEAR_MPS: impulses out of all scale, pushing against each other along dependent
+            # contacts (a jam), leave round-off in the velocities (a puck jumped 50 mm in a step of a pile falling
+            # asleep, its pseudo-velocities' problem having no answer).
+            off = _off_bound(c, polished, target, out, col) if settled or col == 0 else 0.0
+            if not off <= NEAR_MPS:  # (NaN: not)
+                if col == 1 or better_than is None or not off < better_than:
+                    return None
+                exact = False
         w[:] = polished
-        self._exact = True
+        self._exact = exact
         return out
 
     def _try_exactly(self, c: _Contacts, inv: np.ndarray, w: np.ndarray, dt: float) -> np.ndarray | None:
@@ -488,8 +520,7 @@ class ContactSolver:
         inv_bodies = inv.take(bodies)
         response = collapse.response(c.n, a, b, inv_bodies)  # (one matrix for both problems)
         pushed = self._pushed(c.keys) if pushed is None else pushed  # (a pile's pushing set changes little)
-        moving = inv_bodies[inv_bodies > 0.0]
-        safe = m <= SAFE_MAX or (m <= EXACT_MAX and len(moving) > 0 and moving.max() > SAFE_MASS_RATIO * moving.min())
+        safe = m <= SAFE_MAX or (m <= EXACT_MAX and _masses_apart(inv_bodies))
         velocity = collapse.solve(response, vn - target[:, 0], pushed[:, 0], safe)  # vn after: at least the bound
         position = None if velocity is None else collapse.solve(response, -target[:, 1], pushed[:, 1], safe)
         if position is None:
@@ -830,12 +861,24 @@ def _normal_speeds(c: _Contacts, w: np.ndarray, col: int = 0) -> np.ndarray:
     return (c.n.conjugate() * (w.take(c.a, axis=0)[:, col] - w.take(c.b, axis=0)[:, col])).real
 
 
+def _masses_apart(inv: np.ndarray) -> bool:
+    """Whether the masses of the bodies (their 1 / mass: `inv`; 0, a wall or a sleeper, left out) differ more
+    than SAFE_MASS_RATIO times."""
+    moving = inv[inv > 0.0]
+    return len(moving) > 0 and moving.max() > SAFE_MASS_RATIO * moving.min()
+
+
 def _push(c: _Contacts, inv: np.ndarray, w: np.ndarray, impulses: np.ndarray) -> None:
     """Apply the contacts' impulses (m, 2) to the velocities and pseudo-velocities `w`, in place."""
     for col in (0, 1):
-        push = impulses[:, col] * c.n
-        np.add.at(w[:, col], c.a, push * inv.take(c.a))
-        np.add.at(w[:, col], c.b, -push * inv.take(c.b))  # (the walls' row: inv 0)
+        _push_column(c, inv, w, impulses[:, col], col)
+
+
+def _push_column(c: _Contacts, inv: np.ndarray, w: np.ndarray, impulses: np.ndarray, col: int) -> None:
+    """Apply one column of the contacts' impulses to that column of `w` (0: velocities, 1: pseudo-), in place."""
+    push = impulses * c.n
+    np.add.at(w[:, col], c.a, push * inv.take(c.a))
+    np.add.at(w[:, col], c.b, -push * inv.take(c.b))  # (the walls' row: inv 0)
 
 
 def _sinks(c: _Contacts, w: np.ndarray, dt: float) -> float:
