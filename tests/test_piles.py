@@ -299,7 +299,7 @@ def test_a_tall_square_slab_thrown_down_lands_dead(across: int, rows: int, throw
 # contacts, where the iterations alone left them 3.2 and 7.7 mm deep, throwing pucks up at 0.3 and 1.6 m/s.
 @example(across=22, rows=22, r=0.15, throw_mps=2.0, dt=1 / 60)
 @example(across=25, rows=25, r=0.03, throw_mps=3.0, dt=1 / 60)
-def test_a_big_square_slab_thrown_down_lands_dead(across: int, rows: int, r: float, throw_mps: float, dt: float) -> None:
+def test_a_big_square_slab_thrown_down_lands_dead(across: int, rows: int, r: float, throw_mps: float, dt: float):
     """252 to 676 pucks one on another, thrown down at restitution 0 (up to 2900 contacts as they land): by hand
     the slab stops dead on the floor. Nothing moves up (UP_MPS) nor sinks OVERLAP_M until a quarter of a second
     after it lands (later a frictionless square slab may tip over as hard discs do: the test above)."""
