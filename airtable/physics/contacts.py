@@ -577,8 +577,9 @@ class ContactSolver:
         impulse = np.zeros((len(c.keys), 2))  # pseudo-velocities start from nothing each step
         self._warm = impulse[:, 0]
         cached = self._layouts
-        if cached is not None and cached.same(c.keys, asleep, self):
-            # The very contacts of the last step, in the same order, the same pucks asleep: the same rounds.
+        if cached is not None and cached.same(c.keys, asleep, self, lambda: self._bands(c, cached.key_order)):
+            # The very contacts of the last step, in the same order, the same pucks asleep, the same bands: the
+            # same rounds.
             self._key_order = cached.key_order
             impulse[cached.key_order, 0] = self._impulses[:, 0]
         else:
@@ -735,15 +736,19 @@ class _Colouring:
     levels: np.ndarray | None  # each contact's band (key order) when coloured
     ordered: bool  # whether `band` was then in band order everywhere
 
-    def same(self, keys: np.ndarray, asleep: np.ndarray | None, solver: ContactSolver) -> bool:
-        """Whether these contacts are those of the solver's last step, with the same rounds and sleepers."""
+    def same(self, keys: np.ndarray, asleep: np.ndarray | None, solver: ContactSolver, bands) -> bool:
+        """Whether these contacts are those of the solver's last step, with the same rounds and sleepers, and
+        their rounds in the order of their bands now (bands(): each one's band, key order): colouring them again
+        would give the same rounds, as it does after a restore (which keeps the rounds, not this colouring)."""
         if self.band is not solver._band_rounds or self.free is not solver._free_rounds:
             return False  # a restored state: its rounds may be other ones
         if len(solver._keys) != len(keys) or not np.array_equal(self.keys, keys):
             return False
-        return (asleep is None and self.asleep is None) or (
+        if not ((asleep is None and self.asleep is None) or (
             asleep is not None and self.asleep is not None and np.array_equal(asleep, self.asleep)
-        )
+        )):  # fmt: skip
+            return False
+        return self.levels is None or (self.ordered and np.array_equal(self.levels, bands()))
 
     def has(self, band: np.ndarray, free: np.ndarray) -> bool:
         """Whether these are the rounds laid out."""
