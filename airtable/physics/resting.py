@@ -13,7 +13,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from airtable.physics import contacts, vectors
+from airtable.physics import broadphase, contacts, events, vectors
 from airtable.physics.rest_speeds import RestSpeeds
 from airtable.physics.storage import non_negative
 
@@ -59,8 +59,8 @@ def hold(table: Storage, ctx: StepContext) -> bool:
     small one under a big one falling) can leave faster than any puck came: if the answer moves a
     puck faster than the margin allowed, the stage starts again with the margin of the answer's
     speeds, so the puck's path meets its new neighbours as contacts (MARGIN_TRIES times at most).
-    The pairs it may take are the neighbour list's: a pair within the margin but beyond the list's
-    skin is not offered (a step of 1/30 s with a puck at several m/s can leave one out).
+    The pairs it may take are the neighbour list's, and those of the pucks fast enough to pass through
+    one in a step (_candidates).
     """
     if ctx.rest is None:
         return False
@@ -68,12 +68,12 @@ def hold(table: Storage, ctx: StepContext) -> bool:
     pucks = (table.pos_m, table.vel_mps, table.radius_m, table.mass_kg)
     solver = table.contact_solver
     rest = (ctx.rest, ctx.dt, asleep)
+    margin = contacts.margin_m(table.vel_mps, ctx.dt)
     if table.puck_collisions:
-        candidates = table.neighbour_list.pairs(table.pos_m, table.radius_m)
+        candidates = _candidates(table, ctx.dt, margin)
     else:
         none = np.empty(0, dtype=np.intp)
         candidates = (none, none, np.empty(0))
-    margin = contacts.margin_m(table.vel_mps, ctx.dt)
     for tries in range(1, MARGIN_TRIES + 1):
         before = table.pos_m.copy(), table.vel_mps.copy(), solver.save()
         held = solver.solve(*pucks, table.size_m, candidates, *rest, ctx.began, margin)
@@ -84,3 +84,29 @@ def hold(table: Storage, ctx: StepContext) -> bool:
         solver.restore(before[2])
         margin = needed
     return held
+
+
+def _candidates(table: Storage, dt: float, margin: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(i, j, reach): the pairs the contact stage may take. The neighbour list holds every pair touching
+    where the step ends, and those near it; a pair that meets and would pass through within one step is
+    never near where a step ends. So the pucks that move FAST_FRACTION of the smallest radius in a step
+    (events.py's fast pucks) are paired too with every puck their straight paths come within reach of.
+    (At restitution 0 a hit is the contact stage's however fast: a puck at 30 m/s, dt 1/60, passed through
+    another, the pair never in the list.)"""
+    pos, vel, radius = table.pos_m, table.vel_mps, table.radius_m
+    i, j, reach = table.neighbour_list.pairs(pos, radius)
+    travel = np.sqrt(vectors.squared_lengths(vel)) * dt
+    fast = np.flatnonzero(travel >= events.FAST_FRACTION * float(radius.min()))
+    if len(fast) == 0:
+        return i, j, reach
+    fi, fj = broadphase.pairs_near(pos, radius, fast, margin + 2.0 * float(travel.max()))
+    d, w = vectors.take(pos, fi) - vectors.take(pos, fj), vectors.take(vel, fi) - vectors.take(vel, fj)
+    d -= w * dt  # where the step began
+    t = np.clip(-vectors.dot_rows(d, w) / np.maximum(vectors.squared_lengths(w), 1e-300), 0.0, dt)
+    closest = vectors.squared_lengths(d + w * t[:, None])
+    meet = radius.take(fi) + radius.take(fj) + contacts.MARGIN_M
+    k = np.flatnonzero(closest < meet * meet)  # (their paths come within reach in the step)
+    n = len(pos)
+    keys, first = np.unique(np.concatenate([i * n + j, fi.take(k) * n + fj.take(k)]), return_index=True)
+    extra = radius.take(fi.take(k)) + radius.take(fj.take(k))
+    return keys // n, keys % n, np.concatenate([reach, extra]).take(first)  # (each pair once)
