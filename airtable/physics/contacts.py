@@ -114,9 +114,11 @@ SAFE_MASS_RATIO = 100.0
 EXACT_PAUSE = 60
 # Where the iterations (more than EXACT_MAX contacts, or the exact solve paused) leave a contact off
 # its bound by more than POLISH_MPS (m/s), or the last step was solved to the end, their answer is
-# polished, up to POLISH_MAX contacts; up to LEAP_MAX, only where they leave a contact off by LEAP_MPS (a puck
-# leaping or sinking: a slab landing) or one sinking DEEPEST_M (an 800-puck pile settling has 1000 to 2300
-# contacts, which they leave up to 0.16 m/s off, and polishing those doubled its step). A polish is, in turn:
+# polished, up to POLISH_MAX contacts (a 20 x 20 slab landing has 1500: left to them, it sank 0.2-0.4 mm into
+# itself, and pushing that out raised its energy and tipped it over within 0.3 s); up to LEAP_MAX, only where
+# they leave a contact off by LEAP_MPS (a puck leaping or sinking: a slab landing) or one sinking DEEPEST_M (an
+# 800-puck pile settling has 2100 to 2300 contacts, which they leave up to 0.16 m/s off, and polishing those
+# doubled its step). A polish is, in turn:
 # QUICK_STEPS of proportioning.solve from their answer or the last step's (a slab at rest settles in one or
 # two: block pivoting first cost 0.1 to 0.6 s a step on a 20 x 20 slab at rest, 780 contacts); block pivoting
 # from the contacts they have pushing, where it costs little (EXACT_MAX) or the masses differ (SAFE_MASS_RATIO,
@@ -132,7 +134,7 @@ EXACT_PAUSE = 60
 POLISH_MPS = 1e-4
 POLISH_TOL_MPS = 1e-6
 NEAR_MPS = 1e-5
-POLISH_MAX = 1500
+POLISH_MAX = 2000
 PIVOT_MAX = 1000
 POLISH_STEPS = 2000
 QUICK_STEPS = 60
