@@ -207,22 +207,24 @@ def test_a_puck_pushed_into_one_held_in_a_corner_lifts_it_as_hard_discs_do(
     np.testing.assert_allclose(table.vel_mps, [[0.0, lift], [slide, 0.0]], rtol=0, atol=1e-6)
 
 
-def test_a_puck_squeezed_out_from_under_a_falling_one_meets_the_puck_in_its_path() -> None:
+@pytest.mark.parametrize("gap_m", [0.3, 0.4])
+def test_a_puck_squeezed_out_from_under_a_falling_one_meets_the_puck_in_its_path(gap_m: float) -> None:
     # A small puck S (r 0.05 m) on the floor; a big one B (r 0.5 m, 100 times heavier) touching it
     # from above, its centre 5 cm to the left, falling at 3 m/s; a puck C (r 0.1 m) on the floor
-    # 0.3 m to the right of S. Their normal is 5 degrees from vertical, so S leaves the wedge at
-    # about 11 times B's speed, over 16 m/s: in a step of 1/30 s it would cross C's 0.3 m gap and C
+    # gap_m to the right of S. Their normal is 5 degrees from vertical, so S leaves the wedge at
+    # about 11 times B's speed, over 16 m/s: in a step of 1/30 s it would cross C's gap and C
     # itself. The contacts were found within a margin for the speeds the pucks came with (0.24 m);
     # S leaves faster, so the stage starts again with the margin of its answer: C is a contact, S
-    # stops at C and pushes it on. (Before: S passed through C in two steps.)
+    # stops at C and pushes it on. (Before: S passed through C in two steps; at 0.4 m, beyond the
+    # neighbour list's reach, it still did until the stage looked again along S's new path too.)
     dt = 1 / 30
     table = AirTable()
     table.gravity_on, table.sleeping = True, False
     table.cr_puck = table.cr_wall = 0.0
     table.add_puck(pos_m=(5.0, 0.05), radius_m=0.05)
     table.add_puck(pos_m=(4.95, 0.05 + math.sqrt(0.55**2 - 0.05**2)), radius_m=0.5, vel_mps=(0.0, -3.0))
-    table.add_puck(pos_m=(5.45, 0.1), radius_m=0.1)
-    assert 0.3 > contacts.margin_m(table.vel_mps - (0.0, GRAVITY_MPS2 * dt), dt)  # C is beyond the first margin
+    table.add_puck(pos_m=(5.15 + gap_m, 0.1), radius_m=0.1)
+    assert gap_m > contacts.margin_m(table.vel_mps - (0.0, GRAVITY_MPS2 * dt), dt)  # C is beyond the first margin
     for _ in range(3):
         table.step(dt)
         pos, radius = table.pos_m, table.radius_m

@@ -80,6 +80,8 @@ def hold(table: Storage, ctx: StepContext) -> bool:
         needed = contacts.margin_m(table.vel_mps, ctx.dt)
         if needed - contacts.MARGIN_M <= margin or tries == MARGIN_TRIES:  # a pair left out cannot close its gap
             return held
+        if table.puck_collisions:  # (and the paths of the pucks the answer made fast)
+            candidates = _union(table.n_pucks, candidates, _candidates(table, ctx.dt, needed))
         table.pos_m[:], table.vel_mps[:] = before[0], before[1]
         solver.restore(before[2])
         margin = needed
@@ -106,7 +108,12 @@ def _candidates(table: Storage, dt: float, margin: float) -> tuple[np.ndarray, n
     closest = vectors.squared_lengths(d + w * t[:, None])
     meet = radius.take(fi) + radius.take(fj) + contacts.MARGIN_M
     k = np.flatnonzero(closest < meet * meet)  # (their paths come within reach in the step)
-    n = len(pos)
-    keys, first = np.unique(np.concatenate([i * n + j, fi.take(k) * n + fj.take(k)]), return_index=True)
-    extra = radius.take(fi.take(k)) + radius.take(fj.take(k))
-    return keys // n, keys % n, np.concatenate([reach, extra]).take(first)  # (each pair once)
+    fi, fj = fi.take(k), fj.take(k)
+    return _union(len(pos), (i, j, reach), (fi, fj, radius.take(fi) + radius.take(fj)))
+
+
+def _union(n: int, *pairs: tuple[np.ndarray, np.ndarray, np.ndarray]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(i, j, reach) of every pair in any of `pairs` (each (i, j, reach), i < j, of n pucks), each once."""
+    keys = np.concatenate([i * n + j for i, j, _ in pairs])
+    keys, first = np.unique(keys, return_index=True)
+    return keys // n, keys % n, np.concatenate([reach for _, _, reach in pairs]).take(first)
