@@ -114,7 +114,7 @@ def pairs_near(pos: np.ndarray, radius: np.ndarray, rows: np.ndarray, margin_m: 
         empty = np.empty(0, dtype=np.intp)
         return empty, empty
     if len(rows) * n <= NEAR_BRUTE_FORCE_LOOKS:  # a few rows: each against every puck, no grid to build
-        return _each_pair_once(n, *_near_each(pos, radius, rows, margin_m))
+        return each_pair_once(n, *_near_each(pos, radius, rows, margin_m))
     big = too_big_for_the_grid(radius)
     big = np.zeros(n, dtype=bool) if big is None else big
     small = (~big).nonzero()[0]
@@ -132,7 +132,7 @@ def pairs_near(pos: np.ndarray, radius: np.ndarray, rows: np.ndarray, margin_m: 
         b.append(np.full(len(rows), r))
     a, b = np.concatenate(a), np.concatenate(b)
     near = _closer_than(pos, a, b, pair_reach(radius, a, b) + margin_m)
-    return _each_pair_once(n, a.take(near), b.take(near))
+    return each_pair_once(n, a.take(near), b.take(near))
 
 
 def _near_each(pos: np.ndarray, radius: np.ndarray, rows: np.ndarray, margin_m: float):
@@ -152,7 +152,7 @@ def rows_near(z: np.ndarray, radius: np.ndarray, centre: complex, radius_m: floa
     return (vectors.squared_abs(z - centre) < reach * reach).nonzero()[0]
 
 
-def _each_pair_once(n: int, a: np.ndarray, b: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def each_pair_once(n: int, a: np.ndarray, b: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """The pairs (a, b) of n pucks as (i < j), each once, sorted by (i, j); a puck paired with itself dropped."""
     i, j = np.minimum(a, b), np.maximum(a, b)
     key = np.sort((i * n + j)[i != j])  # one key per pair sorts as (i, j) does

@@ -242,11 +242,8 @@ def _passing(d: np.ndarray, w: np.ndarray, gap: np.ndarray, reach: np.ndarray, d
     there) unless something else drives them together. Pairs within SLOP_M touch: theirs stay where the step
     began (a slab of rows of 1 g and 1000 kg, its neighbours 1e-16 m apart, exploded with them turned).
     """
-    dw = vectors.dot_rows(d, w)
-    k = np.flatnonzero((gap > SLOP_M) & (dw < 0.0))  # apart and closing: their closest approach lies ahead
-    wk = vectors.take(w, k)
-    t = np.minimum(-dw.take(k) / vectors.squared_lengths(wk), dt)
-    closest, apart = vectors.unit_vectors(vectors.take(d, k) + wk * t[:, None])
+    k = np.flatnonzero((gap > SLOP_M) & (vectors.dot_rows(d, w) < 0.0))  # apart and closing: closest ahead
+    closest, apart = vectors.unit_vectors(collision.closest_in_step(vectors.take(d, k), vectors.take(w, k), dt))
     passing = np.flatnonzero(apart > reach.take(k))
     k, closest = k.take(passing), vectors.take(closest, passing)
     return k, closest, vectors.dot_rows(vectors.take(d, k), closest) - reach.take(k)

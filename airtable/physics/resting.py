@@ -13,7 +13,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from airtable.physics import broadphase, contacts, events, vectors
+from airtable.physics import broadphase, collision, contacts, events, vectors
 from airtable.physics.rest_speeds import RestSpeeds
 from airtable.physics.storage import non_negative
 
@@ -81,7 +81,7 @@ def hold(table: Storage, ctx: StepContext) -> bool:
         if needed - contacts.MARGIN_M <= margin or tries == MARGIN_TRIES:  # a pair left out cannot close its gap
             return held
         if table.puck_collisions:  # (and the paths of the pucks the answer made fast)
-            candidates = _union(table.n_pucks, candidates, _candidates(table, ctx.dt, needed))
+            candidates = _union(table.radius_m, candidates, _candidates(table, ctx.dt, needed))
         table.pos_m[:], table.vel_mps[:] = before[0], before[1]
         solver.restore(before[2])
         margin = needed
@@ -103,17 +103,13 @@ def _candidates(table: Storage, dt: float, margin: float) -> tuple[np.ndarray, n
         return i, j, reach
     fi, fj = broadphase.pairs_near(pos, radius, fast, margin + 2.0 * float(travel.max()))
     d, w = vectors.take(pos, fi) - vectors.take(pos, fj), vectors.take(vel, fi) - vectors.take(vel, fj)
-    d -= w * dt  # where the step began
-    t = np.clip(-vectors.dot_rows(d, w) / np.maximum(vectors.squared_lengths(w), 1e-300), 0.0, dt)
-    closest = vectors.squared_lengths(d + w * t[:, None])
-    meet = radius.take(fi) + radius.take(fj) + contacts.MARGIN_M
+    closest = vectors.squared_lengths(collision.closest_in_step(d - w * dt, w, dt))  # (from where the step began)
+    meet = broadphase.pair_reach(radius, fi, fj) + contacts.MARGIN_M
     k = np.flatnonzero(closest < meet * meet)  # (their paths come within reach in the step)
-    fi, fj = fi.take(k), fj.take(k)
-    return _union(len(pos), (i, j, reach), (fi, fj, radius.take(fi) + radius.take(fj)))
+    return _union(radius, (i, j, reach), (fi.take(k), fj.take(k)))
 
 
-def _union(n: int, *pairs: tuple[np.ndarray, np.ndarray, np.ndarray]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """(i, j, reach) of every pair in any of `pairs` (each (i, j, reach), i < j, of n pucks), each once."""
-    keys = np.concatenate([i * n + j for i, j, _ in pairs])
-    keys, first = np.unique(keys, return_index=True)
-    return keys // n, keys % n, np.concatenate([reach for _, _, reach in pairs]).take(first)
+def _union(radius: np.ndarray, *pairs: tuple) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(i, j, reach) of every pair in any of `pairs` (each (i, j, ...), i < j), each once, in (i, j) order."""
+    i, j = broadphase.each_pair_once(len(radius), *(np.concatenate([p[k] for p in pairs]) for k in (0, 1)))
+    return i, j, broadphase.pair_reach(radius, i, j)
