@@ -58,7 +58,8 @@ def hold(table: Storage, ctx: StepContext) -> bool:
     the pucks may travel towards them at the speeds they have. A puck squeezed out of a wedge (a
     small one under a big one falling) can leave faster than any puck came: if the answer moves a
     puck faster than the margin allowed, the stage starts again with the margin of the answer's
-    speeds, so the puck's path meets its new neighbours as contacts (MARGIN_TRIES times at most).
+    speeds, so the puck's path meets its new neighbours as contacts; and so too if the answer made a puck
+    fast along a path that meets a puck not among the pairs taken (MARGIN_TRIES times at most).
     The pairs it may take are the neighbour list's, and those of the pucks fast enough to pass through
     one in a step (_candidates).
     """
@@ -69,22 +70,22 @@ def hold(table: Storage, ctx: StepContext) -> bool:
     solver = table.contact_solver
     rest = (ctx.rest, ctx.dt, asleep)
     margin = contacts.margin_m(table.vel_mps, ctx.dt)
-    if table.puck_collisions:
-        candidates = _candidates(table, ctx.dt, margin)
-    else:
-        none = np.empty(0, dtype=np.intp)
-        candidates = (none, none, np.empty(0))
+    none = np.empty(0, dtype=np.intp)
+    candidates = _candidates(table, ctx.dt, margin) if table.puck_collisions else (none, none, np.empty(0))
     for tries in range(1, MARGIN_TRIES + 1):
         before = table.pos_m.copy(), table.vel_mps.copy(), solver.save()
         held = solver.solve(*pucks, table.size_m, candidates, *rest, ctx.began, margin)
-        needed = contacts.margin_m(table.vel_mps, ctx.dt)
-        if needed - contacts.MARGIN_M <= margin or tries == MARGIN_TRIES:  # a pair left out cannot close its gap
+        if tries == MARGIN_TRIES:
             return held
-        if table.puck_collisions:  # (and the paths of the pucks the answer made fast)
-            candidates = _union(table.radius_m, candidates, _candidates(table, ctx.dt, needed))
+        needed = contacts.margin_m(table.vel_mps, ctx.dt)
+        wider = needed - contacts.MARGIN_M > margin  # a pair left out cannot close its gap
+        paths = _along_fast_paths(table, ctx.dt, needed) if table.puck_collisions else (none, none)
+        if not wider and not _any_new(len(table.radius_m), candidates, paths):
+            return held
+        candidates = _union(table.radius_m, candidates, paths)
         table.pos_m[:], table.vel_mps[:] = before[0], before[1]
         solver.restore(before[2])
-        margin = needed
+        margin = max(margin, needed)
     return held
 
 
@@ -95,18 +96,35 @@ def _candidates(table: Storage, dt: float, margin: float) -> tuple[np.ndarray, n
     (events.py's fast pucks) are paired too with every puck their straight paths come within reach of.
     (At restitution 0 a hit is the contact stage's however fast: a puck at 30 m/s, dt 1/60, passed through
     another, the pair never in the list.)"""
+    listed = table.neighbour_list.pairs(table.pos_m, table.radius_m)
+    paths = _along_fast_paths(table, dt, margin)
+    return _union(table.radius_m, listed, paths) if len(paths[0]) else listed
+
+
+def _along_fast_paths(table: Storage, dt: float, margin: float) -> tuple[np.ndarray, np.ndarray]:
+    """(i, j): the pucks moving FAST_FRACTION of the smallest radius in a step, each with every puck
+    their straight paths through the step (ending where the pucks are) come within reach of."""
     pos, vel, radius = table.pos_m, table.vel_mps, table.radius_m
-    i, j, reach = table.neighbour_list.pairs(pos, radius)
     travel = np.sqrt(vectors.squared_lengths(vel)) * dt
     fast = np.flatnonzero(travel >= events.FAST_FRACTION * float(radius.min()))
     if len(fast) == 0:
-        return i, j, reach
+        none = np.empty(0, dtype=np.intp)
+        return none, none
     fi, fj = broadphase.pairs_near(pos, radius, fast, margin + 2.0 * float(travel.max()))
     d, w = vectors.take(pos, fi) - vectors.take(pos, fj), vectors.take(vel, fi) - vectors.take(vel, fj)
     closest = vectors.squared_lengths(collision.closest_in_step(d - w * dt, w, dt))  # (from where the step began)
     meet = broadphase.pair_reach(radius, fi, fj) + contacts.MARGIN_M
     k = np.flatnonzero(closest < meet * meet)  # (their paths come within reach in the step)
-    return _union(radius, (i, j, reach), (fi.take(k), fj.take(k)))
+    return fi.take(k), fj.take(k)
+
+
+def _any_new(n: int, candidates: tuple, pairs: tuple) -> bool:
+    """Whether any of `pairs` (i, j) is not among `candidates` (i, j, ...)."""
+    if len(pairs[0]) == 0:
+        return False
+    have = np.minimum(candidates[0], candidates[1]) * n + np.maximum(candidates[0], candidates[1])
+    want = np.minimum(pairs[0], pairs[1]) * n + np.maximum(pairs[0], pairs[1])
+    return not np.isin(want, have).all()
 
 
 def _union(radius: np.ndarray, *pairs: tuple) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
