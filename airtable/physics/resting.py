@@ -13,7 +13,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from airtable.physics import broadphase, collision, contacts, events, vectors
+from airtable.physics import broadphase, contacts, events, vectors
 from airtable.physics.rest_speeds import RestSpeeds
 from airtable.physics.storage import non_negative
 
@@ -27,7 +27,7 @@ if TYPE_CHECKING:
 # other at restitution cr_puck and keep each other shaking; Box2D's threshold is 1 m/s.
 PRESSED_REST_MPS = 0.2
 # How many times the contact stage may start again with a wider margin (hold).
-MARGIN_TRIES = 3
+MARGIN_TRIES = 6
 
 
 def rest_speeds(table: Storage, ctx: StepContext) -> None:
@@ -93,7 +93,7 @@ def _candidates(table: Storage, dt: float, margin: float) -> tuple[np.ndarray, n
     """(i, j, reach): the pairs the contact stage may take. The neighbour list holds every pair touching
     where the step ends, and those near it; a pair that meets and would pass through within one step is
     never near where a step ends. So the pucks that move FAST_FRACTION of the smallest radius in a step
-    (events.py's fast pucks) are paired too with every puck their straight paths come within reach of.
+    (events.py's fast pucks) are paired too with every puck their motion may bring within reach.
     (At restitution 0 a hit is the contact stage's however fast: a puck at 30 m/s, dt 1/60, passed through
     another, the pair never in the list.)"""
     listed = table.neighbour_list.pairs(table.pos_m, table.radius_m)
@@ -103,7 +103,11 @@ def _candidates(table: Storage, dt: float, margin: float) -> tuple[np.ndarray, n
 
 def _along_fast_paths(table: Storage, dt: float, margin: float) -> tuple[np.ndarray, np.ndarray]:
     """(i, j): the pucks moving FAST_FRACTION of the smallest radius in a step, each with every puck
-    their straight paths through the step (ending where the pucks are) come within reach of."""
+    their motion in the step (ending where the pucks are) may bring within reach: those within reach
+    plus MARGIN_M where the step began, plus as far as the two move towards each other in the step at
+    the most (their relative speed, and the stage's pushes). Not only where their straight paths pass
+    closest: a wall or a contact may turn a path (a puck falling fast onto the floor beside another, 2 mm
+    away, was stopped there and the other slid into it: straight, their paths parted)."""
     pos, vel, radius = table.pos_m, table.vel_mps, table.radius_m
     travel = np.sqrt(vectors.squared_lengths(vel)) * dt
     fast = np.flatnonzero(travel >= events.FAST_FRACTION * float(radius.min()))
@@ -112,9 +116,10 @@ def _along_fast_paths(table: Storage, dt: float, margin: float) -> tuple[np.ndar
         return none, none
     fi, fj = broadphase.pairs_near(pos, radius, fast, margin + 2.0 * float(travel.max()))
     d, w = vectors.take(pos, fi) - vectors.take(pos, fj), vectors.take(vel, fi) - vectors.take(vel, fj)
-    closest = vectors.squared_lengths(collision.closest_in_step(d - w * dt, w, dt))  # (from where the step began)
-    meet = broadphase.pair_reach(radius, fi, fj) + contacts.MARGIN_M
-    k = np.flatnonzero(closest < meet * meet)  # (their paths come within reach in the step)
+    apart = vectors.squared_lengths(d - w * dt)  # (where the step began)
+    closing = np.sqrt(vectors.squared_lengths(w)) + contacts.MAX_PUSH_MPS
+    meet = broadphase.pair_reach(radius, fi, fj) + contacts.MARGIN_M + closing * dt
+    k = np.flatnonzero(apart < meet * meet)
     return fi.take(k), fj.take(k)
 
 
