@@ -308,6 +308,31 @@ def test_a_square_slab_of_masses_three_decades_apart_thrown_down_lands_dead(side
     assert up < UP_MPS
 
 
+@settings(max_examples=3, deadline=None, derandomize=True)
+@given(
+    across=st.integers(6, 10),
+    rows=st.integers(6, 10),
+    seed=st.integers(0, 2**32 - 1),
+    throw_mps=st.floats(0.5, 3.0),
+    dt=st.sampled_from([1 / 240, 1 / 120]),
+)
+@example(across=10, rows=10, seed=7, throw_mps=1.0, dt=1 / 240)  # (a user test's: it gained 8.9e-5 in a step)
+def test_a_hexagonal_slab_of_masses_three_decades_apart_collapsing_never_gains_energy(
+    across: int, rows: int, seed: int, throw_mps: float, dt: float
+) -> None:
+    """Pucks of radius 0.15 m in hexagonal rows, their densities 10^-1.5 to 10^1.5 times 0.3 kg/m^2 at random,
+    thrown down at restitution 0: the slab lands and collapses, heavy pucks pushing light ones aside. Until
+    0.3 s after it lands, no step raises its energy (kinetic and potential) by SLAB_ENERGY_RISE of the start,
+    and no puck sinks OVERLAP_M into another."""
+    table = dead_table()
+    densities = 0.3 * 10.0 ** np.random.default_rng(seed).uniform(-1.5, 1.5, across * rows)
+    slab(table, across, rows, 0.15, hexagonal=True, throw_mps=throw_mps, densities=densities)
+    landed, overlap, _, rise = watch_landing(table, dt, 0.3)
+    assert landed is not None
+    assert rise < SLAB_ENERGY_RISE
+    assert overlap < OVERLAP_M
+
+
 @pytest.mark.parametrize(
     ("across", "rows", "throw_mps", "dt"),
     [
