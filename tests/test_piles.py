@@ -308,15 +308,16 @@ def test_a_square_slab_of_masses_three_decades_apart_thrown_down_lands_dead(side
     assert up < UP_MPS
 
 
-@settings(max_examples=3, deadline=None, derandomize=True)
+@settings(max_examples=2, deadline=None, derandomize=True)
 @given(
-    across=st.integers(6, 10),
+    across=st.integers(6, 16),
     rows=st.integers(6, 10),
     seed=st.integers(0, 2**32 - 1),
     throw_mps=st.floats(0.5, 3.0),
     dt=st.sampled_from([1 / 240, 1 / 120]),
 )
 @example(across=10, rows=10, seed=7, throw_mps=1.0, dt=1 / 240)  # (a user test's: it gained 8.9e-5 in a step)
+@example(across=16, rows=9, seed=116, throw_mps=1.0, dt=1 / 120)  # (sank 1.1 mm into itself, the polish paused)
 def test_a_hexagonal_slab_of_masses_three_decades_apart_collapsing_never_gains_energy(
     across: int, rows: int, seed: int, throw_mps: float, dt: float
 ) -> None:
@@ -331,6 +332,22 @@ def test_a_hexagonal_slab_of_masses_three_decades_apart_collapsing_never_gains_e
     assert landed is not None
     assert rise < SLAB_ENERGY_RISE
     assert overlap < OVERLAP_M
+
+
+@pytest.mark.xfail(strict=True, reason="known: the iterations' answer, the polish paused, gains 9.2e-6 in a step")
+def test_a_hexagonal_slab_of_masses_three_decades_apart_known_to_gain_energy_while_the_polish_pauses() -> None:
+    """A case of the test above that still fails: at its 100th step the iterations' answer (the polish paused after
+    one that did not settle) leaves the pucks' energy, kinetic and potential, 9.2e-6 of the start higher; solved
+    to the end every step, it never rises, but those steps take eight times as long."""
+    table = dead_table()
+    densities = 0.3 * 10.0 ** np.random.default_rng(1).uniform(-1.5, 1.5, 15 * 6)
+    slab(table, 15, 6, 0.15, hexagonal=True, throw_mps=1.0, densities=densities)
+    start = last = energy(table)
+    for _ in range(101):
+        table.step(1 / 240)
+        now = energy(table)
+        assert now - last < SLAB_ENERGY_RISE * start
+        last = now
 
 
 @pytest.mark.parametrize(
