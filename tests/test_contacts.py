@@ -258,7 +258,8 @@ def test_a_puck_squeezed_out_meets_the_puck_in_its_path_however_wide_the_margin(
     tilt_deg from vertical), falling at fall_mps, squeezes it out to the left, at a puck C on the floor
     gap_m from S; far off a puck F falls at 10 m/s, so the contacts' margin covers S's new speed. S moves
     towards C only after the contact stage's answer, so the pair was not among those it took: it starts
-    again with the pairs along S's new path. By hand nothing passes into anything: S stops at C."""
+    again with the pairs along S's new path. By hand nothing passes into anything (S may knock C up and slide
+    under it: along each step's straight lines, no pair comes 1 mm into each other)."""
     table = AirTable()
     table.gravity_on, table.sleeping = True, False
     table.cr_puck = table.cr_wall = 0.0
@@ -278,11 +279,12 @@ def test_a_puck_squeezed_out_meets_the_puck_in_its_path_however_wide_the_margin(
         table.add_puck(pos_m=(0.1 + 0.05 * k, 0.02), radius_m=0.02)
     assume(math.dist(table.pos_m[1], table.pos_m[2]) > big + other_m)  # (B clear of C)
     for _ in range(4):
+        began = table.pos_m.copy()
         table.step(dt)
-        pos, radius = table.pos_m, table.radius_m
-        gaps = [math.dist(pos[a], pos[b]) - radius[a] - radius[b] for a, b in ((0, 1), (0, 2), (1, 2))]
-        assert min(gaps) > -1e-3
-        assert pos[2, 0] < pos[0, 0]  # S stays on its side of C
+        for a, b in ((0, 1), (0, 2), (1, 2)):  # nearest along the straight line from where they began to where they end
+            d0, d1 = began[a] - began[b], table.pos_m[a] - table.pos_m[b]
+            t = np.clip(-np.dot(d0, d1 - d0) / max(float(np.dot(d1 - d0, d1 - d0)), 1e-300), 0.0, 1.0)
+            assert math.hypot(*(d0 + t * (d1 - d0))) > table.radius_m[a] + table.radius_m[b] - 1e-3
 
 
 @settings(max_examples=30, deadline=None, derandomize=True)
