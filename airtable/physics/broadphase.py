@@ -176,6 +176,23 @@ def _grid_around(pos: np.ndarray, cell: float, rows: np.ndarray) -> tuple[np.nda
     return rows.take(at), order.take(b)
 
 
+def clusters(n: int, i: np.ndarray, j: np.ndarray) -> np.ndarray:
+    """Each of n pucks' cluster through the pairs (i, j): the least row it reaches along them."""
+    cluster = np.arange(n)
+    for _ in range(n):  # (bounded: each pass carries the least row one pair further)
+        least = np.minimum(cluster.take(i), cluster.take(j))
+        if not np.count_nonzero((least != cluster.take(i)) | (least != cluster.take(j))):
+            break
+        np.minimum.at(cluster, i, least)
+        np.minimum.at(cluster, j, least)
+    return cluster
+
+
+def touching(pos: np.ndarray, i: np.ndarray, j: np.ndarray, reach) -> np.ndarray:
+    """Which pairs (i, j) touch or overlap (within round-off of their reach)."""
+    return squared_distances(pos, i, j) <= (reach * (1.0 + 1e-9)) ** 2
+
+
 def pair_reach(radius: np.ndarray, i: np.ndarray, j: np.ndarray) -> np.ndarray:
     """Sum of the radii of each pair: closer centres than this overlap."""
     return radius.take(i) + radius.take(j)

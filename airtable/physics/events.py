@@ -392,16 +392,10 @@ class _Step:
         undid each other every step.)"""
         pos = vectors.as_rows(self.zpos)
         i, j, reach = neighbours.pairs(pos, self.radius)  # (the list the pair stage reads next)
-        k = (broadphase.squared_distances(pos, i, j) <= (reach * (1.0 + 1e-9)) ** 2).nonzero()[0]
+        k = broadphase.touching(pos, i, j, reach).nonzero()[0]
         i, j = i.take(k), j.take(k)
         unlike = _unlike(self.mass.take(i), self.mass.take(j)).nonzero()[0]
-        cluster = np.arange(len(pos))  # each puck's cluster: the least row it reaches through touching pairs
-        for _ in range(len(pos)):  # (bounded: each pass carries the least row one pair further)
-            least = np.minimum(cluster.take(i), cluster.take(j))
-            if not np.count_nonzero((least != cluster.take(i)) | (least != cluster.take(j))):
-                break
-            np.minimum.at(cluster, i, least)
-            np.minimum.at(cluster, j, least)
+        cluster = broadphase.clusters(len(pos), i, j)
         self.in_unlike_contact = np.isin(cluster, cluster.take(i.take(unlike)))
 
     def first_pairs(self) -> tuple[np.ndarray, np.ndarray]:

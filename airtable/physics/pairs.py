@@ -37,7 +37,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from airtable.physics import broadphase, collision, either, vectors
+from airtable.physics import broadphase, collapse, collision, either, vectors
 from airtable.physics.collision import CORRECTION_MODES, PairRecords
 from airtable.physics.rest_speeds import RestSpeeds
 
@@ -56,6 +56,10 @@ OVERLAP_SLOP_M = 1e-9
 # same lines (see "one round" below): a round in numpy costs some eighty numpy calls, about as
 # much as this many pairs in Python numbers. A gas step's later rounds mostly hold one or two.
 FEW_PAIRS = 4
+
+# Below restitution 1, the pairs the passes leave overlapping stick (stick_left) with every pair touching them, up
+# to this many contacts (an exact solve, collapse.py: its cost grows as their cube); beyond, only those pairs.
+STICK_MAX = 200
 
 # A relative normal speed smaller than this (m/s) counts as "not moving": such
 # an overlap cannot be explained by the last step's motion.
@@ -80,6 +84,8 @@ def overlapping(table: Storage, ctx: StepContext) -> None:
         if attempt < EXTRA_PASSES:
             records += resolve_pairs(pos, vel, radius, mass, i, j, table.cr_puck, mode, ctx.dt, in_time_order=True)
         else:
+            if table.cr_puck < 1.0 and mode != "off":
+                records += stick_left(pos, vel, radius, mass, table.size_m, *_touching_them(pos, radius, ci, cj, i, j))
             push_apart(pos, radius, mass, i, j)
         moved += [i, j]
         if mode == "off" or attempt == EXTRA_PASSES:
@@ -95,6 +101,58 @@ def overlapping(table: Storage, ctx: StepContext) -> None:
         ctx.records += records
         table.collision_count += sum(r.count for r in records)
         ctx.moved = np.concatenate(moved)
+
+
+def _touching_them(pos: np.ndarray, radius: np.ndarray, ci: np.ndarray, cj: np.ndarray, i: np.ndarray, j: np.ndarray):
+    """(i, j) of the candidate pairs (ci, cj) that touch or overlap, in the clusters of touching pucks that hold
+    the pairs (i, j) (overlapping: among them)."""
+    k = broadphase.touching(pos, ci, cj, broadphase.pair_reach(radius, ci, cj)).nonzero()[0]
+    ti, tj = ci.take(k), cj.take(k)
+    cluster = broadphase.clusters(len(pos), ti, tj)
+    theirs = np.isin(cluster, cluster.take(np.concatenate([i, j])))
+    k = theirs.take(ti).nonzero()[0]
+    if len(k) > STICK_MAX:  # (a pile: these alone)
+        return i, j
+    return ti.take(k), tj.take(k)
+
+
+def stick_left(pos, vel, radius, mass, size_m, i: np.ndarray, j: np.ndarray) -> list[PairRecords]:
+    """Below restitution 1, the overlapping pairs (i, j) the passes leave, with the walls their pucks are on or
+    past, collide at once, perfectly inelastically (collapse.py, as events.py's stuck pairs), in place: the
+    limit of the hits left. A row of touching pucks pushed into a wall hits on and on at ever smaller speeds
+    (inelastic collapse); two passes a step left its pucks approaching, the wall stage sent the first back into
+    the next, and the row's end swapped order. Returns the records of the pairs it pushed (a list of one, or none)."""
+    z, zv = vectors.as_complex(pos), vectors.as_complex(vel)
+    bodies = np.unique(np.concatenate([i, j]))
+    a, b = np.searchsorted(bodies, i), np.searchsorted(bodies, j)
+    x, v, r = z.take(bodies), zv.take(bodies), radius.take(bodies)
+    n_pairs, _ = vectors.units(x.take(a) - x.take(b), lambda: i + j)
+    rooms = np.array(collision.wall_rooms(x.real, x.imag, r, (float(size_m[0]), float(size_m[1]))))
+    side, on = (rooms <= r * 1e-9).nonzero()  # (wall, body): the walls each is on (to round-off) or past
+    n = np.concatenate([n_pairs, np.array(collision.WALL_NORMALS).take(side)])
+    first, second = np.concatenate([a, on]), np.concatenate([b, np.full(len(on), -1)])
+    v_second = np.where(second >= 0, v.take(second.clip(0)), 0.0)
+    vn = vectors.dot(v.take(first) - v_second, n)
+    if not np.count_nonzero(vn < -REST_SPEED_MPS):
+        return []
+    push = collapse.impulses(n, vn, first, second, 1.0 / mass.take(bodies)) * n
+    m = mass.take(bodies)
+    dv = np.zeros(len(bodies), dtype=complex)
+    np.add.at(dv, first, push / m.take(first))
+    pairs = second >= 0
+    np.subtract.at(dv, second[pairs], push[pairs] / m.take(second[pairs]))
+    zv[bodies] = v + dv
+    hit = np.flatnonzero(push[: len(a)] != 0.0)
+    if len(hit) == 0:
+        return []
+    ka, kb = a.take(hit), b.take(hit)
+    xa, xb, reach = x.take(ka), x.take(kb), r.take(ka) + r.take(kb)
+    columns = (i.take(hit), j.take(hit), n_pairs.take(hit), xb, reach - np.abs(xa - xb), reach, r.take(kb), xa, xb)
+    return [
+        PairRecords(
+            len(hit), (*columns, xa, xb, v.take(ka), v.take(kb), v.take(ka) + dv.take(ka), v.take(kb) + dv.take(kb))
+        )
+    ]
 
 
 def _with_rows(ci, cj, reach_sq, rows: np.ndarray, n: int):
