@@ -190,3 +190,18 @@ def test_an_inelastic_cluster_does_not_collapse_into_endless_swept_hits():
         before = table.collision_count
         table.step(1 / 120)
         assert table.collision_count - before < 1000
+
+
+@pytest.mark.parametrize("mode", ["two-step", "perfect-kiss", "off"])
+@pytest.mark.parametrize("gravity", [False, True])
+def test_a_step_of_no_time_moves_nothing(mode: str, gravity: bool) -> None:
+    """step(0) on a table of moving pucks, apart, in any mode: nothing moves, nothing changes speed. (A user
+    test's: with more than 10 pucks, two-step and "off" divided by the step's length, ZeroDivisionError.)"""
+    table = AirTable()
+    table.puck_correction, table.gravity_on = mode, gravity
+    for k in range(30):
+        table.add_puck(pos_m=(0.5 + 0.3 * k, 2.0 + 0.1 * (k % 3)), radius_m=0.1, vel_mps=(5.0, -1.0 + 0.1 * k))
+    pos, vel = table.pos_m.copy(), table.vel_mps.copy()
+    table.step(0.0)
+    np.testing.assert_array_equal(table.pos_m, pos)
+    np.testing.assert_array_equal(table.vel_mps, vel)

@@ -127,8 +127,8 @@ def pieces(vel: np.ndarray, radius: np.ndarray, dt_s: float, mode: str) -> int:
     (m) is cut (see the module docstring): the fewest in which at most FAST_SHARE of them, or FEW_FAST,
     move FAST_FRACTION of their radius; 1 in perfect kiss, and up to MAX_PIECES."""
     allowed = max(FEW_FAST, int(FAST_SHARE * len(radius)))
-    if mode not in ("two-step", "off") or len(radius) <= allowed:
-        return 1
+    if mode not in ("two-step", "off") or len(radius) <= allowed or not dt_s > 0.0:
+        return 1  # (a step of 0 moves nothing: nothing is fast)
     speed_sq = vectors.squared_lengths(vel)
     limit = FAST_FRACTION * float(radius.min()) / dt_s
     if not float(speed_sq.max()) > limit * limit:  # the fastest is not fast for the smallest: the usual case
