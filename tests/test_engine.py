@@ -13,6 +13,7 @@ from airtable.demos import demo_pi_collisions as pi_demo
 from airtable.demos.demo_0p_gas import gas_scene
 
 from airtable import AirTable
+from airtable.physics import integrate
 
 # ---------------------------------------------------------------- the small ones
 
@@ -205,3 +206,22 @@ def test_a_step_of_no_time_moves_nothing(mode: str, gravity: bool) -> None:
     table.step(0.0)
     np.testing.assert_array_equal(table.pos_m, pos)
     np.testing.assert_array_equal(table.vel_mps, vel)
+
+
+@pytest.mark.parametrize("mode", ["two-step", "perfect-kiss", "off"])
+@pytest.mark.parametrize("speed", [2e5, 1e9, 1e300])
+def test_a_puck_thrown_faster_than_anything_on_a_table_is_slowed_and_told(mode: str, speed: float) -> None:
+    """A puck thrown at `speed` into a crowd of 40: its step hit each puck and wall one by one, tens of thousands
+    of times (at 1 Gm/s a step took minutes). It is slowed to integrate.MAX_SPEED_MPS, and the table says so
+    once; nothing leaves the table."""
+    table = AirTable()
+    table.puck_correction = mode
+    table.add_puck(pos_m=(1.0, 1.0), radius_m=0.1, vel_mps=(speed, 0.7 * speed))
+    for k in range(40):
+        table.add_puck(pos_m=(3.0 + 0.5 * (k % 8), 2.0 + 0.5 * (k // 8)), radius_m=0.2)
+    for _ in range(2):
+        table.step(1 / 60)
+    assert float(np.hypot(*table.vel_mps.T).max()) <= integrate.MAX_SPEED_MPS * (1.0 + 1e-12)
+    assert [n for n in table.notices if n == integrate.SPEED_NOTICE] == [integrate.SPEED_NOTICE]
+    inside = (table.pos_m >= table.radius_m[:, None]) & (table.pos_m <= table.size_m - table.radius_m[:, None])
+    assert inside.all()

@@ -129,7 +129,8 @@ def pieces(vel: np.ndarray, radius: np.ndarray, dt_s: float, mode: str) -> int:
     allowed = max(FEW_FAST, int(FAST_SHARE * len(radius)))
     if mode not in ("two-step", "off") or len(radius) <= allowed or not dt_s > 0.0:
         return 1  # (a step of 0 moves nothing: nothing is fast)
-    speed_sq = vectors.squared_lengths(vel)
+    with np.errstate(over="ignore"):  # (a runaway speed: inf, taken as fast; integrate.py slows it)
+        speed_sq = vectors.squared_lengths(vel)
     limit = FAST_FRACTION * float(radius.min()) / dt_s
     if not float(speed_sq.max()) > limit * limit:  # the fastest is not fast for the smallest: the usual case
         return 1
@@ -141,4 +142,4 @@ def pieces(vel: np.ndarray, radius: np.ndarray, dt_s: float, mode: str) -> int:
     most = math.sqrt(float(np.partition(times_sq, at)[at]))  # the (allowed + 1)th most
     if not most >= 1.0:  # (also NaN)
         return 1
-    return min(MAX_PIECES, math.floor(most) + 1)
+    return MAX_PIECES if most >= MAX_PIECES else math.floor(most) + 1  # (inf: MAX_PIECES)
