@@ -83,7 +83,7 @@ def test_the_stage_solves_the_contact_problem(monkeypatch) -> None:
     i, j = broadphase.find_candidate_pairs(pos, radius)
     candidates = (i, j, broadphase.pair_reach(radius, i, j))
     margin = contacts.MARGIN_M + (2.0 * float(np.abs(vel).max()) + contacts.MAX_PUSH_MPS) * dt
-    pc = contacts._pair_contacts(pos, vel, *candidates, rest, solver.held, margin, dt)
+    pc = contacts._pair_contacts(pos, vel, radius, size, *candidates, rest, solver.held, margin, dt)
     wc = contacts._wall_contacts(pos, vel, radius, size, solver.wall_rest(rest.walls), margin)
     c = contacts._Contacts(
         *(np.concatenate([getattr(pc, f), getattr(wc, f)]) for f in contacts._Contacts.__dataclass_fields__)

@@ -101,11 +101,15 @@ def contact_time(d, w, reach):
     return np.where(meets, c / np.where(meets, root - dw, 1.0), np.inf), root / reach
 
 
+def closest_time_in_step(d: np.ndarray, w: np.ndarray, dt: float) -> np.ndarray:
+    """(rows) the t in [0, dt] where two straight paths, d = x1 - x2 apart (m) at w = v1 - v2 (m/s) when a step
+    begins, pass closest: d.w < 0 and they close until -d.w / w.w, else they are closest now."""
+    return np.clip(-vectors.dot_rows(d, w) / np.maximum(vectors.squared_lengths(w), 1e-300), 0.0, dt)
+
+
 def closest_in_step(d: np.ndarray, w: np.ndarray, dt: float) -> np.ndarray:
-    """(rows) d + w t at the t in [0, dt] where two straight paths, d = x1 - x2 apart (m) at w = v1 - v2 (m/s) when
-    a step begins, pass closest: d.w < 0 and they close until -d.w / w.w, else they are closest now."""
-    t = np.clip(-vectors.dot_rows(d, w) / np.maximum(vectors.squared_lengths(w), 1e-300), 0.0, dt)
-    return d + w * t[:, None]
+    """(rows) d + w t where the two straight paths pass closest in the step (closest_time_in_step)."""
+    return d + w * closest_time_in_step(d, w, dt)[:, None]
 
 
 # The four walls' unit normals pointing into the table (complex x + iy), in each_wall's order:

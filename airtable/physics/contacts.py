@@ -203,7 +203,7 @@ class _Contacts:
 _FIELDS = tuple(_Contacts.__dataclass_fields__)
 
 
-def _pair_contacts(pos, vel, ci, cj, reach, rest, held, margin, dt: float, kept=None) -> _Contacts:
+def _pair_contacts(pos, vel, radius, size_m, ci, cj, reach, rest, held, margin, dt: float, kept=None) -> _Contacts:
     """The candidate pairs that touch (within margin) and approach slower than their rest speed;
     and those of `kept` (last step's contacts) within HOLD_M more. Pairs that pass each other are
     taken where they pass (_passing)."""
@@ -222,7 +222,7 @@ def _pair_contacts(pos, vel, ci, cj, reach, rest, held, margin, dt: float, kept=
     d, w, reach = vectors.take(d, near), vectors.take(vel, i) - vectors.take(vel, j), reach.take(near)
     n, dist = vectors.unit_vectors(d, i + j)
     gap = dist - reach
-    k, n_near, gap_near = _passing(d, w, gap, reach, dt)
+    k, n_near, gap_near = _passing(d, gap, reach, dt, _Paths(pos, vel, radius, size_m, i, j))
     if len(k):  # (a pair that pressed in the last step is a resting contact: where the step began)
         free = np.flatnonzero(~held(i.take(k), j.take(k)))
         n[k.take(free)], gap[k.take(free)] = vectors.take(n_near, free), gap_near.take(free)
@@ -238,20 +238,51 @@ def _pair_contacts(pos, vel, ci, cj, reach, rest, held, margin, dt: float, kept=
     return _Contacts(i, j, nc, gap.take(slow), vn.take(slow), keys)
 
 
-def _passing(d: np.ndarray, w: np.ndarray, gap: np.ndarray, reach: np.ndarray, dt: float):
-    """(k, n, gap) of the pairs d apart (rows, from b to a) at w where the step begins, `gap` apart, whose straight
-    paths pass each other in the step without touching: their rows k, and the normal and gap at their closest
-    approach.
+class _Paths:
+    """The straight paths through the step of the pairs (i, j), from `pos` at `vel`, up to the first wall each meets:
+    less what would take a puck into a wall it is on where the step begins (a puck resting on the floor: its step's
+    fall)."""
+
+    def __init__(self, pos, vel, radius, size_m, i: np.ndarray, j: np.ndarray) -> None:
+        self.pos, self.radius, self.size_m, self.i, self.j = pos, radius, size_m, i, j
+        self.vel_i, self.vel_j = self._along_walls(vel, i), self._along_walls(vel, j)
+        self.w = self.vel_i - self.vel_j
+
+    def _along_walls(self, vel, rows: np.ndarray) -> np.ndarray:
+        x, v, r = vectors.take(self.pos, rows), vectors.take(vel, rows).copy(), self.radius.take(rows)[:, None]
+        v[((x - r <= SLOP_M) & (v < 0.0)) | ((self.size_m - r - x <= SLOP_M) & (v > 0.0))] = 0.0
+        return v
+
+    def at_a_wall(self, k: np.ndarray) -> np.ndarray:
+        """When the first puck of each pair k reaches a wall on its path (s; inf: never): there it stops."""
+        t = np.full(len(k), np.inf)
+        for rows, v in ((self.i.take(k), self.vel_i), (self.j.take(k), self.vel_j)):
+            x, vk, r = vectors.take(self.pos, rows), vectors.take(v, k), self.radius.take(rows)[:, None]
+            room = np.where(vk < 0.0, x - r, self.size_m - r - x)
+            with np.errstate(divide="ignore", invalid="ignore"):
+                t = np.minimum(t, np.where(vk != 0.0, np.maximum(room, 0.0) / np.abs(vk), np.inf).min(axis=1))
+        return t
+
+
+def _passing(d: np.ndarray, gap: np.ndarray, reach: np.ndarray, dt: float, paths: _Paths):
+    """(k, n, gap) of the pairs d apart (rows, from b to a) where the step begins, `gap` apart, whose straight
+    paths (_Paths) pass each other in the step without touching: their rows k, and the normal and gap at their
+    closest approach.
 
     A contact asks n . w >= -gap / dt (it may close its gap, not more), which keeps a pair apart along straight
     paths for any normal n with n . d >= reach (then n . (d + w t) >= reach up to t = dt). The normal where the
     step begins asks the most: a puck falling past another 1 mm away at 6 m/s, dt 1/60, was pushed sideways at
     0.57 m/s though they never touch. Along the normal at their closest approach they ask nothing (n . w = 0
     there) unless something else drives them together. Pairs within SLOP_M touch: theirs stay where the step
-    began (a slab of rows of 1 g and 1000 kg, its neighbours 1e-16 m apart, exploded with them turned).
+    began (a slab of rows of 1 g and 1000 kg, its neighbours 1e-16 m apart, exploded with them turned). A path ends
+    at the first wall it meets, where the puck stops (a puck falling past one sliding on the floor was taken where
+    its path, run on through the floor, passed closest: the normal pointed up, and lifted the other at 0.44 m/s).
     """
+    w = paths.w
     k = np.flatnonzero((gap > SLOP_M) & (vectors.dot_rows(d, w) < 0.0))  # apart and closing: closest ahead
-    closest, apart = vectors.unit_vectors(collision.closest_in_step(vectors.take(d, k), vectors.take(w, k), dt))
+    dk, wk = vectors.take(d, k), vectors.take(w, k)
+    t = np.minimum(collision.closest_time_in_step(dk, wk, dt), paths.at_a_wall(k))
+    closest, apart = vectors.unit_vectors(dk + wk * t[:, None])
     passing = np.flatnonzero(apart > reach.take(k))
     k, closest = k.take(passing), vectors.take(closest, passing)
     return k, closest, vectors.dot_rows(vectors.take(d, k), closest) - reach.take(k)
@@ -424,7 +455,7 @@ class ContactSolver:
             plain = np.maximum(off[:, 0], off[:, 1]) <= 1e-9 * (1.0 + np.maximum(size[:, 0], size[:, 1]))
             moved[plain] = 0.0
         start = pos - (vel - moved) * dt
-        pc = _pair_contacts(start, vel, ci, cj, reach, rest, self.held, margin, dt, self.kept)
+        pc = _pair_contacts(start, vel, radius, size_m, ci, cj, reach, rest, self.held, margin, dt, self.kept)
         wc = _wall_contacts(start, vel, radius, size_m, self.wall_rest(rest.walls), margin)
         may = _may_rest(wc.a, wc.a, asleep, rest.pressed)
         if may is not None:
