@@ -254,7 +254,7 @@ class _Paths:
         return v
 
     def at_a_wall(self, k: np.ndarray) -> np.ndarray:
-        """When the first puck of each pair k reaches a wall on its path (s; inf: never): there it stops."""
+        """When either puck of each pair k first reaches a wall on its path (s; inf: never): there it stops."""
         t = np.full(len(k), np.inf)
         for rows, v in ((self.i.take(k), self.vel_i), (self.j.take(k), self.vel_j)):
             x, vk, r = vectors.take(self.pos, rows), vectors.take(v, k), self.radius.take(rows)[:, None]
