@@ -152,10 +152,14 @@ def rows_near(z: np.ndarray, radius: np.ndarray, centre: complex, radius_m: floa
     return (vectors.squared_abs(z - centre) < reach * reach).nonzero()[0]
 
 
+def pair_keys(n: int, a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """One key per pair (a, b) of n pucks, whichever way round: i * n + j for i <= j, which sorts as (i, j) does."""
+    return np.minimum(a, b) * n + np.maximum(a, b)
+
+
 def each_pair_once(n: int, a: np.ndarray, b: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """The pairs (a, b) of n pucks as (i < j), each once, sorted by (i, j); a puck paired with itself dropped."""
-    i, j = np.minimum(a, b), np.maximum(a, b)
-    key = np.sort((i * n + j)[i != j])  # one key per pair sorts as (i, j) does
+    key = np.sort(pair_keys(n, a, b)[a != b])
     first = np.ones(len(key), dtype=bool)
     first[1:] = key[1:] != key[:-1]
     key = key[first]  # each pair once (np.unique hashes such keys, 20 times slower)

@@ -107,11 +107,6 @@ def closest_time_in_step(d: np.ndarray, w: np.ndarray, dt: float) -> np.ndarray:
     return np.clip(-vectors.dot_rows(d, w) / np.maximum(vectors.squared_lengths(w), 1e-300), 0.0, dt)
 
 
-def closest_in_step(d: np.ndarray, w: np.ndarray, dt: float) -> np.ndarray:
-    """(rows) d + w t where the two straight paths pass closest in the step (closest_time_in_step)."""
-    return d + w * closest_time_in_step(d, w, dt)[:, None]
-
-
 # The four walls' unit normals pointing into the table (complex x + iy), in each_wall's order:
 # left, bottom, right and top.
 WALL_NORMALS = (1.0, 1j, -1.0, -1j)

@@ -135,8 +135,8 @@ def stick_left(pos, vel, radius, mass, size_m, i: np.ndarray, j: np.ndarray) -> 
     vn = vectors.dot(v.take(first) - v_second, n)
     if not np.count_nonzero(vn < -REST_SPEED_MPS):
         return []
-    push = collapse.impulses(n, vn, first, second, 1.0 / mass.take(bodies)) * n
     m = mass.take(bodies)
+    push = collapse.impulses(n, vn, first, second, 1.0 / m) * n
     dv = np.zeros(len(bodies), dtype=complex)
     np.add.at(dv, first, push / m.take(first))
     pairs = second >= 0

@@ -128,9 +128,7 @@ def _any_new(n: int, candidates: tuple, pairs: tuple) -> bool:
     """Whether any of `pairs` (i, j) is not among `candidates` (i, j, ...)."""
     if len(pairs[0]) == 0:
         return False
-    have = np.minimum(candidates[0], candidates[1]) * n + np.maximum(candidates[0], candidates[1])
-    want = np.minimum(pairs[0], pairs[1]) * n + np.maximum(pairs[0], pairs[1])
-    return not np.isin(want, have).all()
+    return not np.isin(broadphase.pair_keys(n, *pairs[:2]), broadphase.pair_keys(n, *candidates[:2])).all()
 
 
 def _union(radius: np.ndarray, *pairs: tuple) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
