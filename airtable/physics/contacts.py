@@ -10,19 +10,22 @@ after the collisions, in which walls and puck pairs take part together.
 Which contacts: pairs and puck-wall contacts that touch or nearly touch
 (gap under a margin: MARGIN_M plus as far as the stage may move a puck,
 and HOLD_M more for last step's contacts) and approach slower than the
-rest speed over the restitution (faster ones
-are collisions: they keep the course's model; at restitution 0 no contact
-is: see rest_speeds.py), and pairs that pressed on each other in the last
-step, whatever their speed. Each contact k has a normal
-n (from body b to body a; a wall is a body that never moves) and asks:
+rest speed over the restitution, and pairs that pressed on each other in
+the last step, whatever their speed (up to HELD_MPS). Pairs that approach
+faster are collisions (they keep the course's model, in the next step if not
+in this one; at restitution 0 no contact is: see rest_speeds.py), but they
+take part too, so that the stage never drives them harder: where it stops
+one puck of such a pair, the other must not run into it. Each contact k has
+a normal n (from body b to body a; a wall is a body that never moves) and asks:
 
 * velocity: the relative normal velocity vn after the stage is at least
-  `bound` (0 for pucks already touching: no bounce; for a pair still a gap
-  s apart, -s / dt: it may close the gap, not more);
+  its least speed (0 for pucks already touching: no bounce; for a pair still
+  a gap s apart, -s / dt: it may close the gap, not more; a collision may
+  come on as fast as it comes: _least_speeds);
 * position: a separate pseudo-velocity (a "split impulse") pushes out a
-  fraction POSITION_FRACTION of the overlap beyond SLOP_M per step. It moves
-  positions only and never enters the velocities, so correcting overlap
-  feeds no energy into the motion.
+  fraction POSITION_FRACTION of the overlap beyond SLOP_M per step (into a
+  wall, all beyond WALL_LEFT_M). It moves positions only and never enters the
+  velocities, so correcting overlap feeds no energy into the motion.
 
 Both are solved by sequential impulses (Erin Catto's; Box2D and Chipmunk
 solve contacts this way): each contact's impulse is accumulated over the
@@ -66,6 +69,7 @@ from typing import NamedTuple
 import numpy as np
 
 from airtable.physics import collapse, collision, colouring, proportioning, vectors
+from airtable.physics.rest_speeds import HELD_MPS
 
 # Iterations over all contacts per step (Box2D and pymunk use about ten);
 # the loop stops early once an iteration changes no velocity by CONVERGED_MPS.
@@ -178,6 +182,11 @@ HOLD_M = 0.02
 SLOP_M = 2e-5
 # Share of the overlap beyond the slop pushed out per step.
 POSITION_FRACTION = 0.4
+# ... but into a wall, all beyond this (m): the wall stage after this one (walls.again) puts the puck back on the
+# wall anyway, and pushed out here the pucks resting on it move with it instead of it into them (a light puck struck
+# down onto a heavy one on the floor drove it 1.7 mm into the floor, and the wall stage then 1 mm into the light
+# one). (Not all: a settling pile's floor contacts, pushed out at once, made its steps twice as long.)
+WALL_LEFT_M = 5e-4
 MAX_PUSH_MPS = 0.5
 WALL_NORMALS = np.array(collision.WALL_NORMALS)  # (an array: taken per contact)
 
@@ -196,7 +205,9 @@ class _Contacts:
     b: np.ndarray
     n: np.ndarray  # complex unit normals
     gap: np.ndarray  # m, negative: overlap
-    vn: np.ndarray  # relative normal velocity, negative: approaching
+    least: np.ndarray  # m/s: the least relative normal velocity after the stage (ContactSolver.solve works it out)
+    left: np.ndarray  # m: the most overlap the stage leaves in a step (inf: pairs; WALL_LEFT_M: walls)
+    collides: np.ndarray  # bool: a collision (approaching faster than it rests), not a resting contact
     keys: np.ndarray  # one integer per contact, the same from step to step
 
 
@@ -227,15 +238,15 @@ def _pair_contacts(pos, vel, radius, size_m, ci, cj, reach, rest, held, margin, 
         free = np.flatnonzero(~held(i.take(k), j.take(k)))
         n[k.take(free)], gap[k.take(free)] = vectors.take(n_near, free), gap_near.take(free)
     vn = vectors.dot_rows(w, n)
-    slow = vn >= -rest.pairs(i, j, vectors.as_complex(np.ascontiguousarray(n)))
-    fast = np.flatnonzero(~slow)  # few, even in a pile: look only these up among the held pairs
-    slow[fast] = held(i.take(fast), j.take(fast))
-    slow = np.flatnonzero(slow)
-    i, j = i.take(slow), j.take(slow)
-    nc = vectors.as_complex(vectors.take(n, slow))
-    count = len(pos)
-    keys = i.astype(np.int64) * (count + 4) + j
-    return _Contacts(i, j, nc, gap.take(slow), vn.take(slow), keys)
+    fast = np.flatnonzero(vn < -rest.pairs(i, j, vectors.as_complex(np.ascontiguousarray(n))))
+    least = np.zeros(len(i))  # (a collision may come on as fast as it comes: _least_speeds)
+    vn_fast = vn.take(fast)  # (few, even in a pile)
+    collides = np.zeros(len(i), dtype=bool)
+    collides[fast] = ~held(i.take(fast), j.take(fast)) | (vn_fast <= -HELD_MPS)
+    least[fast] = np.where(collides.take(fast), vn_fast, 0.0)
+    nc = vectors.as_complex(n)
+    keys = i.astype(np.int64) * (len(pos) + 4) + j
+    return _Contacts(i, j, nc, gap, least, np.full(len(i), np.inf), collides, keys)
 
 
 class _Paths:
@@ -303,13 +314,14 @@ def _wall_contacts(pos, vel, radius, size_m, rest, margin) -> _Contacts:
     count = len(pos)
     keys = a.astype(np.int64) * (count + 4) + count + w
     b = np.full(len(a), count)
-    return _Contacts(a, b, WALL_NORMALS.take(w), room[w, a], away[w, a], keys)
+    walls = (WALL_NORMALS.take(w), room[w, a], np.zeros(len(a)), np.full(len(a), WALL_LEFT_M), np.zeros(len(a), bool))
+    return _Contacts(a, b, *walls, keys)
 
 
 def _no_contacts() -> _Contacts:
     """No contact: each field empty, of its type."""
     none = np.empty(0, dtype=np.intp)
-    return _Contacts(none, none, np.empty(0, dtype=complex), np.empty(0), np.empty(0), np.empty(0, dtype=np.int64))
+    return _Contacts(none, none, np.empty(0, dtype=complex), *([np.empty(0)] * 3), np.empty(0, dtype=bool), none)
 
 
 def _may_rest(i: np.ndarray, j: np.ndarray, asleep: np.ndarray | None, pressed: np.ndarray | None):
@@ -341,6 +353,7 @@ class ContactSolver:
     def __init__(self) -> None:
         self._keys = np.empty(0, dtype=np.int64)  # sorted
         self._impulses = np.empty((0, 2))
+        self._resting = np.empty(0, dtype=bool)  # (by _keys) which contacts were resting ones, not collisions
         self._rows = -1
         # Each contact's round (colouring.py), by _keys: bottom-up by bands for the first
         # iteration, and in no order (fewer rounds) for the later ones.
@@ -357,13 +370,15 @@ class ContactSolver:
         self._exact = False  # whether the last step's contacts were solved to the end (exactly, or polished)
 
     def held(self, i: np.ndarray, j: np.ndarray) -> np.ndarray:
-        """Which pairs (i, j) pressed on each other in the last step (a non-zero impulse).
+        """Which pairs (i, j) pressed on each other in the last step (a resting contact's non-zero impulse).
 
-        Such a pair is a resting contact whatever its approach speed: a pile
+        Such a pair is a resting contact whatever its approach speed (up to HELD_MPS): a pile
         whose contacts have not quite converged must not start to bounce.
         """
         found, kept = self._last_step(i, j)
-        return kept & (self._impulses[found, 0] > 0.0) if len(self._keys) else kept
+        if len(self._keys) == 0:
+            return kept
+        return kept & self._resting.take(found) & (self._impulses[found, 0] > 0.0)
 
     def kept(self, i: np.ndarray, j: np.ndarray) -> np.ndarray:
         """Which pairs (i, j) were contacts in the last step."""
@@ -401,9 +416,9 @@ class ContactSolver:
         return len(self._puck_pairs()[0]) > 0
 
     def _puck_pairs(self) -> tuple[np.ndarray, np.ndarray]:
-        """The last step's contacts of two pucks, (i, j), from their keys (a wall's has j >= the row count)."""
+        """The last step's resting contacts of two pucks, (i, j), from their keys (a wall's has j >= the row count)."""
         i, j = np.divmod(self._keys, self._rows + 4)
-        pairs = np.flatnonzero(j < self._rows)
+        pairs = np.flatnonzero((j < self._rows) & self._resting)
         return i.take(pairs), j.take(pairs)
 
     def wall_rest(self, rest: np.ndarray) -> np.ndarray:
@@ -442,6 +457,32 @@ class ContactSolver:
         if len(pos) != self._rows:
             self.forget()
             self._rows = len(pos)
+        c, start = self._contacts(pos, vel, radius, size_m, candidates, rest, dt, asleep, began, margin)
+        self.count = len(c.a)
+        if self.count == 0:
+            self._keys, self._impulses = np.empty(0, dtype=np.int64), np.empty((0, 2))
+            self._resting = np.empty(0, dtype=bool)
+            self._band_rounds = self._free_rounds = np.empty(0, dtype=np.intp)
+            return False
+        self._y, self._r_mean = start[:, 1], float(radius.mean())  # for the bands
+        inv = np.append(1.0 / mass, 0.0)  # the walls never move, nor do sleepers
+        if asleep is not None:
+            inv[:-1][asleep] = 0.0
+        w = np.zeros((len(pos) + 1, 2), dtype=complex)  # velocities and pseudo-velocities; the last row: walls
+        w[:-1, 0] = vectors.as_complex(np.ascontiguousarray(vel))
+        v0 = w[:-1, 0].copy()
+        was_exact, self._exact = self._exact, False
+        impulses = self._try_exactly(c, inv, w, dt)
+        if impulses is None:  # (many contacts, or those the exact solve did not settle)
+            impulses = self._iterate_then_polish(c, inv, w, dt, mass, asleep, was_exact)
+        self._keep(c, impulses)
+        moved = (w[:-1, 0] - v0 + w[:-1, 1]) * dt
+        pos += np.column_stack([moved.real, moved.imag])
+        vel[:, 0], vel[:, 1] = w[:-1, 0].real, w[:-1, 0].imag
+        return True
+
+    def _contacts(self, pos, vel, radius, size_m, candidates, rest, dt, asleep, began, margin) -> tuple:
+        """(_Contacts: the step's contacts, with their least speeds; where each puck's step is taken to begin)."""
         ci, cj, reach = candidates
         may = _may_rest(ci, cj, asleep, rest.pressed)  # (not self.kept: that is last step's contacts)
         if may is not None:
@@ -460,31 +501,14 @@ class ContactSolver:
         may = _may_rest(wc.a, wc.a, asleep, rest.pressed)
         if may is not None:
             wc = _Contacts(*(getattr(wc, f).take(may) for f in _FIELDS))
-        self.count = len(pc.a) + len(wc.a)
-        if self.count == 0:
-            self._keys, self._impulses = np.empty(0, dtype=np.int64), np.empty((0, 2))
-            self._band_rounds = self._free_rounds = np.empty(0, dtype=np.intp)
-            return False
         c = _Contacts(*(np.concatenate([getattr(pc, f), getattr(wc, f)]) for f in _FIELDS))
+        parting = 0.0
         if began is None or not plain.all():  # where they were at the start if they approached
             zm = np.append(vectors.as_complex(np.ascontiguousarray(moved)), 0.0)
-            c.gap = c.gap - np.minimum((c.n.conjugate() * (zm.take(c.a) - zm.take(c.b))).real, 0.0) * dt
-        self._y, self._r_mean = start[:, 1], float(radius.mean())  # for the bands
-        inv = np.append(1.0 / mass, 0.0)  # the walls never move, nor do sleepers
-        if asleep is not None:
-            inv[:-1][asleep] = 0.0
-        w = np.zeros((len(pos) + 1, 2), dtype=complex)  # velocities and pseudo-velocities; the last row: walls
-        w[:-1, 0] = vectors.as_complex(np.ascontiguousarray(vel))
-        v0 = w[:-1, 0].copy()
-        was_exact, self._exact = self._exact, False
-        impulses = self._try_exactly(c, inv, w, dt)
-        if impulses is None:  # (many contacts, or those the exact solve did not settle)
-            impulses = self._iterate_then_polish(c, inv, w, dt, mass, asleep, was_exact)
-        self._keep(c, impulses)
-        moved = (w[:-1, 0] - v0 + w[:-1, 1]) * dt
-        pos += np.column_stack([moved.real, moved.imag])
-        vel[:, 0], vel[:, 1] = w[:-1, 0].real, w[:-1, 0].imag
-        return True
+            parting = (c.n.conjugate() * (zm.take(c.a) - zm.take(c.b))).real
+            c.gap = c.gap - np.minimum(parting, 0.0) * dt
+        c.least = _least_speeds(c, parting, dt)
+        return c, start
 
     def _iterate_then_polish(self, c: _Contacts, inv, w: np.ndarray, dt: float, mass, asleep, was_exact: bool):
         """Sequential impulses in coloured rounds, warm-started, on `w` in place; then polished (see POLISH_MPS)
@@ -705,19 +729,22 @@ class ContactSolver:
         return np.minimum((y - y.min()) / (BAND_RADII * self._r_mean), 30_000).astype(np.int16)
 
     def _keep(self, c: _Contacts, impulses: np.ndarray) -> None:
-        """Keep this step's impulses ((m, 2), contact by contact) by contact key, for the next step's warm start."""
+        """Keep this step's impulses ((m, 2), contact by contact) by contact key, for the next step's warm start,
+        and which were resting contacts (a collision that pushed, lest the stage drive it harder, did not press: it
+        still collides in the next step; nor are its pucks in a pile, pressed every way, for it: RestSpeeds.piled)."""
         order = self._key_order
         self._keys, self._impulses = c.keys.take(order), impulses.take(order, axis=0)
+        self._resting = ~c.collides.take(order)
         # The pucks pressed on a wall, and the wall's axis (normal 1 or -1: x; 1j or -1j: y), for wall_rest.
         walls = np.flatnonzero(c.b == self._rows)
-        held = walls.take(np.flatnonzero(impulses[walls, 0] > 0.0))
+        held = walls.take(np.flatnonzero(impulses[walls, 0] > 0.0))  # (a wall contact never collides)
         self._held_walls = (self._impulses, c.a.take(held), (c.n.take(held).imag != 0.0).astype(np.intp))
 
     # What the solver keeps from step to step: its impulses by contact (the warm start), and each
     # contact's rounds (they depend on the contacts it had before, so they change results). The
     # solver replaces these arrays each step and never changes them in place, so a save keeps references.
     KEPT = (
-        *("_keys", "_impulses", "_rows", "_band_rounds", "_free_rounds", "count", "iterations"),
+        *("_keys", "_impulses", "_resting", "_rows", "_band_rounds", "_free_rounds", "count", "iterations"),
         *("_paused", "_exact", "_polish_paused"),
     )
     # Worked out afresh in each solve (the layouts from the kept rounds, the same in the same order):
@@ -897,12 +924,24 @@ class _Layout:
 
 def _targets(c: _Contacts, dt: float) -> np.ndarray:
     """(m, 2) each contact's least relative normal velocity after the stage, and its pseudo-velocity:
-    from the gaps where the step began, the velocity bound keeps a pair from closing more than its gap,
-    and the pseudo-velocity pushes out a share of its overlap."""
+    the least speed (_least_speeds, in c.least), and the pseudo-velocity that pushes out a share of its overlap
+    (POSITION_FRACTION; into a wall, all beyond WALL_LEFT_M)."""
     return columns(
-        -np.maximum(c.gap, 0.0) / dt,
-        np.minimum(POSITION_FRACTION * np.maximum(-c.gap - SLOP_M, 0.0) / dt, MAX_PUSH_MPS),
+        c.least,
+        np.minimum(np.maximum(POSITION_FRACTION * (-c.gap - SLOP_M), -c.gap - c.left) / dt, MAX_PUSH_MPS).clip(0.0),
     )
+
+
+def _least_speeds(c: _Contacts, parting, dt: float) -> np.ndarray:
+    """Each contact's least relative normal velocity after the stage (m/s): it may close its gap (where the step
+    began) within the step, not more; a collision (c.least: the speed it comes at), as fast as it comes: it is the
+    next step's, and the stage must not drive it harder (it stopped one puck of a pair and the other ran 13 mm into
+    it). parting: how fast the motion already in the positions parts the pair (an earlier stage bounced a puck: the
+    stage moves it by its change of velocity times dt, so slowing that parting moves the pair closer as much), less
+    the overlap the stage leaves alone (SLOP_M: the normal of a pair of a bounced puck and one on its path is
+    taken between where they are at different times, and a bounced puck's fall of g dt, which the floor then stops,
+    showed along it as a parting 5 um/s faster than theirs: a row of 1 kg pucks struck at 3 m/s gained 7e-6 m/s)."""
+    return np.minimum(c.least, -np.maximum(c.gap, 0.0) / dt) + np.maximum(parting - SLOP_M / dt, 0.0)
 
 
 def columns(first: np.ndarray, second: np.ndarray) -> np.ndarray:
@@ -974,13 +1013,13 @@ def _left_deep(c: _Contacts, w: np.ndarray, dt: float) -> float:
     """How deep (m) the velocities and pseudo-velocities `w` leave the deepest contact that they sink further
     (a deeper overlap being pushed out, at MAX_PUSH_MPS at the most, is not looked at), at the step's end; 0 if none."""
     closing = _normal_speeds(c, w, 0) + _normal_speeds(c, w, 1)
-    return float(-(c.gap + closing * dt).min(where=closing < 0.0, initial=0.0))
+    return float(-(c.gap + closing * dt).min(where=closing < np.minimum(c.least, 0.0), initial=0.0))
 
 
 def _sinks(c: _Contacts, w: np.ndarray, dt: float) -> float:
     """How far (m) the velocities `w` would close the worst contact past its bound in dt (past its gap;
-    for a pair touching or overlapping, past where it is)."""
-    return float((-np.maximum(c.gap, 0.0) - _normal_speeds(c, w) * dt).max())
+    for a pair touching or overlapping, past where it is; a collision, faster than it came)."""
+    return float(((c.least - _normal_speeds(c, w)) * dt).max())
 
 
 def _nearest(response: proportioning.Response, q: np.ndarray, *candidates: np.ndarray | None) -> np.ndarray:

@@ -46,7 +46,7 @@ import numpy as np
 
 from airtable.physics import broadphase, collapse, collision, either, vectors
 from airtable.physics.collision import PairRecords
-from airtable.physics.rest_speeds import RestSpeeds
+from airtable.physics.rest_speeds import HELD_MPS, RestSpeeds
 from airtable.physics.walls import room_to_walls
 
 if TYPE_CHECKING:
@@ -419,8 +419,9 @@ class _Step:
                 fast[slow] = self.ours_after(i.take(slow), j.take(slow))
             close &= fast
         k = close.nonzero()[0]
-        if self.rules.held is not None and len(k):
-            k = k.take((~self.rules.held(i.take(k), j.take(k))).nonzero()[0])
+        if self.rules.held is not None and len(k):  # (ww: at least their approach)
+            held = self.rules.held(i.take(k), j.take(k)) & (ww.take(k) < HELD_MPS * HELD_MPS)
+            k = k.take((~held).nonzero()[0])
         i, j = i.take(k), j.take(k)
         by_pair = np.lexsort((j, i))  # in order of (i, j), however the pairs were found (partners_of)
         return i.take(by_pair), j.take(by_pair)
@@ -446,7 +447,7 @@ class _Step:
         if rules.rest is not None:  # slower: a resting contact, the contact stage's
             ok &= speed > rules.rest.pairs(a, b, self.at(a, self.t_now) - self.at(b, self.t_now))
         if rules.held is not None and either.count(ok):  # pressed on each other in the last step: resting
-            ok &= ~_held(rules.held, a, b)
+            ok &= ~(_held(rules.held, a, b) & (speed < HELD_MPS))
         if not isinstance(ok, np.ndarray):  # one pair
             if ok:
                 self.push_pair(t, a, b, speed)

@@ -39,7 +39,7 @@ import numpy as np
 
 from airtable.physics import broadphase, collapse, collision, either, vectors
 from airtable.physics.collision import CORRECTION_MODES, PairRecords
-from airtable.physics.rest_speeds import RestSpeeds
+from airtable.physics.rest_speeds import HELD_MPS, RestSpeeds
 
 if TYPE_CHECKING:
     from airtable.physics.context import StepContext
@@ -165,14 +165,15 @@ def _with_rows(ci, cj, reach_sq, rows: np.ndarray, n: int):
 
 def _colliding(table: Storage, rest: RestSpeeds | None, i: np.ndarray, j: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """The pairs (i, j) that collide: all of them if rest is None, else those that approach
-    faster than their rest speed and did not press on each other in the last step."""
+    faster than their rest speed and did not press on each other in the last step (or approach faster than HELD_MPS)."""
     if rest is None or len(i) == 0:
         return i, j
     pos, vel = table.pos_m, table.vel_mps
     n, _ = vectors.unit_vectors(vectors.take(pos, i) - vectors.take(pos, j), i + j)
     vn = vectors.dot_rows(vectors.take(vel, i) - vectors.take(vel, j), n)
     fast = (vn < -rest.pairs(i, j, vectors.as_complex(np.ascontiguousarray(n)))).nonzero()[0]  # few: look these up
-    fast = fast.take((~table.contact_solver.held(i.take(fast), j.take(fast))).nonzero()[0])
+    held = table.contact_solver.held(i.take(fast), j.take(fast)) & (vn.take(fast) > -HELD_MPS)
+    fast = fast.take((~held).nonzero()[0])
     return i.take(fast), j.take(fast)
 
 

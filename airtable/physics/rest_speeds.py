@@ -36,6 +36,12 @@ import numpy as np
 
 from airtable.physics import either
 
+# A pair that pressed on each other in the last step (ContactSolver.held) rests however it approaches, so that a pile
+# whose contacts have not quite converged does not start to bounce (they leave it some 0.2 m/s off at the most); up
+# to this approach (m/s). Faster, something hit one of them in this step: a collision (a puck bounced off a third
+# ran 20 mm into one it had rested on, as the pair was left to the contact stage).
+HELD_MPS = 1.0
+
 
 def for_restitution(rest, cr: float, pressed):
     """Rest speeds (an array, or one number) for contacts of restitution cr (see the module docstring);
