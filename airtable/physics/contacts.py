@@ -12,16 +12,16 @@ Which contacts: pairs and puck-wall contacts that touch or nearly touch
 and HOLD_M more for last step's contacts) and approach slower than the
 rest speed over the restitution, and pairs that pressed on each other in
 the last step, whatever their speed (up to HELD_MPS). Pairs that approach
-faster are collisions (they keep the course's model, in the next step if not
-in this one; at restitution 0 no contact is: see rest_speeds.py), but they
-take part too, so that the stage never drives them harder: where it stops
-one puck of such a pair, the other must not run into it. Each contact k has
-a normal n (from body b to body a; a wall is a body that never moves) and asks:
+faster are collisions (they keep the course's model: the hit stage's, or the
+next step's; at restitution 0 no contact is: see rest_speeds.py), but they
+take part too, so that the stage never drives them into each other: where it
+stops one puck of such a pair, the other must not run into it. Each contact k
+has a normal n (from body b to body a; a wall is a body that never moves) and
+asks:
 
 * velocity: the relative normal velocity vn after the stage is at least
   its least speed (0 for pucks already touching: no bounce; for a pair still
-  a gap s apart, -s / dt: it may close the gap, not more; a collision may
-  come on as fast as it comes: _least_speeds);
+  a gap s apart, -s / dt: it may close the gap, not more: _least_speeds);
 * position: a separate pseudo-velocity (a "split impulse") pushes out a
   fraction POSITION_FRACTION of the overlap beyond SLOP_M per step (into a
   wall, all beyond WALL_LEFT_M). It moves positions only and never enters the
@@ -205,7 +205,7 @@ class _Contacts:
     b: np.ndarray
     n: np.ndarray  # complex unit normals
     gap: np.ndarray  # m, negative: overlap
-    least: np.ndarray  # m/s: the least relative normal velocity after the stage (ContactSolver.solve works it out)
+    least: np.ndarray  # m/s: the least relative normal velocity after the stage (_least_speeds)
     left: np.ndarray  # m: the most overlap the stage leaves in a step (inf: pairs; WALL_LEFT_M: walls)
     collides: np.ndarray  # bool: a collision (approaching faster than it rests), not a resting contact
     keys: np.ndarray  # one integer per contact, the same from step to step
@@ -239,14 +239,11 @@ def _pair_contacts(pos, vel, radius, size_m, ci, cj, reach, rest, held, margin, 
         n[k.take(free)], gap[k.take(free)] = vectors.take(n_near, free), gap_near.take(free)
     vn = vectors.dot_rows(w, n)
     fast = np.flatnonzero(vn < -rest.pairs(i, j, vectors.as_complex(np.ascontiguousarray(n))))
-    least = np.zeros(len(i))  # (a collision may come on as fast as it comes: _least_speeds)
-    vn_fast = vn.take(fast)  # (few, even in a pile)
     collides = np.zeros(len(i), dtype=bool)
-    collides[fast] = ~held(i.take(fast), j.take(fast)) | (vn_fast <= -HELD_MPS)
-    least[fast] = np.where(collides.take(fast), vn_fast, 0.0)
+    collides[fast] = ~held(i.take(fast), j.take(fast)) | (vn.take(fast) <= -HELD_MPS)  # (few, even in a pile)
     nc = vectors.as_complex(n)
     keys = i.astype(np.int64) * (len(pos) + 4) + j
-    return _Contacts(i, j, nc, gap, least, np.full(len(i), np.inf), collides, keys)
+    return _Contacts(i, j, nc, gap, np.zeros(len(i)), np.full(len(i), np.inf), collides, keys)
 
 
 class _Paths:
@@ -934,14 +931,16 @@ def _targets(c: _Contacts, dt: float) -> np.ndarray:
 
 def _least_speeds(c: _Contacts, parting, dt: float) -> np.ndarray:
     """Each contact's least relative normal velocity after the stage (m/s): it may close its gap (where the step
-    began) within the step, not more; a collision (c.least: the speed it comes at), as fast as it comes: it is the
-    next step's, and the stage must not drive it harder (it stopped one puck of a pair and the other ran 13 mm into
-    it). parting: how fast the motion already in the positions parts the pair (an earlier stage bounced a puck: the
+    began) within the step, not more; so may a collision (the stage stopped one puck of a pair approaching fast
+    and the other ran 13 mm into it; and the hit stage leaves a pair that meets slower than it rests: 0.3996 m/s
+    at their first contact, against 0.4, and 0.4002 where the step began, it ran 1.3 mm into the other).
+
+    parting: how fast the motion already in the positions parts the pair (an earlier stage bounced a puck: the
     stage moves it by its change of velocity times dt, so slowing that parting moves the pair closer as much), less
     the overlap the stage leaves alone (SLOP_M: the normal of a pair of a bounced puck and one on its path is
     taken between where they are at different times, and a bounced puck's fall of g dt, which the floor then stops,
     showed along it as a parting 5 um/s faster than theirs: a row of 1 kg pucks struck at 3 m/s gained 7e-6 m/s)."""
-    return np.minimum(c.least, -np.maximum(c.gap, 0.0) / dt) + np.maximum(parting - SLOP_M / dt, 0.0)
+    return -np.maximum(c.gap, 0.0) / dt + np.maximum(parting - SLOP_M / dt, 0.0)
 
 
 def columns(first: np.ndarray, second: np.ndarray) -> np.ndarray:
