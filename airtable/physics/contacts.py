@@ -69,7 +69,7 @@ from typing import NamedTuple
 import numpy as np
 
 from airtable.physics import collapse, collision, colouring, proportioning, vectors
-from airtable.physics.rest_speeds import HELD_MPS
+from airtable.physics.rest_speeds import still_held
 
 # Iterations over all contacts per step (Box2D and pymunk use about ten);
 # the loop stops early once an iteration changes no velocity by CONVERGED_MPS.
@@ -240,7 +240,7 @@ def _pair_contacts(pos, vel, radius, size_m, ci, cj, reach, rest, held, margin, 
     vn = vectors.dot_rows(w, n)
     fast = np.flatnonzero(vn < -rest.pairs(i, j, vectors.as_complex(np.ascontiguousarray(n))))
     collides = np.zeros(len(i), dtype=bool)
-    collides[fast] = ~held(i.take(fast), j.take(fast)) | (vn.take(fast) <= -HELD_MPS)  # (few, even in a pile)
+    collides[fast] = ~still_held(held(i.take(fast), j.take(fast)), -vn.take(fast))  # (few, even in a pile)
     nc = vectors.as_complex(n)
     keys = i.astype(np.int64) * (len(pos) + 4) + j
     return _Contacts(i, j, nc, gap, np.zeros(len(i)), np.full(len(i), np.inf), collides, keys)
@@ -1012,12 +1012,12 @@ def _left_deep(c: _Contacts, w: np.ndarray, dt: float) -> float:
     """How deep (m) the velocities and pseudo-velocities `w` leave the deepest contact that they sink further
     (a deeper overlap being pushed out, at MAX_PUSH_MPS at the most, is not looked at), at the step's end; 0 if none."""
     closing = _normal_speeds(c, w, 0) + _normal_speeds(c, w, 1)
-    return float(-(c.gap + closing * dt).min(where=closing < np.minimum(c.least, 0.0), initial=0.0))
+    return float(-(c.gap + closing * dt).min(where=closing < 0.0, initial=0.0))
 
 
 def _sinks(c: _Contacts, w: np.ndarray, dt: float) -> float:
     """How far (m) the velocities `w` would close the worst contact past its bound in dt (past its gap;
-    for a pair touching or overlapping, past where it is; a collision, faster than it came)."""
+    for a pair touching or overlapping, past where it is: _least_speeds)."""
     return float(((c.least - _normal_speeds(c, w)) * dt).max())
 
 

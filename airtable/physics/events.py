@@ -46,7 +46,7 @@ import numpy as np
 
 from airtable.physics import broadphase, collapse, collision, either, vectors
 from airtable.physics.collision import PairRecords
-from airtable.physics.rest_speeds import HELD_MPS, RestSpeeds
+from airtable.physics.rest_speeds import RestSpeeds, still_held
 from airtable.physics.walls import room_to_walls
 
 if TYPE_CHECKING:
@@ -420,7 +420,7 @@ class _Step:
             close &= fast
         k = close.nonzero()[0]
         if self.rules.held is not None and len(k):  # (ww: at least their approach)
-            held = self.rules.held(i.take(k), j.take(k)) & (ww.take(k) < HELD_MPS * HELD_MPS)
+            held = still_held(self.rules.held(i.take(k), j.take(k)), np.sqrt(ww.take(k)))
             k = k.take((~held).nonzero()[0])
         i, j = i.take(k), j.take(k)
         by_pair = np.lexsort((j, i))  # in order of (i, j), however the pairs were found (partners_of)
@@ -447,7 +447,7 @@ class _Step:
         if rules.rest is not None:  # slower: a resting contact, the contact stage's
             ok &= speed > rules.rest.pairs(a, b, self.at(a, self.t_now) - self.at(b, self.t_now))
         if rules.held is not None and either.count(ok):  # pressed on each other in the last step: resting
-            ok &= ~(_held(rules.held, a, b) & (speed < HELD_MPS))
+            ok &= ~still_held(_held(rules.held, a, b), speed)
         if not isinstance(ok, np.ndarray):  # one pair
             if ok:
                 self.push_pair(t, a, b, speed)

@@ -39,7 +39,7 @@ import numpy as np
 
 from airtable.physics import broadphase, collapse, collision, either, vectors
 from airtable.physics.collision import CORRECTION_MODES, PairRecords
-from airtable.physics.rest_speeds import HELD_MPS, RestSpeeds
+from airtable.physics.rest_speeds import RestSpeeds, still_held
 
 if TYPE_CHECKING:
     from airtable.physics.context import StepContext
@@ -172,7 +172,7 @@ def _colliding(table: Storage, rest: RestSpeeds | None, i: np.ndarray, j: np.nda
     n, _ = vectors.unit_vectors(vectors.take(pos, i) - vectors.take(pos, j), i + j)
     vn = vectors.dot_rows(vectors.take(vel, i) - vectors.take(vel, j), n)
     fast = (vn < -rest.pairs(i, j, vectors.as_complex(np.ascontiguousarray(n)))).nonzero()[0]  # few: look these up
-    held = table.contact_solver.held(i.take(fast), j.take(fast)) & (vn.take(fast) > -HELD_MPS)
+    held = still_held(table.contact_solver.held(i.take(fast), j.take(fast)), -vn.take(fast))
     fast = fast.take((~held).nonzero()[0])
     return i.take(fast), j.take(fast)
 

@@ -43,6 +43,12 @@ from airtable.physics import either
 HELD_MPS = 1.0
 
 
+def still_held(held, approach):
+    """Which of the pairs that pressed in the last step (`held`: bools, arrays or one) rest still, approaching at
+    `approach` (m/s, positive: closing): those slower than HELD_MPS."""
+    return held & (approach < HELD_MPS)
+
+
 def for_restitution(rest, cr: float, pressed):
     """Rest speeds (an array, or one number) for contacts of restitution cr (see the module docstring);
     `pressed`: whether the forces press the contact's pucks at all, in any direction (at cr = 0 such a
