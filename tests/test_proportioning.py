@@ -91,3 +91,41 @@ def test_a_puck_squeezed_between_two_walls_that_both_push_it_out_has_no_answer_a
         warnings.simplefilter("error")
         _, settled = proportioning.solve(response, np.array([-0.5, -0.5]), np.zeros(2), 1e-9, 10_000)
     assert not settled
+
+
+class _Counted(proportioning.Response):
+    """A Response that counts how often A p is asked for (each step asks once or twice)."""
+
+    calls = 0
+
+    def __call__(self, p: np.ndarray) -> np.ndarray:
+        self.calls += 1
+        return super().__call__(p)
+
+
+def _stacked_grid(across: int, rows: int, seed: int) -> tuple[_Counted, np.ndarray]:
+    """A grid of pucks, each touching its neighbours, on the floor and between the side walls (body across * rows: the
+    walls), masses 0.5 to 2 kg: more contacts than the pucks have ways to move. q: each contact's normal speed less
+    its bound, at random from -1 to 0.2 m/s."""
+    rng = np.random.default_rng(seed)
+    wall = across * rows
+    contacts = []  # (a, b, normal from b to a)
+    for i in range(across):
+        for j in range(rows):
+            k = i * rows + j
+            touching = ((k + rows, k, 1.0, i + 1 < across), (k + 1, k, 1j, j + 1 < rows))
+            walls = ((k, wall, 1.0, i == 0), (k, wall, -1.0, i == across - 1), (k, wall, 1j, j == 0))
+            contacts += [(p, q, normal) for p, q, normal, here in touching + walls if here]
+    a, b, n = (np.array(column) for column in zip(*contacts, strict=True))
+    inv = np.append(1.0 / rng.uniform(0.5, 2.0, wall), 0.0)
+    return _Counted(n.astype(complex), a, b, inv), rng.uniform(-1.0, 0.2, len(a))
+
+
+def test_a_solve_that_comes_no_nearer_its_answer_stops_without_using_up_its_steps():
+    """Demo 4's grid of 9 x 6 pucks on the floor between the walls, its contacts asking at random: the impulses
+    wander, never within the tolerance, and the solve gives up after STALL_STEPS steps and a look (struck, the
+    demo's stacks so wandered for all of their 2000 steps, 120 ms a step), not after the 2000 it was allowed."""
+    response, q = _stacked_grid(9, 6, seed=0)
+    _, settled = proportioning.solve(response, q, np.zeros(len(q)), 1e-6, 2000)
+    assert not settled
+    assert response.calls <= 2 * (proportioning.STALL_STEPS + 1) + 1

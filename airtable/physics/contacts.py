@@ -615,7 +615,15 @@ class ContactSolver:
             self._paused = EXACT_PAUSE  # (the same contacts would not settle the next step either)
             return None
         impulses = columns(velocity, position)
-        _push(c, inv, w, impulses)
+        pushed_w = w.copy()
+        _push(c, inv, pushed_w, impulses)
+        # Checked as applied, as the polish is: on contacts that depend on each other, among sleepers (immovable), an
+        # answer of impulses out of all scale (1e6 N s on 10 g pucks) settled by its own measure and moved a puck
+        # 124 mm in a step by its pseudo-velocities, 0.013 m/s off their bounds as applied.
+        if not max(_off_bound(c, pushed_w, target, impulses, col) for col in (0, 1)) <= NEAR_MPS:
+            self._paused = EXACT_PAUSE
+            return None
+        w[:] = pushed_w
         self._key_order = np.argsort(c.keys)
         self._layouts = None  # (the rounds start afresh when the contacts are many again)
         self._band_rounds = self._free_rounds = np.empty(0, dtype=np.intp)

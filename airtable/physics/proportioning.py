@@ -26,6 +26,13 @@ import numpy as np
 
 # The gradient projection's step, as a share of 2 / |A| (the largest step that always descends).
 STEP_SHARE = 0.95
+# Every this many steps, the worst contact's distance from its bound (in tolerances) must have fallen to
+# STALL_SHARE of what it was at the last look, or the solve stops, unsettled: on contacts that depend on each
+# other (demo 4's 54 pucks stacked in a grid, struck, 131 contacts) it wandered at 1e-4 to 1e-2 m/s for all its
+# 2000 steps, 120 ms a step. (Slabs that settle fall by decades in as many, but not steadily: at 250 steps and
+# half, hexagonal slabs of masses three decades apart stopped short and sank 16 mm.)
+STALL_STEPS = 500
+STALL_SHARE = 0.9
 
 
 class Response:
@@ -92,10 +99,16 @@ def _steps(response: Response, q: np.ndarray, start: np.ndarray, tol: float, mos
     free = p > 0.0
     phi = np.where(free, g, 0.0)
     direction = phi
-    for _ in range(most):
+    last = np.inf
+    for k in range(most):
         beta = np.where(free, 0.0, np.minimum(g, 0.0))
         if (np.abs(phi) <= tol).all() and (-beta <= tol).all():
             return p * scale, True
+        if k % STALL_STEPS == 0:  # (k = 0: the first look)
+            worst = float((np.maximum(np.abs(phi), -beta) / tol).max())
+            if not worst <= STALL_SHARE * last:
+                return p * scale, False
+            last = worst
         reduced = np.where(free, np.minimum(p / alpha, phi), 0.0)
         if beta @ beta > reduced @ phi:  # proportioning: release the contacts that should push
             image = apply(beta)
