@@ -563,12 +563,14 @@ class ContactSolver:
         if it comes within NEAR_MPS of their bounds as applied, or nearer than `better_than` (self._exact False).
         """
         response = proportioning.Response(c.n, c.a, c.b, inv)
+        alike = not _masses_apart(inv.take(np.append(c.a, c.b)))  # (where they differ, it must not stop: see solve)
         target = _targets(c, dt)
         q = np.column_stack([_normal_speeds(c, start, col) for col in (0, 1)]) - target
         out, polished, exact = impulses.copy(), start.copy(), True
         for col, budget in ((0, work), (1, POLISH_WORK)):
             begin = _nearest(response, q[:, col], impulses[:, col], self._warm if col == 0 else None)
-            p, settled = proportioning.solve(response, q[:, col], begin, POLISH_TOL_MPS, min(most, budget // len(c.a)))
+            steps = min(most, budget // len(c.a))
+            p, settled = proportioning.solve(response, q[:, col], begin, POLISH_TOL_MPS, steps, stall=alike)
             if better_than is None and not settled and col == 0:
                 return None
             if settled or col == 0:  # (the velocities' may be near enough unsettled: checked below)
