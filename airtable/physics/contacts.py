@@ -552,25 +552,28 @@ class ContactSolver:
             if polished is not None:
                 w[:] = start
         if polished is None:
-            polished = self._polish(c, inv, w, start, dt, impulses, POLISH_STEPS, work, better_than=off)
+            polished = self._polish(c, inv, w, start, dt, impulses, POLISH_STEPS, work, off, stall=not apart)
         return polished
 
-    def _polish(self, c: _Contacts, inv, w, start, dt: float, impulses, most: int, work=POLISH_WORK, better_than=None):
+    def _polish(
+        self, c: _Contacts, inv, w, start, dt: float, impulses, most: int, work=POLISH_WORK, better_than=None,
+        stall=True,
+    ):  # fmt: skip
         """The iterations' impulses carried to the answer by proportioning.solve, from `start` (the velocities
         before them) or the last step's (_nearest), column by column, in place: the velocities' in at most
         `most` steps and `work` contact-steps, the pseudo-velocities' in POLISH_WORK (unsettled, the iterations'
         are kept). None (`w` untouched) if the velocities' does not settle, unless `better_than` is given: then
         if it comes within NEAR_MPS of their bounds as applied, or nearer than `better_than` (self._exact False).
+        stall: whether it may stop where it comes no nearer (proportioning.solve: not where the masses differ).
         """
         response = proportioning.Response(c.n, c.a, c.b, inv)
-        alike = not _masses_apart(inv.take(np.append(c.a, c.b)))  # (where they differ, it must not stop: see solve)
         target = _targets(c, dt)
         q = np.column_stack([_normal_speeds(c, start, col) for col in (0, 1)]) - target
         out, polished, exact = impulses.copy(), start.copy(), True
         for col, budget in ((0, work), (1, POLISH_WORK)):
             begin = _nearest(response, q[:, col], impulses[:, col], self._warm if col == 0 else None)
             steps = min(most, budget // len(c.a))
-            p, settled = proportioning.solve(response, q[:, col], begin, POLISH_TOL_MPS, steps, stall=alike)
+            p, settled = proportioning.solve(response, q[:, col], begin, POLISH_TOL_MPS, steps, stall)
             if better_than is None and not settled and col == 0:
                 return None
             if settled or col == 0:  # (the velocities' may be near enough unsettled: checked below)
