@@ -122,7 +122,9 @@ EXACT_PAUSE = 60
 # itself, and pushing that out raised its energy and tipped it over within 0.3 s); up to LEAP_MAX, only where
 # they leave a contact off by LEAP_MPS (a puck leaping or sinking: a slab landing) or one sinking DEEPEST_M (an
 # 800-puck pile settling has 2100 to 2300 contacts, which they leave up to 0.16 m/s off, and polishing those
-# doubled its step). A polish is, in turn:
+# doubled its step), or off by POLISH_MPS where a landing kept them going past their plan (_planned_iterations;
+# unless paused: a 22 x 24 slab landing, 2020 contacts 1.5 cm/s off, had its columns left 0.12 mm apart in height,
+# and tipped over within 0.2 s, a puck thrown up at 92 mm/s). A polish is, in turn:
 # QUICK_STEPS of proportioning.solve from their answer or the last step's (a slab at rest settles in one or
 # two: block pivoting first cost 0.1 to 0.6 s a step on a 20 x 20 slab at rest, 780 contacts); block pivoting
 # from the contacts they have pushing, where it costs little (EXACT_MAX) or the masses differ (SAFE_MASS_RATIO,
@@ -526,6 +528,9 @@ class ContactSolver:
             return impulses
         off = _off_bound(c, w, _targets(c, dt), impulses)
         leaping = off > LEAP_MPS or too_deep() or _gains_energy(mass, start, w) or _sinking(c, inv, w, dt)
+        # (a landing: the iterations went on past their plan to keep contacts from sinking; see POLISH_MAX)
+        landing = not self._polish_paused and self.iterations > _planned_iterations(self.count) and off > POLISH_MPS
+        leaping = leaping or landing
         if not (leaping or (not self._polish_paused and was_exact) or (sure and off > POLISH_MPS)):
             return impulses
         work = POLISH_WORK if sure and not (leaping or was_exact) else LEAP_WORK
@@ -1053,6 +1058,12 @@ def _off_bound(c: _Contacts, w: np.ndarray, target: np.ndarray, impulses: np.nda
     return max(float(-off.min()), float(off.max(where=impulses[:, col] > 0.0, initial=0.0)))
 
 
+def _planned_iterations(m: int) -> int:
+    """How many iterations a step of m contacts plans (ITERATION_WORK); beyond, they go on only while a contact
+    would sink too deep (DEEPEST_M)."""
+    return max(ITERATIONS, min(MAX_ITERATIONS, ITERATION_WORK // m))
+
+
 def _iterate(w: np.ndarray, first: _Layout, later: _Layout, too_deep) -> tuple[int, _Layout]:
     """Sequential impulses, round by round, until converged or ITERATIONS; return the iterations used
     and the layout whose rounds hold the impulses. too_deep() says whether the velocities so far
@@ -1076,7 +1087,7 @@ def _iterate(w: np.ndarray, first: _Layout, later: _Layout, too_deep) -> tuple[i
     direction = image = None  # the direction, and the velocity change it makes (kept up as it changes)
     last_gg = (0.0, 0.0)
     m = len(later.order)
-    iterations = max(ITERATIONS, min(MAX_ITERATIONS, ITERATION_WORK // m))
+    iterations = _planned_iterations(m)
     most = max(iterations, min(MAX_ITERATIONS, DEEP_WORK // m))
     for it in range(2, most + 1):
         before = w.copy()
