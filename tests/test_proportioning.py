@@ -14,10 +14,11 @@ from __future__ import annotations
 import warnings
 
 import numpy as np
-from hypothesis import given, settings
+from hypothesis import example, given, settings
 from hypothesis import strategies as st
 
 from airtable.physics import collapse, proportioning
+from airtable.physics import contacts as contacts_stage
 
 TOL_MPS = 1e-9
 
@@ -44,12 +45,18 @@ def scene(seed: int, bodies: int, contacts: int, wall_share: float):
     per_body=st.floats(0.5, 2.0),
     wall_share=st.floats(0.0, 0.5),
 )
+@example(seed=2547168, bodies=29, per_body=2.0, wall_share=0.375)
+@example(seed=1562, bodies=30, per_body=1.59375, wall_share=0.375)
 def test_the_impulses_push_never_pull_and_stop_each_pushing_contact_at_its_bound(seed, bodies, per_body, wall_share):
     contacts = max(1, round(per_body * bodies))
     n, a, b, inv, q = scene(seed, bodies, contacts, wall_share)
     response = proportioning.Response(n, a, b, inv)
     scale = float(np.abs(q).max()) + 1.0
-    p, settled = proportioning.solve(response, q, np.zeros(contacts), TOL_MPS * scale, 20_000)
+    # It may stop where it comes no nearer only where the masses are alike, as the contact stage asks: where they
+    # differ it comes nearer as unsteadily and as slowly as they differ (two scenes of masses six decades apart,
+    # one stopped so at 500 steps, settled at 3000; the other at 20000 to 40000).
+    alike = inv[:-1].max() <= contacts_stage.SAFE_MASS_RATIO * inv[:-1].min()
+    p, settled = proportioning.solve(response, q, np.zeros(contacts), TOL_MPS * scale, 50_000, stall=alike)
     dense = collapse.response(n, a, np.where(b == bodies, -1, b), inv[:-1])
     w = dense @ p + q
     assert np.allclose(response(p), dense @ p, rtol=1e-12, atol=1e-12 * float(np.abs(dense).max() * p.max() + 1))

@@ -85,7 +85,7 @@ def hold(table: Storage, ctx: StepContext) -> bool:
             return held
         candidates = _union(table.radius_m, candidates, paths)
         table.pos_m[:], table.vel_mps[:] = before[0], before[1]
-        solver.restore(before[2])
+        solver.retry(before[2])
         margin = max(margin, needed)
     return held
 
