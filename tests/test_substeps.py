@@ -11,7 +11,7 @@ import math
 
 import numpy as np
 import pytest
-from hypothesis import given, settings
+from hypothesis import example, given, settings
 from hypothesis import strategies as st
 
 from airtable.physics import forces, substeps
@@ -291,13 +291,16 @@ def test_forces_set_from_outside_act_through_every_piece_of_a_step() -> None:
     length=st.floats(0.0, 0.2),
     mode=st.sampled_from(["perfect-kiss", "two-step"]),
 )
+@example(k=4694.0, apart=0.3, length=0.0, mode="perfect-kiss")
 def test_pucks_a_stiff_spring_pulls_together_never_pass_through_each_other(k, apart, length, mode) -> None:
     """Two 14 g pucks (r 0.12 m) set `apart`, joined by a spring shorter than their reach: it pulls them
     into each other at up to 150 m/s. They bounce off each other, elastic; by hand, their order never
     changes. Taken in substeps, the springs carried them through each other, or the energy ran away (40,
-    150 and 535 times its start in 2 s). A leftover: by hand the energy stays at the start, bouncing for
-    ever; here it reaches 1.3 to 2.7 times the start up to k 2000 N/m, and 11 times in 20 s at k 4890 N/m
-    and 0.3 m apart (omega 850 rad/s), where the pucks meet at any phase of a piece of the step."""
+    150 and 535 times its start in 2 s). By hand the energy stays at the start, bouncing for ever. In pieces
+    of a substep, the springs bent the pucks' paths in a piece by up to 15 % of their radius, and the hits,
+    found on straight paths, did work for or against them: 20 times the start in 0.5 s at k 4694 N/m, 0.3 m
+    apart (a wide run's). Cut four times finer (substeps.MEETING_PIECES), 40 random pairs over 2 s read at
+    most 1.3 times the start but one, 4.1 times (36 of them over 1.2 times before, up to 6.2): a leftover."""
     table = AirTable()
     table.puck_correction = mode
     a = table.add_puck(pos_m=(5.0 - apart / 2, 4.0), radius_m=0.12, density_kgpm2=0.3)
@@ -307,7 +310,7 @@ def test_pucks_a_stiff_spring_pulls_together_never_pass_through_each_other(k, ap
     for _ in range(120):
         table.step(DT_S)
         assert b.pos_m[0] - a.pos_m[0] > 0.24 - 1e-3
-        assert table.kinetic_energy_J() + table.spring_energy_J() < 20.0 * start
+        assert table.kinetic_energy_J() + table.spring_energy_J() < 5.0 * start
 
 
 @pytest.mark.parametrize("variation", [0, 1, 2])
