@@ -78,17 +78,20 @@ LANDING_MPS = 0.5
 
 def for_contacts(table, dt_s: float) -> int:
     """Into how many pieces a step of dt_s is cut for its springs' substeps (see the module docstring):
-    `count`'s substeps if the contact stage held a pair last step or a puck is landing on a wall, else 1."""
+    `count`'s substeps if pucks on springs may meet (MEETING_PIECES times as many where their springs bend their
+    paths), the contact stage held a pair last step or a puck is landing on a wall, else 1."""
     if table.n_springs == 0:
         return 1
     n = count(table.mass_kg, *table.spring_ends, table.spring_k_Npm, dt_s)
     if n == 1:
         return 1
     meeting, accel = _meeting(table, dt_s)
-    if len(meeting):
-        bend = accel.take(meeting) * (0.5 * (dt_s / n) ** 2)  # how far a substep's springs bend their paths
-        return min(MAX_SUBSTEPS, MEETING_PIECES * n) if (bend > BEND_SHARE * table.radius_m.take(meeting)).any() else n
-    return n if table.contact_solver.held_pairs() or _hits_a_wall(table, dt_s) else 1
+    if len(meeting) == 0:
+        return n if table.contact_solver.held_pairs() or _hits_a_wall(table, dt_s) else 1
+    bend = accel.take(meeting) * (0.5 * (dt_s / n) ** 2)  # how far a substep's springs bend their paths
+    if (bend > BEND_SHARE * table.radius_m.take(meeting)).any():
+        return min(MAX_SUBSTEPS, MEETING_PIECES * n)
+    return n
 
 
 # Where pucks on springs may meet and a substep's springs bend their paths by more than BEND_SHARE of their radius
@@ -107,12 +110,12 @@ def _meeting(table, dt_s: float) -> tuple[np.ndarray, np.ndarray]:
     springs pull now (a pull's dt^2 travel, twice over: the pull grows as the spring stretches), and those they
     may reach; each puck's acceleration by its springs at the most (m/s^2)). Substeps would carry them there and
     through, unseen: two 14 g pucks pulled together by a 3000 N/m spring flew through each other at 150 m/s."""
+    if not table.puck_collisions:
+        return np.empty(0, dtype=np.intp), np.empty(0)
     pos, a, b = table.pos_m, *table.spring_ends
     pull = table.spring_k_Npm * np.abs(table.spring_stretch_m())
     n = len(pos)
     accel = (np.bincount(a, pull, n) + np.bincount(b, pull, n)) / table.mass_kg  # (pulls may cancel: at the most)
-    if not table.puck_collisions:
-        return np.empty(0, dtype=np.intp), accel
     travel = vectors.lengths(table.vel_mps) * dt_s + accel * dt_s**2
     sprung = np.unique(np.concatenate((a, b)))
     i, j = broadphase.pairs_near(pos, table.radius_m, sprung, 2.0 * float(travel.take(sprung).max()))
